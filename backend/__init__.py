@@ -1,0 +1,1 @@
+"""ParkourLab's service side: the command line now; the FastAPI service, store and robot link next."""

@@ -1,0 +1,43 @@
+"""``parkour bench``: the compiled map against the scipy baseline, side by side."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from backend.cli.options import JsonOption, handles_errors, note, print_json
+from sim_core.bench import run_benchmark
+
+app = typer.Typer(rich_markup_mode=None)
+
+
+@app.command("bench")
+@handles_errors
+def bench_command(
+    baseline_strides: Annotated[int, typer.Option(help="Strides for the scipy baseline.", min=1)] = 200,
+    kernel_strides: Annotated[int, typer.Option(help="Strides for the one-core kernel timing.", min=1)] = 20_000,
+    batch_strides: Annotated[int, typer.Option(help="Strides for the all-cores batch timing.", min=1)] = 100_000,
+    repeats: Annotated[int, typer.Option(help="Timings per figure; the best is kept.", min=1)] = 3,
+    as_json: JsonOption = False,
+) -> None:
+    """Strides per second of the kernel vs scipy solve_ivp (DOP853, rtol=atol=1e-10), and their difference."""
+    result = run_benchmark(
+        baseline_strides=baseline_strides,
+        kernel_strides=kernel_strides,
+        batch_strides=batch_strides,
+        repeats=repeats,
+        progress=lambda stage: note(f"bench: {stage}…"),
+    )
+    if as_json:
+        print_json(result.to_dict())
+        return
+    table = Table("measure", "value", title="parkour bench (paper preset, controls 30:0.9)")
+    table.add_row("kernel, one core", f"{result.kernel_strides_per_s:,.0f} strides/s")
+    table.add_row("scipy DOP853 baseline", f"{result.baseline_strides_per_s:,.0f} strides/s")
+    table.add_row("ratio", f"{result.ratio:,.0f}x")
+    table.add_row("largest difference", f"{result.max_abs_diff:.2e}")
+    table.add_row(f"batch, {result.cores} cores", f"{result.batch_strides_per_s:,.0f} strides/s")
+    Console().print(table)

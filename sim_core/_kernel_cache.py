@@ -1,0 +1,38 @@
+"""Where numba caches the compiled kernels: a directory keyed by a hash of sim_core's source.
+
+numba invalidates a cached function when *its own* file changes, not when a kernel it
+inlines from another file does (``stride.orbit`` inlines ``integrate.stance``), so a plain
+``cache=True`` can silently run stale machine code after an edit or an upgrade. Keying the
+cache directory on all of sim_core's source makes any change start from a clean cache.
+Imported by ``sim_core/__init__.py`` before any kernel is defined.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from pathlib import Path
+
+import numba
+
+
+def _source_hash() -> str:
+    digest = hashlib.sha256()
+    for path in sorted(Path(__file__).parent.glob("*.py")):
+        digest.update(path.name.encode())
+        digest.update(path.read_bytes())
+    digest.update(numba.__version__.encode())
+    return digest.hexdigest()[:16]
+
+
+def configure() -> Path:
+    """Point numba's cache at ``$PARKOUR_CACHE_DIR`` (default ``~/.cache/parkourlab``)/numba/<hash>."""
+    root = os.environ.get("PARKOUR_CACHE_DIR") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "parkourlab"
+    )
+    directory = Path(root) / "numba" / _source_hash()
+    numba.config.CACHE_DIR = str(directory)
+    return directory
+
+
+CACHE_DIR = configure()

@@ -1,0 +1,137 @@
+"""One jump of the Poincaré map and orbits of many jumps, compiled (model.md §2, §4).
+
+A jump starts at the section — touchdown on the left wall, after the coordinate flip — with
+section state ``(xdot, ydot)`` (``xdot < 0``: the body flies toward the left wall). It runs
+the stance (:func:`sim_core.integrate.stance`), the closed-form flight to the right wall, and
+flips coordinates so the next touchdown is again on the left wall.
+
+These are kernels: floats and arrays in, a status out, no validation beyond what keeps them
+from producing garbage. Call them through :mod:`sim_core.poincare`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from sim_core.controls import PSI0_COLUMN, ZETA0_COLUMN
+from sim_core.failures import INVALID_STATE, NO_FLIGHT, OK
+from sim_core.integrate import PSI, PSI_DOT, STATE_SIZE, TIME, ZETA_DOT, stance
+
+
+@njit(cache=True)
+def touchdown_polar_state(xdot, ydot, psi0, zeta0):
+    """Leg-frame rates at touchdown: ``(zeta_dot, psi_dot)`` from the body velocity (model.md §2)."""
+    cos_psi = math.cos(psi0)
+    sin_psi = math.sin(psi0)
+    zeta_dot = xdot * cos_psi + ydot * sin_psi
+    psi_dot = (-xdot * sin_psi + ydot * cos_psi) / zeta0
+    return zeta_dot, psi_dot
+
+
+@njit(cache=True)
+def jump(xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c_psi, mu, record):
+    """One application of the Poincaré map.
+
+    Args:
+        xdot, ydot: section state at this jump's touchdown (after the flip) [sqrt(g l0)].
+        psi0, zeta0: this jump's leg controls [rad, l0]; they set the touchdown just made.
+        next_psi0, next_zeta0: the next jump's controls; they set where this flight ends.
+        alpha, d_hat, c_zeta, c_psi, mu: nondimensional model parameters.
+        record: stance nodes, see :func:`sim_core.integrate.stance` (shape (0, 5) for none).
+
+    Returns:
+        ``(status, next_xdot, next_ydot, rise, stance_time, flight_time, rows_recorded)``.
+        ``rise`` is the next foot's height minus this foot's [l0]. On failure the numbers
+        after ``status`` are NaN, except the stance time where a stance was integrated.
+    """
+    nan = math.nan
+    finite_inputs = math.isfinite(xdot + ydot + psi0 + zeta0 + next_psi0 + next_zeta0)
+    if not finite_inputs or xdot >= 0.0 or not (0.0 < next_zeta0 < 1.0):
+        return INVALID_STATE, nan, nan, nan, nan, nan, 0
+    zeta_dot, psi_dot = touchdown_polar_state(xdot, ydot, psi0, zeta0)
+    final = np.empty(STATE_SIZE)
+    status, rows = stance(zeta0, psi0, zeta_dot, psi_dot, alpha, c_zeta, c_psi, mu, final, record)
+    stance_time = final[TIME]
+    if status != OK:
+        return status, nan, nan, nan, stance_time, nan, rows
+    # Lift-off at zeta = 1: body velocity from the polar rates.
+    psi = final[PSI]
+    cos_psi = math.cos(psi)
+    sin_psi = math.sin(psi)
+    liftoff_xdot = final[ZETA_DOT] * cos_psi - final[PSI_DOT] * sin_psi
+    liftoff_ydot = final[ZETA_DOT] * sin_psi + final[PSI_DOT] * cos_psi
+    # Flight: from x = -d/2 + cos(psi) to the next touchdown x = d/2 - zeta0' cos(psi0').
+    distance = d_hat - cos_psi - next_zeta0 * math.cos(next_psi0)
+    if liftoff_xdot <= 0.0 or distance <= 0.0:
+        return NO_FLIGHT, nan, nan, nan, stance_time, nan, rows
+    flight_time = distance / liftoff_xdot
+    touchdown_height = sin_psi + liftoff_ydot * flight_time - 0.5 * flight_time * flight_time
+    rise = touchdown_height - next_zeta0 * math.sin(next_psi0)
+    # The flip: the right-wall touchdown becomes a left-wall one (x -> -x).
+    return OK, -liftoff_xdot, liftoff_ydot - flight_time, rise, stance_time, flight_time, rows
+
+
+@njit(cache=True)
+def orbit(xdot, ydot, schedule, first_jump, alpha, d_hat, c_zeta, c_psi, mu, states, rises):
+    """Iterate the map ``rises.shape[0]`` times with a cyclic control schedule.
+
+    Args:
+        schedule: shape (m, 2), columns psi0 [rad] and zeta0 [l0]; jump k uses row
+            ``(first_jump + k) % m``.
+        states: output, shape (n + 1, 2): the section states, starting with ``(xdot, ydot)``;
+            rows after a failure are NaN.
+        rises: output, shape (n,): height gain per jump [l0]; NaN after a failure.
+
+    Returns:
+        ``(status, jumps_completed)``; on failure jump ``jumps_completed`` (0-based) failed.
+    """
+    jumps = rises.shape[0]
+    period = schedule.shape[0]
+    no_record = np.empty((0, STATE_SIZE))
+    states[:, :] = math.nan
+    rises[:] = math.nan
+    states[0, 0] = xdot
+    states[0, 1] = ydot
+    for k in range(jumps):
+        this = (first_jump + k) % period
+        following = (first_jump + k + 1) % period
+        status, xdot, ydot, rise, _, _, _ = jump(
+            xdot,
+            ydot,
+            schedule[this, PSI0_COLUMN],
+            schedule[this, ZETA0_COLUMN],
+            schedule[following, PSI0_COLUMN],
+            schedule[following, ZETA0_COLUMN],
+            alpha,
+            d_hat,
+            c_zeta,
+            c_psi,
+            mu,
+            no_record,
+        )
+        if status != OK:
+            return status, k
+        states[k + 1, 0] = xdot
+        states[k + 1, 1] = ydot
+        rises[k] = rise
+    return OK, jumps
+
+
+@njit(cache=True, parallel=True)
+def orbit_batch(initial, schedules, first_jump, alpha, d_hat, c_zeta, c_psi, mu, states, rises, status, completed):
+    """:func:`orbit` for many starts on all cores.
+
+    Args:
+        initial: shape (N, 2) section states.
+        schedules: shape (S, m, 2); S = 1 shares one schedule, S = N gives each start its own.
+        states: output (N, n + 1, 2); rises: output (N, n); status, completed: output (N,) int.
+    """
+    shared = schedules.shape[0] == 1
+    for i in prange(initial.shape[0]):
+        schedule = schedules[0] if shared else schedules[i]
+        status[i], completed[i] = orbit(
+            initial[i, 0], initial[i, 1], schedule, first_jump, alpha, d_hat, c_zeta, c_psi, mu, states[i], rises[i]
+        )

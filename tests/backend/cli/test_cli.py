@@ -1,0 +1,122 @@
+"""The ``parkour`` command-line contract: JSON shapes scripts rely on, and one-line errors."""
+
+import csv
+import json
+
+import pytest
+from typer.testing import CliRunner
+
+from backend.cli.app import app
+
+runner = CliRunner()
+
+
+def invoke(*args: str):
+    return runner.invoke(app, list(args))
+
+
+def test_map_json_contract():
+    result = invoke("map", "--controls", "30:0.9", "--state", "-0.93", "-0.17", "--jumps", "4", "--json")
+    assert result.exit_code == 0, result.output
+    payload = json.loads(result.stdout)
+    assert set(payload) == {"states", "rises", "failure"}
+    assert payload["states"][0] == [-0.93, -0.17] and len(payload["states"]) == 5
+    assert len(payload["rises"]) == 4 and payload["failure"] is None
+
+
+def test_map_json_reports_failure():
+    result = invoke("map", "--state", "-0.3", "5", "--jumps", "3", "--json")
+    payload = json.loads(result.stdout)
+    assert payload["failure"] == {"code": "no_flight", "jump": 1}
+    assert payload["states"] == [[-0.3, 5.0]] and payload["rises"] == []
+
+
+def test_fixed_point_json_contract():
+    result = invoke(
+        "fixed-point", "--controls", "30:0.87,30:0.9", "--period", "2", "--guess", "-0.8", "-0.15", "--json"
+    )
+    assert result.exit_code == 0, result.output
+    payload = json.loads(result.stdout)
+    assert set(payload) == {
+        "state",
+        "period",
+        "eigenvalues",
+        "max_abs_eigenvalue",
+        "stable",
+        "climb_per_period",
+        "residual",
+    }
+    assert payload["period"] == 2 and payload["stable"] is True
+    assert len(payload["eigenvalues"]) == 2 and all(len(pair) == 2 for pair in payload["eigenvalues"])
+    assert payload["residual"] < 1e-9
+
+
+def test_fixed_point_without_guess_searches():
+    result = invoke("fixed-point", "--json")
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.stdout)["stable"] is True
+
+
+def test_gaits_lists_motion():
+    result = invoke("gaits", "--controls", "30:0.98", "--grid", "3", "--json")
+    assert result.exit_code == 0, result.output
+    gaits = json.loads(result.stdout)["gaits"]
+    assert gaits and all(gait["motion"] in {"climbing", "in place", "descending"} for gait in gaits)
+
+
+def test_model_overrides_change_the_result():
+    base = json.loads(invoke("map", "--state", "-0.93", "-0.17", "--jumps", "1", "--json").stdout)
+    stiffer = json.loads(invoke("map", "--state", "-0.93", "-0.17", "--jumps", "1", "--alpha", "90", "--json").stdout)
+    assert stiffer["states"][1] != base["states"][1]
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".json"])
+def test_trajectory_writes_file(tmp_path, suffix):
+    out = tmp_path / f"path{suffix}"
+    result = invoke("trajectory", "--state", "-0.93", "-0.17", "--jumps", "3", "--out", str(out), "--json")
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.stdout)
+    assert summary["jumps_completed"] == 3 and summary["units"] == "SI"
+    if suffix == ".csv":
+        rows = list(csv.DictReader(out.open()))
+        assert len(rows) == summary["samples"] and set(rows[0]) >= {"time", "x", "y", "phase"}
+    else:
+        document = json.loads(out.read_text())
+        assert len(document["columns"]["time"]) == summary["samples"]
+
+
+@pytest.mark.parametrize(
+    ("args", "field"),
+    [
+        (["map", "--controls", "30:1.0", "--state", "-1", "0"], "zeta0"),
+        (["map", "--controls", "95:0.9", "--state", "-1", "0"], "psi0"),
+        (["map", "--controls", "0:0.9", "--state", "-1", "0"], "psi0"),
+        (["map", "--state", "nan", "0"], "state.xdot"),
+        (["map", "--state", "0.5", "0"], "state.xdot"),
+        (["map", "--alpha", "-3", "--state", "-1", "0"], "alpha"),
+        (["map", "--preset", "moon", "--state", "-1", "0"], "preset"),
+        (["map", "--controls", "30-0.9", "--state", "-1", "0"], "controls"),
+        (["fixed-point", "--controls", "30:0.87,30:0.9", "--period", "3"], "period"),
+        (["trajectory", "--out", "x.txt"], "out"),
+    ],
+)
+def test_bad_input_is_one_clear_line(args, field):
+    result = invoke(*args)
+    assert result.exit_code == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"error: {field}:"), result.stderr
+    assert "Traceback" not in result.output
+
+
+def test_bench_json_contract():
+    sizes = ["--baseline-strides", "3", "--kernel-strides", "20", "--batch-strides", "20", "--repeats", "1"]
+    result = invoke("bench", *sizes, "--json")
+    assert result.exit_code == 0, result.output
+    assert set(json.loads(result.stdout)) == {
+        "kernel_strides_per_s",
+        "baseline_strides_per_s",
+        "ratio",
+        "max_abs_diff",
+        "batch_strides_per_s",
+        "cores",
+    }
