@@ -10,7 +10,6 @@ Data flows parameters -> simulate -> analyse:
 No web, database or plotting imports here.
 """
 
-from sim_core import _kernel_cache  # noqa: F401  (must run before any kernel is defined)
 from sim_core.controls import ControlSchedule, LegControl
 from sim_core.failures import Failure
 from sim_core.fixed_points import (

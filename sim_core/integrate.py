@@ -21,9 +21,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 from scipy.integrate._ivp import dop853_coefficients as _dop853
 
+from sim_core._jit import kernel
 from sim_core.failures import COLLAPSE, INVALID_STATE, NO_LIFTOFF, OK, SLIP
 
 ZETA = 0
@@ -66,7 +66,7 @@ _W_BEST = _N_STAGES + 8
 _W_ROWS = _N_STAGES + 9
 
 
-@njit(cache=True)
+@kernel
 def _derivative(state, alpha, c_zeta, c_psi, independent, out):
     """Stance equations of motion (paper eq. 3), with respect to ``state[independent]``."""
     zeta = state[ZETA]
@@ -89,7 +89,7 @@ def _derivative(state, alpha, c_zeta, c_psi, independent, out):
         out[independent] = 1.0
 
 
-@njit(cache=True)
+@kernel
 def _dop853_step(state, derivative, h, alpha, c_zeta, c_psi, independent, work):
     """One DOP853 step of size ``h``; result in the workspace, returns the error norm (<1 = accept)."""
     stages = work[_W_STAGES : _N_STAGES + 1]
@@ -130,7 +130,7 @@ def _dop853_step(state, derivative, h, alpha, c_zeta, c_psi, independent, work):
     return abs(h) * err5 / math.sqrt((err5 + 0.01 * err3) * STATE_SIZE)
 
 
-@njit(cache=True)
+@kernel
 def _accepted_step(state, derivative, h, limit, direction, alpha, c_zeta, c_psi, independent, work):
     """Try steps (magnitude ``h``, at most ``limit``) until one is accepted.
 
@@ -153,7 +153,7 @@ def _accepted_step(state, derivative, h, limit, direction, alpha, c_zeta, c_psi,
             return -1.0, 0.0
 
 
-@njit(cache=True)
+@kernel
 def _land(state, independent, target, alpha, c_zeta, c_psi, work, out):
     """Integrate from ``state`` until coordinate ``independent`` equals ``target`` exactly.
 
@@ -187,7 +187,7 @@ def _land(state, independent, target, alpha, c_zeta, c_psi, work, out):
     return True
 
 
-@njit(cache=True)
+@kernel
 def _record_row(record, row, state):
     if row < record.shape[0]:
         for i in range(STATE_SIZE):
@@ -196,7 +196,7 @@ def _record_row(record, row, state):
     return row
 
 
-@njit(cache=True)
+@kernel
 def stance(zeta0, psi0, zeta_dot0, psi_dot0, alpha, c_zeta, c_psi, mu, final, record):
     """Integrate one stance from touchdown to its end.
 

@@ -14,14 +14,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from sim_core._jit import kernel, parallel_kernel
 from sim_core.controls import PSI0_COLUMN, ZETA0_COLUMN
 from sim_core.failures import INVALID_STATE, NO_FLIGHT, OK
 from sim_core.integrate import PSI, PSI_DOT, STATE_SIZE, TIME, ZETA_DOT, stance
 
 
-@njit(cache=True)
+@kernel
 def touchdown_polar_state(xdot, ydot, psi0, zeta0):
     """Leg-frame rates at touchdown: ``(zeta_dot, psi_dot)`` from the body velocity (model.md §2)."""
     cos_psi = math.cos(psi0)
@@ -31,7 +32,7 @@ def touchdown_polar_state(xdot, ydot, psi0, zeta0):
     return zeta_dot, psi_dot
 
 
-@njit(cache=True)
+@kernel
 def jump(xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c_psi, mu, record):
     """One application of the Poincaré map.
 
@@ -74,7 +75,7 @@ def jump(xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c
     return OK, -liftoff_xdot, liftoff_ydot - flight_time, rise, stance_time, flight_time, rows
 
 
-@njit(cache=True)
+@kernel
 def orbit(xdot, ydot, schedule, first_jump, alpha, d_hat, c_zeta, c_psi, mu, states, rises):
     """Iterate the map ``rises.shape[0]`` times with a cyclic control schedule.
 
@@ -120,7 +121,7 @@ def orbit(xdot, ydot, schedule, first_jump, alpha, d_hat, c_zeta, c_psi, mu, sta
     return OK, jumps
 
 
-@njit(cache=True, parallel=True)
+@parallel_kernel
 def orbit_batch(initial, schedules, first_jump, alpha, d_hat, c_zeta, c_psi, mu, states, rises, status, completed):
     """:func:`orbit` for many starts on all cores.
 
