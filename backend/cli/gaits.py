@@ -78,11 +78,11 @@ def gaits_command(
 
 
 def _print_gaits(gaits: list[FixedPoint], title: str) -> None:
-    table = Table("xdot", "ydot", "period", "max |λ|", "stable", "climb/period [l0]", "motion", title=title)
+    table = Table("xdot", "ydot", "period", "max |λ|", "stable", "climb [l0]", "motion", title=title)
     for gait in gaits:
         table.add_row(
-            f"{gait.state[0]:.9f}",
-            f"{gait.state[1]:.9f}",
+            f"{gait.state[0]:.6f}",
+            f"{gait.state[1]:.6f}",
             str(gait.period),
             f"{gait.max_abs_eigenvalue:.4f}",
             "yes" if gait.stable else "no",
