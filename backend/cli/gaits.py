@@ -78,7 +78,7 @@ def gaits_command(
 
 
 def _print_gaits(gaits: list[FixedPoint], title: str) -> None:
-    table = Table("xdot", "ydot", "period", "max |λ|", "stable", "climb [l0]", "motion", title=title)
+    table = Table("xdot", "ydot", "period", "max |λ|", "stable", "climb (l0)", "motion", title=title)
     for gait in gaits:
         table.add_row(
             f"{gait.state[0]:.6f}",

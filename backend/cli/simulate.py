@@ -53,7 +53,7 @@ def map_command(
     if as_json:
         print_json(orbit.to_dict())
         return
-    table = Table("jump", "xdot", "ydot", "rise [l0]", title=f"Poincaré map, controls {controls}")
+    table = Table("jump", "xdot", "ydot", "rise (l0)", title=f"Poincaré map, controls {controls}")
     table.add_row("0", f"{orbit.states[0, 0]:.9f}", f"{orbit.states[0, 1]:.9f}", "")
     for k, rise in enumerate(orbit.rises, start=1):
         table.add_row(str(k), f"{orbit.states[k, 0]:.9f}", f"{orbit.states[k, 1]:.9f}", f"{rise:+.6f}")
