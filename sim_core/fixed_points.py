@@ -18,7 +18,7 @@ from sim_core import stride
 from sim_core.controls import ControlSchedule
 from sim_core.failures import OK, Failure
 from sim_core.params import ModelParams
-from sim_core.poincare import check_section_state
+from sim_core.poincare import check_section_state, iterate_map
 from sim_core.validation import ParameterError
 
 RESIDUAL_TOL = 1e-9  # |P^n(q) - q| accepted as a fixed point [sqrt(g l0)]
@@ -235,8 +235,6 @@ def minimal_period(model: ModelParams, schedule: ControlSchedule, state, period:
 
 
 def _first_failure(model: ModelParams, schedule: ControlSchedule, state: np.ndarray, jumps: int) -> str:
-    from sim_core.poincare import iterate_map
-
     orbit = iterate_map(model, schedule, state, jumps)
     failure: Failure | None = orbit.failure
     if failure is None:
