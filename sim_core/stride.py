@@ -33,6 +33,14 @@ def touchdown_polar_state(xdot, ydot, psi0, zeta0):
 
 
 @kernel
+def liftoff_velocity(psi, zeta_dot, psi_dot):
+    """Body velocity ``(xdot, ydot)`` at lift-off (``zeta = 1``) from the leg-frame rates (model.md §2)."""
+    cos_psi = math.cos(psi)
+    sin_psi = math.sin(psi)
+    return zeta_dot * cos_psi - psi_dot * sin_psi, zeta_dot * sin_psi + psi_dot * cos_psi
+
+
+@kernel
 def jump(xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c_psi, mu, record):
     """One application of the Poincaré map.
 
@@ -58,18 +66,14 @@ def jump(xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c
     stance_time = final[TIME]
     if status != OK:
         return status, nan, nan, nan, stance_time, nan, rows
-    # Lift-off at zeta = 1: body velocity from the polar rates.
     psi = final[PSI]
-    cos_psi = math.cos(psi)
-    sin_psi = math.sin(psi)
-    liftoff_xdot = final[ZETA_DOT] * cos_psi - final[PSI_DOT] * sin_psi
-    liftoff_ydot = final[ZETA_DOT] * sin_psi + final[PSI_DOT] * cos_psi
+    liftoff_xdot, liftoff_ydot = liftoff_velocity(psi, final[ZETA_DOT], final[PSI_DOT])
     # Flight: from x = -d/2 + cos(psi) to the next touchdown x = d/2 - zeta0' cos(psi0').
-    distance = d_hat - cos_psi - next_zeta0 * math.cos(next_psi0)
+    distance = d_hat - math.cos(psi) - next_zeta0 * math.cos(next_psi0)
     if liftoff_xdot <= 0.0 or distance <= 0.0:
         return NO_FLIGHT, nan, nan, nan, stance_time, nan, rows
     flight_time = distance / liftoff_xdot
-    touchdown_height = sin_psi + liftoff_ydot * flight_time - 0.5 * flight_time * flight_time
+    touchdown_height = math.sin(psi) + liftoff_ydot * flight_time - 0.5 * flight_time * flight_time
     rise = touchdown_height - next_zeta0 * math.sin(next_psi0)
     # The flip: the right-wall touchdown becomes a left-wall one (x -> -x).
     return OK, -liftoff_xdot, liftoff_ydot - flight_time, rise, stance_time, flight_time, rows

@@ -182,8 +182,7 @@ def _flight_piece(liftoff, clock, flight_time, rate, side, half_width, foot_heig
     start = clock + liftoff[TIME]
     times = _sample_times(start, flight_time, rate)
     local = times - start
-    xdot = zeta_dot * math.cos(psi) - psi_dot * math.sin(psi)
-    ydot = zeta_dot * math.sin(psi) + psi_dot * math.cos(psi)
+    xdot, ydot = stride.liftoff_velocity(psi, zeta_dot, psi_dot)
     x_flipped = -half_width + math.cos(psi) + xdot * local
     y = foot_height + math.sin(psi) + ydot * local - 0.5 * local**2
     x = side * x_flipped

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+from dataclasses import asdict
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -103,7 +104,7 @@ def trajectory_command(
         document = {
             "units": trajectory.units,
             "controls": controls,
-            "model": {name: getattr(setup.model, name) for name in ("alpha", "d_hat", "c_zeta", "c_psi", "mu")},
+            "model": asdict(setup.model),
             "touchdown_times": trajectory.touchdown_times.tolist(),
             "rises": trajectory.rises.tolist(),
             "failure": None if trajectory.failure is None else trajectory.failure.code,
