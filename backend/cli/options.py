@@ -146,16 +146,17 @@ def default_gait(model: ModelParams, schedule: ControlSchedule, period: int) -> 
 
 def print_json(payload: object) -> None:
     """JSON on stdout; NaN and infinities are not JSON, so they become null."""
-    typer.echo(json.dumps(_finite(payload)))
+    typer.echo(json.dumps(json_safe(payload)))
 
 
-def _finite(value):
+def json_safe(value):
+    """``value`` with NaN and infinities replaced by None (they are not JSON), recursively."""
     if isinstance(value, float) and not math.isfinite(value):
         return None
     if isinstance(value, dict):
-        return {key: _finite(item) for key, item in value.items()}
+        return {key: json_safe(item) for key, item in value.items()}
     if isinstance(value, list | tuple):
-        return [_finite(item) for item in value]
+        return [json_safe(item) for item in value]
     return value
 
 

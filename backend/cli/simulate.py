@@ -19,6 +19,7 @@ from backend.cli.options import (
     ModelSetup,
     default_gait,
     handles_errors,
+    json_safe,
     note,
     parse_controls,
     print_json,
@@ -110,7 +111,7 @@ def trajectory_command(
             "failure": None if trajectory.failure is None else trajectory.failure.code,
             "columns": {name: column.tolist() for name, column in columns.items()},
         }
-        out.write_text(json.dumps(document))
+        out.write_text(json.dumps(json_safe(document)))
     summary = {
         "out": str(out),
         "samples": int(trajectory.time.size),

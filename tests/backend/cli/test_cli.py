@@ -85,6 +85,14 @@ def test_trajectory_writes_file(tmp_path, suffix):
         assert len(document["columns"]["time"]) == summary["samples"]
 
 
+def test_trajectory_json_is_strict_json_with_infinite_friction(tmp_path):
+    out = tmp_path / "path.json"
+    result = invoke("trajectory", "--state", "-0.93", "-0.17", "--jumps", "1", "--mu", "inf", "--out", str(out))
+    assert result.exit_code == 0, result.output
+    document = json.loads(out.read_text(), parse_constant=lambda name: pytest.fail(f"non-JSON constant {name}"))
+    assert document["model"]["mu"] is None
+
+
 @pytest.mark.parametrize(
     ("args", "field"),
     [
