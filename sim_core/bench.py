@@ -4,7 +4,9 @@ Both run side by side in one process over the same section states (perturbations
 paper preset's period-1 gait, seeded), so the ratio is meaningful on a shared, noisy machine:
 the kernel's strides per second on one core, the baseline's (:mod:`sim_core.reference`,
 DOP853 at rtol = atol = 1e-10), their ratio, the largest difference between their next
-section states and rises, and the batch throughput on all cores.
+section states and rises, and the batch throughput on all cores. It also times the basin of
+that gait over a 200 x 200 grid x 60 jumps (issue 4's target: under 10 s on 2 cores) and
+projects the baseline's time for the same jumps.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from dataclasses import asdict, dataclass
 import numba
 import numpy as np
 
+from sim_core.basin import BasinGrid, compute_basin
 from sim_core.controls import ControlSchedule
 from sim_core.failures import OK
 from sim_core.fixed_points import find_fixed_point
@@ -37,6 +40,12 @@ class BenchResult:
     max_abs_diff: float
     batch_strides_per_s: float
     cores: int
+    basin_grid: int
+    basin_jumps: int
+    basin_seconds: float
+    basin_jumps_computed: int
+    basin_baseline_projected_seconds: float
+    basin_speedup: float
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -48,6 +57,8 @@ def run_benchmark(
     kernel_strides: int = 20_000,
     batch_strides: int = 100_000,
     repeats: int = 3,
+    basin_grid: int = 200,
+    basin_jumps: int = 60,
     seed: int = 0,
     progress: Callable[[str], None] | None = None,
 ) -> BenchResult:
@@ -57,6 +68,8 @@ def run_benchmark(
         ("kernel_strides", kernel_strides),
         ("batch_strides", batch_strides),
         ("repeats", repeats),
+        ("basin_grid", basin_grid),
+        ("basin_jumps", basin_jumps),
     ):
         check_range(name, value, 1, 10_000_000, low_open=False, high_open=False)
     say = progress or (lambda _stage: None)
@@ -98,8 +111,14 @@ def run_benchmark(
     batch = np.resize(states, (batch_strides, 2))
     batch_time, _ = _best_time(lambda: iterate_map_batch(model, schedule, batch, 1), repeats)
 
+    say(f"basin {basin_grid}x{basin_grid} x {basin_jumps} jumps on {threads} cores")
+    grid = BasinGrid.around(gait.state, basin_grid)
+    compute_basin(model, schedule, gait, BasinGrid.around(gait.state, 2), max_jumps=basin_jumps)  # compile
+    basin_time, basin = _best_time(lambda: compute_basin(model, schedule, gait, grid, max_jumps=basin_jumps), 1)
+
     kernel_rate = kernel_strides / kernel_time
     baseline_rate = baseline_strides / baseline_time
+    baseline_basin_time = basin.jumps_computed / baseline_rate
     return BenchResult(
         kernel_strides_per_s=kernel_rate,
         baseline_strides_per_s=baseline_rate,
@@ -107,6 +126,12 @@ def run_benchmark(
         max_abs_diff=max_abs_diff,
         batch_strides_per_s=batch_strides / batch_time,
         cores=threads,
+        basin_grid=basin_grid,
+        basin_jumps=basin_jumps,
+        basin_seconds=basin_time,
+        basin_jumps_computed=basin.jumps_computed,
+        basin_baseline_projected_seconds=baseline_basin_time,
+        basin_speedup=baseline_basin_time / basin_time,
     )
 
 

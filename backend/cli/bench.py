@@ -21,6 +21,8 @@ def bench_command(
     kernel_strides: Annotated[int, typer.Option(help="Strides for the one-core kernel timing.", min=1)] = 20_000,
     batch_strides: Annotated[int, typer.Option(help="Strides for the all-cores batch timing.", min=1)] = 100_000,
     repeats: Annotated[int, typer.Option(help="Timings per figure; the best is kept.", min=1)] = 3,
+    basin_grid: Annotated[int, typer.Option(help="Cells per axis of the timed basin.", min=2, max=2000)] = 200,
+    basin_jumps: Annotated[int, typer.Option(help="Jumps per cell of the timed basin.", min=1)] = 60,
     as_json: JsonOption = False,
 ) -> None:
     """Strides per second of the kernel vs scipy solve_ivp (DOP853, rtol=atol=1e-10), and their difference."""
@@ -29,6 +31,8 @@ def bench_command(
         kernel_strides=kernel_strides,
         batch_strides=batch_strides,
         repeats=repeats,
+        basin_grid=basin_grid,
+        basin_jumps=basin_jumps,
         progress=lambda stage: note(f"bench: {stage}…"),
     )
     if as_json:
@@ -40,4 +44,12 @@ def bench_command(
     table.add_row("ratio", f"{result.ratio:,.0f}x")
     table.add_row("largest difference", f"{result.max_abs_diff:.2e}")
     table.add_row(f"batch, {result.cores} cores", f"{result.batch_strides_per_s:,.0f} strides/s")
+    table.add_row(
+        f"basin {result.basin_grid}x{result.basin_grid} x {result.basin_jumps} jumps",
+        f"{result.basin_seconds:.2f} s ({result.basin_jumps_computed:,} jumps)",
+    )
+    table.add_row(
+        "  baseline, projected",
+        f"{result.basin_baseline_projected_seconds:,.0f} s ({result.basin_speedup:,.0f}x slower)",
+    )
     Console().print(table)

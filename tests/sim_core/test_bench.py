@@ -8,15 +8,32 @@ from sim_core.validation import ParameterError
 
 def test_benchmark_reports_all_figures():
     stages = []
-    result = run_benchmark(baseline_strides=5, kernel_strides=50, batch_strides=50, repeats=1, progress=stages.append)
+    result = run_benchmark(
+        baseline_strides=5,
+        kernel_strides=50,
+        batch_strides=50,
+        repeats=1,
+        basin_grid=8,
+        basin_jumps=10,
+        progress=stages.append,
+    )
     assert set(result.to_dict()) == {
+        # issue 3's contract
         "kernel_strides_per_s",
         "baseline_strides_per_s",
         "ratio",
         "max_abs_diff",
         "batch_strides_per_s",
         "cores",
+        # issue 4's extension
+        "basin_grid",
+        "basin_jumps",
+        "basin_seconds",
+        "basin_jumps_computed",
+        "basin_baseline_projected_seconds",
+        "basin_speedup",
     }
+    assert 0 < result.basin_jumps_computed <= 8 * 8 * 10
     assert result.max_abs_diff <= 1e-8
     assert result.ratio == pytest.approx(result.kernel_strides_per_s / result.baseline_strides_per_s)
     assert result.cores >= 1 and stages

@@ -106,6 +106,10 @@ def test_trajectory_json_is_strict_json_with_infinite_friction(tmp_path):
         (["map", "--controls", "30-0.9", "--state", "-1", "0"], "controls"),
         (["fixed-point", "--controls", "30:0.87,30:0.9", "--period", "3"], "period"),
         (["trajectory", "--out", "x.txt"], "out"),
+        (["basin", "--grid", "1000000000"], "grid"),
+        (["basin", "--xdot-range", "-0.5", "-1.5"], "xdot_range"),
+        (["basin", "--tolerance", "-1"], "tolerance"),
+        (["basin", "--jumps", "-5"], "jumps"),
     ],
 )
 def test_bad_input_is_one_clear_line(args, field):
@@ -116,11 +120,35 @@ def test_bad_input_is_one_clear_line(args, field):
     assert "Traceback" not in result.output
 
 
+def test_basin_json_contract():
+    args = ["--controls", "30:0.9", "--guess", "-0.9", "-0.2", "--grid", "6", "--jumps", "20"]
+    result = invoke("basin", *args, "--json")
+    assert result.exit_code == 0, result.output
+    payload = json.loads(result.stdout)
+    assert set(payload) == {
+        "gait",
+        "xdot_range",
+        "ydot_range",
+        "grid",
+        "jumps",
+        "tolerance",
+        "area",
+        "fraction",
+        "counts",
+        "jumps_computed",
+        "failure_codes",
+        "jumps_to_converge",
+        "failure",
+    }
+    assert payload["grid"] == 6 and len(payload["jumps_to_converge"]) == 6 and len(payload["failure"][0]) == 6
+    assert sum(payload["counts"].values()) == 36 and payload["gait"]["period"] == 1
+
+
 def test_bench_json_contract():
     sizes = ["--baseline-strides", "3", "--kernel-strides", "20", "--batch-strides", "20", "--repeats", "1"]
-    result = invoke("bench", *sizes, "--json")
+    result = invoke("bench", *sizes, "--basin-grid", "4", "--basin-jumps", "5", "--json")
     assert result.exit_code == 0, result.output
-    assert set(json.loads(result.stdout)) == {
+    assert set(json.loads(result.stdout)) >= {
         "kernel_strides_per_s",
         "baseline_strides_per_s",
         "ratio",
