@@ -110,6 +110,10 @@ def test_trajectory_json_is_strict_json_with_infinite_friction(tmp_path):
         (["basin", "--xdot-range", "-0.5", "-1.5"], "xdot_range"),
         (["basin", "--tolerance", "-1"], "tolerance"),
         (["basin", "--jumps", "-5"], "jumps"),
+        (["sweep", "--zeta0-range", "0.9", "0.8"], "zeta0_range"),
+        (["sweep", "--steps", "0"], "steps"),
+        (["sweep", "--fixed-leg", "30:0.9,30:0.8"], "fixed_leg"),
+        (["sweep", "--basin-grid", "1"], "grid"),
     ],
 )
 def test_bad_input_is_one_clear_line(args, field):
@@ -142,6 +146,27 @@ def test_basin_json_contract():
     }
     assert payload["grid"] == 6 and len(payload["jumps_to_converge"]) == 6 and len(payload["failure"][0]) == 6
     assert sum(payload["counts"].values()) == 36 and payload["gait"]["period"] == 1
+
+
+def test_sweep_json_contract():
+    args = ["--psi0", "30", "--zeta0-range", "0.90", "0.97", "--steps", "3", "--guess", "-0.93", "-0.2"]
+    result = invoke("sweep", *args, "--basin-grid", "6", "--json")
+    assert result.exit_code == 0, result.output
+    payload = json.loads(result.stdout)
+    assert set(payload) == {"psi0_deg", "fixed_leg", "points", "in_place_zeta0", "basin"}
+    assert [point["zeta0"] for point in payload["points"]] == [0.9, 0.935, 0.97]
+    assert set(payload["points"][0]) == {
+        "zeta0",
+        "energy",
+        "found",
+        "state",
+        "period",
+        "max_abs_eigenvalue",
+        "stable",
+        "climb_per_jump",
+        "basin_area",
+    }
+    assert len(payload["in_place_zeta0"]) == 1 and payload["basin"]["grid"] == 6
 
 
 def test_bench_json_contract():

@@ -1,0 +1,212 @@
+"""Energy sweeps: a gait followed over leg retraction zeta0 (paper Fig. 8, model.md §5).
+
+For each zeta0 of a sweep the fixed point is solved by continuation — seeded from the
+neighbour's solution — and characterised: max |eigenvalue|, stability, climb per jump, and
+optionally its basin area on one fixed window (so areas compare across the sweep). Where the
+climb changes sign between neighbours, the zeta0 of jumping in place is located by Brent's
+method on ``climb(zeta0)``.
+
+Either both legs sweep together (symmetric controls), or one leg is held fixed and the
+other sweeps (schedule ``[fixed leg, swept leg]``, period 2).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from sim_core.basin import DEFAULT_JUMPS, BasinGrid, compute_basin
+from sim_core.controls import ControlSchedule, LegControl
+from sim_core.fixed_points import FixedPoint, FixedPointNotFound, find_fixed_point, search_gaits
+from sim_core.params import ModelParams
+from sim_core.validation import ParameterError, check_range
+
+MAX_STEPS = 10_000
+DEFAULT_BASIN_WINDOW = ((-3.0, -0.02), (-2.0, 2.0))  # [sqrt(g l0)]: holds the paper gaits' basins
+IN_PLACE_XTOL = 1e-9  # [l0 of zeta0]
+
+
+@dataclass(frozen=True)
+class SweepPoint:
+    """One zeta0 of a sweep; ``gait`` is None where continuation found no fixed point."""
+
+    zeta0: float
+    energy: float  # stored spring energy alpha (1 - zeta0)^2 / 2 [m g l0]
+    gait: FixedPoint | None
+    basin_area: float | None  # [g l0]; None when not computed
+
+    @property
+    def climb_per_jump(self) -> float:
+        return math.nan if self.gait is None else self.gait.climb_per_period / self.gait.period
+
+    def to_dict(self) -> dict:
+        gait = self.gait
+        return {
+            "zeta0": self.zeta0,
+            "energy": self.energy,
+            "found": gait is not None,
+            "state": None if gait is None else gait.state.tolist(),
+            "period": None if gait is None else gait.period,
+            "max_abs_eigenvalue": None if gait is None else gait.max_abs_eigenvalue,
+            "stable": None if gait is None else gait.stable,
+            "climb_per_jump": None if gait is None else self.climb_per_jump,
+            "basin_area": self.basin_area,
+        }
+
+
+@dataclass(frozen=True)
+class EnergySweep:
+    """A gait over a range of zeta0.
+
+    Attributes:
+        psi0: the swept leg's angle [rad].
+        fixed_leg: the leg held fixed, or None for symmetric controls.
+        points: one per zeta0, in sweep order.
+        in_place_zeta0: the zeta0 values where the climb crosses zero (jumping in place).
+        basin_grid: the window and resolution of the basin areas, or None.
+    """
+
+    psi0: float
+    fixed_leg: LegControl | None
+    points: tuple[SweepPoint, ...]
+    in_place_zeta0: tuple[float, ...]
+    basin_grid: BasinGrid | None
+    basin_jumps: int
+
+    @property
+    def zeta0(self) -> np.ndarray:
+        return np.array([p.zeta0 for p in self.points])
+
+    @property
+    def max_abs_eigenvalue(self) -> np.ndarray:
+        return np.array([math.nan if p.gait is None else p.gait.max_abs_eigenvalue for p in self.points])
+
+    @property
+    def climb_per_jump(self) -> np.ndarray:
+        return np.array([p.climb_per_jump for p in self.points])
+
+    @property
+    def basin_area(self) -> np.ndarray:
+        return np.array([math.nan if p.basin_area is None else p.basin_area for p in self.points])
+
+    def to_dict(self) -> dict:
+        """The ``parkour sweep --json`` contract."""
+        grid = self.basin_grid
+        return {
+            "psi0_deg": round(math.degrees(self.psi0), 9),
+            "fixed_leg": None
+            if self.fixed_leg is None
+            else {"psi0_deg": self.fixed_leg.psi0_deg, "zeta0": self.fixed_leg.zeta0},
+            "points": [p.to_dict() for p in self.points],
+            "in_place_zeta0": list(self.in_place_zeta0),
+            "basin": None
+            if grid is None
+            else {
+                "xdot_range": list(grid.xdot_range),
+                "ydot_range": list(grid.ydot_range),
+                "grid": grid.cells,
+                "jumps": self.basin_jumps,
+            },
+        }
+
+
+def sweep_schedule(psi0: float, zeta0: float, fixed_leg: LegControl | None) -> ControlSchedule:
+    """The schedule at one point of a sweep: symmetric, or ``[fixed leg, swept leg]``."""
+    swept = LegControl(psi0, zeta0)
+    return ControlSchedule.of(swept) if fixed_leg is None else ControlSchedule.of(fixed_leg, swept)
+
+
+def zeta0_values(low: float, high: float, steps: int) -> np.ndarray:
+    """``steps`` evenly spaced zeta0 in [low, high], validated."""
+    low = check_range("zeta0_range", low, 0.0, 1.0)
+    high = check_range("zeta0_range", high, 0.0, 1.0)
+    if not low < high:
+        raise ParameterError("zeta0_range", f"must be a non-empty interval with low < high, got [{low:g}, {high:g}]")
+    if isinstance(steps, bool) or int(steps) != steps or not 2 <= steps <= MAX_STEPS:
+        raise ParameterError("steps", f"must be an integer in [2, {MAX_STEPS}], got {steps!r}")
+    return np.linspace(low, high, int(steps))
+
+
+def energy_sweep(
+    model: ModelParams,
+    psi0: float,
+    zeta0s: Sequence[float],
+    *,
+    fixed_leg: LegControl | None = None,
+    guess=None,
+    basin_grid: BasinGrid | None = None,
+    basin_jumps: int = DEFAULT_JUMPS,
+    progress: Callable[[int, int], None] | None = None,
+) -> EnergySweep:
+    """Follow the gait over ``zeta0s`` (in the given order) by continuation.
+
+    Args:
+        psi0: the swept leg's angle [rad].
+        fixed_leg: hold this leg and sweep the other (period 2); None sweeps both legs.
+        guess: section state to seed the first solve; default: the most stable gait a search
+            finds at the first zeta0 that has one.
+        basin_grid: if given, each gait's basin area on this grid.
+        progress: called as ``progress(done, total)`` after each point.
+    """
+    zeta0s = [check_range("zeta0", z, 0.0, 1.0) for z in zeta0s]
+    if not zeta0s:
+        raise ParameterError("zeta0", "the sweep needs at least one zeta0")
+    LegControl(psi0, zeta0s[0])  # validates psi0 before any work
+    period = 1 if fixed_leg is None else 2
+    seed = None if guess is None else np.asarray(guess, dtype=float)
+    points = []
+    for done, zeta0 in enumerate(zeta0s, start=1):
+        schedule = sweep_schedule(psi0, zeta0, fixed_leg)
+        gait = _continue(model, schedule, period, seed)
+        if gait is not None:
+            seed = gait.state
+        area = None
+        if gait is not None and basin_grid is not None:
+            area = compute_basin(model, schedule, gait, basin_grid, max_jumps=basin_jumps).area
+        points.append(SweepPoint(zeta0, LegControl(psi0, zeta0).stored_energy(model.alpha), gait, area))
+        if progress is not None:
+            progress(done, len(zeta0s))
+    return EnergySweep(
+        psi0=psi0,
+        fixed_leg=fixed_leg,
+        points=tuple(points),
+        in_place_zeta0=tuple(_in_place_crossings(model, psi0, fixed_leg, points, period)),
+        basin_grid=basin_grid,
+        basin_jumps=basin_jumps,
+    )
+
+
+def _continue(model, schedule, period, seed) -> FixedPoint | None:
+    """The gait from the neighbour's state; a gait search when there is no neighbour yet."""
+    if seed is not None:
+        try:
+            return find_fixed_point(model, schedule, period, seed)
+        except FixedPointNotFound:
+            return None
+    gaits = search_gaits(model, schedule, period)
+    return gaits[0] if gaits else None
+
+
+def _in_place_crossings(model, psi0, fixed_leg, points, period) -> list[float]:
+    """Brent's method on ``climb(zeta0)`` between neighbours whose climbs differ in sign."""
+    crossings = []
+    for left, right in itertools.pairwise(points):
+        if left.gait is None or right.gait is None:
+            continue
+        if not left.climb_per_jump * right.climb_per_jump < 0.0:
+            continue
+
+        def climb(zeta0: float, seed=left.gait.state) -> float:
+            gait = find_fixed_point(model, sweep_schedule(psi0, zeta0, fixed_leg), period, seed)
+            return gait.climb_per_period / gait.period
+
+        try:
+            crossings.append(float(brentq(climb, left.zeta0, right.zeta0, xtol=IN_PLACE_XTOL)))
+        except FixedPointNotFound:
+            continue  # the branch breaks between the neighbours; no crossing to report
+    return crossings
