@@ -181,6 +181,21 @@ def energy_sweep(
     )
 
 
+def find_in_place_zeta0(
+    model: ModelParams, psi0: float, *, zeta0_range: tuple[float, float] = (0.8, 0.99), steps: int = 12, guess=None
+) -> float:
+    """The zeta0 of jumping in place for symmetric legs at ``psi0`` (the largest one in range).
+
+    Raises :class:`ParameterError` if the climb does not change sign over ``zeta0_range``.
+    """
+    sweep = energy_sweep(model, psi0, zeta0_values(*zeta0_range, steps), guess=guess)
+    if not sweep.in_place_zeta0:
+        raise ParameterError(
+            "zeta0_range", f"no zeta0 of jumping in place in [{zeta0_range[0]:g}, {zeta0_range[1]:g}] at this psi0"
+        )
+    return max(sweep.in_place_zeta0)
+
+
 def _continue(model, schedule, period, seed) -> FixedPoint | None:
     """The gait from the neighbour's state; a gait search when there is no neighbour yet."""
     if seed is not None:

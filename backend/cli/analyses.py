@@ -1,4 +1,4 @@
-"""``parkour basin`` and ``parkour sweep``: studies over many start states and controls (issue 4)."""
+"""``parkour basin``, ``sweep``, ``mjtf`` and ``pid``: the lab's studies (issue 4)."""
 
 from __future__ import annotations
 
@@ -19,9 +19,14 @@ from backend.cli.options import (
     progress_bar,
     with_model,
 )
-from sim_core import LegControl, ParameterError, find_fixed_point
+from sim_core import ControlSchedule, LegControl, ParameterError, find_fixed_point
 from sim_core.basin import DEFAULT_JUMPS, DEFAULT_TOLERANCE, BasinGrid, check_convergence_test, compute_basin
-from sim_core.sweep import DEFAULT_BASIN_WINDOW, energy_sweep, zeta0_values
+from sim_core.closed_loop import HeightController, closed_loop_climb
+from sim_core.mjtf import CAPPED, check_trials, mjtf_study
+from sim_core.noise import NO_NOISE, NoiseModel
+from sim_core.poincare import check_jumps
+from sim_core.sweep import DEFAULT_BASIN_WINDOW, energy_sweep, find_in_place_zeta0, zeta0_values
+from sim_core.validation import check_range
 
 app = typer.Typer(rich_markup_mode=None)
 
@@ -110,12 +115,7 @@ def sweep_command(
 ) -> None:
     """Follow a gait over zeta0: max |λ|, climb, basin area, and the zeta0 of jumping in place."""
     zeta0s = zeta0_values(*zeta0_range, steps)
-    fixed = None
-    if fixed_leg is not None:
-        schedule = parse_controls(fixed_leg)
-        if len(schedule) != 1:
-            raise ParameterError("fixed_leg", f"must be one PSI0:ZETA0 pair, got {fixed_leg!r}")
-        fixed = schedule[0]
+    fixed = _fixed_leg(fixed_leg)
     grid = None if basin_grid == 0 else BasinGrid(*DEFAULT_BASIN_WINDOW, basin_grid)
     check_convergence_test(basin_jumps, DEFAULT_TOLERANCE)
     with progress_bar(f"sweeping {steps} zeta0 values") as progress:
@@ -150,3 +150,174 @@ def sweep_command(
     Console().print(table)
     crossings = ", ".join(f"{z:.6f}" for z in sweep.in_place_zeta0) or "none in range"
     typer.echo(f"jumping in place at zeta0 = {crossings}")
+
+
+def _noise_options(
+    noise_psi0: float,
+    noise_zeta0: float,
+    noise_velocity: float,
+    pitch_drift: float,
+    asym_psi0: float,
+    asym_zeta0: float,
+) -> NoiseModel:
+    return NoiseModel(noise_psi0, noise_zeta0, noise_velocity, pitch_drift, asym_psi0, asym_zeta0)
+
+
+_DEFAULT_NOISE = NoiseModel()
+NoisePsi0 = Annotated[float, typer.Option("--noise-psi0", help="Per-jump sigma of psi0 [deg].")]
+NoiseZeta0 = Annotated[float, typer.Option("--noise-zeta0", help="Per-jump sigma of zeta0.")]
+NoiseVelocity = Annotated[float, typer.Option("--noise-velocity", help="Per-jump sigma of xdot, ydot [sqrt(g l0)].")]
+PitchDrift = Annotated[float, typer.Option("--pitch-drift", help="Sigma of the pitch random walk per jump [deg].")]
+AsymPsi0 = Annotated[float, typer.Option("--asymmetry-psi0", help="Right leg's psi0 offset [deg].")]
+AsymZeta0 = Annotated[float, typer.Option("--asymmetry-zeta0", help="Right leg's zeta0 offset.")]
+SeedOption = Annotated[int, typer.Option("--seed", help="Seed; the same seed gives the same numbers.", min=0)]
+
+
+@app.command("mjtf")
+@handles_errors
+@with_model
+def mjtf_command(
+    setup: ModelSetup,
+    psi0: Annotated[float, typer.Option("--psi0", help="Leg angle [degrees].")] = 30.0,
+    zeta0_range: Annotated[
+        tuple[float, float], typer.Option("--zeta0-range", help="LOW HIGH of zeta0 over the energy levels.")
+    ] = (0.84, 0.96),
+    levels: Annotated[int, typer.Option("--levels", help="Number of energy levels.")] = 10,
+    trials: Annotated[int, typer.Option("--trials", help="Trials per level.")] = 8,
+    cap: Annotated[int, typer.Option("--cap", help="Jumps after which a trial counts as survived.")] = 1000,
+    seed: SeedOption = 0,
+    fixed_leg: Annotated[
+        str | None, typer.Option("--fixed-leg", help="PSI0:ZETA0 of a leg held fixed; the other sweeps.")
+    ] = None,
+    guess: GuessOption = None,
+    noise_psi0: NoisePsi0 = _DEFAULT_NOISE.psi0_deg,
+    noise_zeta0: NoiseZeta0 = _DEFAULT_NOISE.zeta0,
+    noise_velocity: NoiseVelocity = _DEFAULT_NOISE.velocity,
+    pitch_drift: PitchDrift = _DEFAULT_NOISE.pitch_drift_deg,
+    asymmetry_psi0: AsymPsi0 = 0.0,
+    asymmetry_zeta0: AsymZeta0 = 0.0,
+    as_json: JsonOption = False,
+) -> None:
+    """Mean Jumps To Failure under noise, per energy level (zeta0)."""
+    noise = NoiseModel(noise_psi0, noise_zeta0, noise_velocity, pitch_drift, asymmetry_psi0, asymmetry_zeta0)
+    zeta0s = zeta0_values(*zeta0_range, levels)
+    check_trials(trials, cap)
+    fixed = _fixed_leg(fixed_leg)
+    with progress_bar(f"MJTF: {levels} levels x {trials} trials") as progress:
+        study = mjtf_study(
+            setup.model,
+            LegControl.from_degrees(psi0, zeta0s[0]).psi0,
+            zeta0s,
+            noise=noise,
+            trials=trials,
+            cap=cap,
+            seed=seed,
+            fixed_leg=fixed,
+            guess=guess,
+            progress=progress,
+        )
+    if as_json:
+        print_json(study.to_dict())
+        return
+    table = Table("zeta0", "E (m g l0)", "MJTF", "std", "95% CI", "capped", "failures", title=f"psi0 {psi0:g}°")
+    for level in study.levels:
+        outcomes = level.histogram()
+        capped = outcomes.pop(CAPPED)
+        low, high = level.ci95
+        table.add_row(
+            f"{level.zeta0:.4f}",
+            f"{level.energy:.3f}",
+            f"{level.mean:.1f}",
+            f"{level.std:.1f}",
+            f"{low:.1f} … {high:.1f}",
+            f"{capped}/{level.jumps.size}",
+            ", ".join(f"{code} {count}" for code, count in outcomes.items() if count),
+        )
+    Console().print(table)
+
+
+@app.command("pid")
+@handles_errors
+@with_model
+def pid_command(
+    setup: ModelSetup,
+    target: Annotated[float, typer.Option("--target", help="Height to hold [m] (the robot's l0 converts it).")] = 0.55,
+    psi0: Annotated[float, typer.Option("--psi0", help="Leg angle [degrees].")] = 35.0,
+    start_zeta0: Annotated[float, typer.Option("--start-zeta0", help="zeta0 of the climbing gait at the start.")] = 0.9,
+    jumps: Annotated[int, typer.Option("--jumps", help="Jumps to simulate.")] = 80,
+    kp: Annotated[float, typer.Option("--kp", help="Proportional gain [zeta0 per l0].")] = HeightController.kp,
+    ki: Annotated[float, typer.Option("--ki", help="Integral gain [zeta0 per l0 jump].")] = HeightController.ki,
+    kd: Annotated[float, typer.Option("--kd", help="Derivative gain [zeta0 jump per l0].")] = HeightController.kd,
+    zeta0_min: Annotated[
+        float, typer.Option("--zeta0-min", help="Leg range: most retraction.")
+    ] = HeightController.zeta0_min,
+    zeta0_max: Annotated[
+        float, typer.Option("--zeta0-max", help="Leg range: least retraction.")
+    ] = HeightController.zeta0_max,
+    noisy: Annotated[bool, typer.Option("--noisy", help="Apply the noise model (options as for mjtf).")] = False,
+    seed: SeedOption = 0,
+    noise_psi0: NoisePsi0 = _DEFAULT_NOISE.psi0_deg,
+    noise_zeta0: NoiseZeta0 = _DEFAULT_NOISE.zeta0,
+    noise_velocity: NoiseVelocity = _DEFAULT_NOISE.velocity,
+    pitch_drift: PitchDrift = _DEFAULT_NOISE.pitch_drift_deg,
+    asymmetry_psi0: AsymPsi0 = 0.0,
+    asymmetry_zeta0: AsymZeta0 = 0.0,
+    as_json: JsonOption = False,
+) -> None:
+    """Closed-loop climb to a target height: a PID on the touchdown height sets the next zeta0."""
+    noise = NoiseModel(noise_psi0, noise_zeta0, noise_velocity, pitch_drift, asymmetry_psi0, asymmetry_zeta0)
+    scales = setup.robot.scales
+    target_l0 = check_range("target", target, 0.0, 1e3) / scales.length
+    leg = LegControl.from_degrees(psi0, start_zeta0)
+    HeightController(target_l0, (zeta0_min + zeta0_max) / 2, kp, ki, kd, zeta0_min, zeta0_max)  # check first
+    check_jumps(jumps)
+    hover = find_in_place_zeta0(setup.model, leg.psi0, zeta0_range=(zeta0_min, zeta0_max))
+    controller = HeightController(target_l0, hover, kp, ki, kd, zeta0_min, zeta0_max)
+    start = find_fixed_point(setup.model, ControlSchedule.of(leg), 1, _START_GUESS).state
+    run = closed_loop_climb(
+        setup.model,
+        controller,
+        leg.psi0,
+        start,
+        jumps,
+        start_zeta0=start_zeta0,
+        noise=noise if noisy else NO_NOISE,
+        seed=seed,
+    )
+    result = run.to_dict()
+    result["si"] = {
+        "target_m": target,
+        "height_m": (run.height * scales.length).tolist(),
+        "time_s": (run.time * scales.time).tolist(),
+        "rise_time_s": run.rise_time() * scales.time,
+        "steady_error_m": run.steady_error() * scales.length,
+    }
+    result["noise"] = noise.to_dict() if noisy else None
+    if as_json:
+        print_json(result)
+        return
+    settled = run.settling_jump()
+    table = Table("measure", "value", title=f"Closed-loop climb to {target:g} m, psi0 {psi0:g}°")
+    table.add_row("hover zeta0 (feed-forward)", f"{hover:.5f}")
+    table.add_row("gains kp, ki, kd", f"{kp:g}, {ki:g}, {kd:g}")
+    table.add_row("outcome", "completed" if run.failure is None else f"failed: {run.failure.code}")
+    table.add_row("rise time (10-90%)", f"{run.rise_time() * scales.time:.2f} s")
+    table.add_row("overshoot", f"{run.overshoot():.1%}")
+    table.add_row(
+        "settled (±2%)", "no" if settled is None else f"jump {settled}, {run.time[settled] * scales.time:.2f} s"
+    )
+    table.add_row("steady error", f"{run.steady_error() * scales.length * 100:.2f} cm")
+    table.add_row("final height", f"{run.height[-1] * scales.length * 100:.2f} cm")
+    Console().print(table)
+
+
+_START_GUESS = (-0.93, -0.2)
+
+
+def _fixed_leg(text: str | None) -> LegControl | None:
+    if text is None:
+        return None
+    schedule = parse_controls(text)
+    if len(schedule) != 1:
+        raise ParameterError("fixed_leg", f"must be one PSI0:ZETA0 pair, got {text!r}")
+    return schedule[0]

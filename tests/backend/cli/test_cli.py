@@ -114,6 +114,12 @@ def test_trajectory_json_is_strict_json_with_infinite_friction(tmp_path):
         (["sweep", "--steps", "0"], "steps"),
         (["sweep", "--fixed-leg", "30:0.9,30:0.8"], "fixed_leg"),
         (["sweep", "--basin-grid", "1"], "grid"),
+        (["mjtf", "--trials", "-1"], "trials"),
+        (["mjtf", "--cap", "0"], "cap"),
+        (["mjtf", "--noise-psi0", "-1"], "noise.psi0_deg"),
+        (["pid", "--kp", "-1"], "kp"),
+        (["pid", "--zeta0-min", "0.97", "--zeta0-max", "0.9"], "zeta0_max"),
+        (["pid", "--target", "0"], "target"),
     ],
 )
 def test_bad_input_is_one_clear_line(args, field):
@@ -167,6 +173,53 @@ def test_sweep_json_contract():
         "basin_area",
     }
     assert len(payload["in_place_zeta0"]) == 1 and payload["basin"]["grid"] == 6
+
+
+def test_mjtf_json_contract():
+    args = [
+        "--zeta0-range",
+        "0.88",
+        "0.92",
+        "--levels",
+        "2",
+        "--trials",
+        "3",
+        "--cap",
+        "30",
+        "--guess",
+        "-0.93",
+        "-0.2",
+    ]
+    result = invoke("mjtf", *args, "--seed", "3", "--json")
+    assert result.exit_code == 0, result.output
+    payload = json.loads(result.stdout)
+    assert set(payload) == {"psi0_deg", "fixed_leg", "noise", "trials", "cap", "seed", "levels"}
+    level = payload["levels"][0]
+    assert set(level) == {"zeta0", "energy", "start", "trials", "mean", "std", "ci95", "outcomes", "jumps"}
+    assert level["trials"] == 3 and sum(level["outcomes"].values()) == 3
+    again = json.loads(invoke("mjtf", *args, "--seed", "3", "--json").stdout)
+    assert again == payload, "seeded"
+
+
+def test_pid_json_contract():
+    result = invoke("pid", "--jumps", "40", "--json")
+    assert result.exit_code == 0, result.output
+    payload = json.loads(result.stdout)
+    assert set(payload) >= {
+        "target",
+        "gains",
+        "zeta0_hover",
+        "failure",
+        "rise_time",
+        "overshoot",
+        "settling_jump",
+        "steady_error",
+        "time",
+        "height",
+        "zeta0",
+        "si",
+    }
+    assert payload["si"]["target_m"] == 0.55 and len(payload["si"]["height_m"]) == 41
 
 
 def test_bench_json_contract():

@@ -1,0 +1,257 @@
+"""Mean Jumps To Failure: Monte-Carlo robustness of a gait under noise (paper Fig. 11, model.md §5).
+
+A trial starts on the gait's fixed point and jumps with the disturbances of
+:mod:`sim_core.noise` until a jump fails or ``cap`` jumps succeed. Per energy level (zeta0),
+``trials`` trials give the mean and standard deviation of the jumps completed, a 95%
+confidence interval of the mean, and a histogram of how the trials ended. Capped trials count
+as ``cap`` jumps, so with capped trials the mean is a lower bound; the result says how many.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numba import prange
+
+from sim_core._jit import kernel, parallel_kernel
+from sim_core.controls import LegControl
+from sim_core.failures import OK, Failure
+from sim_core.integrate import STATE_SIZE
+from sim_core.noise import NoiseModel, disturbed_state, perturbed_controls, pitch_step, seed_trial, trial_seeds
+from sim_core.params import ModelParams
+from sim_core.stride import jump
+from sim_core.sweep import energy_sweep, sweep_schedule
+from sim_core.validation import ParameterError
+
+MAX_TRIALS = 1_000_000
+MAX_CAP = 1_000_000
+CAPPED = "capped"  # histogram key of trials that reached the cap
+
+
+@dataclass(frozen=True)
+class MJTFLevel:
+    """The trials of one energy level.
+
+    Attributes:
+        zeta0: the swept leg length; energy: stored spring energy [m g l0].
+        start: the section state trials start from (the gait's fixed point).
+        jumps: shape (trials,), jumps completed before the failure (``cap`` if none).
+        status: shape (trials,), kernel status of the failing jump, 0 for capped trials.
+    """
+
+    zeta0: float
+    energy: float
+    start: np.ndarray
+    jumps: np.ndarray
+    status: np.ndarray
+    cap: int
+
+    @property
+    def mean(self) -> float:
+        return float(np.mean(self.jumps))
+
+    @property
+    def std(self) -> float:
+        """Sample standard deviation (ddof = 1; 0 for a single trial)."""
+        return float(np.std(self.jumps, ddof=1)) if self.jumps.size > 1 else 0.0
+
+    @property
+    def ci95(self) -> tuple[float, float]:
+        """Normal-approximation 95% confidence interval of the mean."""
+        half = 1.96 * self.std / math.sqrt(self.jumps.size)
+        return self.mean - half, self.mean + half
+
+    def histogram(self) -> dict[str, int]:
+        counts = {CAPPED: int(np.count_nonzero(self.status == OK))}
+        for failure in Failure:
+            counts[failure.code] = int(np.count_nonzero(self.status == failure.value))
+        return counts
+
+    def to_dict(self) -> dict:
+        return {
+            "zeta0": self.zeta0,
+            "energy": self.energy,
+            "start": self.start.tolist(),
+            "trials": int(self.jumps.size),
+            "mean": self.mean,
+            "std": self.std,
+            "ci95": list(self.ci95),
+            "outcomes": self.histogram(),
+            "jumps": self.jumps.tolist(),
+        }
+
+
+@dataclass(frozen=True)
+class MJTFStudy:
+    psi0: float
+    fixed_leg: LegControl | None
+    noise: NoiseModel
+    trials: int
+    cap: int
+    seed: int
+    levels: tuple[MJTFLevel, ...]
+
+    def to_dict(self) -> dict:
+        """The ``parkour mjtf --json`` contract."""
+        return {
+            "psi0_deg": round(math.degrees(self.psi0), 9),
+            "fixed_leg": None
+            if self.fixed_leg is None
+            else {"psi0_deg": self.fixed_leg.psi0_deg, "zeta0": self.fixed_leg.zeta0},
+            "noise": self.noise.to_dict(),
+            "trials": self.trials,
+            "cap": self.cap,
+            "seed": self.seed,
+            "levels": [level.to_dict() for level in self.levels],
+        }
+
+
+def check_trials(trials: int, cap: int) -> tuple[int, int]:
+    for field, value, high in (("trials", trials, MAX_TRIALS), ("cap", cap, MAX_CAP)):
+        if isinstance(value, bool) or int(value) != value or not 1 <= value <= high:
+            raise ParameterError(field, f"must be an integer in [1, {high:,}], got {value!r}")
+    return int(trials), int(cap)
+
+
+def mjtf_study(
+    model: ModelParams,
+    psi0: float,
+    zeta0s: Sequence[float],
+    *,
+    noise: NoiseModel,
+    trials: int,
+    cap: int,
+    seed: int = 0,
+    fixed_leg: LegControl | None = None,
+    guess=None,
+    progress: Callable[[int, int], None] | None = None,
+) -> MJTFStudy:
+    """MJTF at each zeta0 (symmetric legs, or one leg fixed as in :func:`sim_core.sweep.energy_sweep`).
+
+    Trials start on each level's fixed point, found by continuation; a level without one
+    starts from its neighbour's. Level ``i`` draws its trials' seeds from stream ``i`` of
+    ``seed``, so results do not depend on how the work is split.
+    """
+    trials, cap = check_trials(trials, cap)
+    gaits = energy_sweep(model, psi0, zeta0s, fixed_leg=fixed_leg, guess=guess)
+    known = [point.gait.state for point in gaits.points if point.gait is not None]
+    if not known:
+        raise ParameterError("zeta0", "no gait found at any level to start the trials from; give a guess")
+    start = known[0]
+    levels = []
+    for index, point in enumerate(gaits.points):
+        if point.gait is not None:
+            start = point.gait.state
+        schedule = sweep_schedule(psi0, point.zeta0, fixed_leg)
+        jumps, status = run_trials(model, schedule.as_array(), start, noise, trial_seeds(seed, index, trials), cap)
+        levels.append(MJTFLevel(point.zeta0, point.energy, start.copy(), jumps, status, cap))
+        if progress is not None:
+            progress(index + 1, len(gaits.points))
+    return MJTFStudy(psi0, fixed_leg, noise, trials, cap, int(seed), tuple(levels))
+
+
+def run_trials(
+    model: ModelParams, schedule: np.ndarray, start, noise: NoiseModel, seeds: np.ndarray, cap: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """One trial per seed from ``start``, on all cores: ``(jumps completed, status)`` arrays."""
+    jumps = np.empty(seeds.size, dtype=np.int64)
+    status = np.empty(seeds.size, dtype=np.int64)
+    trials_batch(
+        float(start[0]),
+        float(start[1]),
+        schedule,
+        seeds,
+        cap,
+        *noise.kernel_args(),
+        *model.kernel_args(),
+        jumps,
+        status,
+    )
+    return jumps, status
+
+
+@kernel
+def trial(
+    xdot,
+    ydot,
+    schedule,
+    seed,
+    cap,
+    sigma_psi0,
+    sigma_zeta0,
+    sigma_velocity,
+    sigma_pitch,
+    asymmetry_psi0,
+    asymmetry_zeta0,
+    alpha,
+    d_hat,
+    c_zeta,
+    c_psi,
+    mu,
+):
+    """One noisy run: ``(jumps completed, status of the failing jump or OK at the cap)``."""
+    seed_trial(seed)
+    no_record = np.empty((0, STATE_SIZE))
+    pitch = 0.0
+    psi0, zeta0 = perturbed_controls(
+        schedule, 0, pitch, math.nan, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
+    )
+    for k in range(cap):
+        next_pitch = pitch_step(pitch, sigma_pitch)
+        next_psi0, next_zeta0 = perturbed_controls(
+            schedule, k + 1, next_pitch, math.nan, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
+        )
+        status, xdot, ydot, _, _, _, _ = jump(
+            xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c_psi, mu, no_record
+        )
+        if status != OK:
+            return k, status
+        xdot, ydot = disturbed_state(xdot, ydot, sigma_velocity)
+        pitch, psi0, zeta0 = next_pitch, next_psi0, next_zeta0
+    return cap, OK
+
+
+@parallel_kernel
+def trials_batch(
+    xdot,
+    ydot,
+    schedule,
+    seeds,
+    cap,
+    sigma_psi0,
+    sigma_zeta0,
+    sigma_velocity,
+    sigma_pitch,
+    asymmetry_psi0,
+    asymmetry_zeta0,
+    alpha,
+    d_hat,
+    c_zeta,
+    c_psi,
+    mu,
+    jumps,
+    status,
+):
+    """:func:`trial` for each seed on all cores."""
+    for i in prange(seeds.size):
+        jumps[i], status[i] = trial(
+            xdot,
+            ydot,
+            schedule,
+            seeds[i],
+            cap,
+            sigma_psi0,
+            sigma_zeta0,
+            sigma_velocity,
+            sigma_pitch,
+            asymmetry_psi0,
+            asymmetry_zeta0,
+            alpha,
+            d_hat,
+            c_zeta,
+            c_psi,
+            mu,
+        )
