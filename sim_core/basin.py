@@ -20,6 +20,7 @@ import numpy as np
 from numba import prange
 
 from sim_core._jit import kernel, parallel_kernel
+from sim_core.chunks import ChunkMap, Progress, chunk_slices, in_process
 from sim_core.controls import PSI0_COLUMN, ZETA0_COLUMN, ControlSchedule
 from sim_core.failures import OK, Failure
 from sim_core.fixed_points import FixedPoint
@@ -32,6 +33,7 @@ from sim_core.validation import ParameterError, check_range
 DEFAULT_TOLERANCE = 0.02  # [sqrt(g l0)]: inside the linear region of a stable gait, far above integrator noise
 DEFAULT_JUMPS = 60
 DEFAULT_HALF_WIDTH = 1.5  # [sqrt(g l0)]: default window half-width around the gait's state
+DEFAULT_CHUNK_CELLS = 10_000  # ~0.3 s of work per chunk: fine-grained progress, cheap to ship
 MAX_CELLS = 4_000_000  # a 2000 x 2000 grid; larger grids are almost certainly a typo
 NOT_CONVERGED = -1  # jumps_to_converge of a cell that never reached the gait
 
@@ -181,27 +183,25 @@ def compute_basin(
     *,
     max_jumps: int = DEFAULT_JUMPS,
     tolerance: float = DEFAULT_TOLERANCE,
+    chunk_map: ChunkMap = in_process,
+    chunk_cells: int = DEFAULT_CHUNK_CELLS,
+    progress: Progress | None = None,
 ) -> Basin:
-    """The basin of ``gait`` (a fixed point of ``schedule``) over ``grid``, on all cores."""
+    """The basin of ``gait`` (a fixed point of ``schedule``) over ``grid``.
+
+    The cells are split into chunks of ``chunk_cells`` run by ``chunk_map``
+    (:mod:`sim_core.chunks`; in-process on all cores by default).
+    """
     max_jumps, tolerance = check_convergence_test(max_jumps, tolerance)
     if gait.period % len(schedule) != 0:
         raise ParameterError("gait", f"period {gait.period} is not a multiple of the schedule length {len(schedule)}")
     starts = grid.states()
-    count = starts.shape[0]
-    jumps_to_converge = np.empty(count, dtype=np.int64)
-    failure = np.empty(count, dtype=np.int64)
-    jumps_done = np.empty(count, dtype=np.int64)
-    converge_batch(
-        starts,
-        schedule.as_array(),
-        np.ascontiguousarray(gait.orbit, dtype=np.float64),
-        tolerance,
-        max_jumps,
-        *model.kernel_args(),
-        jumps_to_converge,
-        failure,
-        jumps_done,
-    )
+    arguments = [
+        (model, schedule, gait.orbit, starts[part], max_jumps, tolerance)
+        for part in chunk_slices(starts.shape[0], chunk_cells)
+    ]
+    parts = chunk_map(converge_states, arguments, progress)
+    jumps_to_converge, failure, jumps_done = (np.concatenate(column) for column in zip(*parts, strict=True))
     shape = (grid.cells, grid.cells)
     return Basin(
         gait=gait,
@@ -212,6 +212,37 @@ def compute_basin(
         tolerance=tolerance,
         jumps_computed=int(jumps_done.sum()),
     )
+
+
+def converge_states(
+    model: ModelParams,
+    schedule: ControlSchedule,
+    orbit: np.ndarray,
+    starts: np.ndarray,
+    max_jumps: int,
+    tolerance: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The basin test for each row of ``starts`` (N, 2) on all cores: one chunk of a basin.
+
+    Returns int arrays ``(jumps_to_converge, failure status, jumps simulated)``, shape (N,).
+    """
+    starts = np.ascontiguousarray(starts, dtype=np.float64)
+    count = starts.shape[0]
+    jumps_to_converge = np.empty(count, dtype=np.int64)
+    failure = np.empty(count, dtype=np.int64)
+    jumps_done = np.empty(count, dtype=np.int64)
+    converge_batch(
+        starts,
+        schedule.as_array(),
+        np.ascontiguousarray(orbit, dtype=np.float64),
+        tolerance,
+        max_jumps,
+        *model.kernel_args(),
+        jumps_to_converge,
+        failure,
+        jumps_done,
+    )
+    return jumps_to_converge, failure, jumps_done
 
 
 @kernel

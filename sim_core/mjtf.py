@@ -10,13 +10,14 @@ as ``cap`` jumps, so with capped trials the mean is a lower bound; the result sa
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numba import prange
 
 from sim_core._jit import kernel, parallel_kernel
+from sim_core.chunks import ChunkMap, Progress, chunk_slices, in_process
 from sim_core.controls import LegControl
 from sim_core.failures import OK, Failure
 from sim_core.integrate import STATE_SIZE
@@ -28,6 +29,7 @@ from sim_core.validation import ParameterError
 
 MAX_TRIALS = 1_000_000
 MAX_CAP = 1_000_000
+DEFAULT_CHUNK_TRIALS = 256
 CAPPED = "capped"  # histogram key of trials that reached the cap
 
 
@@ -127,29 +129,40 @@ def mjtf_study(
     seed: int = 0,
     fixed_leg: LegControl | None = None,
     guess=None,
-    progress: Callable[[int, int], None] | None = None,
+    chunk_map: ChunkMap = in_process,
+    chunk_trials: int = DEFAULT_CHUNK_TRIALS,
+    progress: Progress | None = None,
 ) -> MJTFStudy:
     """MJTF at each zeta0 (symmetric legs, or one leg fixed as in :func:`sim_core.sweep.energy_sweep`).
 
     Trials start on each level's fixed point, found by continuation; a level without one
     starts from its neighbour's. Level ``i`` draws its trials' seeds from stream ``i`` of
-    ``seed``, so results do not depend on how the work is split.
+    ``seed``; the trials run in chunks of ``chunk_trials`` through ``chunk_map``
+    (:mod:`sim_core.chunks`), so results do not depend on how the work is split.
     """
     trials, cap = check_trials(trials, cap)
+    seeds = [trial_seeds(seed, index, trials) for index in range(len(zeta0s))]
     gaits = energy_sweep(model, psi0, zeta0s, fixed_leg=fixed_leg, guess=guess)
     known = [point.gait.state for point in gaits.points if point.gait is not None]
     if not known:
         raise ParameterError("zeta0", "no gait found at any level to start the trials from; give a guess")
     start = known[0]
-    levels = []
+    starts, chunks, owners = [], [], []
     for index, point in enumerate(gaits.points):
         if point.gait is not None:
             start = point.gait.state
-        schedule = sweep_schedule(psi0, point.zeta0, fixed_leg)
-        jumps, status = run_trials(model, schedule.as_array(), start, noise, trial_seeds(seed, index, trials), cap)
-        levels.append(MJTFLevel(point.zeta0, point.energy, start.copy(), jumps, status, cap))
-        if progress is not None:
-            progress(index + 1, len(gaits.points))
+        starts.append(start.copy())
+        schedule = sweep_schedule(psi0, point.zeta0, fixed_leg).as_array()
+        for part in chunk_slices(trials, chunk_trials):
+            chunks.append((model, schedule, start, noise, seeds[index][part], cap))
+            owners.append(index)
+    results = chunk_map(run_trials, chunks, progress)
+    levels = []
+    for index, point in enumerate(gaits.points):
+        mine = [result for owner, result in zip(owners, results, strict=True) if owner == index]
+        jumps = np.concatenate([jumps for jumps, _ in mine])
+        status = np.concatenate([status for _, status in mine])
+        levels.append(MJTFLevel(point.zeta0, point.energy, starts[index], jumps, status, cap))
     return MJTFStudy(psi0, fixed_leg, noise, trials, cap, int(seed), tuple(levels))
 
 

@@ -14,13 +14,14 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import brentq
 
-from sim_core.basin import DEFAULT_JUMPS, BasinGrid, compute_basin
+from sim_core.basin import DEFAULT_JUMPS, DEFAULT_TOLERANCE, NOT_CONVERGED, BasinGrid, converge_states
+from sim_core.chunks import ChunkMap, Progress, in_process
 from sim_core.controls import ControlSchedule, LegControl
 from sim_core.fixed_points import FixedPoint, FixedPointNotFound, find_fixed_point, search_gaits
 from sim_core.params import ModelParams
@@ -141,7 +142,9 @@ def energy_sweep(
     guess=None,
     basin_grid: BasinGrid | None = None,
     basin_jumps: int = DEFAULT_JUMPS,
-    progress: Callable[[int, int], None] | None = None,
+    basin_tolerance: float = DEFAULT_TOLERANCE,
+    chunk_map: ChunkMap = in_process,
+    progress: Progress | None = None,
 ) -> EnergySweep:
     """Follow the gait over ``zeta0s`` (in the given order) by continuation.
 
@@ -150,8 +153,9 @@ def energy_sweep(
         fixed_leg: hold this leg and sweep the other (period 2); None sweeps both legs.
         guess: section state to seed the first solve; default: the most stable gait a search
             finds at the first zeta0 that has one.
-        basin_grid: if given, each gait's basin area on this grid.
-        progress: called as ``progress(done, total)`` after each point.
+        basin_grid: if given, each gait's basin area on this grid (:mod:`sim_core.basin`).
+        chunk_map: runs the basins, one chunk per gait (:mod:`sim_core.chunks`).
+        progress: called as ``progress(done, total)`` after each gait and each basin.
     """
     zeta0s = [check_range("zeta0", z, 0.0, 1.0) for z in zeta0s]
     if not zeta0s:
@@ -159,22 +163,42 @@ def energy_sweep(
     LegControl(psi0, zeta0s[0])  # validates psi0 before any work
     period = 1 if fixed_leg is None else 2
     seed = None if guess is None else np.asarray(guess, dtype=float)
-    points = []
+    total = len(zeta0s) * (2 if basin_grid is not None else 1)
+    gaits = []
     for done, zeta0 in enumerate(zeta0s, start=1):
-        schedule = sweep_schedule(psi0, zeta0, fixed_leg)
-        gait = _continue(model, schedule, period, seed)
+        gait = _continue(model, sweep_schedule(psi0, zeta0, fixed_leg), period, seed)
         if gait is not None:
             seed = gait.state
-        area = None
-        if gait is not None and basin_grid is not None:
-            area = compute_basin(model, schedule, gait, basin_grid, max_jumps=basin_jumps).area
-        points.append(SweepPoint(zeta0, LegControl(psi0, zeta0).stored_energy(model.alpha), gait, area))
+        gaits.append(gait)
         if progress is not None:
-            progress(done, len(zeta0s))
+            progress(done, total)
+    areas: list[float | None] = [None] * len(zeta0s)
+    if basin_grid is not None:
+        # One chunk per gait: the basins are independent, so a cluster runs them side by side.
+        found = [i for i, gait in enumerate(gaits) if gait is not None]
+        starts = basin_grid.states()
+        arguments = [
+            (model, sweep_schedule(psi0, zeta0s[i], fixed_leg), gaits[i].orbit, starts, basin_jumps, basin_tolerance)
+            for i in found
+        ]
+        offset = len(zeta0s) + len(zeta0s) - len(found)
+
+        def basin_progress(done: int, _total: int) -> None:
+            if progress is not None:
+                progress(offset + done, total)
+
+        for i, (jumps_to_converge, _, _) in zip(
+            found, chunk_map(converge_states, arguments, basin_progress), strict=True
+        ):
+            areas[i] = float(np.count_nonzero(jumps_to_converge != NOT_CONVERGED)) * basin_grid.cell_area
+    points = tuple(
+        SweepPoint(zeta0, LegControl(psi0, zeta0).stored_energy(model.alpha), gait, area)
+        for zeta0, gait, area in zip(zeta0s, gaits, areas, strict=True)
+    )
     return EnergySweep(
         psi0=psi0,
         fixed_leg=fixed_leg,
-        points=tuple(points),
+        points=points,
         in_place_zeta0=tuple(_in_place_crossings(model, psi0, fixed_leg, points, period)),
         basin_grid=basin_grid,
         basin_jumps=basin_jumps,

@@ -19,6 +19,7 @@ from backend.cli.options import (
     progress_bar,
     with_model,
 )
+from experiments.cluster import SCHEDULER_ENV, chunk_map_for, scheduler_address
 from sim_core import ControlSchedule, LegControl, ParameterError, find_fixed_point
 from sim_core.basin import DEFAULT_JUMPS, DEFAULT_TOLERANCE, BasinGrid, check_convergence_test, compute_basin
 from sim_core.closed_loop import HeightController, closed_loop_climb
@@ -29,6 +30,14 @@ from sim_core.sweep import DEFAULT_BASIN_WINDOW, energy_sweep, find_in_place_zet
 from sim_core.validation import check_range
 
 app = typer.Typer(rich_markup_mode=None)
+
+SchedulerOption = Annotated[
+    str | None,
+    typer.Option(
+        "--scheduler",
+        help=f"Dask scheduler (tcp://host:8786) to run on a cluster; default ${SCHEDULER_ENV}, else in-process.",
+    ),
+]
 
 PeriodOption = Annotated[
     int | None, typer.Option("--period", help="Period n of the gait in jumps; a multiple of the schedule length.")
@@ -61,6 +70,7 @@ def basin_command(
         float, typer.Option("--tolerance", help="Distance to the gait's orbit that counts as converged.")
     ] = DEFAULT_TOLERANCE,
     summary: Annotated[bool, typer.Option("--summary", help="With --json: leave out the per-cell grids.")] = False,
+    scheduler: SchedulerOption = None,
     as_json: JsonOption = False,
 ) -> None:
     """Basin of attraction of a gait over a grid of section states (xdot, ydot)."""
@@ -69,14 +79,25 @@ def basin_command(
     # The whole spec is checked before the (slow) gait search; placeholders stand in for default ranges.
     BasinGrid(xdot_range or (-2.0, -1.0), ydot_range or (-1.0, 1.0), grid)
     check_convergence_test(jumps, tolerance)
-    gait = (
-        default_gait(setup.model, schedule, period)
-        if guess is None
-        else find_fixed_point(setup.model, schedule, period, guess)
-    )
-    default = BasinGrid.around(gait.state, grid)
-    cells = BasinGrid(xdot_range or default.xdot_range, ydot_range or default.ydot_range, grid)
-    basin = compute_basin(setup.model, schedule, gait, cells, max_jumps=jumps, tolerance=tolerance)
+    with chunk_map_for(scheduler_address(scheduler)) as chunk_map:
+        gait = (
+            default_gait(setup.model, schedule, period)
+            if guess is None
+            else find_fixed_point(setup.model, schedule, period, guess)
+        )
+        default = BasinGrid.around(gait.state, grid)
+        cells = BasinGrid(xdot_range or default.xdot_range, ydot_range or default.ydot_range, grid)
+        with progress_bar(f"basin: {grid}x{grid} cells") as progress:
+            basin = compute_basin(
+                setup.model,
+                schedule,
+                gait,
+                cells,
+                max_jumps=jumps,
+                tolerance=tolerance,
+                chunk_map=chunk_map,
+                progress=progress,
+            )
     if as_json:
         print_json(basin.to_dict(include_grids=not summary))
         return
@@ -111,6 +132,7 @@ def sweep_command(
         int, typer.Option("--basin-grid", help="Cells per axis of each basin; 0 skips the basins.")
     ] = 40,
     basin_jumps: Annotated[int, typer.Option("--basin-jumps", help="Jumps allowed to converge.")] = DEFAULT_JUMPS,
+    scheduler: SchedulerOption = None,
     as_json: JsonOption = False,
 ) -> None:
     """Follow a gait over zeta0: max |λ|, climb, basin area, and the zeta0 of jumping in place."""
@@ -118,7 +140,10 @@ def sweep_command(
     fixed = _fixed_leg(fixed_leg)
     grid = None if basin_grid == 0 else BasinGrid(*DEFAULT_BASIN_WINDOW, basin_grid)
     check_convergence_test(basin_jumps, DEFAULT_TOLERANCE)
-    with progress_bar(f"sweeping {steps} zeta0 values") as progress:
+    with (
+        chunk_map_for(scheduler_address(scheduler)) as chunk_map,
+        progress_bar(f"sweeping {steps} zeta0 values") as progress,
+    ):
         sweep = energy_sweep(
             setup.model,
             LegControl.from_degrees(psi0, zeta0s[0]).psi0,
@@ -127,6 +152,7 @@ def sweep_command(
             guess=guess,
             basin_grid=grid,
             basin_jumps=basin_jumps,
+            chunk_map=chunk_map,
             progress=progress,
         )
     if as_json:
@@ -196,6 +222,7 @@ def mjtf_command(
     pitch_drift: PitchDrift = _DEFAULT_NOISE.pitch_drift_deg,
     asymmetry_psi0: AsymPsi0 = 0.0,
     asymmetry_zeta0: AsymZeta0 = 0.0,
+    scheduler: SchedulerOption = None,
     as_json: JsonOption = False,
 ) -> None:
     """Mean Jumps To Failure under noise, per energy level (zeta0)."""
@@ -203,7 +230,10 @@ def mjtf_command(
     zeta0s = zeta0_values(*zeta0_range, levels)
     check_trials(trials, cap)
     fixed = _fixed_leg(fixed_leg)
-    with progress_bar(f"MJTF: {levels} levels x {trials} trials") as progress:
+    with (
+        chunk_map_for(scheduler_address(scheduler)) as chunk_map,
+        progress_bar(f"MJTF: {levels} levels x {trials} trials") as progress,
+    ):
         study = mjtf_study(
             setup.model,
             LegControl.from_degrees(psi0, zeta0s[0]).psi0,
@@ -214,6 +244,7 @@ def mjtf_command(
             seed=seed,
             fixed_leg=fixed,
             guess=guess,
+            chunk_map=chunk_map,
             progress=progress,
         )
     if as_json:
