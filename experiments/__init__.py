@@ -1,1 +1,3 @@
-"""Reproducible studies of the paper (issue 4): one file per figure, each a Config, run, plot, claims."""
+"""Reproducible studies of the paper: one module per figure (a Config, run, plot, claims),
+``reproduce`` to write them with their data and a report, and ``cluster`` to run big studies
+on Dask."""

@@ -164,16 +164,21 @@ def json_safe(value):
 
 
 @contextmanager
-def progress_bar(description: str) -> Iterator[Callable[[int, int], None]]:
+def progress_bar(description: str) -> Iterator[Callable[..., None]]:
     """A progress bar on stderr for long work; yields the ``progress(done, total)`` callback.
 
-    It draws only on a terminal, so piped ``--json`` output and logs stay clean.
+    The callback also takes ``description=`` to relabel the bar. It draws only on a terminal,
+    so piped ``--json`` output and logs stay clean.
     """
     console = Console(stderr=True)
     columns = (*Progress.get_default_columns(), TimeElapsedColumn())
     with Progress(*columns, console=console, transient=True, disable=not console.is_terminal) as progress:
         task = progress.add_task(description, total=None)
-        yield lambda done, total: progress.update(task, completed=done, total=total)
+
+        def update(done: int, total: int, description: str | None = None) -> None:
+            progress.update(task, completed=done, total=total, **({"description": description} if description else {}))
+
+        yield update
 
 
 def note(message: str) -> None:
