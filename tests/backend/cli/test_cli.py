@@ -120,6 +120,9 @@ def test_trajectory_json_is_strict_json_with_infinite_friction(tmp_path):
         (["pid", "--kp", "-1"], "kp"),
         (["pid", "--zeta0-min", "0.97", "--zeta0-max", "0.9"], "zeta0_max"),
         (["pid", "--target", "0"], "target"),
+        (["atlas", "--psi0-range", "40", "20"], "psi0_range"),
+        (["atlas", "--plot", "map.pdf"], "plot"),
+        (["reproduce", "fig99", "--out", "x"], "figure"),
     ],
 )
 def test_bad_input_is_one_clear_line(args, field):
@@ -220,6 +223,27 @@ def test_pid_json_contract():
         "si",
     }
     assert payload["si"]["target_m"] == 0.55 and len(payload["si"]["height_m"]) == 41
+
+
+def test_atlas_json_contract(tmp_path):
+    plot = tmp_path / "atlas.png"
+    args = ["--psi0-range", "25", "35", "--zeta0-range", "0.88", "0.97", "--grid", "2", "3", "--plot", str(plot)]
+    result = invoke("atlas", *args, "--json")
+    assert result.exit_code == 0, result.output
+    payload = json.loads(result.stdout)
+    assert set(payload) == {
+        "row_label",
+        "column_label",
+        "rows",
+        "columns",
+        "period",
+        "climb_per_jump",
+        "max_abs_eigenvalue",
+        "count",
+        "cells",
+    }
+    assert len(payload["period"]) == 2 and len(payload["period"][0]) == 3
+    assert plot.read_bytes()[:4] == b"\x89PNG"
 
 
 def test_bench_json_contract():
