@@ -159,6 +159,7 @@ def closed_loop_climb(
     LegControl(psi0, controller.zeta0_hover)  # validates psi0
     state = check_section_state(start)
     jumps = check_jumps(jumps)
+    check_range("seed", seed, 0, 2**32, low_open=False, high_open=True)
     first_zeta0 = controller.zeta0_hover if start_zeta0 is None else start_zeta0
     check_range("start_zeta0", first_zeta0, 0.0, 1.0)
     schedule = ControlSchedule.of(LegControl(psi0, first_zeta0)).as_array()

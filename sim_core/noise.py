@@ -75,6 +75,7 @@ NO_NOISE = NoiseModel(0.0, 0.0, 0.0, 0.0)
 def trial_seeds(seed: int, stream: int, trials: int) -> np.ndarray:
     """Independent 32-bit seeds for ``trials`` trials of one stream (e.g. one energy level)."""
     check_range("seed", seed, 0, 2**63, low_open=False)
+    check_range("stream", stream, 0, 2**63, low_open=False)
     return np.random.SeedSequence([int(seed), int(stream)]).generate_state(trials).astype(np.int64)
 
 

@@ -201,7 +201,7 @@ NoiseVelocity = Annotated[float, typer.Option("--noise-velocity", help="Per-jump
 PitchDrift = Annotated[float, typer.Option("--pitch-drift", help="Sigma of the pitch random walk per jump [deg].")]
 AsymPsi0 = Annotated[float, typer.Option("--asymmetry-psi0", help="Right leg's psi0 offset [deg].")]
 AsymZeta0 = Annotated[float, typer.Option("--asymmetry-zeta0", help="Right leg's zeta0 offset.")]
-SeedOption = Annotated[int, typer.Option("--seed", help="Seed; the same seed gives the same numbers.", min=0)]
+SeedOption = Annotated[int, typer.Option("--seed", help="Seed >= 0; the same seed gives the same numbers.")]
 
 
 @app.command("mjtf")

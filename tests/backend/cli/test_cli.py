@@ -117,6 +117,8 @@ def test_trajectory_json_is_strict_json_with_infinite_friction(tmp_path):
         (["mjtf", "--trials", "-1"], "trials"),
         (["mjtf", "--cap", "0"], "cap"),
         (["mjtf", "--noise-psi0", "-1"], "noise.psi0_deg"),
+        (["mjtf", "--seed", "-1"], "seed"),
+        (["pid", "--seed", "-1"], "seed"),
         (["pid", "--kp", "-1"], "kp"),
         (["pid", "--zeta0-min", "0.97", "--zeta0-max", "0.9"], "zeta0_max"),
         (["pid", "--target", "0"], "target"),
