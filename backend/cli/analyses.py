@@ -183,17 +183,6 @@ def sweep_command(
     typer.echo(f"jumping in place at zeta0 = {crossings}")
 
 
-def _noise_options(
-    noise_psi0: float,
-    noise_zeta0: float,
-    noise_velocity: float,
-    pitch_drift: float,
-    asym_psi0: float,
-    asym_zeta0: float,
-) -> NoiseModel:
-    return NoiseModel(noise_psi0, noise_zeta0, noise_velocity, pitch_drift, asym_psi0, asym_zeta0)
-
-
 _DEFAULT_NOISE = NoiseModel()
 NoisePsi0 = Annotated[float, typer.Option("--noise-psi0", help="Per-jump sigma of psi0 [deg].")]
 NoiseZeta0 = Annotated[float, typer.Option("--noise-zeta0", help="Per-jump sigma of zeta0.")]
