@@ -5,15 +5,16 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from matplotlib.colors import TwoSlopeNorm
 
-from experiments.report import STYLE, new_figure
+from experiments.report import STYLE, new_figure, pyplot
 from sim_core.atlas import GaitAtlas
 
 
 def plot_atlas(atlas: GaitAtlas, title: str):
     """Climb per jump of each cell's most stable gait (red climbs, blue descends; blank: none)
     with the in-place contour, and the gaits' periods."""
+    from matplotlib.colors import TwoSlopeNorm
+
     figure, axes = new_figure(1, 2, (12.0, 4.8))
     extent = [*_edges(atlas.columns), *_edges(atlas.rows)]  # cells centred on their values
     climb = atlas.climb_per_jump
@@ -61,8 +62,7 @@ def _edges(values: np.ndarray) -> tuple[float, float]:
 
 def save_atlas(atlas: GaitAtlas, path: Path, title: str) -> Path:
     """Write the map to ``path`` (.png or .svg)."""
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     figure = plot_atlas(atlas, title)
     with plt.rc_context(STYLE):
         figure.savefig(path)

@@ -16,11 +16,6 @@ import subprocess
 from dataclasses import asdict, dataclass, is_dataclass
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")  # files only; no display on servers and CI
-
-import matplotlib.pyplot as plt
 import numpy as np
 
 STYLE = {
@@ -68,7 +63,18 @@ def code_version() -> str:
         return f"parkourlab {version('parkourlab')}"
 
 
+def pyplot():
+    """matplotlib's pyplot on the file-only Agg backend, imported on first use (it is slow)."""
+    import matplotlib
+
+    matplotlib.use("Agg")  # files only; no display on servers and CI
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
 def new_figure(rows: int, columns: int, size: tuple[float, float]):
+    plt = pyplot()
     with plt.rc_context(STYLE):
         return plt.subplots(rows, columns, figsize=size, squeeze=False, layout="constrained")
 
@@ -77,12 +83,13 @@ def write_outputs(name: str, out: Path, *, figure, columns: dict[str, np.ndarray
     """Write ``name``.png/.svg/.csv/.json into ``out``; returns the paths written."""
     out.mkdir(parents=True, exist_ok=True)
     paths = [out / f"{name}.png", out / f"{name}.svg", out / f"{name}.csv", out / f"{name}.json"]
+    plt = pyplot()
     with plt.rc_context(STYLE):
         figure.savefig(paths[0])
         figure.savefig(paths[1])
     plt.close(figure)
     _write_csv(paths[2], columns)
-    paths[3].write_text(json.dumps(_jsonable(document), indent=1, allow_nan=False) + "\n")
+    paths[3].write_text(json.dumps(json_safe(document), indent=1, allow_nan=False) + "\n")
     return paths
 
 
@@ -101,18 +108,19 @@ def _csv_cell(value) -> str:
     return str(value)
 
 
-def _jsonable(value):
-    """Dataclasses, arrays and numpy scalars as plain JSON; NaN and infinities as null."""
+def json_safe(value):
+    """``value`` as plain JSON types: dataclasses, arrays and numpy scalars converted, NaN and
+    infinities (not JSON) as None, recursively. The one sanitiser for every JSON we write."""
     if is_dataclass(value) and not isinstance(value, type):
-        return _jsonable(asdict(value))
+        return json_safe(asdict(value))
     if isinstance(value, dict):
-        return {str(key): _jsonable(item) for key, item in value.items()}
+        return {str(key): json_safe(item) for key, item in value.items()}
     if isinstance(value, list | tuple):
-        return [_jsonable(item) for item in value]
+        return [json_safe(item) for item in value]
     if isinstance(value, np.ndarray):
-        return _jsonable(value.tolist())
+        return json_safe(value.tolist())
     if isinstance(value, np.generic):
-        return _jsonable(value.item())
+        return json_safe(value.item())
     if isinstance(value, float) and not math.isfinite(value):
         return None
     return value

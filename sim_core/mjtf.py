@@ -142,28 +142,53 @@ def mjtf_study(
     """
     trials, cap = check_trials(trials, cap)
     seeds = [trial_seeds(seed, index, trials) for index in range(len(zeta0s))]
+    levels = level_starts(model, psi0, zeta0s, fixed_leg=fixed_leg, guess=guess)
+    chunks, owners = [], []
+    for index, level in enumerate(levels):
+        for part in chunk_slices(trials, chunk_trials):
+            chunks.append((model, level.schedule, level.start, noise, seeds[index][part], cap))
+            owners.append(index)
+    results = chunk_map(run_trials, chunks, progress)
+    out = []
+    for index, level in enumerate(levels):
+        mine = [result for owner, result in zip(owners, results, strict=True) if owner == index]
+        jumps = np.concatenate([jumps for jumps, _ in mine])
+        status = np.concatenate([status for _, status in mine])
+        out.append(MJTFLevel(level.zeta0, level.energy, level.start, jumps, status, cap))
+    return MJTFStudy(psi0, fixed_leg, noise, trials, cap, int(seed), tuple(out))
+
+
+@dataclass(frozen=True)
+class LevelStart:
+    """Where one energy level's trials begin: its zeta0, energy, schedule (m, 2) and start state."""
+
+    zeta0: float
+    energy: float
+    schedule: np.ndarray
+    start: np.ndarray
+
+
+def level_starts(
+    model: ModelParams,
+    psi0: float,
+    zeta0s: Sequence[float],
+    *,
+    fixed_leg: LegControl | None = None,
+    guess=None,
+) -> list[LevelStart]:
+    """Each level's fixed point by continuation; a level without one starts from its neighbour's."""
     gaits = energy_sweep(model, psi0, zeta0s, fixed_leg=fixed_leg, guess=guess)
     known = [point.gait.state for point in gaits.points if point.gait is not None]
     if not known:
         raise ParameterError("zeta0", "no gait found at any level to start the trials from; give a guess")
     start = known[0]
-    starts, chunks, owners = [], [], []
-    for index, point in enumerate(gaits.points):
+    levels = []
+    for point in gaits.points:
         if point.gait is not None:
             start = point.gait.state
-        starts.append(start.copy())
         schedule = sweep_schedule(psi0, point.zeta0, fixed_leg).as_array()
-        for part in chunk_slices(trials, chunk_trials):
-            chunks.append((model, schedule, start, noise, seeds[index][part], cap))
-            owners.append(index)
-    results = chunk_map(run_trials, chunks, progress)
-    levels = []
-    for index, point in enumerate(gaits.points):
-        mine = [result for owner, result in zip(owners, results, strict=True) if owner == index]
-        jumps = np.concatenate([jumps for jumps, _ in mine])
-        status = np.concatenate([status for _, status in mine])
-        levels.append(MJTFLevel(point.zeta0, point.energy, starts[index], jumps, status, cap))
-    return MJTFStudy(psi0, fixed_leg, noise, trials, cap, int(seed), tuple(levels))
+        levels.append(LevelStart(point.zeta0, point.energy, schedule, start.copy()))
+    return levels
 
 
 def run_trials(

@@ -10,7 +10,6 @@ from __future__ import annotations
 import functools
 import inspect
 import json
-import math
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -21,6 +20,7 @@ import typer
 from rich.console import Console
 from rich.progress import Progress, TimeElapsedColumn
 
+from experiments.report import json_safe
 from sim_core import (
     ControlSchedule,
     FixedPoint,
@@ -150,17 +150,6 @@ def default_gait(model: ModelParams, schedule: ControlSchedule, period: int) -> 
 def print_json(payload: object) -> None:
     """JSON on stdout; NaN and infinities are not JSON, so they become null."""
     typer.echo(json.dumps(json_safe(payload)))
-
-
-def json_safe(value):
-    """``value`` with NaN and infinities replaced by None (they are not JSON), recursively."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {key: json_safe(item) for key, item in value.items()}
-    if isinstance(value, list | tuple):
-        return [json_safe(item) for item in value]
-    return value
 
 
 @contextmanager

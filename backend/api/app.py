@@ -1,0 +1,324 @@
+"""The FastAPI application: ``create_app(settings)``.
+
+Routes are thin: they check the token where state changes, open a session, call
+``backend.services`` and shape the answer. Errors a client can fix come back as 4xx with the
+field and the allowed range; nothing returns a traceback.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import datetime
+import logging
+import secrets
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Annotated
+
+from fastapi import Depends, FastAPI, HTTPException, Query, Request, status
+from fastapi.responses import HTMLResponse, JSONResponse
+from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
+from sqlalchemy import select
+from sqlalchemy.orm import Session
+
+from backend import schemas
+from backend.services import jobs, records, simulation
+from backend.settings import Settings
+from backend.store.database import make_engine, migrate, session_factory
+from sim_core import FixedPointNotFound, ParameterError
+
+log = logging.getLogger("parkourlab.api")
+TOKEN_FILE = "api_token"
+PageLimit = Annotated[int, Query(ge=1, le=records.MAX_PAGE, description="items per page")]
+bearer = HTTPBearer(auto_error=False)
+
+
+def get_session(request: Request) -> Iterator[Session]:
+    with request.app.state.sessions() as session:
+        yield session
+
+
+def require_token(
+    request: Request, credentials: Annotated[HTTPAuthorizationCredentials | None, Depends(bearer)]
+) -> None:
+    """Mutating calls carry ``Authorization: Bearer <token>``; the token is in the data directory."""
+    if credentials is None or not secrets.compare_digest(credentials.credentials, request.app.state.token):
+        raise HTTPException(
+            status.HTTP_401_UNAUTHORIZED,
+            "a valid bearer token is required for changes (see api_token in the data directory)",
+            headers={"WWW-Authenticate": "Bearer"},
+        )
+
+
+Db = Annotated[Session, Depends(get_session)]
+AUTHORIZED = [Depends(require_token)]
+Cursor = Annotated[int | None, Query(ge=1, description="next_cursor of the previous page")]
+
+
+def api_token(data_dir: Path) -> tuple[str, bool]:
+    """The bearer token for mutating calls: ``(token, created_now)``; created once, kept in the data dir."""
+    path = Path(data_dir) / TOKEN_FILE
+    if path.exists():
+        return path.read_text().strip(), False
+    path.parent.mkdir(parents=True, exist_ok=True)
+    token = secrets.token_urlsafe(32)
+    path.touch(mode=0o600)
+    path.write_text(token + "\n")
+    return token, True
+
+
+def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
+    """The service. ``run_jobs=False`` leaves queued jobs alone (for tools that only read)."""
+    settings.data_dir.mkdir(parents=True, exist_ok=True)
+    engine = make_engine(settings.database_url)
+    sessions = session_factory(engine)
+    token, _ = api_token(settings.data_dir)
+    runner = jobs.JobRunner(sessions)
+
+    @contextlib.asynccontextmanager
+    async def lifespan(_app: FastAPI):
+        migrate(engine)
+        if run_jobs:
+            runner.start()
+        yield
+        runner.stop()
+        engine.dispose()
+
+    app = FastAPI(
+        title="ParkourLab",
+        version="0.1.0",
+        summary="Simulate, run, record and review the ParkourBot wall-climbing robot.",
+        lifespan=lifespan,
+    )
+    app.state.settings = settings
+    app.state.sessions = sessions
+    app.state.token = token
+
+    @app.middleware("http")
+    async def limit_request_size(request: Request, call_next):
+        length = request.headers.get("content-length")
+        if length is not None and (not length.isdigit() or int(length) > settings.max_request_bytes):
+            return JSONResponse(
+                {"detail": f"request body must be at most {settings.max_request_bytes} bytes"},
+                status_code=status.HTTP_413_CONTENT_TOO_LARGE,
+            )
+        return await call_next(request)
+
+    @app.exception_handler(records.NotFound)
+    async def not_found(_request, error):
+        return JSONResponse({"detail": str(error)}, status_code=status.HTTP_404_NOT_FOUND)
+
+    @app.exception_handler(records.Conflict)
+    async def conflict(_request, error):
+        return JSONResponse({"detail": str(error)}, status_code=status.HTTP_409_CONFLICT)
+
+    @app.exception_handler(ParameterError)
+    async def bad_parameter(_request, error: ParameterError):
+        body = {"detail": [{"loc": ["body", error.field], "msg": str(error), "type": "value_error"}]}
+        return JSONResponse(body, status_code=status.HTTP_422_UNPROCESSABLE_CONTENT)
+
+    @app.exception_handler(FixedPointNotFound)
+    async def no_fixed_point(_request, error):
+        return JSONResponse({"detail": str(error)}, status_code=status.HTTP_422_UNPROCESSABLE_CONTENT)
+
+    @app.get("/", response_class=HTMLResponse, include_in_schema=False)
+    def index() -> str:
+        return _INDEX
+
+    @app.get("/api/v1/health")
+    def health(db: Db) -> dict:
+        db.execute(select(1))
+        return {"status": "ok", "database": engine.dialect.name, "code_version": simulation.current_code_version()}
+
+    # Experiments
+    @app.post("/api/v1/experiments", status_code=201, dependencies=AUTHORIZED, response_model=schemas.ExperimentOut)
+    def create_experiment(body: schemas.ExperimentCreate, db: Db):
+        return _experiment_out(db, records.create_experiment(db, body))
+
+    @app.get("/api/v1/experiments", response_model=schemas.Page)
+    def list_experiments(db: Db, limit: PageLimit = 50, cursor: Cursor = None):
+        rows, next_cursor = records.list_experiments(db, limit=limit, cursor=cursor)
+        return {"items": [_experiment_out(db, row) for row in rows], "next_cursor": next_cursor}
+
+    @app.get("/api/v1/experiments/{experiment_id}", response_model=schemas.ExperimentOut)
+    def get_experiment(experiment_id: int, db: Db):
+        return _experiment_out(db, records.get_experiment(db, experiment_id))
+
+    @app.patch("/api/v1/experiments/{experiment_id}", dependencies=AUTHORIZED, response_model=schemas.ExperimentOut)
+    def update_experiment(experiment_id: int, body: schemas.ExperimentUpdate, db: Db):
+        return _experiment_out(db, records.update_experiment(db, experiment_id, body))
+
+    @app.delete("/api/v1/experiments/{experiment_id}", status_code=204, dependencies=AUTHORIZED)
+    def delete_experiment(experiment_id: int, db: Db) -> None:
+        records.delete_experiment(db, experiment_id)
+
+    # Runs
+    @app.post("/api/v1/runs", status_code=201, dependencies=AUTHORIZED, response_model=schemas.RunDetail)
+    def create_run(body: schemas.RunCreate, db: Db):
+        return _run_out(records.create_run(db, body), detail=True)
+
+    @app.get("/api/v1/runs", response_model=schemas.Page)
+    def list_runs(
+        db: Db,
+        limit: PageLimit = 50,
+        cursor: Cursor = None,
+        experiment_id: int | None = None,
+        kind: Annotated[str | None, Query(pattern="^(sim|robot|replay)$")] = None,
+        status_: Annotated[str | None, Query(alias="status", pattern="^(done|failed)$")] = None,
+        tag: Annotated[str | None, Query(max_length=64)] = None,
+        failure_code: Annotated[str | None, Query(max_length=32)] = None,
+        zeta0_min: Annotated[float | None, Query(ge=0.0, le=1.0)] = None,
+        zeta0_max: Annotated[float | None, Query(ge=0.0, le=1.0)] = None,
+        psi0_min: Annotated[float | None, Query(ge=0.0, le=90.0)] = None,
+        psi0_max: Annotated[float | None, Query(ge=0.0, le=90.0)] = None,
+        created_after: datetime.datetime | None = None,
+        created_before: datetime.datetime | None = None,
+    ):
+        where = records.RunFilter(
+            experiment_id=experiment_id,
+            kind=kind,
+            status=status_,
+            tag=tag,
+            failure_code=failure_code,
+            zeta0_min=zeta0_min,
+            zeta0_max=zeta0_max,
+            psi0_min=psi0_min,
+            psi0_max=psi0_max,
+            created_after=created_after,
+            created_before=created_before,
+        )
+        rows, next_cursor = records.list_runs(db, where, limit=limit, cursor=cursor)
+        return {"items": [_run_out(row) for row in rows], "next_cursor": next_cursor}
+
+    @app.get("/api/v1/runs/{run_id}", response_model=schemas.RunDetail)
+    def get_run(run_id: int, db: Db):
+        return _run_out(records.get_run(db, run_id), detail=True)
+
+    @app.get("/api/v1/runs/{run_id}/trajectory")
+    def get_trajectory(run_id: int, db: Db) -> dict:
+        run = records.get_run(db, run_id)
+        if run.trajectory is None:
+            raise records.NotFound("trajectory of run", run_id)
+        columns = simulation.unpack_trajectory(run.trajectory)
+        return {"units": "nondimensional", "columns": {name: values.tolist() for name, values in columns.items()}}
+
+    @app.delete("/api/v1/runs/{run_id}", status_code=204, dependencies=AUTHORIZED)
+    def delete_run(run_id: int, db: Db) -> None:
+        records.delete_run(db, run_id)
+
+    # Jobs
+    @app.post("/api/v1/jobs", status_code=202, dependencies=AUTHORIZED, response_model=schemas.JobOut)
+    def create_job(body: schemas.MJTFJobCreate, db: Db):
+        job = jobs.create_job(db, body)
+        if run_jobs:
+            runner.submit(job.id)
+        return _job_out(job)
+
+    @app.get("/api/v1/jobs", response_model=schemas.Page)
+    def list_jobs(
+        db: Db,
+        limit: PageLimit = 50,
+        cursor: Cursor = None,
+        state: Annotated[str | None, Query(pattern="^(queued|running|cancelling|cancelled|done|failed)$")] = None,
+    ):
+        rows, next_cursor = jobs.list_jobs(db, state=state, limit=limit, cursor=cursor)
+        return {"items": [_job_out(row) for row in rows], "next_cursor": next_cursor}
+
+    @app.get("/api/v1/jobs/{job_id}", response_model=schemas.JobOut)
+    def get_job(job_id: int, db: Db):
+        return _job_out(jobs.get_job(db, job_id))
+
+    @app.get("/api/v1/jobs/{job_id}/results", response_model=schemas.JobResults)
+    def job_results(job_id: int, db: Db):
+        job = jobs.get_job(db, job_id)
+        return {"job": _job_out(job), "levels": [_finite(level) for level in jobs.level_summaries(db, job)]}
+
+    @app.post("/api/v1/jobs/{job_id}/cancel", dependencies=AUTHORIZED, response_model=schemas.JobOut)
+    def cancel_job(job_id: int, db: Db):
+        return _job_out(jobs.cancel_job(db, job_id))
+
+    # Quick calls for the control panel: computed, not stored.
+    @app.post("/api/v1/sim/map")
+    def sim_map(body: schemas.MapIn) -> dict:
+        return simulation.map_orbit(body)
+
+    @app.post("/api/v1/sim/fixed-point")
+    def sim_fixed_point(body: schemas.FixedPointIn) -> dict:
+        return simulation.fixed_point(body)
+
+    return app
+
+
+def _experiment_out(db: Session, experiment) -> dict:
+    return {
+        "id": experiment.id,
+        "name": experiment.name,
+        "description": experiment.description,
+        "notes": experiment.notes,
+        "tags": experiment.tags,
+        "created_at": experiment.created_at,
+        "updated_at": experiment.updated_at,
+        "runs": records.run_count(db, experiment.id),
+    }
+
+
+def _run_out(run, *, detail: bool = False) -> dict:
+    out = {
+        "id": run.id,
+        "experiment_id": run.experiment_id,
+        "kind": run.kind,
+        "status": run.status,
+        "created_at": run.created_at,
+        "duration_s": run.duration_s,
+        "code_version": run.code_version,
+        "model": run.model,
+        "controls": run.controls,
+        "start_state": run.start_state,
+        "jumps": run.jumps,
+        "jumps_completed": run.jumps_completed,
+        "failure_code": run.failure_code,
+        "climb": run.climb,
+        "tags": run.tags,
+        "has_trajectory": run.trajectory is not None,
+    }
+    if detail:
+        out["results"] = run.results
+    return out
+
+
+def _job_out(job) -> dict:
+    return {
+        "id": job.id,
+        "experiment_id": job.experiment_id,
+        "kind": job.kind,
+        "state": job.state,
+        "total": job.total,
+        "completed": job.completed,
+        "progress": job.completed / job.total if job.total else 1.0,
+        "error": job.error,
+        "spec": job.spec,
+        "created_at": job.created_at,
+        "started_at": job.started_at,
+        "finished_at": job.finished_at,
+    }
+
+
+def _finite(level: dict) -> dict:
+    """JSON has no NaN: a level without trials yet reports mean 0 with trials 0."""
+    mean = level["mean"]
+    return level | {"mean": mean if mean == mean else 0.0}
+
+
+_INDEX = """<!doctype html>
+<html lang="en"><head><meta charset="utf-8"><title>ParkourLab</title>
+<style>body{font-family:system-ui,sans-serif;max-width:42rem;margin:3rem auto;line-height:1.5}</style></head>
+<body><h1>ParkourLab</h1>
+<p>The ParkourLab service is running. The control panel and the 3D view arrive with the next releases.</p>
+<ul>
+<li><a href="/docs">API documentation</a> (OpenAPI, try the calls)</li>
+<li><a href="/api/v1/health">Health</a> · <a href="/api/v1/experiments">Experiments</a> ·
+<a href="/api/v1/runs">Runs</a> · <a href="/api/v1/jobs">Jobs</a></li>
+</ul>
+<p>Changes need the bearer token stored in <code>api_token</code> in the data directory.</p>
+</body></html>
+"""

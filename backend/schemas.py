@@ -1,0 +1,184 @@
+"""Request and response bodies of the service. Ranges are explicit, so bad input is a 422 naming the field."""
+
+from __future__ import annotations
+
+import datetime
+import math
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator
+
+Psi0Deg = Annotated[float, Field(gt=0.0, lt=90.0, description="leg angle at touchdown [degrees], in (0, 90)")]
+Zeta0 = Annotated[float, Field(gt=0.0, lt=1.0, description="leg length at touchdown [l0], in (0, 1)")]
+Tag = Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[\w.:/-]+$")]
+
+MAX_JUMPS = 10_000
+MAX_TRIALS = 100_000
+MAX_LEVELS = 100
+
+
+class Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class LegIn(Strict):
+    psi0_deg: Psi0Deg
+    zeta0: Zeta0
+
+
+class ModelIn(Strict):
+    """The ``paper`` preset with optional nondimensional overrides (model.md §1)."""
+
+    preset: Literal["paper"] = "paper"
+    alpha: Annotated[float, Field(gt=0.0, le=1e4)] | None = None
+    d_hat: Annotated[float, Field(gt=0.0, le=100.0)] | None = None
+    c_zeta: Annotated[float, Field(ge=0.0, le=1e3)] | None = None
+    c_psi: Annotated[float, Field(ge=0.0, le=1e3)] | None = None
+    mu: Annotated[float, Field(gt=0.0)] | None = Field(None, description="friction coefficient; omit for the preset")
+
+
+class StateIn(Strict):
+    xdot: Annotated[float, Field(lt=0.0, ge=-100.0, description="section xdot [sqrt(g l0)], < 0")]
+    ydot: Annotated[float, Field(ge=-100.0, le=100.0)]
+
+
+class RunCreate(Strict):
+    experiment_id: int | None = None
+    model: ModelIn = ModelIn()
+    controls: Annotated[list[LegIn], Field(min_length=1, max_length=16)]
+    start: StateIn
+    jumps: Annotated[int, Field(ge=1, le=MAX_JUMPS)] = 20
+    trajectory_rate: Annotated[float, Field(gt=0.0, le=1000.0)] | None = Field(
+        None, description="also store the sampled path, samples per sqrt(l0/g)"
+    )
+    tags: Annotated[list[Tag], Field(max_length=32)] = []
+
+
+class RunOut(BaseModel):
+    id: int
+    experiment_id: int | None
+    kind: str
+    status: str
+    created_at: datetime.datetime
+    duration_s: float
+    code_version: str
+    model: dict
+    controls: list
+    start_state: list
+    jumps: int
+    jumps_completed: int
+    failure_code: str | None
+    climb: float
+    tags: list[str]
+    has_trajectory: bool
+
+
+class RunDetail(RunOut):
+    results: dict
+
+
+class Page(BaseModel):
+    items: list
+    next_cursor: int | None = Field(None, description="pass as ?cursor= for the next page; null at the end")
+
+
+class ExperimentCreate(Strict):
+    name: Annotated[str, Field(min_length=1, max_length=200)]
+    description: Annotated[str, Field(max_length=10_000)] = ""
+    notes: Annotated[str, Field(max_length=100_000)] = ""
+    tags: Annotated[list[Tag], Field(max_length=32)] = []
+
+
+class ExperimentUpdate(Strict):
+    name: Annotated[str, Field(min_length=1, max_length=200)] | None = None
+    description: Annotated[str, Field(max_length=10_000)] | None = None
+    notes: Annotated[str, Field(max_length=100_000)] | None = None
+    tags: Annotated[list[Tag], Field(max_length=32)] | None = None
+
+
+class ExperimentOut(BaseModel):
+    id: int
+    name: str
+    description: str
+    notes: str
+    tags: list[str]
+    created_at: datetime.datetime
+    updated_at: datetime.datetime
+    runs: int
+
+
+class NoiseIn(Strict):
+    psi0_deg: Annotated[float, Field(ge=0.0, lt=30.0)] = 0.5
+    zeta0: Annotated[float, Field(ge=0.0, lt=0.2)] = 0.003
+    velocity: Annotated[float, Field(ge=0.0, lt=1.0)] = 0.01
+    pitch_drift_deg: Annotated[float, Field(ge=0.0, lt=30.0)] = 0.5
+    asymmetry_psi0_deg: Annotated[float, Field(gt=-30.0, lt=30.0)] = 0.0
+    asymmetry_zeta0: Annotated[float, Field(gt=-0.5, lt=0.5)] = 0.0
+
+
+class MJTFJobCreate(Strict):
+    """Mean Jumps To Failure: ``levels`` zeta0 values x ``trials`` noisy trials each."""
+
+    kind: Literal["mjtf"] = "mjtf"
+    experiment_id: int | None = None
+    model: ModelIn = ModelIn()
+    psi0_deg: Psi0Deg = 30.0
+    zeta0s: Annotated[list[Zeta0], Field(min_length=1, max_length=MAX_LEVELS)]
+    trials: Annotated[int, Field(ge=1, le=MAX_TRIALS)] = 8
+    cap: Annotated[int, Field(ge=1, le=100_000)] = 1000
+    seed: Annotated[int, Field(ge=0, lt=2**63)] = 0
+    noise: NoiseIn = NoiseIn()
+    guess: StateIn | None = None
+
+    @field_validator("zeta0s")
+    @classmethod
+    def _distinct(cls, values: list[float]) -> list[float]:
+        if len(set(values)) != len(values):
+            raise ValueError("zeta0 values must be distinct")
+        return values
+
+
+class JobOut(BaseModel):
+    id: int
+    experiment_id: int | None
+    kind: str
+    state: str
+    total: int
+    completed: int
+    progress: float
+    error: str | None
+    spec: dict
+    created_at: datetime.datetime
+    started_at: datetime.datetime | None
+    finished_at: datetime.datetime | None
+
+
+class MJTFLevelOut(BaseModel):
+    zeta0: float
+    trials: int
+    mean: float
+    std: float
+    outcomes: dict[str, int]
+
+
+class JobResults(BaseModel):
+    job: JobOut
+    levels: list[MJTFLevelOut]
+
+
+class MapIn(Strict):
+    model: ModelIn = ModelIn()
+    controls: Annotated[list[LegIn], Field(min_length=1, max_length=16)]
+    start: StateIn
+    jumps: Annotated[int, Field(ge=1, le=1000)] = 1
+
+
+class FixedPointIn(Strict):
+    model: ModelIn = ModelIn()
+    controls: Annotated[list[LegIn], Field(min_length=1, max_length=16)]
+    period: Annotated[int, Field(ge=1, le=64)] | None = None
+    guess: StateIn | None = None
+
+
+def finite_or_none(value: float) -> float | None:
+    return value if math.isfinite(value) else None

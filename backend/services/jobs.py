@@ -1,0 +1,207 @@
+"""Batch jobs: MJTF studies that live in the database and survive crashes.
+
+A job is a row; its trials are rows with the idempotent key ``(job, level, index)``. The
+runner (one background thread) works through a job in chunks of trials: it computes the
+trials still missing, runs a chunk, and commits the chunk's trials and the progress in one
+transaction. Killed mid-job, the service finds the job at the next start, recomputes only
+the missing trials — their seeds depend on ``(seed, level, index)`` alone — and ends with
+exactly the trials asked for, none lost and none duplicated (the unique key refuses a second
+copy). Cancelling marks the job; the runner stops before its next chunk.
+"""
+
+from __future__ import annotations
+
+import logging
+import queue
+import threading
+
+import numpy as np
+from sqlalchemy import func, select, update
+from sqlalchemy.orm import Session, sessionmaker
+
+from backend.schemas import MJTFJobCreate
+from backend.services.records import NotFound, get_experiment
+from backend.services.simulation import KERNEL_LOCK, current_code_version, model_params
+from backend.store.models import Job, Trial, utcnow
+from sim_core.failures import OK, Failure
+from sim_core.mjtf import level_starts, run_trials
+from sim_core.noise import NoiseModel, trial_seeds
+
+log = logging.getLogger("parkourlab.jobs")
+
+CHUNK_TRIALS = 32  # tens of trials per commit: a 3 ms trial alone would drown in overhead
+ACTIVE = ("queued", "running", "cancelling")
+FINAL = ("done", "cancelled", "failed")
+
+
+def create_job(session: Session, body: MJTFJobCreate) -> Job:
+    if body.experiment_id is not None:
+        get_experiment(session, body.experiment_id)
+    job = Job(
+        experiment_id=body.experiment_id,
+        kind=body.kind,
+        spec=body.model_dump(mode="json"),
+        state="queued",
+        total=len(body.zeta0s) * body.trials,
+        code_version=current_code_version(),
+    )
+    session.add(job)
+    session.commit()
+    return job
+
+
+def get_job(session: Session, job_id: int) -> Job:
+    job = session.get(Job, job_id)
+    if job is None:
+        raise NotFound("job", job_id)
+    return job
+
+
+def list_jobs(session: Session, *, state: str | None, limit: int, cursor: int | None) -> tuple[list[Job], int | None]:
+    query = select(Job).order_by(Job.id.desc()).limit(limit + 1)
+    if state is not None:
+        query = query.where(Job.state == state)
+    if cursor is not None:
+        query = query.where(Job.id < cursor)
+    rows = list(session.scalars(query))
+    return (rows[:limit], rows[limit - 1].id) if len(rows) > limit else (rows, None)
+
+
+def cancel_job(session: Session, job_id: int) -> Job:
+    """Queued jobs stop at once; running ones before their next chunk. Finished jobs are left as they are."""
+    job = get_job(session, job_id)
+    if job.state == "queued":
+        job.state, job.finished_at = "cancelled", utcnow()
+    elif job.state == "running":
+        job.state = "cancelling"
+    session.commit()
+    return job
+
+
+def level_summaries(session: Session, job: Job) -> list[dict]:
+    """Per level: trials so far, mean and standard deviation of jumps to failure, outcomes."""
+    spec = MJTFJobCreate(**job.spec)
+    rows = session.execute(
+        select(Trial.level, Trial.jumps, Trial.failure_code).where(Trial.job_id == job.id).order_by(Trial.level)
+    ).all()
+    summaries = []
+    for level, zeta0 in enumerate(spec.zeta0s):
+        jumps = np.array([r.jumps for r in rows if r.level == level], dtype=float)
+        codes = [r.failure_code for r in rows if r.level == level]
+        outcomes = {"capped": codes.count(None)} | {f.code: codes.count(f.code) for f in Failure}
+        summaries.append(
+            {
+                "zeta0": zeta0,
+                "trials": int(jumps.size),
+                "mean": float(jumps.mean()) if jumps.size else float("nan"),
+                "std": float(jumps.std(ddof=1)) if jumps.size > 1 else 0.0,
+                "outcomes": outcomes,
+            }
+        )
+    return summaries
+
+
+class JobRunner:
+    """Runs jobs one at a time on a background thread, resuming unfinished ones at start."""
+
+    def __init__(self, sessions: sessionmaker[Session], *, chunk_trials: int = CHUNK_TRIALS):
+        self.sessions = sessions
+        self.chunk_trials = chunk_trials
+        self.queue: queue.Queue[int | None] = queue.Queue()
+        self.thread: threading.Thread | None = None
+
+    def start(self) -> None:
+        with self.sessions() as session:
+            # A job that was running when the process died is picked up again from its trials.
+            session.execute(update(Job).where(Job.state == "running").values(state="queued"))
+            session.execute(
+                update(Job).where(Job.state == "cancelling").values(state="cancelled", finished_at=utcnow())
+            )
+            session.commit()
+            pending = list(session.scalars(select(Job.id).where(Job.state == "queued").order_by(Job.id)))
+        for job_id in pending:
+            self.queue.put(job_id)
+        self.thread = threading.Thread(target=self._loop, name="parkourlab-jobs", daemon=True)
+        self.thread.start()
+
+    def submit(self, job_id: int) -> None:
+        self.queue.put(job_id)
+
+    def stop(self, timeout: float = 10.0) -> None:
+        if self.thread is not None:
+            self.queue.put(None)
+            self.thread.join(timeout)
+
+    def _loop(self) -> None:
+        while (job_id := self.queue.get()) is not None:
+            try:
+                self.run(job_id)
+            except Exception as error:  # a job's failure is recorded; the runner goes on
+                log.exception("job %s failed", job_id)
+                with self.sessions() as session:
+                    job = session.get(Job, job_id)
+                    if job is not None:
+                        job.state, job.error, job.finished_at = "failed", f"{type(error).__name__}: {error}", utcnow()
+                        session.commit()
+
+    def run(self, job_id: int) -> None:
+        """Run (or resume) one job to its end, committing every chunk."""
+        with self.sessions() as session:
+            job = session.get(Job, job_id)
+            if job is None or job.state not in ("queued", "running"):
+                return
+            job.state = "running"
+            job.started_at = job.started_at or utcnow()
+            session.commit()
+            spec = MJTFJobCreate(**job.spec)
+        model = model_params(spec.model)
+        noise = NoiseModel(**spec.noise.model_dump())
+        guess = None if spec.guess is None else (spec.guess.xdot, spec.guess.ydot)
+        with KERNEL_LOCK:
+            levels = level_starts(model, np.radians(spec.psi0_deg), spec.zeta0s, guess=guess)
+        for index, level in enumerate(levels):
+            seeds = trial_seeds(spec.seed, index, spec.trials)
+            for chunk in self._missing_chunks(job_id, index, spec.trials):
+                if self._cancelled(job_id):
+                    return
+                with KERNEL_LOCK:
+                    jumps, status = run_trials(model, level.schedule, level.start, noise, seeds[chunk], spec.cap)
+                self._commit_chunk(job_id, index, level.zeta0, chunk, seeds[chunk], jumps, status)
+        with self.sessions() as session:
+            job = session.get(Job, job_id)
+            job.state, job.finished_at = "done", utcnow()
+            session.commit()
+
+    def _missing_chunks(self, job_id: int, level: int, trials: int) -> list[np.ndarray]:
+        with self.sessions() as session:
+            done = set(session.scalars(select(Trial.index).where(Trial.job_id == job_id, Trial.level == level)))
+        missing = np.array([i for i in range(trials) if i not in done], dtype=np.int64)
+        return [missing[i : i + self.chunk_trials] for i in range(0, missing.size, self.chunk_trials)]
+
+    def _cancelled(self, job_id: int) -> bool:
+        with self.sessions() as session:
+            job = session.get(Job, job_id)
+            if job.state == "cancelling":
+                job.state, job.finished_at = "cancelled", utcnow()
+                session.commit()
+                return True
+            return job.state != "running"
+
+    def _commit_chunk(self, job_id, level, zeta0, indices, seeds, jumps, status) -> None:
+        with self.sessions() as session:
+            session.add_all(
+                Trial(
+                    job_id=job_id,
+                    level=level,
+                    index=int(i),
+                    zeta0=float(zeta0),
+                    seed=int(seed),
+                    jumps=int(n),
+                    failure_code=None if code == OK else Failure(int(code)).code,
+                )
+                for i, seed, n, code in zip(indices, seeds, jumps, status, strict=True)
+            )
+            session.flush()
+            completed = session.scalar(select(func.count()).select_from(Trial).where(Trial.job_id == job_id))
+            session.execute(update(Job).where(Job.id == job_id).values(completed=completed, updated_at=utcnow()))
+            session.commit()

@@ -1,0 +1,103 @@
+"""Simulations the service runs: translating request bodies into sim_core calls and back."""
+
+from __future__ import annotations
+
+import io
+import threading
+import time
+import zlib
+from dataclasses import asdict, replace
+
+import numpy as np
+
+from backend.schemas import FixedPointIn, LegIn, MapIn, ModelIn, RunCreate
+from experiments.report import code_version, json_safe
+from sim_core import ControlSchedule, ModelParams, get_preset, iterate_map, simulate_trajectory
+from sim_core.fixed_points import find_fixed_point, search_gaits
+from sim_core.validation import ParameterError
+
+_CODE_VERSION = None
+
+# numba's default threading layer (workqueue) aborts the process if two threads launch
+# parallel kernels at once; the service's threads take turns through this lock.
+KERNEL_LOCK = threading.Lock()
+
+
+def current_code_version() -> str:
+    global _CODE_VERSION
+    if _CODE_VERSION is None:
+        _CODE_VERSION = code_version()[:64]
+    return _CODE_VERSION
+
+
+def model_params(body: ModelIn) -> ModelParams:
+    overrides = {k: v for k, v in body.model_dump(exclude={"preset"}).items() if v is not None}
+    return replace(get_preset(body.preset).to_model(), **overrides)
+
+
+def schedule_of(controls: list[LegIn]) -> ControlSchedule:
+    return ControlSchedule.from_degrees([(leg.psi0_deg, leg.zeta0) for leg in controls])
+
+
+def map_orbit(body: MapIn) -> dict:
+    start = (body.start.xdot, body.start.ydot)
+    with KERNEL_LOCK:
+        return iterate_map(model_params(body.model), schedule_of(body.controls), start, body.jumps).to_dict()
+
+
+def fixed_point(body: FixedPointIn) -> dict:
+    model, schedule = model_params(body.model), schedule_of(body.controls)
+    period = body.period or len(schedule)
+    with KERNEL_LOCK:
+        if body.guess is None:
+            gaits = search_gaits(model, schedule, period)
+            if not gaits:
+                raise ParameterError("controls", f"no period-{period} gait found from a grid of guesses; give a guess")
+            gait = gaits[0]
+        else:
+            gait = find_fixed_point(model, schedule, period, (body.guess.xdot, body.guess.ydot))
+    return {**gait.to_dict(), "orbit": gait.orbit.tolist(), "motion": gait.motion}
+
+
+def simulate_run(body: RunCreate) -> dict:
+    """Run the map (and the sampled path if asked); the fields of a stored run."""
+    model, schedule = model_params(body.model), schedule_of(body.controls)
+    start = (body.start.xdot, body.start.ydot)
+    began = time.perf_counter()
+    trajectory = None
+    with KERNEL_LOCK:
+        orbit = iterate_map(model, schedule, start, body.jumps)
+        if body.trajectory_rate is not None:
+            path = simulate_trajectory(model, schedule, start, body.jumps, sample_rate=body.trajectory_rate)
+            trajectory = pack_trajectory(path.columns())
+    results = orbit.to_dict()
+    return {
+        "kind": "sim",
+        "status": "done",
+        "duration_s": time.perf_counter() - began,
+        "code_version": current_code_version(),
+        "model": asdict(model) | {"mu": model.mu if np.isfinite(model.mu) else None},
+        "controls": [[leg.psi0_deg, leg.zeta0] for leg in body.controls],
+        "start_state": list(start),
+        "jumps": body.jumps,
+        "alpha": model.alpha,
+        "psi0_deg": body.controls[0].psi0_deg,
+        "zeta0": body.controls[0].zeta0,
+        "failure_code": None if orbit.failure is None else orbit.failure.code,
+        "jumps_completed": orbit.jumps_completed,
+        "climb": float(np.sum(orbit.rises)),
+        "results": json_safe(results),
+        "trajectory": trajectory,
+    }
+
+
+def pack_trajectory(columns: dict[str, np.ndarray]) -> bytes:
+    """Columns as one compressed .npz blob: a run stays one row however many samples it has."""
+    buffer = io.BytesIO()
+    np.savez(buffer, **columns)
+    return zlib.compress(buffer.getvalue(), level=6)
+
+
+def unpack_trajectory(blob: bytes) -> dict[str, np.ndarray]:
+    with np.load(io.BytesIO(zlib.decompress(blob))) as data:
+        return {name: data[name] for name in data.files}

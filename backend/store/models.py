@@ -1,0 +1,132 @@
+"""The stored records (SQLAlchemy 2.x, typed): experiments contain runs; jobs contain trials.
+
+Filterable run attributes (kind, status, the first leg's controls, alpha, failure) are columns
+with indexes; the full parameters, schedule and results are JSON, and trajectories a
+compressed binary, so a run is one row however long it is.
+"""
+
+from __future__ import annotations
+
+import datetime
+from typing import ClassVar
+
+from sqlalchemy import JSON, DateTime, ForeignKey, Index, LargeBinary, String, Text, TypeDecorator, UniqueConstraint
+from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column, relationship
+
+
+def utcnow() -> datetime.datetime:
+    return datetime.datetime.now(datetime.UTC)
+
+
+class UTCDateTime(TypeDecorator):
+    """Timestamps in UTC, timezone-aware on the way out too (SQLite stores them without one)."""
+
+    impl = DateTime(timezone=True)
+    cache_ok = True
+
+    def process_result_value(self, value, _dialect):
+        if value is not None and value.tzinfo is None:
+            return value.replace(tzinfo=datetime.UTC)
+        return value
+
+
+class Base(DeclarativeBase):
+    type_annotation_map: ClassVar = {dict: JSON, list: JSON, datetime.datetime: UTCDateTime}
+
+
+class Experiment(Base):
+    __tablename__ = "experiments"
+
+    id: Mapped[int] = mapped_column(primary_key=True)
+    name: Mapped[str] = mapped_column(String(200))
+    description: Mapped[str] = mapped_column(Text, default="")
+    notes: Mapped[str] = mapped_column(Text, default="")
+    tags: Mapped[list] = mapped_column(default=list)
+    created_at: Mapped[datetime.datetime] = mapped_column(default=utcnow, index=True)
+    updated_at: Mapped[datetime.datetime] = mapped_column(default=utcnow, onupdate=utcnow)
+
+    runs: Mapped[list[Run]] = relationship(back_populates="experiment")
+
+
+class Run(Base):
+    __tablename__ = "runs"
+
+    id: Mapped[int] = mapped_column(primary_key=True)
+    experiment_id: Mapped[int | None] = mapped_column(ForeignKey("experiments.id", ondelete="RESTRICT"), index=True)
+    kind: Mapped[str] = mapped_column(String(16), index=True)  # sim | robot | replay
+    status: Mapped[str] = mapped_column(String(16), index=True)  # done | failed (a physical failure is "done")
+    created_at: Mapped[datetime.datetime] = mapped_column(default=utcnow, index=True)
+    duration_s: Mapped[float] = mapped_column(default=0.0)
+    code_version: Mapped[str] = mapped_column(String(64))
+    model: Mapped[dict]  # nondimensional parameters
+    controls: Mapped[list]  # [[psi0_deg, zeta0], ...]
+    start_state: Mapped[list]
+    jumps: Mapped[int]
+    # Indexed copies for filtering.
+    alpha: Mapped[float] = mapped_column(index=True)
+    psi0_deg: Mapped[float] = mapped_column(index=True)  # first leg
+    zeta0: Mapped[float] = mapped_column(index=True)  # first leg
+    failure_code: Mapped[str | None] = mapped_column(String(32), index=True)
+    jumps_completed: Mapped[int]
+    climb: Mapped[float]  # total height gain [l0]
+    results: Mapped[dict]  # section states, rises, failure, fixed point
+    trajectory: Mapped[bytes | None] = mapped_column(LargeBinary)  # zlib'd .npz of the sampled path
+
+    experiment: Mapped[Experiment | None] = relationship(back_populates="runs")
+    run_tags: Mapped[list[RunTag]] = relationship(cascade="all, delete-orphan", lazy="selectin")
+
+    @property
+    def tags(self) -> list[str]:
+        return sorted(tag.tag for tag in self.run_tags)
+
+
+class RunTag(Base):
+    """One row per (run, tag): tags filter through an index instead of scanning JSON."""
+
+    __tablename__ = "run_tags"
+
+    run_id: Mapped[int] = mapped_column(ForeignKey("runs.id", ondelete="CASCADE"), primary_key=True)
+    tag: Mapped[str] = mapped_column(String(64), primary_key=True)
+
+    __table_args__ = (Index("ix_run_tags_tag", "tag", "run_id"),)
+
+
+class Job(Base):
+    """A batch of trials; it lives here, not in memory, so a restart resumes it."""
+
+    __tablename__ = "jobs"
+
+    id: Mapped[int] = mapped_column(primary_key=True)
+    experiment_id: Mapped[int | None] = mapped_column(ForeignKey("experiments.id", ondelete="RESTRICT"), index=True)
+    kind: Mapped[str] = mapped_column(String(16))  # mjtf
+    spec: Mapped[dict]
+    state: Mapped[str] = mapped_column(String(16), index=True)  # queued running cancelling cancelled done failed
+    total: Mapped[int]
+    completed: Mapped[int] = mapped_column(default=0)
+    error: Mapped[str | None] = mapped_column(Text)
+    code_version: Mapped[str] = mapped_column(String(64))
+    created_at: Mapped[datetime.datetime] = mapped_column(default=utcnow, index=True)
+    updated_at: Mapped[datetime.datetime] = mapped_column(default=utcnow, onupdate=utcnow)
+    started_at: Mapped[datetime.datetime | None]
+    finished_at: Mapped[datetime.datetime | None]
+
+    trials: Mapped[list[Trial]] = relationship(back_populates="job", cascade="all, delete-orphan")
+
+
+class Trial(Base):
+    """One MJTF trial; (job, level, index) is its idempotent key."""
+
+    __tablename__ = "trials"
+
+    id: Mapped[int] = mapped_column(primary_key=True)
+    job_id: Mapped[int] = mapped_column(ForeignKey("jobs.id", ondelete="CASCADE"))
+    level: Mapped[int]
+    index: Mapped[int]
+    zeta0: Mapped[float]
+    seed: Mapped[int]
+    jumps: Mapped[int]
+    failure_code: Mapped[str | None] = mapped_column(String(32))
+
+    job: Mapped[Job] = relationship(back_populates="trials")
+
+    __table_args__ = (UniqueConstraint("job_id", "level", "index", name="uq_trials_key"),)

@@ -1,0 +1,24 @@
+"""The real app on a real SQLite file in a temporary data directory."""
+
+import pytest
+from fastapi.testclient import TestClient
+
+from backend.api.app import create_app
+from backend.settings import Settings
+
+
+@pytest.fixture
+def settings(tmp_path):
+    return Settings.from_environment(tmp_path / "data")
+
+
+@pytest.fixture
+def client(settings):
+    with TestClient(create_app(settings)) as test_client:
+        yield test_client
+
+
+@pytest.fixture
+def auth(settings, client):
+    token = (settings.data_dir / "api_token").read_text().strip()
+    return {"Authorization": f"Bearer {token}"}

@@ -1,0 +1,156 @@
+"""The REST API against the real app and a real SQLite file (httpx through TestClient)."""
+
+import math
+import time
+
+import numpy as np
+import pytest
+
+from sim_core import get_preset
+from sim_core.mjtf import mjtf_study
+from sim_core.noise import NoiseModel
+
+RUN = {"controls": [{"psi0_deg": 30, "zeta0": 0.9}], "start": {"xdot": -0.93, "ydot": -0.17}, "jumps": 4}
+
+
+def test_health_and_index(client):
+    assert client.get("/api/v1/health").json()["status"] == "ok"
+    page = client.get("/")
+    assert page.status_code == 200 and "/docs" in page.text
+
+
+def test_changes_need_the_token(client, auth):
+    assert client.post("/api/v1/experiments", json={"name": "x"}).status_code == 401
+    wrong = {"Authorization": "Bearer not-the-token"}
+    assert client.post("/api/v1/experiments", json={"name": "x"}, headers=wrong).status_code == 401
+    assert client.post("/api/v1/experiments", json={"name": "x"}, headers=auth).status_code == 201
+    assert client.get("/api/v1/experiments").status_code == 200, "reads are open"
+
+
+def test_experiment_lifecycle(client, auth):
+    created = client.post(
+        "/api/v1/experiments", json={"name": "retraction", "tags": ["fig8"], "description": "d"}, headers=auth
+    ).json()
+    experiment = created["id"]
+    patched = client.patch(f"/api/v1/experiments/{experiment}", json={"notes": "looks good"}, headers=auth).json()
+    assert patched["notes"] == "looks good" and patched["name"] == "retraction"
+    run = client.post("/api/v1/runs", json=RUN | {"experiment_id": experiment}, headers=auth).json()
+    assert client.get(f"/api/v1/experiments/{experiment}").json()["runs"] == 1
+    assert client.delete(f"/api/v1/experiments/{experiment}", headers=auth).status_code == 409, "runs first"
+    assert client.delete(f"/api/v1/runs/{run['id']}", headers=auth).status_code == 204
+    assert client.delete(f"/api/v1/experiments/{experiment}", headers=auth).status_code == 204
+    assert client.get(f"/api/v1/experiments/{experiment}").status_code == 404
+
+
+def test_run_matches_the_simulator_and_stores_its_path(client, auth):
+    body = RUN | {"trajectory_rate": 40.0, "tags": ["a", "b"]}
+    run = client.post("/api/v1/runs", json=body, headers=auth).json()
+    direct = client.post("/api/v1/sim/map", json={k: RUN[k] for k in ("controls", "start", "jumps")}).json()
+    assert run["results"]["states"] == direct["states"] and run["jumps_completed"] == 4
+    assert run["climb"] == pytest.approx(sum(direct["rises"])) and run["tags"] == ["a", "b"]
+    path = client.get(f"/api/v1/runs/{run['id']}/trajectory").json()["columns"]
+    assert len(path["time"]) == len(path["y"]) > 100
+    assert (
+        run["created_at"].endswith("Z")
+        and client.get(f"/api/v1/runs/{run['id']}").json()["created_at"] == run["created_at"]
+    )
+
+
+def test_run_lists_filter_and_page(client, auth):
+    for zeta0, tag in [(0.86, "low"), (0.88, "low"), (0.9, "mid"), (0.92, "high"), (0.94, "high")]:
+        body = RUN | {"controls": [{"psi0_deg": 30, "zeta0": zeta0}], "tags": [tag]}
+        assert client.post("/api/v1/runs", json=body, headers=auth).status_code == 201
+    in_range = client.get("/api/v1/runs", params={"zeta0_min": 0.87, "zeta0_max": 0.93}).json()["items"]
+    assert sorted(run["controls"][0][1] for run in in_range) == [0.88, 0.9, 0.92]
+    assert [run["tags"] for run in client.get("/api/v1/runs", params={"tag": "high"}).json()["items"]] == [["high"]] * 2
+    seen, cursor = [], None
+    while True:
+        page = client.get("/api/v1/runs", params={"limit": 2} | ({"cursor": cursor} if cursor else {})).json()
+        seen += [run["id"] for run in page["items"]]
+        if (cursor := page["next_cursor"]) is None:
+            break
+    assert seen == sorted(seen, reverse=True) and len(seen) == len(set(seen)) == 5
+
+
+@pytest.mark.parametrize(
+    ("body", "field"),
+    [
+        (RUN | {"controls": [{"psi0_deg": 30, "zeta0": 1.2}]}, "zeta0"),
+        (RUN | {"controls": [{"psi0_deg": 95, "zeta0": 0.9}]}, "psi0_deg"),
+        (RUN | {"start": {"xdot": 0.5, "ydot": 0}}, "xdot"),
+        (RUN | {"jumps": 10**7}, "jumps"),
+        (RUN | {"model": {"alpha": -1}}, "alpha"),
+        (RUN | {"unknown": 1}, "unknown"),
+    ],
+)
+def test_bad_input_is_a_422_naming_the_field(client, auth, body, field):
+    response = client.post("/api/v1/runs", json=body, headers=auth)
+    assert response.status_code == 422
+    assert any(field in error["loc"] for error in response.json()["detail"]), response.json()
+
+
+def test_oversized_requests_are_refused(client, auth):
+    huge = RUN | {"tags": ["x" * 60] * 20_000}
+    assert client.post("/api/v1/runs", json=huge, headers=auth).status_code == 413
+
+
+def test_unknown_records_are_404(client, auth):
+    assert client.get("/api/v1/runs/999").status_code == 404
+    assert client.get("/api/v1/jobs/999").status_code == 404
+    assert client.post("/api/v1/runs", json=RUN | {"experiment_id": 999}, headers=auth).status_code == 404
+
+
+def _wait(client, job_id, states=("done", "failed", "cancelled"), timeout=60.0):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        job = client.get(f"/api/v1/jobs/{job_id}").json()
+        if job["state"] in states:
+            return job
+        time.sleep(0.05)
+    pytest.fail(f"job {job_id} still {job['state']} after {timeout} s")
+
+
+def test_mjtf_job_gives_the_library_numbers(client, auth):
+    spec = {"zeta0s": [0.88, 0.94], "trials": 40, "cap": 200, "seed": 5, "guess": {"xdot": -0.93, "ydot": -0.2}}
+    job = client.post("/api/v1/jobs", json=spec, headers=auth)
+    assert job.status_code == 202 and job.json()["total"] == 80
+    assert _wait(client, job.json()["id"])["state"] == "done"
+    levels = client.get(f"/api/v1/jobs/{job.json()['id']}/results").json()["levels"]
+    study = mjtf_study(
+        get_preset("paper").to_model(), math.radians(30), [0.88, 0.94], noise=NoiseModel(), trials=40, cap=200, seed=5,
+        guess=(-0.93, -0.2),
+    )  # fmt: skip
+    for got, expected in zip(levels, study.levels, strict=True):
+        assert got["trials"] == 40
+        assert got["mean"] == pytest.approx(float(np.mean(expected.jumps)))
+        assert got["outcomes"] == expected.histogram()
+
+
+def test_cancel_stops_a_job(client, auth):
+    spec = {"zeta0s": [0.84, 0.86, 0.88], "trials": 3000, "cap": 2000, "guess": {"xdot": -0.93, "ydot": 0.2}}
+    job_id = client.post("/api/v1/jobs", json=spec, headers=auth).json()["id"]
+    assert client.post(f"/api/v1/jobs/{job_id}/cancel").status_code == 401
+    client.post(f"/api/v1/jobs/{job_id}/cancel", headers=auth)
+    job = _wait(client, job_id)
+    assert job["state"] == "cancelled" and job["completed"] < job["total"]
+
+
+@pytest.mark.parametrize(
+    ("spec", "field"),
+    [
+        ({"zeta0s": [], "trials": 8}, "zeta0s"),
+        ({"zeta0s": [0.9], "trials": -1}, "trials"),
+        ({"zeta0s": [0.9], "trials": 10**9}, "trials"),
+        ({"zeta0s": [0.9, 0.9]}, "zeta0s"),
+    ],
+)
+def test_bad_job_specs_are_refused_before_any_work(client, auth, spec, field):
+    response = client.post("/api/v1/jobs", json=spec, headers=auth)
+    assert response.status_code == 422 and any(field in e["loc"] for e in response.json()["detail"])
+    assert client.get("/api/v1/jobs").json()["items"] == []
+
+
+def test_quick_fixed_point(client):
+    body = {"controls": [{"psi0_deg": 30, "zeta0": 0.9}], "guess": {"xdot": -0.9, "ydot": -0.2}}
+    gait = client.post("/api/v1/sim/fixed-point", json=body).json()
+    assert gait["period"] == 1 and gait["stable"] and gait["max_abs_eigenvalue"] == pytest.approx(0.8486, abs=1e-4)
