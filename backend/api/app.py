@@ -15,9 +15,12 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Annotated
 
+import fastapi_offline
 from fastapi import Depends, FastAPI, HTTPException, Query, Request, status
+from fastapi.openapi.docs import get_swagger_ui_html
 from fastapi.responses import HTMLResponse, JSONResponse
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
+from fastapi.staticfiles import StaticFiles
 from sqlalchemy import select
 from sqlalchemy.orm import Session
 
@@ -29,6 +32,7 @@ from sim_core import FixedPointNotFound, ParameterError
 
 log = logging.getLogger("parkourlab.api")
 TOKEN_FILE = "api_token"
+SWAGGER_ASSETS = Path(fastapi_offline.__file__).parent / "static"  # Swagger UI 5: reads OpenAPI 3.1
 PageLimit = Annotated[int, Query(ge=1, le=records.MAX_PAGE, description="items per page")]
 bearer = HTTPBearer(auto_error=False)
 
@@ -89,7 +93,10 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
         version="0.1.0",
         summary="Simulate, run, record and review the ParkourBot wall-climbing robot.",
         lifespan=lifespan,
+        docs_url=None,  # served below from local assets: the lab has no internet at run time
+        redoc_url=None,
     )
+    app.mount("/static/swagger", StaticFiles(directory=SWAGGER_ASSETS), name="swagger")
     app.state.settings = settings
     app.state.sessions = sessions
     app.state.token = token
@@ -125,39 +132,60 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
     def index() -> str:
         return _INDEX
 
-    @app.get("/api/v1/health")
+    @app.get("/docs", include_in_schema=False)
+    def docs() -> HTMLResponse:
+        return get_swagger_ui_html(
+            openapi_url=app.openapi_url,
+            title="ParkourLab API",
+            swagger_js_url="/static/swagger/swagger-ui-bundle.js",
+            swagger_css_url="/static/swagger/swagger-ui.css",
+            swagger_favicon_url="/static/swagger/favicon.png",
+        )
+
+    @app.get("/api/v1/health", tags=["service"])
     def health(db: Db) -> dict:
         db.execute(select(1))
         return {"status": "ok", "database": engine.dialect.name, "code_version": simulation.current_code_version()}
 
     # Experiments
-    @app.post("/api/v1/experiments", status_code=201, dependencies=AUTHORIZED, response_model=schemas.ExperimentOut)
+    @app.post(
+        "/api/v1/experiments",
+        status_code=201,
+        dependencies=AUTHORIZED,
+        response_model=schemas.ExperimentOut,
+        tags=["experiments"],
+    )
     def create_experiment(body: schemas.ExperimentCreate, db: Db):
         return _experiment_out(db, records.create_experiment(db, body))
 
-    @app.get("/api/v1/experiments", response_model=schemas.Page)
+    @app.get("/api/v1/experiments", response_model=schemas.Page, tags=["experiments"])
     def list_experiments(db: Db, limit: PageLimit = 50, cursor: Cursor = None):
         rows, next_cursor = records.list_experiments(db, limit=limit, cursor=cursor)
         return {"items": [_experiment_out(db, row) for row in rows], "next_cursor": next_cursor}
 
-    @app.get("/api/v1/experiments/{experiment_id}", response_model=schemas.ExperimentOut)
+    @app.get("/api/v1/experiments/{experiment_id}", response_model=schemas.ExperimentOut, tags=["experiments"])
     def get_experiment(experiment_id: int, db: Db):
         return _experiment_out(db, records.get_experiment(db, experiment_id))
 
-    @app.patch("/api/v1/experiments/{experiment_id}", dependencies=AUTHORIZED, response_model=schemas.ExperimentOut)
+    @app.patch(
+        "/api/v1/experiments/{experiment_id}",
+        dependencies=AUTHORIZED,
+        response_model=schemas.ExperimentOut,
+        tags=["experiments"],
+    )
     def update_experiment(experiment_id: int, body: schemas.ExperimentUpdate, db: Db):
         return _experiment_out(db, records.update_experiment(db, experiment_id, body))
 
-    @app.delete("/api/v1/experiments/{experiment_id}", status_code=204, dependencies=AUTHORIZED)
+    @app.delete("/api/v1/experiments/{experiment_id}", status_code=204, dependencies=AUTHORIZED, tags=["experiments"])
     def delete_experiment(experiment_id: int, db: Db) -> None:
         records.delete_experiment(db, experiment_id)
 
     # Runs
-    @app.post("/api/v1/runs", status_code=201, dependencies=AUTHORIZED, response_model=schemas.RunDetail)
+    @app.post("/api/v1/runs", status_code=201, dependencies=AUTHORIZED, response_model=schemas.RunDetail, tags=["runs"])
     def create_run(body: schemas.RunCreate, db: Db):
         return _run_out(records.create_run(db, body), detail=True)
 
-    @app.get("/api/v1/runs", response_model=schemas.Page)
+    @app.get("/api/v1/runs", response_model=schemas.Page, tags=["runs"])
     def list_runs(
         db: Db,
         limit: PageLimit = 50,
@@ -190,11 +218,11 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
         rows, next_cursor = records.list_runs(db, where, limit=limit, cursor=cursor)
         return {"items": [_run_out(row) for row in rows], "next_cursor": next_cursor}
 
-    @app.get("/api/v1/runs/{run_id}", response_model=schemas.RunDetail)
+    @app.get("/api/v1/runs/{run_id}", response_model=schemas.RunDetail, tags=["runs"])
     def get_run(run_id: int, db: Db):
         return _run_out(records.get_run(db, run_id), detail=True)
 
-    @app.get("/api/v1/runs/{run_id}/trajectory")
+    @app.get("/api/v1/runs/{run_id}/trajectory", tags=["runs"])
     def get_trajectory(run_id: int, db: Db) -> dict:
         run = records.get_run(db, run_id)
         if run.trajectory is None:
@@ -202,19 +230,19 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
         columns = simulation.unpack_trajectory(run.trajectory)
         return {"units": "nondimensional", "columns": {name: values.tolist() for name, values in columns.items()}}
 
-    @app.delete("/api/v1/runs/{run_id}", status_code=204, dependencies=AUTHORIZED)
+    @app.delete("/api/v1/runs/{run_id}", status_code=204, dependencies=AUTHORIZED, tags=["runs"])
     def delete_run(run_id: int, db: Db) -> None:
         records.delete_run(db, run_id)
 
     # Jobs
-    @app.post("/api/v1/jobs", status_code=202, dependencies=AUTHORIZED, response_model=schemas.JobOut)
+    @app.post("/api/v1/jobs", status_code=202, dependencies=AUTHORIZED, response_model=schemas.JobOut, tags=["jobs"])
     def create_job(body: schemas.MJTFJobCreate, db: Db):
         job = jobs.create_job(db, body)
         if run_jobs:
             runner.submit(job.id)
         return _job_out(job)
 
-    @app.get("/api/v1/jobs", response_model=schemas.Page)
+    @app.get("/api/v1/jobs", response_model=schemas.Page, tags=["jobs"])
     def list_jobs(
         db: Db,
         limit: PageLimit = 50,
@@ -224,25 +252,25 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
         rows, next_cursor = jobs.list_jobs(db, state=state, limit=limit, cursor=cursor)
         return {"items": [_job_out(row) for row in rows], "next_cursor": next_cursor}
 
-    @app.get("/api/v1/jobs/{job_id}", response_model=schemas.JobOut)
+    @app.get("/api/v1/jobs/{job_id}", response_model=schemas.JobOut, tags=["jobs"])
     def get_job(job_id: int, db: Db):
         return _job_out(jobs.get_job(db, job_id))
 
-    @app.get("/api/v1/jobs/{job_id}/results", response_model=schemas.JobResults)
+    @app.get("/api/v1/jobs/{job_id}/results", response_model=schemas.JobResults, tags=["jobs"])
     def job_results(job_id: int, db: Db):
         job = jobs.get_job(db, job_id)
         return {"job": _job_out(job), "levels": [_finite(level) for level in jobs.level_summaries(db, job)]}
 
-    @app.post("/api/v1/jobs/{job_id}/cancel", dependencies=AUTHORIZED, response_model=schemas.JobOut)
+    @app.post("/api/v1/jobs/{job_id}/cancel", dependencies=AUTHORIZED, response_model=schemas.JobOut, tags=["jobs"])
     def cancel_job(job_id: int, db: Db):
         return _job_out(jobs.cancel_job(db, job_id))
 
     # Quick calls for the control panel: computed, not stored.
-    @app.post("/api/v1/sim/map")
+    @app.post("/api/v1/sim/map", tags=["simulate"])
     def sim_map(body: schemas.MapIn) -> dict:
         return simulation.map_orbit(body)
 
-    @app.post("/api/v1/sim/fixed-point")
+    @app.post("/api/v1/sim/fixed-point", tags=["simulate"])
     def sim_fixed_point(body: schemas.FixedPointIn) -> dict:
         return simulation.fixed_point(body)
 

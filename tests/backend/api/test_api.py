@@ -13,10 +13,14 @@ from sim_core.noise import NoiseModel
 RUN = {"controls": [{"psi0_deg": 30, "zeta0": 0.9}], "start": {"xdot": -0.93, "ydot": -0.17}, "jumps": 4}
 
 
-def test_health_and_index(client):
+def test_health_index_and_offline_docs(client):
     assert client.get("/api/v1/health").json()["status"] == "ok"
     page = client.get("/")
     assert page.status_code == 200 and "/docs" in page.text
+    docs = client.get("/docs").text
+    assert "cdn" not in docs.lower() and "/static/swagger/swagger-ui-bundle.js" in docs, "no CDN at run time"
+    assert client.get("/static/swagger/swagger-ui-bundle.js").status_code == 200
+    assert client.get("/openapi.json").json()["info"]["title"] == "ParkourLab"
 
 
 def test_changes_need_the_token(client, auth):
