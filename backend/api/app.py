@@ -7,18 +7,22 @@ field and the allowed range; nothing returns a traceback.
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import datetime
+import json
 import logging
 import secrets
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Annotated
 
 import fastapi_offline
 from fastapi import Depends, FastAPI, HTTPException, Query, Request, status
+from fastapi.encoders import jsonable_encoder
 from fastapi.openapi.docs import get_swagger_ui_html
-from fastapi.responses import HTMLResponse, JSONResponse
+from fastapi.responses import HTMLResponse, JSONResponse, StreamingResponse
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 from fastapi.staticfiles import StaticFiles
 from sqlalchemy import select
@@ -32,6 +36,7 @@ from sim_core import FixedPointNotFound, ParameterError
 
 log = logging.getLogger("parkourlab.api")
 TOKEN_FILE = "api_token"
+EVENT_POLL_S = 0.25  # progress comes from committed chunks; a quarter second is live enough
 SWAGGER_ASSETS = Path(fastapi_offline.__file__).parent / "static"  # Swagger UI 5: reads OpenAPI 3.1
 PageLimit = Annotated[int, Query(ge=1, le=records.MAX_PAGE, description="items per page")]
 bearer = HTTPBearer(auto_error=False)
@@ -54,7 +59,37 @@ def require_token(
         )
 
 
+def run_filter(
+    experiment_id: int | None = None,
+    kind: Annotated[str | None, Query(pattern="^(sim|robot|replay)$")] = None,
+    status_: Annotated[str | None, Query(alias="status", pattern="^(done|failed)$")] = None,
+    tag: Annotated[str | None, Query(max_length=64)] = None,
+    failure_code: Annotated[str | None, Query(max_length=32)] = None,
+    zeta0_min: Annotated[float | None, Query(ge=0.0, le=1.0)] = None,
+    zeta0_max: Annotated[float | None, Query(ge=0.0, le=1.0)] = None,
+    psi0_min: Annotated[float | None, Query(ge=0.0, le=90.0)] = None,
+    psi0_max: Annotated[float | None, Query(ge=0.0, le=90.0)] = None,
+    created_after: datetime.datetime | None = None,
+    created_before: datetime.datetime | None = None,
+) -> records.RunFilter:
+    """The run filters shared by list, export and aggregate."""
+    return records.RunFilter(
+        experiment_id=experiment_id,
+        kind=kind,
+        status=status_,
+        tag=tag,
+        failure_code=failure_code,
+        zeta0_min=zeta0_min,
+        zeta0_max=zeta0_max,
+        psi0_min=psi0_min,
+        psi0_max=psi0_max,
+        created_after=created_after,
+        created_before=created_before,
+    )
+
+
 Db = Annotated[Session, Depends(get_session)]
+RunQuery = Annotated[records.RunFilter, Depends(run_filter)]
 AUTHORIZED = [Depends(require_token)]
 Cursor = Annotated[int | None, Query(ge=1, description="next_cursor of the previous page")]
 
@@ -186,37 +221,38 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
         return _run_out(records.create_run(db, body), detail=True)
 
     @app.get("/api/v1/runs", response_model=schemas.Page, tags=["runs"])
-    def list_runs(
-        db: Db,
-        limit: PageLimit = 50,
-        cursor: Cursor = None,
-        experiment_id: int | None = None,
-        kind: Annotated[str | None, Query(pattern="^(sim|robot|replay)$")] = None,
-        status_: Annotated[str | None, Query(alias="status", pattern="^(done|failed)$")] = None,
-        tag: Annotated[str | None, Query(max_length=64)] = None,
-        failure_code: Annotated[str | None, Query(max_length=32)] = None,
-        zeta0_min: Annotated[float | None, Query(ge=0.0, le=1.0)] = None,
-        zeta0_max: Annotated[float | None, Query(ge=0.0, le=1.0)] = None,
-        psi0_min: Annotated[float | None, Query(ge=0.0, le=90.0)] = None,
-        psi0_max: Annotated[float | None, Query(ge=0.0, le=90.0)] = None,
-        created_after: datetime.datetime | None = None,
-        created_before: datetime.datetime | None = None,
-    ):
-        where = records.RunFilter(
-            experiment_id=experiment_id,
-            kind=kind,
-            status=status_,
-            tag=tag,
-            failure_code=failure_code,
-            zeta0_min=zeta0_min,
-            zeta0_max=zeta0_max,
-            psi0_min=psi0_min,
-            psi0_max=psi0_max,
-            created_after=created_after,
-            created_before=created_before,
-        )
+    def list_runs(db: Db, where: RunQuery, limit: PageLimit = 50, cursor: Cursor = None):
         rows, next_cursor = records.list_runs(db, where, limit=limit, cursor=cursor)
         return {"items": [_run_out(row) for row in rows], "next_cursor": next_cursor}
+
+    @app.get("/api/v1/runs/export", tags=["runs"], response_class=StreamingResponse)
+    def export_runs(
+        db: Db, where: RunQuery, format_: Annotated[str, Query(alias="format", pattern="^(csv|json)$")] = "csv"
+    ):
+        """Every run matching the filters, streamed, with tags, timings and parameters (not the path)."""
+        rows = records.export_rows(sessions, where)
+        media = "text/csv" if format_ == "csv" else "application/json"
+        body = records.rows_as_csv(rows) if format_ == "csv" else records.rows_as_json(rows)
+        disposition = {"Content-Disposition": f'attachment; filename="runs.{format_}"'}
+        return StreamingResponse(body, media_type=media, headers=disposition)
+
+    @app.get("/api/v1/runs/compare", tags=["runs"])
+    def compare_runs(
+        db: Db,
+        ids: Annotated[list[int], Query(min_length=2, max_length=records.MAX_COMPARE, description="run ids")],
+        only_differences: bool = True,
+    ) -> dict:
+        """Runs side by side as flat fields; by default only the fields whose values differ."""
+        return records.compare_runs(db, ids, only_differences=only_differences)
+
+    @app.get("/api/v1/runs/aggregate", tags=["runs"])
+    def aggregate_runs(
+        db: Db,
+        where: RunQuery,
+        by: Annotated[str, Query(pattern=f"^({'|'.join(records.GROUP_BY)})$")] = "zeta0",
+    ) -> dict:
+        """Runs grouped by a parameter or tag: count, mean, std, min and max of climb and jumps completed."""
+        return {"by": by, "groups": records.aggregate_runs(db, where, by)}
 
     @app.get("/api/v1/runs/{run_id}", response_model=schemas.RunDetail, tags=["runs"])
     def get_run(run_id: int, db: Db):
@@ -260,6 +296,37 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
     def job_results(job_id: int, db: Db):
         job = jobs.get_job(db, job_id)
         return {"job": _job_out(job), "levels": [_finite(level) for level in jobs.level_summaries(db, job)]}
+
+    @app.get("/api/v1/jobs/{job_id}/events", tags=["jobs"], response_class=StreamingResponse)
+    async def job_events(
+        job_id: int,
+        request: Request,
+        timeout: Annotated[
+            float, Query(gt=0, le=86_400, description="close the stream after this many seconds")
+        ] = 3600,
+    ):
+        """Server-sent events: a ``progress`` event whenever the job's state or count changes; the
+        stream ends after the job's final state (done, cancelled, failed) or ``timeout``."""
+
+        def snapshot() -> dict:
+            with sessions() as db:
+                return _job_out(jobs.get_job(db, job_id))
+
+        first = await asyncio.to_thread(snapshot)  # a missing job is a 404 before the stream opens
+
+        async def stream():
+            job, last, deadline = first, None, time.monotonic() + timeout
+            while True:
+                key = (job["state"], job["completed"])
+                if key != last:
+                    last = key
+                    yield f"event: progress\ndata: {json.dumps(jsonable_encoder(job))}\n\n"
+                if job["state"] in jobs.FINAL or time.monotonic() > deadline or await request.is_disconnected():
+                    return
+                await asyncio.sleep(EVENT_POLL_S)
+                job = await asyncio.to_thread(snapshot)
+
+        return StreamingResponse(stream(), media_type="text/event-stream", headers={"Cache-Control": "no-cache"})
 
     @app.post("/api/v1/jobs/{job_id}/cancel", dependencies=AUTHORIZED, response_model=schemas.JobOut, tags=["jobs"])
     def cancel_job(job_id: int, db: Db):

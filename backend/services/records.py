@@ -6,7 +6,12 @@ so a page costs the same at 100 runs or 100,000.
 
 from __future__ import annotations
 
+import csv
 import datetime
+import io
+import json
+import math
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 from sqlalchemy import func, select
@@ -15,6 +20,7 @@ from sqlalchemy.orm import Session
 from backend.schemas import ExperimentCreate, ExperimentUpdate, RunCreate
 from backend.services.simulation import simulate_run
 from backend.store.models import Experiment, Run, RunTag
+from experiments.report import json_safe
 
 MAX_PAGE = 500
 
@@ -111,7 +117,13 @@ class RunFilter:
 
 def list_runs(session: Session, where: RunFilter, *, limit: int, cursor: int | None) -> tuple[list[Run], int | None]:
     """A page of runs, newest first; ``cursor`` is the last id of the previous page."""
-    query = select(Run).order_by(Run.id.desc()).limit(limit + 1)
+    query = _filtered(select(Run).order_by(Run.id.desc()).limit(limit + 1), where)
+    if cursor is not None:
+        query = query.where(Run.id < cursor)
+    return _page(list(session.scalars(query)), limit)
+
+
+def _filtered(query, where: RunFilter):
     conditions = [
         (where.experiment_id, lambda v: Run.experiment_id == v),
         (where.kind, lambda v: Run.kind == v),
@@ -123,14 +135,117 @@ def list_runs(session: Session, where: RunFilter, *, limit: int, cursor: int | N
         (where.psi0_max, lambda v: Run.psi0_deg <= v),
         (where.created_after, lambda v: Run.created_at >= v),
         (where.created_before, lambda v: Run.created_at < v),
-        (cursor, lambda v: Run.id < v),
     ]
     for value, condition in conditions:
         if value is not None:
             query = query.where(condition(value))
     if where.tag is not None:
         query = query.where(Run.id.in_(select(RunTag.run_id).where(RunTag.tag == where.tag)))
-    return _page(list(session.scalars(query)), limit)
+    return query
+
+
+EXPORT_BATCH = 1000
+MAX_COMPARE = 50
+GROUP_BY = ("zeta0", "psi0_deg", "alpha", "kind", "failure_code", "experiment_id", "tag")
+
+
+def run_row(run: Run) -> dict:
+    """A run as one flat record: what export writes and compare lines up."""
+    row = {
+        "id": run.id,
+        "experiment_id": run.experiment_id,
+        "kind": run.kind,
+        "status": run.status,
+        "created_at": run.created_at.isoformat(),
+        "duration_s": run.duration_s,
+        "code_version": run.code_version,
+        "tags": " ".join(run.tags),
+        "jumps": run.jumps,
+        "jumps_completed": run.jumps_completed,
+        "failure_code": run.failure_code,
+        "climb": run.climb,
+        "start_xdot": run.start_state[0],
+        "start_ydot": run.start_state[1],
+    }
+    row |= {f"model.{name}": value for name, value in run.model.items()}
+    for leg, (psi0_deg, zeta0) in enumerate(run.controls):
+        row |= {f"leg{leg}.psi0_deg": psi0_deg, f"leg{leg}.zeta0": zeta0}
+    return row
+
+
+def export_rows(sessions, where: RunFilter) -> Iterator[dict]:
+    """All matching runs, oldest first, read in batches in a session of their own (the response
+    streams after the request's session has closed)."""
+    with sessions() as session:
+        query = _filtered(select(Run).order_by(Run.id), where).execution_options(yield_per=EXPORT_BATCH)
+        for run in session.scalars(query):
+            yield run_row(run)
+
+
+def rows_as_csv(rows: Iterator[dict]) -> Iterator[str]:
+    buffer = io.StringIO()
+    writer = None
+    for row in rows:
+        if writer is None:
+            writer = csv.DictWriter(buffer, fieldnames=list(row), extrasaction="ignore", restval="")
+            writer.writeheader()
+        writer.writerow(row)
+        if buffer.tell() > 64_000:
+            yield buffer.getvalue()
+            buffer.seek(0)
+            buffer.truncate()
+    yield buffer.getvalue()
+
+
+def rows_as_json(rows: Iterator[dict]) -> Iterator[str]:
+    yield "["
+    for index, row in enumerate(rows):
+        yield ("," if index else "") + json.dumps(json_safe(row))
+    yield "]"
+
+
+def compare_runs(session: Session, ids: list[int], *, only_differences: bool) -> dict:
+    runs = [run_row(get_run(session, run_id)) for run_id in ids]
+    fields = list(dict.fromkeys(key for run in runs for key in run))
+    differing = [key for key in fields if len({json.dumps(run.get(key)) for run in runs}) > 1]
+    shown = [key for key in fields if key == "id" or not only_differences or key in differing]
+    return {
+        "fields": shown,
+        "differing": differing,
+        "runs": [{key: run.get(key) for key in shown} for run in runs],
+    }
+
+
+def aggregate_runs(session: Session, where: RunFilter, by: str) -> list[dict]:
+    """Groups with count and mean/std/min/max of climb and jumps completed, computed in SQL."""
+    key = RunTag.tag if by == "tag" else getattr(Run, by)
+    columns = [key.label("key"), func.count(Run.id).label("runs")]
+    for name in ("climb", "jumps_completed"):
+        column = getattr(Run, name)
+        columns += [
+            func.avg(column).label(f"{name}_mean"),
+            func.avg(column * column).label(f"{name}_mean_square"),
+            func.min(column).label(f"{name}_min"),
+            func.max(column).label(f"{name}_max"),
+        ]
+    query = select(*columns)
+    if by == "tag":
+        query = query.join(RunTag, RunTag.run_id == Run.id)
+    query = _filtered(query.select_from(Run) if by != "tag" else query, where).group_by(key).order_by(key)
+    groups = []
+    for row in session.execute(query).mappings():
+        group = {"key": row["key"], "runs": row["runs"]}
+        for name in ("climb", "jumps_completed"):
+            mean = row[f"{name}_mean"]
+            variance = max(row[f"{name}_mean_square"] - mean * mean, 0.0)
+            group[name] = {
+                "mean": mean,
+                "std": math.sqrt(variance),  # population std over the group
+                "min": row[f"{name}_min"],
+                "max": row[f"{name}_max"],
+            }
+        groups.append(group)
+    return groups
 
 
 def _page(rows: list, limit: int) -> tuple[list, int | None]:

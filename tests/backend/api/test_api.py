@@ -1,5 +1,8 @@
 """The REST API against the real app and a real SQLite file (httpx through TestClient)."""
 
+import csv
+import io
+import json
 import math
 import time
 
@@ -76,6 +79,49 @@ def test_run_lists_filter_and_page(client, auth):
     assert seen == sorted(seen, reverse=True) and len(seen) == len(set(seen)) == 5
 
 
+def _seed_runs(client, auth):
+    ids = []
+    for zeta0, tag in [(0.88, "low"), (0.88, "low"), (0.92, "high")]:
+        body = RUN | {"controls": [{"psi0_deg": 30, "zeta0": zeta0}], "tags": [tag, "all"]}
+        ids.append(client.post("/api/v1/runs", json=body, headers=auth).json()["id"])
+    return ids
+
+
+def test_export_csv_and_json(client, auth):
+    ids = _seed_runs(client, auth)
+    exported = client.get("/api/v1/runs/export", params={"format": "csv", "tag": "low"})
+    assert exported.status_code == 200 and exported.headers["content-type"].startswith("text/csv")
+    rows = list(csv.DictReader(io.StringIO(exported.text)))
+    assert [int(row["id"]) for row in rows] == ids[:2]
+    assert {"tags", "duration_s", "created_at", "climb", "leg0.zeta0", "model.alpha"} <= set(rows[0])
+    assert rows[0]["tags"] == "all low"
+    as_json = client.get("/api/v1/runs/export", params={"format": "json"}).json()
+    assert [row["id"] for row in as_json] == ids and as_json[2]["leg0.zeta0"] == 0.92
+    assert client.get("/api/v1/runs/export", params={"format": "xml"}).status_code == 422
+
+
+def test_compare_shows_only_what_differs(client, auth):
+    first, second, third = _seed_runs(client, auth)
+    same = client.get("/api/v1/runs/compare", params={"ids": [first, second]}).json()
+    assert set(same["differing"]) <= {"id", "created_at", "duration_s"}
+    differ = client.get("/api/v1/runs/compare", params={"ids": [first, third]}).json()
+    assert {"leg0.zeta0", "climb", "tags"} <= set(differ["differing"]) and "model.alpha" not in differ["fields"]
+    assert [run["leg0.zeta0"] for run in differ["runs"]] == [0.88, 0.92]
+    assert client.get("/api/v1/runs/compare", params={"ids": [first]}).status_code == 422
+    assert client.get("/api/v1/runs/compare", params={"ids": [first, 999]}).status_code == 404
+
+
+def test_aggregate_groups_runs(client, auth):
+    _seed_runs(client, auth)
+    by_zeta0 = client.get("/api/v1/runs/aggregate", params={"by": "zeta0"}).json()["groups"]
+    assert [(group["key"], group["runs"]) for group in by_zeta0] == [(0.88, 2), (0.92, 1)]
+    low = by_zeta0[0]["climb"]
+    assert low["std"] == pytest.approx(0.0, abs=1e-9) and low["min"] == low["max"] == pytest.approx(low["mean"])
+    by_tag = client.get("/api/v1/runs/aggregate", params={"by": "tag"}).json()["groups"]
+    assert [(group["key"], group["runs"]) for group in by_tag] == [("all", 3), ("high", 1), ("low", 2)]
+    assert client.get("/api/v1/runs/aggregate", params={"by": "secret"}).status_code == 422
+
+
 @pytest.mark.parametrize(
     ("body", "field"),
     [
@@ -128,6 +174,21 @@ def test_mjtf_job_gives_the_library_numbers(client, auth):
         assert got["trials"] == 40
         assert got["mean"] == pytest.approx(float(np.mean(expected.jumps)))
         assert got["outcomes"] == expected.histogram()
+
+
+def test_job_progress_streams_as_server_sent_events(client, auth):
+    spec = {"zeta0s": [0.88, 0.9], "trials": 96, "cap": 300, "guess": {"xdot": -0.93, "ydot": -0.2}}
+    job_id = client.post("/api/v1/jobs", json=spec, headers=auth).json()["id"]
+    events = []
+    with client.stream("GET", f"/api/v1/jobs/{job_id}/events") as stream:
+        assert stream.headers["content-type"].startswith("text/event-stream")
+        for line in stream.iter_lines():
+            if line.startswith("data: "):
+                events.append(json.loads(line.removeprefix("data: ")))
+    counts = [event["completed"] for event in events]
+    assert events[-1]["state"] == "done" and counts[-1] == 192
+    assert counts == sorted(counts), "progress only grows"
+    assert client.get("/api/v1/jobs/999/events").status_code == 404
 
 
 def test_cancel_stops_a_job(client, auth):
