@@ -6,7 +6,7 @@ import datetime
 import math
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 Psi0Deg = Annotated[float, Field(gt=0.0, lt=90.0, description="leg angle at touchdown [degrees], in (0, 90)")]
 Zeta0 = Annotated[float, Field(gt=0.0, lt=1.0, description="leg length at touchdown [l0], in (0, 1)")]
@@ -15,6 +15,9 @@ Tag = Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[\w.:/-]+$")]
 MAX_JUMPS = 10_000
 MAX_TRIALS = 100_000
 MAX_LEVELS = 100
+MAX_PATH_SAMPLES = 100_000
+MAX_ID = 2**63 - 1  # the databases' integer keys
+RecordRef = Annotated[int, Field(ge=1, le=MAX_ID)]
 
 
 class Strict(BaseModel):
@@ -43,7 +46,7 @@ class StateIn(Strict):
 
 
 class RunCreate(Strict):
-    experiment_id: int | None = None
+    experiment_id: RecordRef | None = None
     model: ModelIn = ModelIn()
     controls: Annotated[list[LegIn], Field(min_length=1, max_length=16)]
     start: StateIn
@@ -52,6 +55,14 @@ class RunCreate(Strict):
         None, description="also store the sampled path, samples per sqrt(l0/g)"
     )
     tags: Annotated[list[Tag], Field(max_length=32)] = []
+
+    @model_validator(mode="after")
+    def _bounded_path(self) -> RunCreate:
+        # A jump lasts about 1.5 time units: this caps a stored path near 150,000 samples.
+        if self.trajectory_rate is not None and self.trajectory_rate * self.jumps > MAX_PATH_SAMPLES:
+            samples = self.trajectory_rate * self.jumps
+            raise ValueError(f"trajectory_rate x jumps must be at most {MAX_PATH_SAMPLES:,}, got {samples:g}")
+        return self
 
 
 class RunOut(BaseModel):
@@ -120,7 +131,7 @@ class MJTFJobCreate(Strict):
     """Mean Jumps To Failure: ``levels`` zeta0 values x ``trials`` noisy trials each."""
 
     kind: Literal["mjtf"] = "mjtf"
-    experiment_id: int | None = None
+    experiment_id: RecordRef | None = None
     model: ModelIn = ModelIn()
     psi0_deg: Psi0Deg = 30.0
     zeta0s: Annotated[list[Zeta0], Field(min_length=1, max_length=MAX_LEVELS)]
@@ -176,7 +187,7 @@ class MapIn(Strict):
 class FixedPointIn(Strict):
     model: ModelIn = ModelIn()
     controls: Annotated[list[LegIn], Field(min_length=1, max_length=16)]
-    period: Annotated[int, Field(ge=1, le=64)] | None = None
+    period: Annotated[int, Field(ge=1, le=16)] | None = None
     guess: StateIn | None = None
 
 

@@ -20,11 +20,13 @@ from typing import Annotated
 
 import fastapi_offline
 from fastapi import Depends, FastAPI, HTTPException, Query, Request, status
+from fastapi import Path as FastAPIPath
 from fastapi.encoders import jsonable_encoder
 from fastapi.openapi.docs import get_swagger_ui_html
 from fastapi.responses import HTMLResponse, JSONResponse, StreamingResponse
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 from fastapi.staticfiles import StaticFiles
+from pydantic import Field
 from sqlalchemy import select
 from sqlalchemy.orm import Session
 
@@ -60,7 +62,7 @@ def require_token(
 
 
 def run_filter(
-    experiment_id: int | None = None,
+    experiment_id: Annotated[int | None, Query(ge=1, le=schemas.MAX_ID)] = None,
     kind: Annotated[str | None, Query(pattern="^(sim|robot|replay)$")] = None,
     status_: Annotated[str | None, Query(alias="status", pattern="^(done|failed)$")] = None,
     tag: Annotated[str | None, Query(max_length=64)] = None,
@@ -91,7 +93,8 @@ def run_filter(
 Db = Annotated[Session, Depends(get_session)]
 RunQuery = Annotated[records.RunFilter, Depends(run_filter)]
 AUTHORIZED = [Depends(require_token)]
-Cursor = Annotated[int | None, Query(ge=1, description="next_cursor of the previous page")]
+Cursor = Annotated[int | None, Query(ge=1, le=schemas.MAX_ID, description="next_cursor of the previous page")]
+RecordId = Annotated[int, FastAPIPath(ge=1, le=schemas.MAX_ID)]
 
 
 def api_token(data_dir: Path) -> tuple[str, bool]:
@@ -199,7 +202,7 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
         return {"items": [_experiment_out(db, row) for row in rows], "next_cursor": next_cursor}
 
     @app.get("/api/v1/experiments/{experiment_id}", response_model=schemas.ExperimentOut, tags=["experiments"])
-    def get_experiment(experiment_id: int, db: Db):
+    def get_experiment(experiment_id: RecordId, db: Db):
         return _experiment_out(db, records.get_experiment(db, experiment_id))
 
     @app.patch(
@@ -208,11 +211,11 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
         response_model=schemas.ExperimentOut,
         tags=["experiments"],
     )
-    def update_experiment(experiment_id: int, body: schemas.ExperimentUpdate, db: Db):
+    def update_experiment(experiment_id: RecordId, body: schemas.ExperimentUpdate, db: Db):
         return _experiment_out(db, records.update_experiment(db, experiment_id, body))
 
     @app.delete("/api/v1/experiments/{experiment_id}", status_code=204, dependencies=AUTHORIZED, tags=["experiments"])
-    def delete_experiment(experiment_id: int, db: Db) -> None:
+    def delete_experiment(experiment_id: RecordId, db: Db) -> None:
         records.delete_experiment(db, experiment_id)
 
     # Runs
@@ -239,7 +242,10 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
     @app.get("/api/v1/runs/compare", tags=["runs"])
     def compare_runs(
         db: Db,
-        ids: Annotated[list[int], Query(min_length=2, max_length=records.MAX_COMPARE, description="run ids")],
+        ids: Annotated[
+            list[Annotated[int, Field(ge=1, le=schemas.MAX_ID)]],
+            Query(min_length=2, max_length=records.MAX_COMPARE, description="run ids"),
+        ],
         only_differences: bool = True,
     ) -> dict:
         """Runs side by side as flat fields; by default only the fields whose values differ."""
@@ -255,11 +261,11 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
         return {"by": by, "groups": records.aggregate_runs(db, where, by)}
 
     @app.get("/api/v1/runs/{run_id}", response_model=schemas.RunDetail, tags=["runs"])
-    def get_run(run_id: int, db: Db):
+    def get_run(run_id: RecordId, db: Db):
         return _run_out(records.get_run(db, run_id), detail=True)
 
     @app.get("/api/v1/runs/{run_id}/trajectory", tags=["runs"])
-    def get_trajectory(run_id: int, db: Db) -> dict:
+    def get_trajectory(run_id: RecordId, db: Db) -> dict:
         run = records.get_run(db, run_id)
         if run.trajectory is None:
             raise records.NotFound("trajectory of run", run_id)
@@ -267,7 +273,7 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
         return {"units": "nondimensional", "columns": {name: values.tolist() for name, values in columns.items()}}
 
     @app.delete("/api/v1/runs/{run_id}", status_code=204, dependencies=AUTHORIZED, tags=["runs"])
-    def delete_run(run_id: int, db: Db) -> None:
+    def delete_run(run_id: RecordId, db: Db) -> None:
         records.delete_run(db, run_id)
 
     # Jobs
@@ -289,17 +295,17 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
         return {"items": [_job_out(row) for row in rows], "next_cursor": next_cursor}
 
     @app.get("/api/v1/jobs/{job_id}", response_model=schemas.JobOut, tags=["jobs"])
-    def get_job(job_id: int, db: Db):
+    def get_job(job_id: RecordId, db: Db):
         return _job_out(jobs.get_job(db, job_id))
 
     @app.get("/api/v1/jobs/{job_id}/results", response_model=schemas.JobResults, tags=["jobs"])
-    def job_results(job_id: int, db: Db):
+    def job_results(job_id: RecordId, db: Db):
         job = jobs.get_job(db, job_id)
         return {"job": _job_out(job), "levels": [_finite(level) for level in jobs.level_summaries(db, job)]}
 
     @app.get("/api/v1/jobs/{job_id}/events", tags=["jobs"], response_class=StreamingResponse)
     async def job_events(
-        job_id: int,
+        job_id: RecordId,
         request: Request,
         timeout: Annotated[
             float, Query(gt=0, le=86_400, description="close the stream after this many seconds")
@@ -329,7 +335,7 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
         return StreamingResponse(stream(), media_type="text/event-stream", headers={"Cache-Control": "no-cache"})
 
     @app.post("/api/v1/jobs/{job_id}/cancel", dependencies=AUTHORIZED, response_model=schemas.JobOut, tags=["jobs"])
-    def cancel_job(job_id: int, db: Db):
+    def cancel_job(job_id: RecordId, db: Db):
         return _job_out(jobs.cancel_job(db, job_id))
 
     # Quick calls for the control panel: computed, not stored.

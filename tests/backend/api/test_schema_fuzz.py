@@ -1,0 +1,30 @@
+"""Schemathesis against the OpenAPI schema: generated requests never get a 5xx."""
+
+import tempfile
+from pathlib import Path
+
+import pytest
+import schemathesis
+from hypothesis import HealthCheck, settings
+
+from backend.api.app import api_token, create_app
+from backend.settings import Settings
+from backend.store.database import make_engine, migrate
+
+pytestmark = pytest.mark.slow  # a few hundred generated requests
+
+_DATA = Path(tempfile.mkdtemp(prefix="parkourlab-fuzz-"))
+_SETTINGS = Settings.from_environment(_DATA)
+migrate(make_engine(_SETTINGS.database_url))
+_TOKEN, _ = api_token(_DATA)
+# Jobs are stored but not run here (no runner), so fuzzed specs cost no compute.
+schema = schemathesis.openapi.from_asgi("/openapi.json", create_app(_SETTINGS, run_jobs=False))
+
+
+@schema.parametrize()
+@settings(max_examples=20, deadline=None, suppress_health_check=list(HealthCheck))
+def test_no_server_errors(case):
+    response = case.call(headers={"Authorization": f"Bearer {_TOKEN}"})
+    assert response.status_code < 500, (
+        f"{case.method} {case.formatted_path}: {response.status_code} {response.text[:300]}"
+    )
