@@ -35,6 +35,30 @@ def chunk_map_for(address: str | None, *, timeout: str = CONNECT_TIMEOUT) -> Ite
     if address is None:
         yield in_process
         return
+    with dask_client(address, timeout=timeout) as client:
+        yield _DaskChunkMap(client)
+
+
+def as_completed_results(client, function: Callable, arguments: Sequence[tuple]) -> Iterator[tuple[int, object]]:
+    """Submit one task per chunk; yield ``(chunk index, result)`` as each finishes.
+
+    Closing the generator early (a cancelled job, an error, Ctrl-C) cancels the chunks not yet
+    finished, so the cluster is freed at once.
+    """
+    from distributed import as_completed
+
+    futures = [client.submit(function, *chunk, pure=False) for chunk in arguments]
+    index_of = {future.key: index for index, future in enumerate(futures)}
+    try:
+        for future in as_completed(futures, loop=client.loop):
+            yield index_of[future.key], future.result()
+    finally:
+        client.cancel([future for future in futures if not future.done()])
+
+
+@contextmanager
+def dask_client(address: str, *, timeout: str = CONNECT_TIMEOUT):
+    """A connected client for the ``with`` block; an unreachable scheduler is a ParameterError."""
     from distributed import Client  # imported only when a cluster is asked for: it is heavy
 
     try:
@@ -42,7 +66,7 @@ def chunk_map_for(address: str | None, *, timeout: str = CONNECT_TIMEOUT) -> Ite
     except (OSError, TimeoutError) as error:
         raise ParameterError("scheduler", f"cannot reach the Dask scheduler at {address!r}: {error}") from None
     try:
-        yield _DaskChunkMap(client)
+        yield client
     finally:
         client.close()
 
@@ -52,15 +76,9 @@ class _DaskChunkMap:
         self.client = client
 
     def __call__(self, function: Callable, arguments: Sequence[tuple], progress: Progress | None = None) -> list:
-        from distributed import as_completed
-
-        futures = [self.client.submit(function, *chunk, pure=False) for chunk in arguments]
-        try:
-            for done, _ in enumerate(as_completed(futures, loop=self.client.loop), start=1):
-                if progress is not None:
-                    progress(done, len(futures))
-            return self.client.gather(futures)
-        except BaseException:
-            # Cancelled, interrupted or failed: free the cluster of this study's remaining work.
-            self.client.cancel(futures)
-            raise
+        results: list = [None] * len(arguments)
+        for done, (index, result) in enumerate(as_completed_results(self.client, function, arguments), start=1):
+            results[index] = result
+            if progress is not None:
+                progress(done, len(arguments))
+        return results

@@ -115,7 +115,7 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
     engine = make_engine(settings.database_url)
     sessions = session_factory(engine)
     token, _ = api_token(settings.data_dir)
-    runner = jobs.JobRunner(sessions)
+    runner = jobs.JobRunner(sessions, dask_address=settings.dask_address)
 
     @contextlib.asynccontextmanager
     async def lifespan(_app: FastAPI):

@@ -2,8 +2,9 @@
 
 A job is a row; its trials are rows with the idempotent key ``(job, level, index)``. The
 runner (one background thread) works through a job in chunks of trials: it computes the
-trials still missing, runs a chunk, and commits the chunk's trials and the progress in one
-transaction. Killed mid-job, the service finds the job at the next start, recomputes only
+trials still missing, runs the chunks — in this process, or on the Dask cluster named by
+``PARKOUR_DASK_ADDRESS`` — and commits each chunk's trials and the progress in one
+transaction as it finishes. Killed mid-job, the service finds the job at the next start, recomputes only
 the missing trials — their seeds depend on ``(seed, level, index)`` alone — and ends with
 exactly the trials asked for, none lost and none duplicated (the unique key refuses a second
 copy). Cancelling marks the job; the runner stops before its next chunk.
@@ -14,6 +15,7 @@ from __future__ import annotations
 import logging
 import queue
 import threading
+from collections.abc import Iterator
 
 import numpy as np
 from sqlalchemy import func, select, update
@@ -23,6 +25,7 @@ from backend.schemas import MJTFJobCreate
 from backend.services.records import NotFound, get_experiment
 from backend.services.simulation import KERNEL_LOCK, current_code_version, model_params
 from backend.store.models import Job, Trial, utcnow
+from experiments.cluster import as_completed_results, dask_client
 from sim_core.failures import OK, Failure
 from sim_core.mjtf import level_starts, run_trials
 from sim_core.noise import NoiseModel, trial_seeds
@@ -104,9 +107,12 @@ def level_summaries(session: Session, job: Job) -> list[dict]:
 class JobRunner:
     """Runs jobs one at a time on a background thread, resuming unfinished ones at start."""
 
-    def __init__(self, sessions: sessionmaker[Session], *, chunk_trials: int = CHUNK_TRIALS):
+    def __init__(
+        self, sessions: sessionmaker[Session], *, chunk_trials: int = CHUNK_TRIALS, dask_address: str | None = None
+    ):
         self.sessions = sessions
         self.chunk_trials = chunk_trials
+        self.dask_address = dask_address
         self.queue: queue.Queue[int | None] = queue.Queue()
         self.thread: threading.Thread | None = None
 
@@ -159,18 +165,38 @@ class JobRunner:
         guess = None if spec.guess is None else (spec.guess.xdot, spec.guess.ydot)
         with KERNEL_LOCK:
             levels = level_starts(model, np.radians(spec.psi0_deg), spec.zeta0s, guess=guess)
+        chunks, arguments = [], []
         for index, level in enumerate(levels):
             seeds = trial_seeds(spec.seed, index, spec.trials)
             for chunk in self._missing_chunks(job_id, index, spec.trials):
+                chunks.append((index, level.zeta0, chunk, seeds[chunk]))
+                arguments.append((model, level.schedule, level.start, noise, seeds[chunk], spec.cap))
+        if self._cancelled(job_id):
+            return
+        results = self._execute(arguments)
+        try:
+            for chunk, (jumps, status) in results:
+                level, zeta0, indices, seeds = chunks[chunk]
+                self._commit_chunk(job_id, level, zeta0, indices, seeds, jumps, status)
                 if self._cancelled(job_id):
                     return
-                with KERNEL_LOCK:
-                    jumps, status = run_trials(model, level.schedule, level.start, noise, seeds[chunk], spec.cap)
-                self._commit_chunk(job_id, index, level.zeta0, chunk, seeds[chunk], jumps, status)
+        finally:
+            results.close()  # on a Dask cluster, cancels the chunks not yet finished
         with self.sessions() as session:
             job = session.get(Job, job_id)
             job.state, job.finished_at = "done", utcnow()
             session.commit()
+
+    def _execute(self, arguments: list[tuple]) -> Iterator[tuple[int, tuple[np.ndarray, np.ndarray]]]:
+        """``(chunk index, result)`` as chunks finish: here in order, or on the Dask cluster."""
+        if self.dask_address is None:
+            for index, chunk in enumerate(arguments):
+                with KERNEL_LOCK:
+                    result = run_trials(*chunk)
+                yield index, result
+            return
+        with dask_client(self.dask_address) as client:
+            yield from as_completed_results(client, run_trials, arguments)
 
     def _missing_chunks(self, job_id: int, level: int, trials: int) -> list[np.ndarray]:
         with self.sessions() as session:

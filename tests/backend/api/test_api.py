@@ -219,3 +219,20 @@ def test_quick_fixed_point(client):
     body = {"controls": [{"psi0_deg": 30, "zeta0": 0.9}], "guess": {"xdot": -0.9, "ydot": -0.2}}
     gait = client.post("/api/v1/sim/fixed-point", json=body).json()
     assert gait["period"] == 1 and gait["stable"] and gait["max_abs_eigenvalue"] == pytest.approx(0.8486, abs=1e-4)
+
+
+def test_concurrent_clients_do_not_corrupt_state(client, auth):
+    from concurrent.futures import ThreadPoolExecutor
+
+    experiment = client.post("/api/v1/experiments", json={"name": "busy"}, headers=auth).json()["id"]
+
+    def create(i):
+        body = RUN | {"experiment_id": experiment, "jumps": 2, "tags": [f"t{i % 3}"]}
+        return client.post("/api/v1/runs", json=body, headers=auth).status_code
+
+    with ThreadPoolExecutor(8) as pool:
+        codes = list(pool.map(create, range(40)))
+    assert codes == [201] * 40
+    assert client.get(f"/api/v1/experiments/{experiment}").json()["runs"] == 40
+    counts = {g["key"]: g["runs"] for g in client.get("/api/v1/runs/aggregate", params={"by": "tag"}).json()["groups"]}
+    assert counts == {"t0": 14, "t1": 13, "t2": 13}
