@@ -6,11 +6,12 @@ import datetime
 import math
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, field_validator, model_validator
+from pydantic import Tag as KindTag
 
 Psi0Deg = Annotated[float, Field(gt=0.0, lt=90.0, description="leg angle at touchdown [degrees], in (0, 90)")]
 Zeta0 = Annotated[float, Field(gt=0.0, lt=1.0, description="leg length at touchdown [l0], in (0, 1)")]
-Tag = Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[\w.:/-]+$")]
+Label = Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[\w.:/-]+$")]  # a tag
 
 MAX_JUMPS = 10_000
 MAX_TRIALS = 100_000
@@ -54,7 +55,7 @@ class RunCreate(Strict):
     trajectory_rate: Annotated[float, Field(gt=0.0, le=1000.0)] | None = Field(
         None, description="also store the sampled path, samples per sqrt(l0/g)"
     )
-    tags: Annotated[list[Tag], Field(max_length=32)] = []
+    tags: Annotated[list[Label], Field(max_length=32)] = []
 
     @model_validator(mode="after")
     def _bounded_path(self) -> RunCreate:
@@ -97,14 +98,14 @@ class ExperimentCreate(Strict):
     name: Annotated[str, Field(min_length=1, max_length=200)]
     description: Annotated[str, Field(max_length=10_000)] = ""
     notes: Annotated[str, Field(max_length=100_000)] = ""
-    tags: Annotated[list[Tag], Field(max_length=32)] = []
+    tags: Annotated[list[Label], Field(max_length=32)] = []
 
 
 class ExperimentUpdate(Strict):
     name: Annotated[str, Field(min_length=1, max_length=200)] | None = None
     description: Annotated[str, Field(max_length=10_000)] | None = None
     notes: Annotated[str, Field(max_length=100_000)] | None = None
-    tags: Annotated[list[Tag], Field(max_length=32)] | None = None
+    tags: Annotated[list[Label], Field(max_length=32)] | None = None
 
 
 class ExperimentOut(BaseModel):
@@ -149,6 +150,71 @@ class MJTFJobCreate(Strict):
         return values
 
 
+class SweepJobCreate(Strict):
+    """An energy sweep: the gait followed over zeta0, with basin areas (``basin_grid`` 0: none)."""
+
+    kind: Literal["sweep"]
+    experiment_id: RecordRef | None = None
+    model: ModelIn = ModelIn()
+    psi0_deg: Psi0Deg = 30.0
+    zeta0_low: Zeta0 = 0.8
+    zeta0_high: Zeta0 = 0.97
+    steps: Annotated[int, Field(ge=2, le=500)] = 30
+    basin_grid: Annotated[int, Field(ge=0, le=200)] = 40
+    basin_jumps: Annotated[int, Field(ge=1, le=1000)] = 60
+    guess: StateIn | None = None
+
+    @model_validator(mode="after")
+    def _ordered(self) -> SweepJobCreate:
+        if not self.zeta0_low < self.zeta0_high:
+            raise ValueError(f"zeta0_low must be below zeta0_high, got {self.zeta0_low:g} >= {self.zeta0_high:g}")
+        if self.basin_grid == 1:
+            raise ValueError("basin_grid must be 0 (no basins) or at least 2")
+        return self
+
+
+class BasinJobCreate(Strict):
+    """The basin of attraction of a gait over a grid of section states."""
+
+    kind: Literal["basin"]
+    experiment_id: RecordRef | None = None
+    model: ModelIn = ModelIn()
+    controls: Annotated[list[LegIn], Field(min_length=1, max_length=16)]
+    period: Annotated[int, Field(ge=1, le=16)] | None = None
+    guess: StateIn | None = None
+    grid: Annotated[int, Field(ge=2, le=1000)] = 100
+    jumps: Annotated[int, Field(ge=1, le=1000)] = 60
+    tolerance: Annotated[float, Field(gt=0.0, lt=10.0)] = 0.02
+
+
+class GaitSearchJobCreate(Strict):
+    """Distinct gaits of one control schedule, from a grid of guesses."""
+
+    kind: Literal["gaits"]
+    experiment_id: RecordRef | None = None
+    model: ModelIn = ModelIn()
+    controls: Annotated[list[LegIn], Field(min_length=1, max_length=16)]
+    period: Annotated[int, Field(ge=1, le=16)] | None = None
+    grid: Annotated[int, Field(ge=1, le=20)] = 6
+
+
+def _job_kind(value) -> str:
+    """The job's ``kind``; MJTF when absent (the first kind, which clients may leave out)."""
+    if isinstance(value, dict):
+        return value.get("kind", "mjtf")
+    return getattr(value, "kind", "mjtf")
+
+
+JobCreate = Annotated[
+    Annotated[MJTFJobCreate, KindTag("mjtf")]
+    | Annotated[SweepJobCreate, KindTag("sweep")]
+    | Annotated[BasinJobCreate, KindTag("basin")]
+    | Annotated[GaitSearchJobCreate, KindTag("gaits")],
+    Discriminator(_job_kind),
+]
+JOB_KINDS = {"mjtf": MJTFJobCreate, "sweep": SweepJobCreate, "basin": BasinJobCreate, "gaits": GaitSearchJobCreate}
+
+
 class JobOut(BaseModel):
     id: int
     experiment_id: int | None
@@ -174,7 +240,8 @@ class MJTFLevelOut(BaseModel):
 
 class JobResults(BaseModel):
     job: JobOut
-    levels: list[MJTFLevelOut]
+    levels: list[MJTFLevelOut] | None = Field(None, description="MJTF jobs: per energy level")
+    result: dict | None = Field(None, description="other jobs: the study's result, once done")
 
 
 class MapIn(Strict):

@@ -278,7 +278,7 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
 
     # Jobs
     @app.post("/api/v1/jobs", status_code=202, dependencies=AUTHORIZED, response_model=schemas.JobOut, tags=["jobs"])
-    def create_job(body: schemas.MJTFJobCreate, db: Db):
+    def create_job(body: schemas.JobCreate, db: Db):
         job = jobs.create_job(db, body)
         if run_jobs:
             runner.submit(job.id)
@@ -301,6 +301,8 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
     @app.get("/api/v1/jobs/{job_id}/results", response_model=schemas.JobResults, tags=["jobs"])
     def job_results(job_id: RecordId, db: Db):
         job = jobs.get_job(db, job_id)
+        if job.kind != "mjtf":
+            return {"job": _job_out(job), "result": job.result}
         return {"job": _job_out(job), "levels": [_finite(level) for level in jobs.level_summaries(db, job)]}
 
     @app.get("/api/v1/jobs/{job_id}/events", tags=["jobs"], response_class=StreamingResponse)

@@ -21,11 +21,13 @@ import numpy as np
 from sqlalchemy import func, select, update
 from sqlalchemy.orm import Session, sessionmaker
 
-from backend.schemas import MJTFJobCreate
+from backend.schemas import JOB_KINDS, MJTFJobCreate
 from backend.services.records import NotFound, get_experiment
-from backend.services.simulation import KERNEL_LOCK, current_code_version, model_params
+from backend.services.simulation import KERNEL_LOCK, current_code_version, locked_chunk_map, model_params, run_study
 from backend.store.models import Job, Trial, utcnow
-from experiments.cluster import as_completed_results, dask_client
+from experiments.cluster import as_completed_results, chunk_map_for, dask_client
+from experiments.report import json_safe
+from sim_core.chunks import Cancelled
 from sim_core.failures import OK, Failure
 from sim_core.mjtf import level_starts, run_trials
 from sim_core.noise import NoiseModel, trial_seeds
@@ -37,7 +39,8 @@ ACTIVE = ("queued", "running", "cancelling")
 FINAL = ("done", "cancelled", "failed")
 
 
-def create_job(session: Session, body: MJTFJobCreate) -> Job:
+def create_job(session: Session, body) -> Job:
+    """Store a job (any of ``schemas.JOB_KINDS``); MJTF totals count trials, other kinds chunks."""
     if body.experiment_id is not None:
         get_experiment(session, body.experiment_id)
     job = Job(
@@ -45,7 +48,7 @@ def create_job(session: Session, body: MJTFJobCreate) -> Job:
         kind=body.kind,
         spec=body.model_dump(mode="json"),
         state="queued",
-        total=len(body.zeta0s) * body.trials,
+        total=len(body.zeta0s) * body.trials if body.kind == "mjtf" else 1,
         code_version=current_code_version(),
     )
     session.add(job)
@@ -159,7 +162,10 @@ class JobRunner:
             job.state = "running"
             job.started_at = job.started_at or utcnow()
             session.commit()
-            spec = MJTFJobCreate(**job.spec)
+            kind, spec = job.kind, JOB_KINDS[job.kind](**job.spec)
+        if kind != "mjtf":
+            self._run_study(job_id, spec)
+            return
         model = model_params(spec.model)
         noise = NoiseModel(**spec.noise.model_dump())
         guess = None if spec.guess is None else (spec.guess.xdot, spec.guess.ydot)
@@ -184,6 +190,37 @@ class JobRunner:
             results.close()  # on a Dask cluster, cancels the chunks not yet finished
         with self.sessions() as session:
             job = session.get(Job, job_id)
+            job.state, job.finished_at = "done", utcnow()
+            session.commit()
+
+    def _run_study(self, job_id: int, spec) -> None:
+        """Sweeps, basins and gait searches: computed whole (a restart recomputes them — they are
+        deterministic), chunked through the chunk map, progress per chunk, result stored at the end."""
+
+        def progress(done: int, total: int) -> None:
+            with self.sessions() as session:
+                job = session.get(Job, job_id)
+                if job.state == "cancelling":
+                    raise Cancelled
+                job.completed, job.total = done, total
+                session.commit()
+
+        try:
+            if self.dask_address is None:
+                result = run_study(spec, locked_chunk_map, progress)
+            else:
+                with chunk_map_for(self.dask_address) as chunk_map:
+                    result = run_study(spec, chunk_map, progress)
+        except Cancelled:
+            with self.sessions() as session:
+                job = session.get(Job, job_id)
+                job.state, job.finished_at = "cancelled", utcnow()
+                session.commit()
+            return
+        with self.sessions() as session:
+            job = session.get(Job, job_id)
+            job.result = json_safe(result)
+            job.completed = job.total
             job.state, job.finished_at = "done", utcnow()
             session.commit()
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import math
 import threading
 import time
 import zlib
@@ -13,7 +14,9 @@ import numpy as np
 from backend.schemas import FixedPointIn, LegIn, MapIn, ModelIn, RunCreate
 from experiments.report import code_version, json_safe
 from sim_core import ControlSchedule, ModelParams, get_preset, iterate_map, simulate_trajectory
+from sim_core.basin import BasinGrid, compute_basin
 from sim_core.fixed_points import find_fixed_point, search_gaits
+from sim_core.sweep import DEFAULT_BASIN_WINDOW, energy_sweep, zeta0_values
 from sim_core.validation import ParameterError
 
 _CODE_VERSION = None
@@ -57,6 +60,63 @@ def fixed_point(body: FixedPointIn) -> dict:
         else:
             gait = find_fixed_point(model, schedule, period, (body.guess.xdot, body.guess.ydot))
     return {**gait.to_dict(), "orbit": gait.orbit.tolist(), "motion": gait.motion}
+
+
+def locked_chunk_map(function, arguments, progress=None) -> list:
+    """:func:`sim_core.chunks.in_process` with each chunk under :data:`KERNEL_LOCK`: chunks are the
+    parallel kernels, and holding the lock per chunk lets API calls interleave with a long study."""
+    results = []
+    for done, chunk in enumerate(arguments, start=1):
+        with KERNEL_LOCK:
+            results.append(function(*chunk))
+        if progress is not None:
+            progress(done, len(arguments))
+    return results
+
+
+def run_study(spec, chunk_map, progress) -> dict:
+    """A sweep, basin or gait-search job's computation; returns its JSON result."""
+    model = model_params(spec.model)
+    if spec.kind == "sweep":
+        psi0 = math.radians(spec.psi0_deg)
+        grid = None if spec.basin_grid == 0 else BasinGrid(*DEFAULT_BASIN_WINDOW, spec.basin_grid)
+        guess = None if spec.guess is None else (spec.guess.xdot, spec.guess.ydot)
+        sweep = energy_sweep(
+            model,
+            psi0,
+            zeta0_values(spec.zeta0_low, spec.zeta0_high, spec.steps),
+            guess=guess,
+            basin_grid=grid,
+            basin_jumps=spec.basin_jumps,
+            chunk_map=chunk_map,
+            progress=progress,
+        )
+        return sweep.to_dict()
+    schedule = schedule_of(spec.controls)
+    period = spec.period or len(schedule)
+    if spec.kind == "gaits":
+        gaits = search_gaits(model, schedule, period, grid=(spec.grid, spec.grid))
+        progress(1, 1)
+        return {"gaits": [{**gait.to_dict(), "motion": gait.motion, "orbit": gait.orbit.tolist()} for gait in gaits]}
+    # basin
+    if spec.guess is None:
+        gaits = search_gaits(model, schedule, period)
+        if not gaits:
+            raise ParameterError("controls", f"no period-{period} gait found from a grid of guesses; give a guess")
+        gait = gaits[0]
+    else:
+        gait = find_fixed_point(model, schedule, period, (spec.guess.xdot, spec.guess.ydot))
+    basin = compute_basin(
+        model,
+        schedule,
+        gait,
+        BasinGrid.around(gait.state, spec.grid),
+        max_jumps=spec.jumps,
+        tolerance=spec.tolerance,
+        chunk_map=chunk_map,
+        progress=progress,
+    )
+    return basin.to_dict()
 
 
 def simulate_run(body: RunCreate) -> dict:

@@ -98,12 +98,13 @@ class Job(Base):
 
     id: Mapped[int] = mapped_column(primary_key=True)
     experiment_id: Mapped[int | None] = mapped_column(ForeignKey("experiments.id", ondelete="RESTRICT"), index=True)
-    kind: Mapped[str] = mapped_column(String(16))  # mjtf
+    kind: Mapped[str] = mapped_column(String(16))  # mjtf | sweep | basin | gaits
     spec: Mapped[dict]
     state: Mapped[str] = mapped_column(String(16), index=True)  # queued running cancelling cancelled done failed
     total: Mapped[int]
     completed: Mapped[int] = mapped_column(default=0)
     error: Mapped[str | None] = mapped_column(Text)
+    result: Mapped[dict | None]  # studies other than MJTF: their result once done (MJTF's are its trials)
     code_version: Mapped[str] = mapped_column(String(64))
     created_at: Mapped[datetime.datetime] = mapped_column(default=utcnow, index=True)
     updated_at: Mapped[datetime.datetime] = mapped_column(default=utcnow, onupdate=utcnow)

@@ -236,3 +236,36 @@ def test_concurrent_clients_do_not_corrupt_state(client, auth):
     assert client.get(f"/api/v1/experiments/{experiment}").json()["runs"] == 40
     counts = {g["key"]: g["runs"] for g in client.get("/api/v1/runs/aggregate", params={"by": "tag"}).json()["groups"]}
     assert counts == {"t0": 14, "t1": 13, "t2": 13}
+
+
+def test_sweep_basin_and_gait_search_jobs(client, auth):
+    specs = {
+        "sweep": {"kind": "sweep", "zeta0_low": 0.9, "zeta0_high": 0.97, "steps": 4, "basin_grid": 8,
+                  "guess": {"xdot": -0.93, "ydot": -0.2}},
+        "basin": {"kind": "basin", "controls": [{"psi0_deg": 30, "zeta0": 0.9}], "grid": 12, "jumps": 30,
+                  "guess": {"xdot": -0.9, "ydot": -0.2}},
+        "gaits": {"kind": "gaits", "controls": [{"psi0_deg": 30, "zeta0": 0.9}], "grid": 2},
+    }  # fmt: skip
+    ids = {kind: client.post("/api/v1/jobs", json=spec, headers=auth).json()["id"] for kind, spec in specs.items()}
+    results = {}
+    for kind, job_id in ids.items():
+        job = _wait(client, job_id)
+        assert job["state"] == "done" and job["completed"] == job["total"], job
+        results[kind] = client.get(f"/api/v1/jobs/{job_id}/results").json()["result"]
+    assert len(results["sweep"]["points"]) == 4 and len(results["sweep"]["in_place_zeta0"]) == 1
+    assert sum(results["basin"]["counts"].values()) == 144 and results["basin"]["counts"]["converged"] > 0
+    assert results["gaits"]["gaits"][0]["period"] == 1
+
+
+@pytest.mark.parametrize(
+    ("spec", "field"),
+    [
+        ({"kind": "sweep", "zeta0_low": 0.95, "zeta0_high": 0.9}, "sweep"),
+        ({"kind": "basin", "controls": [{"psi0_deg": 30, "zeta0": 0.9}], "grid": 10**6}, "grid"),
+        ({"kind": "atlas"}, "kind"),
+    ],
+)
+def test_bad_study_specs_are_a_422(client, auth, spec, field):
+    response = client.post("/api/v1/jobs", json=spec, headers=auth)
+    assert response.status_code == 422, response.text
+    assert field in str(response.json()["detail"])

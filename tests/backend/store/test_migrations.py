@@ -23,3 +23,17 @@ def test_sqlite_runs_in_wal_mode_with_foreign_keys(tmp_path):
     with engine.connect() as connection:
         assert connection.exec_driver_sql("PRAGMA journal_mode").scalar() == "wal"
         assert connection.exec_driver_sql("PRAGMA foreign_keys").scalar() == 1
+
+
+def test_upgrade_from_the_previous_revision_keeps_the_data(tmp_path):
+    engine = make_engine(sqlite_url(tmp_path))
+    migrate(engine, "0001")
+    with engine.begin() as connection:
+        connection.exec_driver_sql(
+            "INSERT INTO jobs (kind, spec, state, total, completed, code_version, created_at, updated_at) "
+            "VALUES ('mjtf', '{}', 'done', 8, 8, 'old', '2026-01-01 00:00:00', '2026-01-01 00:00:00')"
+        )
+    migrate(engine)
+    with engine.connect() as connection:
+        row = connection.exec_driver_sql("SELECT kind, total, code_version, result FROM jobs").one()
+    assert tuple(row) == ("mjtf", 8, "old", None)
