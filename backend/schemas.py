@@ -251,6 +251,14 @@ class MapIn(Strict):
     jumps: Annotated[int, Field(ge=1, le=1000)] = 1
 
 
+class TrajectoryIn(Strict):
+    model: ModelIn = ModelIn()
+    controls: Annotated[list[LegIn], Field(min_length=1, max_length=16)]
+    start: StateIn
+    jumps: Annotated[int, Field(ge=1, le=50)] = 4
+    rate: Annotated[float, Field(gt=0.0, le=500.0, description="samples per sqrt(l0/g)")] = 60.0
+
+
 class FixedPointIn(Strict):
     model: ModelIn = ModelIn()
     controls: Annotated[list[LegIn], Field(min_length=1, max_length=16)]

@@ -224,8 +224,17 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
         return _run_out(records.create_run(db, body), detail=True)
 
     @app.get("/api/v1/runs", response_model=schemas.Page, tags=["runs"])
-    def list_runs(db: Db, where: RunQuery, limit: PageLimit = 50, cursor: Cursor = None):
-        rows, next_cursor = records.list_runs(db, where, limit=limit, cursor=cursor)
+    def list_runs(
+        db: Db,
+        where: RunQuery,
+        limit: PageLimit = 50,
+        cursor: Cursor = None,
+        sort: Annotated[str, Query(pattern=f"^({'|'.join(records.SORTS)})$", description="-climb: best first")] = "-id",
+        offset: Annotated[int, Query(ge=0, le=10_000_000, description="for sorts other than id")] = 0,
+    ):
+        """Runs matching the filters. Sorted by id, ``next_cursor`` pages by keyset; sorted by another
+        field, pass ``next_cursor`` back as ``offset``."""
+        rows, next_cursor = records.list_runs(db, where, limit=limit, cursor=cursor, sort=sort, offset=offset)
         return {"items": [_run_out(row) for row in rows], "next_cursor": next_cursor}
 
     @app.get("/api/v1/runs/export", tags=["runs"], response_class=StreamingResponse)
@@ -344,6 +353,11 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
     @app.post("/api/v1/sim/map", tags=["simulate"])
     def sim_map(body: schemas.MapIn) -> dict:
         return simulation.map_orbit(body)
+
+    @app.post("/api/v1/sim/trajectory", tags=["simulate"])
+    def sim_trajectory(body: schemas.TrajectoryIn) -> dict:
+        """The sampled path in wall coordinates (nondimensional), for drawing; not stored."""
+        return simulation.trajectory_columns(body)
 
     @app.post("/api/v1/sim/fixed-point", tags=["simulate"])
     def sim_fixed_point(body: schemas.FixedPointIn) -> dict:

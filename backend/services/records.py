@@ -115,12 +115,25 @@ class RunFilter:
     created_before: datetime.datetime | None = None
 
 
-def list_runs(session: Session, where: RunFilter, *, limit: int, cursor: int | None) -> tuple[list[Run], int | None]:
-    """A page of runs, newest first; ``cursor`` is the last id of the previous page."""
-    query = _filtered(select(Run).order_by(Run.id.desc()).limit(limit + 1), where)
-    if cursor is not None:
-        query = query.where(Run.id < cursor)
-    return _page(list(session.scalars(query)), limit)
+SORTS = ("-id", "id", "-created_at", "created_at", "-climb", "climb", "-zeta0", "zeta0", "-duration_s", "duration_s")
+
+
+def list_runs(
+    session: Session, where: RunFilter, *, limit: int, cursor: int | None, sort: str = "-id", offset: int = 0
+) -> tuple[list[Run], int | None]:
+    """A page of runs. By id (newest first by default) pages by keyset: ``cursor`` is the last id
+    of the previous page. Other orders (``-climb``: best first) page by ``offset``; the returned
+    cursor is then the next offset."""
+    descending = sort.startswith("-")
+    column = getattr(Run, sort.lstrip("-"))
+    order = [column.desc() if descending else column.asc(), Run.id.desc() if descending else Run.id.asc()]
+    query = _filtered(select(Run).order_by(*order).limit(limit + 1), where)
+    if sort.lstrip("-") == "id":
+        if cursor is not None:
+            query = query.where(Run.id < cursor if descending else Run.id > cursor)
+        return _page(list(session.scalars(query)), limit)
+    rows = list(session.scalars(query.offset(offset)))
+    return rows[:limit], (offset + limit if len(rows) > limit else None)
 
 
 def _filtered(query, where: RunFilter):

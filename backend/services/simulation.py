@@ -11,7 +11,7 @@ from dataclasses import asdict, replace
 
 import numpy as np
 
-from backend.schemas import FixedPointIn, LegIn, MapIn, ModelIn, RunCreate
+from backend.schemas import FixedPointIn, LegIn, MapIn, ModelIn, RunCreate, TrajectoryIn
 from experiments.report import code_version, json_safe
 from sim_core import ControlSchedule, ModelParams, get_preset, iterate_map, simulate_trajectory
 from sim_core.basin import BasinGrid, compute_basin
@@ -46,6 +46,21 @@ def map_orbit(body: MapIn) -> dict:
     start = (body.start.xdot, body.start.ydot)
     with KERNEL_LOCK:
         return iterate_map(model_params(body.model), schedule_of(body.controls), start, body.jumps).to_dict()
+
+
+def trajectory_columns(body: TrajectoryIn) -> dict:
+    start = (body.start.xdot, body.start.ydot)
+    path = simulate_trajectory(
+        model_params(body.model), schedule_of(body.controls), start, body.jumps, sample_rate=body.rate
+    )
+    return json_safe(
+        {
+            "units": path.units,
+            "columns": path.columns(),
+            "touchdown_times": path.touchdown_times,
+            "failure": None if path.failure is None else {"code": path.failure.code, "jump": path.failed_jump},
+        }
+    )
 
 
 def fixed_point(body: FixedPointIn) -> dict:

@@ -269,3 +269,22 @@ def test_bad_study_specs_are_a_422(client, auth, spec, field):
     response = client.post("/api/v1/jobs", json=spec, headers=auth)
     assert response.status_code == 422, response.text
     assert field in str(response.json()["detail"])
+
+
+def test_sorting_best_first_pages_by_offset(client, auth):
+    for zeta0 in (0.9, 0.84, 0.94, 0.88):
+        body = RUN | {"controls": [{"psi0_deg": 30, "zeta0": zeta0}]}
+        client.post("/api/v1/runs", json=body, headers=auth)
+    first = client.get("/api/v1/runs", params={"sort": "-climb", "limit": 3}).json()
+    climbs = [run["climb"] for run in first["items"]]
+    assert climbs == sorted(climbs, reverse=True) and first["next_cursor"] == 3
+    rest = client.get("/api/v1/runs", params={"sort": "-climb", "limit": 3, "offset": 3}).json()
+    assert len(rest["items"]) == 1 and rest["next_cursor"] is None and rest["items"][0]["climb"] < climbs[-1]
+    assert client.get("/api/v1/runs", params={"sort": "password"}).status_code == 422
+
+
+def test_quick_trajectory(client):
+    body = {k: RUN[k] for k in ("controls", "start")} | {"jumps": 2, "rate": 50}
+    path = client.post("/api/v1/sim/trajectory", json=body).json()
+    assert path["units"] == "nondimensional" and len(path["touchdown_times"]) == 3
+    assert len(path["columns"]["x"]) == len(path["columns"]["time"]) > 50 and path["failure"] is None
