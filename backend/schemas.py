@@ -17,7 +17,7 @@ MAX_JUMPS = 10_000
 MAX_TRIALS = 100_000
 MAX_LEVELS = 100
 MAX_PATH_SAMPLES = 100_000
-MAX_ID = 2**63 - 1  # the databases' integer keys
+MAX_ID = 2**31 - 1  # integer keys: the smallest range among the supported databases (PostgreSQL)
 RecordRef = Annotated[int, Field(ge=1, le=MAX_ID)]
 
 

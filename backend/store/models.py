@@ -10,7 +10,18 @@ from __future__ import annotations
 import datetime
 from typing import ClassVar
 
-from sqlalchemy import JSON, DateTime, ForeignKey, Index, LargeBinary, String, Text, TypeDecorator, UniqueConstraint
+from sqlalchemy import (
+    JSON,
+    BigInteger,
+    DateTime,
+    ForeignKey,
+    Index,
+    LargeBinary,
+    String,
+    Text,
+    TypeDecorator,
+    UniqueConstraint,
+)
 from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column, relationship
 
 
@@ -124,7 +135,7 @@ class Trial(Base):
     level: Mapped[int]
     index: Mapped[int]
     zeta0: Mapped[float]
-    seed: Mapped[int]
+    seed: Mapped[int] = mapped_column(BigInteger)  # 32-bit unsigned: beyond PostgreSQL's INTEGER
     jumps: Mapped[int]
     failure_code: Mapped[str | None] = mapped_column(String(32))
 
