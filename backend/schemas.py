@@ -56,6 +56,7 @@ class RunCreate(Strict):
         None, description="also store the sampled path, samples per sqrt(l0/g)"
     )
     tags: Annotated[list[Label], Field(max_length=32)] = []
+    fixed_point: bool = Field(False, description="also find the gait near the start state and store its eigenvalues")
 
     @model_validator(mode="after")
     def _bounded_path(self) -> RunCreate:
@@ -64,6 +65,12 @@ class RunCreate(Strict):
             samples = self.trajectory_rate * self.jumps
             raise ValueError(f"trajectory_rate x jumps must be at most {MAX_PATH_SAMPLES:,}, got {samples:g}")
         return self
+
+
+class RunUpdate(Strict):
+    """Runs are records of what happened: only their labels change."""
+
+    tags: Annotated[list[Label], Field(max_length=32)]
 
 
 class RunOut(BaseModel):

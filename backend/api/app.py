@@ -281,6 +281,10 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
         columns = simulation.unpack_trajectory(run.trajectory)
         return {"units": "nondimensional", "columns": {name: values.tolist() for name, values in columns.items()}}
 
+    @app.patch("/api/v1/runs/{run_id}", dependencies=AUTHORIZED, response_model=schemas.RunOut, tags=["runs"])
+    def update_run(run_id: RecordId, body: schemas.RunUpdate, db: Db):
+        return _run_out(records.update_run_tags(db, run_id, body.tags))
+
     @app.delete("/api/v1/runs/{run_id}", status_code=204, dependencies=AUTHORIZED, tags=["runs"])
     def delete_run(run_id: RecordId, db: Db) -> None:
         records.delete_run(db, run_id)

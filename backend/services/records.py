@@ -95,6 +95,13 @@ def get_run(session: Session, run_id: int) -> Run:
     return run
 
 
+def update_run_tags(session: Session, run_id: int, tags: list[str]) -> Run:
+    run = get_run(session, run_id)
+    run.run_tags = [RunTag(tag=tag) for tag in sorted(set(tags))]
+    session.commit()
+    return run
+
+
 def delete_run(session: Session, run_id: int) -> None:
     session.delete(get_run(session, run_id))
     session.commit()

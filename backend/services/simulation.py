@@ -13,7 +13,7 @@ import numpy as np
 
 from backend.schemas import FixedPointIn, LegIn, MapIn, ModelIn, RunCreate, TrajectoryIn
 from experiments.report import code_version, json_safe
-from sim_core import ControlSchedule, ModelParams, get_preset, iterate_map, simulate_trajectory
+from sim_core import ControlSchedule, FixedPointNotFound, ModelParams, get_preset, iterate_map, simulate_trajectory
 from sim_core.basin import BasinGrid, compute_basin
 from sim_core.fixed_points import find_fixed_point, search_gaits
 from sim_core.sweep import DEFAULT_BASIN_WINDOW, energy_sweep, zeta0_values
@@ -146,6 +146,8 @@ def simulate_run(body: RunCreate) -> dict:
             path = simulate_trajectory(model, schedule, start, body.jumps, sample_rate=body.trajectory_rate)
             trajectory = pack_trajectory(path.columns())
     results = orbit.to_dict()
+    if body.fixed_point:
+        results["fixed_point"] = _gait_near(model, schedule, start)
     return {
         "kind": "sim",
         "status": "done",
@@ -164,6 +166,16 @@ def simulate_run(body: RunCreate) -> dict:
         "results": json_safe(results),
         "trajectory": trajectory,
     }
+
+
+def _gait_near(model, schedule, start) -> dict:
+    """The period-m gait nearest the start state (m: the schedule length), or why there is none."""
+    try:
+        with KERNEL_LOCK:
+            gait = find_fixed_point(model, schedule, len(schedule), start)
+    except FixedPointNotFound as error:
+        return {"found": False, "reason": str(error)}
+    return {"found": True, **gait.to_dict(), "orbit": gait.orbit.tolist(), "motion": gait.motion}
 
 
 def pack_trajectory(columns: dict[str, np.ndarray]) -> bytes:

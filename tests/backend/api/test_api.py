@@ -288,3 +288,16 @@ def test_quick_trajectory(client):
     path = client.post("/api/v1/sim/trajectory", json=body).json()
     assert path["units"] == "nondimensional" and len(path["touchdown_times"]) == 3
     assert len(path["columns"]["x"]) == len(path["columns"]["time"]) > 50 and path["failure"] is None
+
+
+def test_run_with_fixed_point_and_retagging(client, auth):
+    run = client.post("/api/v1/runs", json=RUN | {"fixed_point": True}, headers=auth).json()
+    gait = run["results"]["fixed_point"]
+    assert gait["found"] and gait["period"] == 1 and gait["max_abs_eigenvalue"] == pytest.approx(0.8486, abs=1e-4)
+    lost = client.post(
+        "/api/v1/runs", json=RUN | {"fixed_point": True, "start": {"xdot": -0.3, "ydot": 5.0}}, headers=auth
+    ).json()
+    assert lost["results"]["fixed_point"]["found"] is False and lost["failure_code"] == "no_flight"
+    retagged = client.patch(f"/api/v1/runs/{run['id']}", json={"tags": ["keep", "keep", "best"]}, headers=auth)
+    assert retagged.json()["tags"] == ["best", "keep"]
+    assert client.patch(f"/api/v1/runs/{run['id']}", json={"climb": 9}, headers=auth).status_code == 422
