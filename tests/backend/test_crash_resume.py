@@ -60,6 +60,7 @@ def test_kill_nine_mid_job_resumes_exactly(tmp_path):
         os.kill(first.pid, signal.SIGKILL)
         first.wait()
     assert 0 < completed < total, f"the kill must land mid-job (completed {completed} of {total})"
+    print(f"SIGKILL with {completed} of {total} trials committed")
 
     second = _start(data_dir, port)
     try:
@@ -78,6 +79,7 @@ def test_kill_nine_mid_job_resumes_exactly(tmp_path):
             {"job": job["id"]},
         ).all()
     assert len(rows) == total == len({(level, index) for level, index, _ in rows}), "none lost, none duplicated"
+    print(f"after restart: {len(rows)} trials, {len({(level, index) for level, index, _ in rows})} distinct")
     study = mjtf_study(
         get_preset("paper").to_model(), math.radians(30), SPEC["zeta0s"], noise=NoiseModel(),
         trials=SPEC["trials"], cap=SPEC["cap"], seed=SPEC["seed"], guess=(-0.93, 0.1),
