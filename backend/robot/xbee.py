@@ -1,0 +1,156 @@
+"""XBee API frames in escaped mode (AP=2), per Digi's API-mode documentation.
+
+A frame on the wire is ``0x7E``, a 16-bit big-endian length of the frame data, the frame data,
+and a checksum ``0xFF - (sum(frame data) & 0xFF)``. After the start byte, every ``0x7E 0x7D 0x11
+0x13`` (length and checksum included) is sent as ``0x7D`` followed by the byte XOR ``0x20``. The
+checksum is computed on the unescaped data.
+
+:class:`FrameParser` reads a byte stream of any chunking and yields the frames' data. It
+resynchronises on the next ``0x7E`` after garbage, a bad checksum, a frame cut short by a new
+start byte, or an impossible length, and counts each kind; it never raises on input.
+"""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass, field
+
+START = 0x7E
+ESCAPE = 0x7D
+XON = 0x11
+XOFF = 0x13
+SPECIAL = frozenset({START, ESCAPE, XON, XOFF})
+MAX_FRAME_DATA = 256  # far above our largest message; a longer length is corruption
+
+TX_REQUEST = 0x10  # frame types used by the link
+RX_PACKET = 0x90
+TX_STATUS = 0x8B
+BROADCAST_16 = 0xFFFE  # "address unknown": route by the 64-bit address
+
+
+class FrameError(ValueError):
+    """A frame's data is not the frame type it claims (raised by the typed decoders only)."""
+
+
+def checksum(data: bytes) -> int:
+    return 0xFF - (sum(data) & 0xFF)
+
+
+def escape(data: bytes) -> bytes:
+    out = bytearray()
+    for byte in data:
+        if byte in SPECIAL:
+            out += bytes((ESCAPE, byte ^ 0x20))
+        else:
+            out.append(byte)
+    return bytes(out)
+
+
+def encode_frame(data: bytes) -> bytes:
+    """One API frame, escaped, around ``data`` (frame type and payload)."""
+    if not 1 <= len(data) <= MAX_FRAME_DATA:
+        raise ValueError(f"frame data must be 1 to {MAX_FRAME_DATA} bytes, got {len(data)}")
+    return bytes((START,)) + escape(struct.pack(">H", len(data)) + data + bytes((checksum(data),)))
+
+
+@dataclass
+class ParserStats:
+    """What the parser saw: good frames and each kind of damage."""
+
+    frames: int = 0
+    bad_checksum: int = 0
+    truncated: int = 0  # a new start byte arrived before the frame was complete
+    bad_length: int = 0
+    garbage_bytes: int = 0  # bytes outside any frame
+
+
+@dataclass
+class FrameParser:
+    """Incremental decoder: ``feed(chunk)`` returns the data of every complete, valid frame."""
+
+    stats: ParserStats = field(default_factory=ParserStats)
+    _body: bytearray = field(default_factory=bytearray)  # unescaped bytes after the start byte
+    _in_frame: bool = False
+    _escaped: bool = False
+
+    def feed(self, chunk: bytes) -> list[bytes]:
+        frames = []
+        for byte in chunk:
+            if byte == START:
+                if self._in_frame and self._body:
+                    self.stats.truncated += 1
+                self._begin()
+                continue
+            if not self._in_frame:
+                self.stats.garbage_bytes += 1
+                continue
+            if self._escaped:
+                byte ^= 0x20
+                self._escaped = False
+            elif byte == ESCAPE:
+                self._escaped = True
+                continue
+            self._body.append(byte)
+            frame = self._complete()
+            if frame is not None:
+                frames.append(frame)
+        return frames
+
+    def _begin(self) -> None:
+        self._body.clear()
+        self._in_frame = True
+        self._escaped = False
+
+    def _complete(self) -> bytes | None:
+        body = self._body
+        if len(body) < 2:
+            return None
+        length = (body[0] << 8) | body[1]
+        if not 1 <= length <= MAX_FRAME_DATA:
+            self.stats.bad_length += 1
+            self._in_frame = False
+            return None
+        if len(body) < length + 3:
+            return None
+        data, received = bytes(body[2 : 2 + length]), body[2 + length]
+        self._in_frame = False
+        if checksum(data) != received:
+            self.stats.bad_checksum += 1
+            return None
+        self.stats.frames += 1
+        return data
+
+
+def tx_request(payload: bytes, *, frame_id: int, destination64: int, destination16: int = BROADCAST_16) -> bytes:
+    """Frame data of a Transmit Request (0x10) carrying ``payload`` (no broadcast radius, no options)."""
+    return struct.pack(">BBQHBB", TX_REQUEST, frame_id & 0xFF, destination64, destination16, 0, 0) + payload
+
+
+@dataclass(frozen=True)
+class Received:
+    """A Receive Packet (0x90)."""
+
+    source64: int
+    source16: int
+    options: int
+    payload: bytes
+
+
+def parse_rx_packet(data: bytes) -> Received:
+    if len(data) < 12 or data[0] != RX_PACKET:
+        raise FrameError(f"not a receive packet (0x90): {data[:1].hex() or 'empty'}, {len(data)} bytes")
+    _kind, source64, source16, options = struct.unpack(">BQHB", data[:12])
+    return Received(source64, source16, options, bytes(data[12:]))
+
+
+def parse_tx_request(data: bytes) -> tuple[int, int, bytes]:
+    """``(frame id, destination64, payload)`` of a Transmit Request — what a robot's radio receives."""
+    if len(data) < 14 or data[0] != TX_REQUEST:
+        raise FrameError(f"not a transmit request (0x10): {data[:1].hex() or 'empty'}, {len(data)} bytes")
+    _kind, frame_id, destination64, _destination16, _radius, _options = struct.unpack(">BBQHBB", data[:14])
+    return frame_id, destination64, bytes(data[14:])
+
+
+def rx_packet(payload: bytes, *, source64: int, source16: int = BROADCAST_16, options: int = 0x01) -> bytes:
+    """Frame data of a Receive Packet (0x90), as the PC's radio delivers the robot's messages."""
+    return struct.pack(">BQHB", RX_PACKET, source64, source16, options) + payload
