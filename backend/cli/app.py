@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import typer
 
-from backend.cli import analyses, bench, gaits, reproduce, serve, simulate
+from backend.cli import analyses, bench, gaits, reproduce, robot, serve, simulate
 
 app = typer.Typer(
     name="parkour",
@@ -20,7 +20,7 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     rich_markup_mode=None,
 )
-for sub_app in (serve.app, simulate.app, gaits.app, analyses.app, reproduce.app, bench.app):
+for sub_app in (serve.app, simulate.app, gaits.app, analyses.app, reproduce.app, robot.app, bench.app):
     app.add_typer(sub_app)
 
 

@@ -1,0 +1,114 @@
+"""The robot's side of protocol v1: what the firmware does, and what the virtual robot runs.
+
+A pure state machine: :meth:`Firmware.receive` takes a PC message and returns the replies;
+:meth:`Firmware.tick` runs the watchdog and the periodic heartbeat and telemetry. Safety rules
+(docs/protocol.md §3): commands outside the servo limits are refused; the e-stop latches until
+RESET; silence from the PC for ``heartbeat_timeout`` disarms and raises a fault.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from backend.robot.limits import ServoLimits
+from backend.robot.messages import (
+    Ack,
+    Command,
+    Fault,
+    Kind,
+    Leg,
+    Message,
+    Result,
+    RobotState,
+    SetLeg,
+    Telemetry,
+)
+
+HEARTBEAT_TIMEOUT = 1.0  # [s] silence from the PC after which the robot disarms
+HEARTBEAT_PERIOD = 0.2  # [s]
+TELEMETRY_PERIOD = 0.1  # [s]
+
+
+@dataclass
+class Firmware:
+    limits: ServoLimits = field(default_factory=ServoLimits)
+    heartbeat_timeout: float = HEARTBEAT_TIMEOUT
+    battery_mv: int = 7400
+    state: RobotState = RobotState.DISARMED
+    faults: int = 0
+    legs: dict[Leg, tuple[float, float]] = field(
+        default_factory=lambda: {Leg.LEFT: (30.0, 0.9), Leg.RIGHT: (30.0, 0.9)}
+    )
+    _seq: int = 0
+    _last_heard: float | None = None
+    _last_heartbeat_sent: float = float("-inf")
+    _last_telemetry_sent: float = float("-inf")
+
+    def receive(self, message: Message, now: float) -> list[Message]:
+        self._last_heard = now
+        if isinstance(message, SetLeg):
+            return [self._ack(message.seq, self._set_leg(message))]
+        if not isinstance(message, Command):
+            return []  # robot-bound traffic only
+        if message.kind == Kind.HEARTBEAT:
+            return []
+        result = self._command(message.kind)
+        return [self._ack(message.seq, result), self.telemetry()]
+
+    def tick(self, now: float) -> list[Message]:
+        out: list[Message] = []
+        silent = self._last_heard is None or now - self._last_heard > self.heartbeat_timeout
+        if silent and self.state in (RobotState.ARMED, RobotState.RUNNING):
+            self.state = RobotState.DISARMED
+            self.faults |= Fault.HEARTBEAT_LOST
+            out.append(self.telemetry())
+        if now - self._last_heartbeat_sent >= HEARTBEAT_PERIOD:
+            self._last_heartbeat_sent = now
+            out.append(Command(self._next_seq(), Kind.HEARTBEAT))
+        if now - self._last_telemetry_sent >= TELEMETRY_PERIOD:
+            self._last_telemetry_sent = now
+            out.append(self.telemetry())
+        return out
+
+    def telemetry(self) -> Telemetry:
+        left, right = self.legs[Leg.LEFT], self.legs[Leg.RIGHT]
+        return Telemetry(
+            self._next_seq(), self.state, (left[0], right[0]), (left[1], right[1]), self.battery_mv, self.faults
+        )
+
+    def _set_leg(self, message: SetLeg) -> Result:
+        if self.state == RobotState.ESTOPPED:
+            return Result.REJECTED_STATE
+        if not self.limits.allows(message.psi0_deg, message.zeta0):
+            self.faults |= Fault.SERVO_LIMIT
+            return Result.REJECTED_LIMITS
+        self.legs[message.leg] = (message.psi0_deg, message.zeta0)
+        return Result.OK
+
+    def _command(self, kind: Kind) -> Result:
+        if kind == Kind.ESTOP:
+            self.state = RobotState.ESTOPPED
+            return Result.OK
+        if kind == Kind.RESET:
+            if self.state == RobotState.ESTOPPED:
+                self.state = RobotState.DISARMED
+                self.faults = 0
+            return Result.OK
+        if self.state == RobotState.ESTOPPED:
+            return Result.REJECTED_STATE
+        if kind == Kind.ARM:
+            if self.state == RobotState.DISARMED:
+                self.state = RobotState.ARMED
+                self.faults &= ~Fault.HEARTBEAT_LOST
+            return Result.OK
+        if kind == Kind.DISARM:
+            self.state = RobotState.DISARMED
+            return Result.OK
+        return Result.UNKNOWN
+
+    def _ack(self, seq: int, result: Result) -> Ack:
+        return Ack(self._next_seq(), seq, result)
+
+    def _next_seq(self) -> int:
+        self._seq = (self._seq + 1) & 0xFFFF
+        return self._seq

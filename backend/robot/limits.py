@@ -1,0 +1,34 @@
+"""Servo limits: every leg command is checked against them on the PC and again on the robot."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from sim_core.validation import ParameterError, check_range
+
+
+@dataclass(frozen=True)
+class ServoLimits:
+    """What the leg servos can reach: leg angle [degrees] and length [l0] at touchdown."""
+
+    psi0_deg: tuple[float, float] = (10.0, 60.0)
+    zeta0: tuple[float, float] = (0.75, 0.98)
+
+    def __post_init__(self) -> None:
+        for name, (low, high), bound in (("psi0_deg", self.psi0_deg, (0.0, 90.0)), ("zeta0", self.zeta0, (0.0, 1.0))):
+            check_range(f"limits.{name}", low, *bound)
+            check_range(f"limits.{name}", high, *bound)
+            if not low < high:
+                raise ParameterError(f"limits.{name}", f"must be an interval low < high, got [{low:g}, {high:g}]")
+
+    def check(self, psi0_deg: float, zeta0: float) -> None:
+        """Raise :class:`ParameterError` naming the field and the servo range if a command is outside it."""
+        check_range("psi0_deg", psi0_deg, *self.psi0_deg, low_open=False, high_open=False)
+        check_range("zeta0", zeta0, *self.zeta0, low_open=False, high_open=False)
+
+    def allows(self, psi0_deg: float, zeta0: float) -> bool:
+        try:
+            self.check(psi0_deg, zeta0)
+        except ParameterError:
+            return False
+        return True

@@ -1,0 +1,107 @@
+"""The virtual robot's radio: protocol v1 over TCP, the firmware state machine behind it.
+
+PC software connects with the pyserial URL ``socket://HOST:PORT`` exactly as it would open the
+XBee's serial port. One PC at a time; a new connection replaces the old one (like a radio
+re-association). The SLIP motion and the tracker stream come next (issue 6).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import select
+import socket
+import threading
+import time
+
+from backend.robot.firmware import Firmware
+from backend.robot.messages import ProtocolError, decode, encode
+from backend.robot.xbee import FrameError, FrameParser, encode_frame, parse_tx_request, rx_packet
+
+log = logging.getLogger("parkourlab.robot")
+ROBOT_ADDRESS = 0x0013A20040B0B0B0  # the robot radio's 64-bit address
+TICK = 0.02  # [s] watchdog and telemetry resolution
+
+
+class VirtualRobot:
+    def __init__(self, host: str = "127.0.0.1", port: int = 0, *, firmware: Firmware | None = None):
+        self.firmware = firmware or Firmware()
+        self.server = socket.create_server((host, port))
+        self.address = self.server.getsockname()
+        self.lock = threading.Lock()  # the firmware is shared by the reader and the ticker
+        self.parser = FrameParser()
+        self.rejected_payloads = 0
+        self._connection: socket.socket | None = None
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._serve, name="virtual-robot", daemon=True)
+
+    @property
+    def url(self) -> str:
+        return f"socket://{self.address[0]}:{self.address[1]}"
+
+    def start(self) -> VirtualRobot:
+        self._thread.start()
+        return self
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._thread.join(5)
+        self._close_connection()
+        self.server.close()
+
+    def _serve(self) -> None:
+        # One thread waits on the listening socket and the connection at once: a command is
+        # answered as soon as it arrives, and the watchdog still runs every TICK.
+        next_tick = time.monotonic()
+        while not self._stop.is_set():
+            sockets = [self.server] + ([self._connection] if self._connection is not None else [])
+            ready, _, _ = select.select(sockets, [], [], max(0.0, next_tick - time.monotonic()))
+            if self.server in ready:
+                connection, _ = self.server.accept()
+                self._close_connection()
+                self._connection = connection
+                self.parser = FrameParser()
+            elif ready:
+                self._exchange(ready[0])
+            if time.monotonic() >= next_tick:
+                next_tick = time.monotonic() + TICK
+                self._send(self._tick())
+
+    def _exchange(self, connection: socket.socket) -> None:
+        try:
+            chunk = connection.recv(4096)
+        except OSError:
+            self._close_connection()
+            return
+        if not chunk:
+            self._close_connection()
+            return
+        for data in self.parser.feed(chunk):
+            try:
+                _frame_id, _destination, payload = parse_tx_request(data)
+                message = decode(payload)
+            except (FrameError, ProtocolError):
+                self.rejected_payloads += 1
+                continue
+            with self.lock:
+                replies = self.firmware.receive(message, time.monotonic())
+            self._send(replies)
+
+    def _tick(self) -> list:
+        with self.lock:
+            return self.firmware.tick(time.monotonic())
+
+    def _send(self, messages: list) -> None:
+        if self._connection is None or not messages:
+            return
+        data = b"".join(encode_frame(rx_packet(encode(message), source64=ROBOT_ADDRESS)) for message in messages)
+        try:
+            self._connection.sendall(data)
+        except OSError:
+            self._close_connection()
+
+    def _close_connection(self) -> None:
+        if self._connection is not None:
+            with contextlib.suppress(OSError):
+                self._connection.close()
+            self._connection = None
