@@ -1,0 +1,95 @@
+"""Touchdowns from tracker poses: the robot's Poincaré section states and height gains.
+
+The PC knows each touchdown's controls, so it knows where the body is when a foot meets the
+wall: ``zeta0 l0 cos psi0`` from it. A touchdown is the tracked body crossing that line on its
+way to the wall. Between the chute's centre line and that crossing the body is in flight, so
+those poses follow ``x = a + b t`` and ``y = c + e t - g t^2 / 2`` exactly: a least-squares fit
+through them gives the crossing time and the velocity at touchdown, averaging tracker noise and
+bridging dropped frames. States come out as the simulator's — nondimensional, flipped so every
+touchdown is on the left wall — so robot and model compare jump by jump.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim_core.controls import LegControl
+from sim_core.params import PhysicalParams
+
+MIN_FIT_POSES = 4
+
+
+@dataclass(frozen=True)
+class Touchdown:
+    """One detected touchdown (SI time and heights; nondimensional section state)."""
+
+    index: int  # 0-based touchdown number
+    time: float  # [s]
+    wall: int  # -1 left, +1 right
+    state: tuple[float, float]  # (xdot, ydot) [sqrt(g l0)], flipped to the left wall
+    body_height: float  # [m]
+    foot_height: float  # [m]
+    poses_fitted: int
+
+
+def detect_touchdowns(
+    time: np.ndarray,
+    x: np.ndarray,
+    y: np.ndarray,
+    robot: PhysicalParams,
+    leg_for: Callable[[int], LegControl],
+) -> list[Touchdown]:
+    """Touchdowns in a pose stream (SI, wall coordinates; ``leg_for(k)`` is touchdown k's controls).
+
+    A crossing whose flight could not be fitted (fewer than ``MIN_FIT_POSES`` flight poses) is
+    skipped; the stream may start and end anywhere.
+    """
+    scales = robot.scales
+    half = 0.5 * robot.wall_distance
+    touchdowns: list[Touchdown] = []
+    flight_start = None  # index where the body crossed the centre line heading for a wall
+    for i in range(1, len(time)):
+        if x[i - 1] * x[i] <= 0.0 and x[i] != x[i - 1]:
+            flight_start = i
+            continue
+        if flight_start is None:
+            continue
+        wall = 1 if x[i] > 0 else -1
+        leg = leg_for(len(touchdowns))
+        line = wall * (half - leg.zeta0 * robot.leg_length * math.cos(leg.psi0))
+        if wall * x[i] < wall * line:
+            continue
+        fit = slice(flight_start, i)  # flight poses before the line
+        flight_start = None
+        if fit.stop - fit.start < MIN_FIT_POSES:
+            continue
+        t, xs, ys = time[fit], x[fit], y[fit]
+        t0 = t[0]
+        b, a = np.polyfit(t - t0, xs, 1)
+        e, c = np.polyfit(t - t0, ys + 0.5 * robot.gravity * (t - t0) ** 2, 1)
+        crossing = (line - a) / b
+        vx, vy = b, e - robot.gravity * crossing
+        body = c + e * crossing - 0.5 * robot.gravity * crossing**2
+        state = (-wall * vx / scales.velocity, vy / scales.velocity)  # the flip: toward the wall is -x
+        touchdowns.append(
+            Touchdown(
+                index=len(touchdowns),
+                time=t0 + crossing,
+                wall=wall,
+                state=state,
+                body_height=body,
+                foot_height=body - leg.zeta0 * robot.leg_length * math.sin(leg.psi0),
+                poses_fitted=fit.stop - fit.start,
+            )
+        )
+    return touchdowns
+
+
+def height_gains(touchdowns: list[Touchdown], robot: PhysicalParams) -> np.ndarray:
+    """Per-jump height gain between consecutive touchdowns [l0], as the simulator's ``rises``."""
+    feet = np.array([td.foot_height for td in touchdowns])
+    return np.diff(feet) / robot.leg_length

@@ -1,0 +1,181 @@
+"""Tracker input: body poses from the overhead camera, behind one interface.
+
+A pose is ``(time [s], x [m], y [m], pitch [rad] or NaN)`` in wall coordinates — x across the
+chute from its centre line, y up — after :class:`Calibration` maps camera coordinates there.
+
+Sources (all ``PoseSource``: ``latest()`` and ``poses_since(t)``):
+
+- :class:`UdpPoseSource` — datagrams on a UDP port. The lab's bridge from the camera software
+  (NaturalPoint/OptiTrack NatNet: data port 1511, multicast 239.255.42.99) forwards each frame
+  as one ParkourLab tracker datagram (below); the virtual robot sends the same. Tests use
+  unicast on 127.0.0.1.
+- :func:`recorded_poses` — a recorded run (replay).
+
+Tracker datagram v1 (big-endian, 40 bytes): magic ``b"PKT1"``, frame number u32, time f64,
+x f64, y f64, pitch f64 (NaN when the markers do not give it). Gaps in frame numbers are
+counted as dropped frames; malformed datagrams are counted and ignored.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+import socket
+import struct
+import threading
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim_core.validation import check_range
+
+DATAGRAM = struct.Struct(">4sIdddd")
+MAGIC = b"PKT1"
+STALE_AFTER = 0.1  # [s] a pose older than this is stale (10 frames at 100 Hz)
+HISTORY = 60_000  # poses kept in memory (10 minutes at 100 Hz)
+
+
+@dataclass(frozen=True)
+class Pose:
+    time: float
+    x: float
+    y: float
+    pitch: float = math.nan
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """Camera to wall coordinates: ``wall = scale * (camera - origin)``, rotated by ``angle``.
+
+    ``origin`` is the camera point of the chute's centre line at the floor, ``angle`` [rad] the
+    camera's rotation from the walls' direction, ``scale`` [m per camera unit]. Stored with each run.
+    """
+
+    origin: tuple[float, float] = (0.0, 0.0)
+    angle: float = 0.0
+    scale: float = 1.0
+
+    def __post_init__(self) -> None:
+        check_range("calibration.scale", self.scale, 0.0)
+        check_range("calibration.angle", self.angle, -math.pi, math.pi, low_open=False, high_open=False)
+
+    def to_wall(self, x: float, y: float) -> tuple[float, float]:
+        dx, dy = x - self.origin[0], y - self.origin[1]
+        cos, sin = math.cos(self.angle), math.sin(self.angle)
+        return self.scale * (cos * dx + sin * dy), self.scale * (-sin * dx + cos * dy)
+
+
+def encode_datagram(frame: int, pose: Pose) -> bytes:
+    return DATAGRAM.pack(MAGIC, frame & 0xFFFFFFFF, pose.time, pose.x, pose.y, pose.pitch)
+
+
+def decode_datagram(data: bytes) -> tuple[int, Pose]:
+    if len(data) != DATAGRAM.size:
+        raise ValueError(f"tracker datagram of {len(data)} bytes, expected {DATAGRAM.size}")
+    magic, frame, t, x, y, pitch = DATAGRAM.unpack(data)
+    if magic != MAGIC or not all(math.isfinite(v) for v in (t, x, y)):
+        raise ValueError("not a ParkourLab tracker datagram")
+    return frame, Pose(t, x, y, pitch)
+
+
+@dataclass
+class TrackerStats:
+    received: int = 0
+    dropped: int = 0  # frame-number gaps
+    malformed: int = 0
+
+    @property
+    def loss(self) -> float:
+        """Fraction of frames lost (dropped / expected)."""
+        expected = self.received + self.dropped
+        return self.dropped / expected if expected else 0.0
+
+
+class PoseHistory:
+    """Poses in time order with thread-safe appends and reads."""
+
+    def __init__(self, calibration: Calibration, stale_after: float = STALE_AFTER):
+        self.calibration = calibration
+        self.stale_after = stale_after
+        self._poses: list[Pose] = []
+        self._times: list[float] = []
+        self._lock = threading.Lock()
+
+    def add(self, pose: Pose) -> None:
+        x, y = self.calibration.to_wall(pose.x, pose.y)
+        with self._lock:
+            self._poses.append(Pose(pose.time, x, y, pose.pitch))
+            self._times.append(pose.time)
+            if len(self._poses) > HISTORY:
+                del self._poses[: len(self._poses) - HISTORY]
+                del self._times[: len(self._times) - HISTORY]
+
+    def latest(self, now: float | None = None) -> Pose | None:
+        """The newest pose, or None if there is none or it is stale (older than ``stale_after``)."""
+        with self._lock:
+            pose = self._poses[-1] if self._poses else None
+        if pose is None:
+            return None
+        if (time.time() if now is None else now) - pose.time > self.stale_after:
+            return None
+        return pose
+
+    def poses_since(self, since: float) -> list[Pose]:
+        with self._lock:
+            return self._poses[bisect.bisect_left(self._times, since) :]
+
+    def as_arrays(self) -> dict[str, np.ndarray]:
+        with self._lock:
+            poses = list(self._poses)
+        return {name: np.array([getattr(p, name) for p in poses]) for name in ("time", "x", "y", "pitch")}
+
+
+class UdpPoseSource(PoseHistory):
+    """Receives tracker datagrams on ``host:port`` in a background thread."""
+
+    def __init__(self, host: str = "127.0.0.1", port: int = 0, *, calibration: Calibration | None = None, **kwargs):
+        super().__init__(calibration or Calibration(), **kwargs)
+        self.stats = TrackerStats()
+        self.socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.socket.bind((host, port))
+        self.socket.settimeout(0.05)
+        self.address = self.socket.getsockname()
+        self._last_frame: int | None = None
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._receive, name="tracker-udp", daemon=True)
+        self._thread.start()
+
+    def close(self) -> None:
+        self._stop.set()
+        self._thread.join(2)
+        self.socket.close()
+
+    def _receive(self) -> None:
+        while not self._stop.is_set():
+            try:
+                data = self.socket.recv(1024)
+            except TimeoutError:
+                continue
+            except OSError:
+                return
+            try:
+                frame, pose = decode_datagram(data)
+            except ValueError:
+                self.stats.malformed += 1
+                continue
+            if self._last_frame is not None and frame > self._last_frame + 1:
+                self.stats.dropped += frame - self._last_frame - 1
+            if self._last_frame is None or frame > self._last_frame:
+                self._last_frame = frame
+            self.stats.received += 1
+            self.add(pose)
+
+
+def recorded_poses(columns: dict[str, np.ndarray]) -> PoseHistory:
+    """A recorded pose stream (arrays ``time, x, y`` and optionally ``pitch``, wall coordinates), for replay."""
+    history = PoseHistory(Calibration())
+    pitch = columns.get("pitch", np.full(len(columns["time"]), math.nan))
+    for t, x, y, p in zip(columns["time"], columns["x"], columns["y"], pitch, strict=True):
+        history.add(Pose(float(t), float(x), float(y), float(p)))
+    return history

@@ -1,0 +1,89 @@
+"""Tracker input and touchdown detection against the simulator's own path."""
+
+import math
+import socket
+import time
+
+import numpy as np
+import pytest
+
+from backend.robot.touchdown import detect_touchdowns, height_gains
+from backend.robot.tracker import Calibration, Pose, UdpPoseSource, decode_datagram, encode_datagram, recorded_poses
+from sim_core import ControlSchedule, find_fixed_point, get_preset, simulate_trajectory
+
+
+@pytest.fixture(scope="module")
+def climb():
+    """The paper's period-2 gait, 13 jumps (the record ends on the 13th touchdown, which therefore
+    is not crossed), sampled at the camera's 100 Hz, in SI wall coordinates."""
+    robot = get_preset("paper")
+    model = robot.to_model()
+    schedule = ControlSchedule.from_degrees([(30.0, 0.87), (30.0, 0.9)])
+    gait = find_fixed_point(model, schedule, 2, (-0.8, -0.15))
+    rate = 100.0 * robot.scales.time  # samples per sqrt(l0/g) for 100 Hz
+    path = simulate_trajectory(model, schedule, gait.state, 13, sample_rate=rate)
+    return robot, schedule, path, path.to_si(robot)
+
+
+def _detect(robot, schedule, t, x, y):
+    return detect_touchdowns(t, x, y, robot, lambda k: schedule[k + 1])
+
+
+def test_touchdowns_match_the_simulator(climb):
+    robot, schedule, path, si = climb
+    found = _detect(robot, schedule, si.time, si.x, si.y)
+    assert len(found) == 12
+    np.testing.assert_allclose([td.time for td in found], si.touchdown_times[1:13], atol=1e-4)
+    np.testing.assert_allclose([td.state for td in found], path.section_states[1:13], atol=1e-4)
+    np.testing.assert_allclose(height_gains(found, robot), path.rises[1:12], atol=1e-4)
+    assert [td.wall for td in found] == [1, -1] * 6
+
+
+def test_touchdowns_survive_tracker_noise_and_dropped_frames(climb):
+    robot, schedule, path, si = climb
+    rng = np.random.default_rng(1)
+    keep = rng.random(si.time.size) > 0.1  # 10% of frames lost
+    noise = 0.001  # 1 mm
+    x = si.x[keep] + rng.normal(0, noise, keep.sum())
+    y = si.y[keep] + rng.normal(0, noise, keep.sum())
+    found = _detect(robot, schedule, si.time[keep], x, y)
+    assert len(found) == 12
+    np.testing.assert_allclose([td.state for td in found], path.section_states[1:13], atol=0.03)
+    np.testing.assert_allclose(height_gains(found, robot), path.rises[1:12], atol=0.02)
+
+
+def test_datagrams_round_trip_and_reject_garbage():
+    pose = Pose(12.5, -0.1, 0.42, math.nan)
+    frame, back = decode_datagram(encode_datagram(7, pose))
+    assert frame == 7 and back.time == 12.5 and back.y == 0.42 and math.isnan(back.pitch)
+    for bad in (b"", b"x" * 40, encode_datagram(1, pose)[:-1]):
+        with pytest.raises(ValueError):
+            decode_datagram(bad)
+
+
+def test_udp_source_counts_drops_and_goes_stale():
+    source = UdpPoseSource(calibration=Calibration(origin=(1.0, 0.0)), stale_after=0.2)
+    sender = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    try:
+        now = time.time()
+        for frame in (1, 2, 5, 6):  # frames 3 and 4 lost
+            sender.sendto(encode_datagram(frame, Pose(now, 1.25, 0.5)), source.address)
+        sender.sendto(b"garbage", source.address)
+        deadline = time.monotonic() + 2
+        while source.stats.received + source.stats.malformed < 5 and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert (source.stats.received, source.stats.dropped, source.stats.malformed) == (4, 2, 1)
+        assert source.stats.loss == pytest.approx(2 / 6)
+        latest = source.latest(now + 0.05)
+        assert latest is not None and latest.x == pytest.approx(0.25), "calibrated to wall coordinates"
+        assert source.latest(now + 1.0) is None, "stale"
+    finally:
+        sender.close()
+        source.close()
+
+
+def test_recorded_poses_replay(climb):
+    _robot, _schedule, _path, si = climb
+    history = recorded_poses({"time": si.time, "x": si.x, "y": si.y})
+    assert len(history.poses_since(si.time[-10])) == 10
+    assert history.as_arrays()["y"][-1] == si.y[-1]
