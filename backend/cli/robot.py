@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from backend.cli.options import handles_errors, note
+from sim_core import ParameterError
 
 app = typer.Typer(rich_markup_mode=None)
 
@@ -17,12 +18,19 @@ app = typer.Typer(rich_markup_mode=None)
 def robot_sim_command(
     host: Annotated[str, typer.Option("--host", help="Interface to listen on.")] = "127.0.0.1",
     port: Annotated[int, typer.Option("--port", help="TCP port of the robot's 'radio'.", min=1, max=65535)] = 9750,
+    tracker: Annotated[
+        str, typer.Option("--tracker", help="HOST:PORT to stream the 100 Hz tracker datagrams to.")
+    ] = "127.0.0.1:9751",
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the robot's imperfections.")] = 0,
 ) -> None:
     """Run the virtual robot until Ctrl-C; connect with the pyserial URL socket://HOST:PORT."""
     from backend.robot.virtual import VirtualRobot
 
-    robot = VirtualRobot(host, port).start()
-    note(f"virtual robot listening: {robot.url}  (protocol v1, docs/protocol.md; Ctrl-C stops it)")
+    tracker_host, _, tracker_port = tracker.rpartition(":")
+    if not tracker_host or not tracker_port.isdigit():
+        raise ParameterError("tracker", f"must be HOST:PORT, got {tracker!r}")
+    robot = VirtualRobot(host, port, tracker_to=(tracker_host, int(tracker_port)), seed=seed).start()
+    note(f"virtual robot listening: {robot.url}  tracker to udp://{tracker}  (docs/protocol.md; Ctrl-C stops it)")
     try:
         while True:
             time.sleep(1.0)

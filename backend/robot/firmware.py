@@ -70,6 +70,12 @@ class Firmware:
             out.append(self.telemetry())
         return out
 
+    def fell(self) -> None:
+        """A jump failed: the robot is down, disarmed, and says so."""
+        if self.state == RobotState.RUNNING:
+            self.state = RobotState.DISARMED
+            self.faults |= Fault.FELL
+
     def telemetry(self) -> Telemetry:
         left, right = self.legs[Leg.LEFT], self.legs[Leg.RIGHT]
         return Telemetry(
@@ -100,6 +106,12 @@ class Firmware:
             if self.state == RobotState.DISARMED:
                 self.state = RobotState.ARMED
                 self.faults &= ~Fault.HEARTBEAT_LOST
+            return Result.OK
+        if kind == Kind.START:
+            if self.state != RobotState.ARMED:
+                return Result.REJECTED_STATE
+            self.state = RobotState.RUNNING
+            self.faults &= ~Fault.FELL
             return Result.OK
         if kind == Kind.DISARM:
             self.state = RobotState.DISARMED

@@ -136,13 +136,17 @@ class RobotLink:
 
     # Commands -------------------------------------------------------------------------------
     def arm(self) -> None:
-        self._command(Command(self._next_seq(), Kind.ARM))
+        self._command(Command(self._next_seq(), Kind.ARM), expect=LinkState.ARMED)
+
+    def start(self) -> None:
+        """Armed robot: launch and keep jumping with the legs' current controls."""
+        self._command(Command(self._next_seq(), Kind.START), expect=LinkState.RUNNING)
 
     def disarm(self) -> None:
-        self._command(Command(self._next_seq(), Kind.DISARM))
+        self._command(Command(self._next_seq(), Kind.DISARM), expect=LinkState.DISARMED)
 
     def reset(self) -> None:
-        self._command(Command(self._next_seq(), Kind.RESET))
+        self._command(Command(self._next_seq(), Kind.RESET), expect=LinkState.DISARMED)
 
     def set_leg(self, leg: Leg, psi0_deg: float, zeta0: float) -> None:
         """Send a leg's controls for its next touchdown; outside the servo limits, refuse to send."""
@@ -166,7 +170,8 @@ class RobotLink:
         return time.monotonic() - started
 
     # Internals ------------------------------------------------------------------------------
-    def _command(self, message) -> Ack:
+    def _command(self, message, expect: LinkState | None = None) -> Ack:
+        """Send, wait for the acknowledgement, and (``expect``) for the telemetry showing its effect."""
         if self.state == LinkState.DISCONNECTED:
             raise LinkError("the link is down; connect first")
         event, box = self._expect(message.seq)
@@ -177,8 +182,14 @@ class RobotLink:
         finally:
             self._acks.pop(message.seq, None)
         ack = box[0]
+        name = message.kind.name if isinstance(message, Command) else type(message).__name__
         if ack.result != Result.OK:
-            raise LinkError(f"the robot refused {type(message).__name__}: {ack.result.name.lower()}")
+            raise LinkError(f"the robot refused {name}: {ack.result.name.lower()}")
+        deadline = time.monotonic() + COMMAND_TIMEOUT
+        while expect is not None and self.state != expect:
+            if time.monotonic() > deadline:
+                raise LinkError(f"{name} acknowledged but the robot reports {self.state.value}, not {expect.value}")
+            time.sleep(0.001)
         return ack
 
     def _expect(self, seq: int) -> tuple[threading.Event, list[Ack]]:

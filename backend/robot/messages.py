@@ -4,8 +4,9 @@ Every message starts with a 4-byte header: protocol version (u8), message type (
 number (u16, wrapping), then a fixed body for its type; integers are big-endian. Angles travel
 in centidegrees (i16), leg lengths in 1/10000 of l0 (u16), so a message never carries a float.
 
-PC → robot:  SET_LEG (a leg's angle and retraction for its next touchdown), ARM, DISARM, ESTOP
-(latching; sent repeatedly), RESET (clears an e-stop), HEARTBEAT.
+PC → robot:  SET_LEG (a leg's angle and retraction for its next touchdown), ARM, START (armed:
+launch and keep jumping), DISARM, ESTOP (latching; sent repeatedly), RESET (clears an e-stop),
+HEARTBEAT.
 Robot → PC:  ACK (of a command's sequence number, with a result code), TELEMETRY (state, servo
 positions, battery, fault flags), HEARTBEAT.
 
@@ -33,6 +34,7 @@ class Kind(IntEnum):
     ESTOP = 0x04
     RESET = 0x05
     HEARTBEAT = 0x06
+    START = 0x07
     ACK = 0x81
     TELEMETRY = 0x82
 
@@ -65,6 +67,7 @@ class Fault(IntEnum):
     LOW_BATTERY = 1 << 1
     SERVO_LIMIT = 1 << 2
     BROWNOUT = 1 << 3
+    FELL = 1 << 4  # a jump failed (slip, no flight, ...): the robot is down
 
 
 @dataclass(frozen=True)
@@ -105,7 +108,7 @@ Message = SetLeg | Command | Ack | Telemetry
 _SET_LEG = struct.Struct(">BhH")
 _ACK = struct.Struct(">HB")
 _TELEMETRY = struct.Struct(">BhhHHHH")
-_BARE = {Kind.ARM, Kind.DISARM, Kind.ESTOP, Kind.RESET, Kind.HEARTBEAT}
+_BARE = {Kind.ARM, Kind.DISARM, Kind.ESTOP, Kind.RESET, Kind.HEARTBEAT, Kind.START}
 
 
 def encode(message: Message) -> bytes:

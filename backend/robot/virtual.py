@@ -2,7 +2,8 @@
 
 PC software connects with the pyserial URL ``socket://HOST:PORT`` exactly as it would open the
 XBee's serial port. One PC at a time; a new connection replaces the old one (like a radio
-re-association). The SLIP motion and the tracker stream come next (issue 6).
+re-association). Given a tracker address, the body moves (:mod:`backend.robot.climber`) while
+the firmware is running, and the camera's view of it streams there over UDP.
 """
 
 from __future__ import annotations
@@ -14,8 +15,9 @@ import socket
 import threading
 import time
 
+from backend.robot.climber import Climber
 from backend.robot.firmware import Firmware
-from backend.robot.messages import ProtocolError, decode, encode
+from backend.robot.messages import ProtocolError, RobotState, decode, encode
 from backend.robot.xbee import FrameError, FrameParser, encode_frame, parse_tx_request, rx_packet
 
 log = logging.getLogger("parkourlab.robot")
@@ -24,7 +26,17 @@ TICK = 0.02  # [s] watchdog and telemetry resolution
 
 
 class VirtualRobot:
-    def __init__(self, host: str = "127.0.0.1", port: int = 0, *, firmware: Firmware | None = None):
+    def __init__(
+        self,
+        host: str = "127.0.0.1",
+        port: int = 0,
+        *,
+        firmware: Firmware | None = None,
+        tracker_to: tuple[str, int] | None = None,
+        **climber_options,
+    ):
+        """``tracker_to``: where to stream the body's tracker datagrams (None: no motion, radio only).
+        ``climber_options`` go to :class:`backend.robot.climber.Climber` (noise, speed, seed ...)."""
         self.firmware = firmware or Firmware()
         self.server = socket.create_server((host, port))
         self.address = self.server.getsockname()
@@ -34,6 +46,9 @@ class VirtualRobot:
         self._connection: socket.socket | None = None
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._serve, name="virtual-robot", daemon=True)
+        self.climber = None
+        if tracker_to is not None:
+            self.climber = Climber(self._legs, self._running, self._fell, tracker_to, **climber_options)
 
     @property
     def url(self) -> str:
@@ -41,13 +56,28 @@ class VirtualRobot:
 
     def start(self) -> VirtualRobot:
         self._thread.start()
+        if self.climber is not None:
+            self.climber.start()
         return self
 
     def stop(self) -> None:
         self._stop.set()
         self._thread.join(5)
+        if self.climber is not None:
+            self.climber.stop()
         self._close_connection()
         self.server.close()
+
+    def _legs(self) -> dict:
+        with self.lock:
+            return dict(self.firmware.legs)
+
+    def _running(self) -> bool:
+        return self.firmware.state == RobotState.RUNNING and not self._stop.is_set()
+
+    def _fell(self) -> None:
+        with self.lock:
+            self.firmware.fell()
 
     def _serve(self) -> None:
         # One thread waits on the listening socket and the connection at once: a command is

@@ -1,0 +1,70 @@
+"""An open-loop run against the virtual robot: it climbs, and its tracked touchdowns follow the map."""
+
+import time
+
+import numpy as np
+
+from backend.robot.link import LinkState, RobotLink
+from backend.robot.messages import Fault, Leg
+from backend.robot.touchdown import detect_touchdowns, height_gains
+from backend.robot.tracker import UdpPoseSource
+from backend.robot.virtual import VirtualRobot
+from sim_core import ControlSchedule, LegControl, get_preset, iterate_map
+from sim_core.noise import NO_NOISE, NoiseModel
+
+LEGS = {Leg.LEFT: (30.0, 0.87), Leg.RIGHT: (30.0, 0.9)}
+ROBOT = get_preset("paper")
+
+
+def _run(noise, jumps, *, speed=6.0, seed=1):
+    tracker = UdpPoseSource()
+    robot = VirtualRobot(tracker_to=tracker.address, noise=noise, speed=speed, seed=seed).start()
+    link = RobotLink(robot.url)
+    try:
+        link.connect()
+        for leg, (psi0, zeta0) in LEGS.items():
+            link.set_leg(leg, psi0, zeta0)
+        link.arm()
+        link.start()
+        deadline = time.monotonic() + 30
+        while robot.climber.jumps < jumps and link.state == LinkState.RUNNING:
+            assert time.monotonic() < deadline, "the robot stopped climbing"
+            time.sleep(0.02)
+        state_at_end = link.state
+        if state_at_end == LinkState.RUNNING:
+            link.disarm()
+        time.sleep(0.05)
+        return tracker, robot, link, state_at_end
+    finally:
+        link.close()
+        robot.stop()
+        tracker.close()
+
+
+def _leg_for(k: int) -> LegControl:
+    # Detected touchdown k is the climb's touchdown k + 1; even touchdowns are the left leg's.
+    return LegControl.from_degrees(*LEGS[Leg.LEFT if (k + 1) % 2 == 0 else Leg.RIGHT])
+
+
+def test_open_loop_climb_follows_the_map():
+    tracker, robot, _link, state = _run(NO_NOISE, jumps=10)
+    assert state == LinkState.RUNNING
+    poses = tracker.as_arrays()
+    found = detect_touchdowns(poses["time"], poses["x"], poses["y"], ROBOT, _leg_for)
+    assert len(found) >= 8
+    assert np.all(height_gains(found, ROBOT) > 0), "it climbs"
+    schedule = ControlSchedule.of(*(_leg_for(k) for k in range(len(found))))
+    model = ROBOT.to_model()
+    errors = []
+    for k in range(len(found) - 1):
+        predicted = iterate_map(model, schedule, found[k].state, 1, first_jump=k).states[-1]
+        errors.append(np.max(np.abs(predicted - found[k + 1].state)))
+    assert max(errors) < 0.05, f"one-jump prediction errors {np.round(errors, 4)} (1 mm tracker noise)"
+    assert tracker.stats.loss < 0.1 and robot.climber.frames_sent > 100
+
+
+def test_noisy_robot_eventually_falls_and_says_so():
+    noise = NoiseModel(psi0_deg=3.0, zeta0=0.02, velocity=0.05, pitch_drift_deg=3.0)
+    _tracker, robot, link, state = _run(noise, jumps=400, speed=20.0, seed=3)
+    assert state == LinkState.DISARMED, "a failing jump disarms the robot"
+    assert link.telemetry.faults & Fault.FELL and robot.climber.jumps < 400
