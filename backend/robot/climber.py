@@ -23,6 +23,7 @@ from backend.robot.tracker import Pose, encode_datagram
 from sim_core import ControlSchedule, LegControl, PhysicalParams, find_fixed_point, get_preset, simulate_trajectory
 from sim_core.fixed_points import FixedPointNotFound
 from sim_core.noise import NoiseModel
+from sim_core.trajectory import STANCE
 from sim_core.validation import check_range
 
 FRAME_RATE = 100.0  # [Hz] the FLEX V100's
@@ -102,22 +103,28 @@ class Climber:
         started = time.monotonic()
         jump = 0
         while self.running() and not self._stop.is_set():
-            next_pitch = pitch + (
-                self.rng.normal(0.0, math.radians(self.noise.pitch_drift_deg)) if self.noise.pitch_drift_deg else 0.0
+            # Stance does not depend on the next leg: stream it first, then read the next leg's
+            # controls at lift-off — as the real robot positions that leg during this stance.
+            rate = FRAME_RATE * self.robot.scales.time
+            side = 1.0 if jump % 2 == 0 else -1.0  # the wall frame alternates: odd jumps start on the right
+            stance = simulate_trajectory(
+                self.model, ControlSchedule.of(this, this), state, 1, sample_rate=rate, start_height=height
+            ).to_si(self.robot)
+            in_stance = stance.phase == STANCE
+            self._stream(
+                clock + stance.time[in_stance], side * stance.x[in_stance], stance.y[in_stance], pitch, started
             )
+            if not self.running() or self._stop.is_set():
+                return
+            drift = math.radians(self.noise.pitch_drift_deg)
+            next_pitch = pitch + (self.rng.normal(0.0, drift) if drift else 0.0)
             following = self._controls(jump + 1, next_pitch)
             path = simulate_trajectory(
-                self.model,
-                ControlSchedule.of(this, following),
-                state,
-                1,
-                sample_rate=FRAME_RATE * self.robot.scales.time,
-                start_height=height,
+                self.model, ControlSchedule.of(this, following), state, 1, sample_rate=rate, start_height=height
             )
-            # The wall frame alternates: odd jumps start on the right wall.
             si = path.to_si(self.robot)
-            side = 1.0 if jump % 2 == 0 else -1.0
-            self._stream(clock + si.time, side * si.x, si.y, pitch, started)
+            in_flight = si.phase != STANCE
+            self._stream(clock + si.time[in_flight], side * si.x[in_flight], si.y[in_flight], pitch, started)
             if path.failure is not None:
                 self.fell()
                 return
