@@ -273,5 +273,43 @@ class FixedPointIn(Strict):
     guess: StateIn | None = None
 
 
+class RobotConnect(Strict):
+    """Open the link: a pyserial URL (``/dev/ttyUSB0``, ``socket://host:port``) and the tracker's UDP port."""
+
+    # Serial devices, the virtual robot's socket, or a loopback: never an arbitrary device file.
+    url: Annotated[
+        str,
+        Field(
+            max_length=200,
+            pattern=r"^(/dev/tty[A-Za-z]+[0-9]*|/dev/serial/by-id/[\w.:-]+|socket://[\w.-]+:[0-9]{1,5}|loop://|COM[0-9]{1,3})$",
+        ),
+    ]
+    baud: Annotated[int, Field(ge=1200, le=1_000_000)] = 57_600
+    tracker_host: Annotated[str, Field(max_length=100, pattern=r"^[\w.:-]+$")] = "127.0.0.1"
+    tracker_port: Annotated[int, Field(ge=0, le=65535)] = 9751
+    psi0_limits_deg: Annotated[list[Psi0Deg], Field(min_length=2, max_length=2)] = [10.0, 60.0]
+    zeta0_limits: Annotated[list[Zeta0], Field(min_length=2, max_length=2)] = [0.75, 0.98]
+
+
+class ClosedLoopIn(Strict):
+    target_m: Annotated[float, Field(gt=0.0, le=100.0, description="height to hold [m]")]
+    kp: Annotated[float, Field(ge=0.0, le=10.0)] = 0.04
+    ki: Annotated[float, Field(ge=0.0, le=10.0)] = 0.0
+    kd: Annotated[float, Field(ge=0.0, le=10.0)] = 0.02
+    zeta0_min: Zeta0 = 0.80
+    zeta0_max: Zeta0 = 0.98
+
+
+class RobotRunCreate(Strict):
+    """A live run: the left and right legs' controls, bounded in jumps and time; optionally closed loop."""
+
+    experiment_id: RecordRef | None = None
+    controls: Annotated[list[LegIn], Field(min_length=2, max_length=2, description="[left, right]")]
+    jumps: Annotated[int, Field(ge=1, le=10_000)] = 20
+    max_seconds: Annotated[float, Field(gt=0.0, le=3600.0)] = 60.0
+    closed_loop: ClosedLoopIn | None = None
+    tags: Annotated[list[Label], Field(max_length=32)] = []
+
+
 def finite_or_none(value: float) -> float | None:
     return value if math.isfinite(value) else None

@@ -200,6 +200,20 @@ def closed_loop_climb(
 
 
 @kernel
+def pid_step(error, previous_error, integral, zeta0_hover, kp, ki, kd, zeta0_min, zeta0_max):
+    """One PID update: ``(next touchdown's zeta0, new integral)``; ``previous_error`` NaN at the first.
+
+    The one implementation of the height law, compiled, so the simulated loop and a live run on
+    the robot (``backend``) use the same arithmetic.
+    """
+    derivative = 0.0 if math.isnan(previous_error) else error - previous_error
+    unclamped = zeta0_hover - (kp * error + ki * (integral + error) + kd * derivative)
+    command = min(max(unclamped, zeta0_min), zeta0_max)
+    pushing_out = (unclamped < zeta0_min and error > 0.0) or (unclamped > zeta0_max and error < 0.0)
+    return command, integral if pushing_out else integral + error
+
+
+@kernel
 def pid_loop(
     xdot,
     ydot,
@@ -252,12 +266,7 @@ def pid_loop(
             break
         # The PID: this touchdown's error sets the next touchdown's leg length.
         error = target - body
-        derivative = 0.0 if math.isnan(previous_error) else error - previous_error
-        unclamped = zeta0_hover - (kp * error + ki * (integral + error) + kd * derivative)
-        command = min(max(unclamped, zeta0_min), zeta0_max)
-        pushing_out = (unclamped < zeta0_min and error > 0.0) or (unclamped > zeta0_max and error < 0.0)
-        if not pushing_out:
-            integral += error
+        command, integral = pid_step(error, previous_error, integral, zeta0_hover, kp, ki, kd, zeta0_min, zeta0_max)
         previous_error = error
         next_pitch = pitch_step(pitch, sigma_pitch)
         next_psi0, next_zeta0 = perturbed_controls(

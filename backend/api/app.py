@@ -31,7 +31,9 @@ from sqlalchemy import select
 from sqlalchemy.orm import Session
 
 from backend import schemas
+from backend.robot.link import LinkError
 from backend.services import jobs, records, simulation
+from backend.services.robot import RobotService, RobotUnavailable
 from backend.settings import Settings
 from backend.store.database import make_engine, migrate, session_factory
 from sim_core import FixedPointNotFound, ParameterError
@@ -116,6 +118,7 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
     sessions = session_factory(engine)
     token, _ = api_token(settings.data_dir)
     runner = jobs.JobRunner(sessions, dask_address=settings.dask_address)
+    robot = RobotService(sessions)
 
     @contextlib.asynccontextmanager
     async def lifespan(_app: FastAPI):
@@ -123,6 +126,7 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
         if run_jobs:
             runner.start()
         yield
+        robot.disconnect()
         runner.stop()
         engine.dispose()
 
@@ -161,6 +165,14 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
     async def bad_parameter(_request, error: ParameterError):
         body = {"detail": [{"loc": ["body", error.field], "msg": str(error), "type": "value_error"}]}
         return JSONResponse(body, status_code=status.HTTP_422_UNPROCESSABLE_CONTENT)
+
+    @app.exception_handler(RobotUnavailable)
+    async def robot_unavailable(_request, error):
+        return JSONResponse({"detail": str(error)}, status_code=status.HTTP_409_CONFLICT)
+
+    @app.exception_handler(LinkError)
+    async def link_error(_request, error):
+        return JSONResponse({"detail": f"robot link: {error}"}, status_code=status.HTTP_503_SERVICE_UNAVAILABLE)
 
     @app.exception_handler(FixedPointNotFound)
     async def no_fixed_point(_request, error):
@@ -352,6 +364,46 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
     @app.post("/api/v1/jobs/{job_id}/cancel", dependencies=AUTHORIZED, response_model=schemas.JobOut, tags=["jobs"])
     def cancel_job(job_id: RecordId, db: Db):
         return _job_out(jobs.cancel_job(db, job_id))
+
+    # The robot: one link per service; every call that moves or commands it needs the token.
+    @app.get("/api/v1/robot", tags=["robot"])
+    def robot_status() -> dict:
+        return robot.status()
+
+    @app.post("/api/v1/robot/connect", dependencies=AUTHORIZED, tags=["robot"])
+    def robot_connect(body: schemas.RobotConnect) -> dict:
+        return robot.connect(body)
+
+    @app.post("/api/v1/robot/disconnect", dependencies=AUTHORIZED, tags=["robot"])
+    def robot_disconnect() -> dict:
+        return robot.disconnect()
+
+    @app.post("/api/v1/robot/arm", dependencies=AUTHORIZED, tags=["robot"])
+    def robot_arm() -> dict:
+        return robot.arm()
+
+    @app.post("/api/v1/robot/disarm", dependencies=AUTHORIZED, tags=["robot"])
+    def robot_disarm() -> dict:
+        return robot.disarm()
+
+    @app.post("/api/v1/robot/reset", dependencies=AUTHORIZED, tags=["robot"])
+    def robot_reset() -> dict:
+        return robot.reset()
+
+    @app.post("/api/v1/robot/estop", dependencies=AUTHORIZED, tags=["robot"])
+    def robot_estop() -> dict:
+        """Emergency stop, at any moment (a live run ends and is stored); returns the ack latency."""
+        return robot.estop()
+
+    @app.post("/api/v1/robot/runs", status_code=202, dependencies=AUTHORIZED, tags=["robot"])
+    def robot_run(body: schemas.RobotRunCreate) -> dict:
+        """Start a live run; it is stored as a run of kind robot when it ends (see GET /api/v1/robot)."""
+        robot.start_run(body)
+        return robot.status()
+
+    @app.post("/api/v1/robot/runs/stop", dependencies=AUTHORIZED, tags=["robot"])
+    def robot_run_stop() -> dict:
+        return robot.stop_run()
 
     # Quick calls for the control panel: computed, not stored.
     @app.post("/api/v1/sim/map", tags=["simulate"])

@@ -1,0 +1,319 @@
+"""Live runs on the robot: the service's one link, its tracker, and the run in progress.
+
+A live run sets the legs, arms and starts the robot, and records everything: raw tracker
+frames, the touchdowns detected in them, every command sent, telemetry and link transitions.
+Closed loop, each detected touchdown's height goes through the simulator's PID
+(:func:`sim_core.closed_loop.pid_step`) to the leg of the touchdown after next — the one the
+robot positions during the coming stance. The run ends when its jumps or time are used up,
+when stopped, or when anything goes wrong (e-stop, fall, lost link); it is then stored as a run
+of kind ``robot``, with the model's prediction for the same controls beside it, whatever ended it.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from backend.robot.limits import ServoLimits
+from backend.robot.link import LinkError, LinkState, RobotLink
+from backend.robot.messages import Leg
+from backend.robot.touchdown import Touchdown, detect_touchdowns, height_gains
+from backend.robot.tracker import UdpPoseSource
+from backend.schemas import RobotConnect, RobotRunCreate
+from backend.services.records import NotFound
+from backend.services.simulation import current_code_version, pack_trajectory
+from backend.store.models import Run, RunTag
+from experiments.report import json_safe
+from sim_core import ControlSchedule, LegControl, ParameterError, get_preset, iterate_map
+from sim_core.closed_loop import pid_step
+from sim_core.sweep import find_in_place_zeta0
+
+POLL = 0.005  # [s] how often a live run looks at new poses
+
+
+class RobotUnavailable(RuntimeError):
+    """The robot is not connected, or busy with another run."""
+
+
+@dataclass
+class LiveRun:
+    request: RobotRunCreate
+    started: float = field(default_factory=time.time)
+    touchdowns: list[Touchdown] = field(default_factory=list)
+    commands: list[dict] = field(default_factory=list)
+    telemetry: list[dict] = field(default_factory=list)
+    end_reason: str | None = None
+    stored_run_id: int | None = None
+    stop_requested: threading.Event = field(default_factory=threading.Event)
+    done: threading.Event = field(default_factory=threading.Event)
+
+
+class RobotService:
+    def __init__(self, sessions, robot=None):
+        self.sessions = sessions
+        self.robot = robot or get_preset("paper")  # the robot's physical parameters
+        self.link: RobotLink | None = None
+        self.tracker: UdpPoseSource | None = None
+        self.run: LiveRun | None = None
+        self._lock = threading.Lock()
+
+    # Connection -------------------------------------------------------------------------------
+    def connect(self, body: RobotConnect) -> dict:
+        with self._lock:
+            self._disconnect()
+            limits = ServoLimits(tuple(body.psi0_limits_deg), tuple(body.zeta0_limits))
+            self.tracker = UdpPoseSource(body.tracker_host, body.tracker_port)
+            link = RobotLink(body.url, baud=body.baud, limits=limits)
+            try:
+                link.connect()
+            except LinkError:
+                self.tracker.close()
+                self.tracker = None
+                raise
+            self.link = link
+        return self.status()
+
+    def disconnect(self) -> dict:
+        with self._lock:
+            self._disconnect()
+        return self.status()
+
+    def _disconnect(self) -> None:
+        if self.run is not None and not self.run.done.is_set():
+            self.run.stop_requested.set()
+            self.run.done.wait(5)
+        if self.link is not None:
+            self.link.close()
+            self.link = None
+        if self.tracker is not None:
+            self.tracker.close()
+            self.tracker = None
+
+    def status(self) -> dict:
+        link, tracker, run = self.link, self.tracker, self.run
+        pose = tracker.latest() if tracker is not None else None
+        return json_safe(
+            {
+                "state": LinkState.DISCONNECTED.value if link is None else link.state.value,
+                "url": None if link is None else link.url,
+                "telemetry": None if link is None or link.telemetry is None else _telemetry(link.telemetry),
+                "tracker": None
+                if tracker is None
+                else {
+                    "address": list(tracker.address),
+                    "received": tracker.stats.received,
+                    "dropped": tracker.stats.dropped,
+                    "malformed": tracker.stats.malformed,
+                    "loss": tracker.stats.loss,
+                    "latest": None if pose is None else vars(pose),
+                },
+                "run": None
+                if run is None
+                else {
+                    "active": not run.done.is_set(),
+                    "touchdowns": len(run.touchdowns),
+                    "end_reason": run.end_reason,
+                    "stored_run_id": run.stored_run_id,
+                },
+                "transitions": []
+                if link is None
+                else [
+                    {"time": t.time, "from": t.before.value, "to": t.after.value, "reason": t.reason}
+                    for t in link.transitions[-20:]
+                ],
+            }
+        )
+
+    # Commands --------------------------------------------------------------------------------
+    def _connected(self) -> RobotLink:
+        if self.link is None or self.link.state == LinkState.DISCONNECTED:
+            raise RobotUnavailable("the robot is not connected")
+        return self.link
+
+    def arm(self) -> dict:
+        self._connected().arm()
+        return self.status()
+
+    def disarm(self) -> dict:
+        self._connected().disarm()
+        return self.status()
+
+    def reset(self) -> dict:
+        self._connected().reset()
+        return self.status()
+
+    def estop(self) -> dict:
+        """Emergency stop at any moment; ends a live run (which is still stored)."""
+        link = self._connected()
+        latency = link.estop()
+        if self.run is not None and not self.run.done.is_set():
+            self.run.end_reason = self.run.end_reason or "e-stop"
+            self.run.stop_requested.set()
+        return {"latency_ms": latency * 1000.0, **self.status()}
+
+    # Live runs -------------------------------------------------------------------------------
+    def start_run(self, body: RobotRunCreate) -> LiveRun:
+        link = self._connected()
+        with self._lock:
+            if self.run is not None and not self.run.done.is_set():
+                raise RobotUnavailable("a live run is in progress; stop it first")
+            if link.state not in (LinkState.DISARMED, LinkState.ARMED):
+                raise RobotUnavailable(f"the robot is {link.state.value}; it must be disarmed or armed to start")
+            legs = [LegControl.from_degrees(leg.psi0_deg, leg.zeta0) for leg in body.controls]
+            for leg in legs:
+                link.limits.check(leg.psi0_deg, leg.zeta0)  # a clear 422 before anything moves
+            run = LiveRun(body)
+            self.run = run
+        threading.Thread(target=self._execute, args=(run, legs), name="live-run", daemon=True).start()
+        return run
+
+    def stop_run(self) -> dict:
+        if self.run is None:
+            raise NotFound("live run", 0)
+        self.run.stop_requested.set()
+        self.run.done.wait(10)
+        return self.status()
+
+    def _execute(self, run: LiveRun, legs: list[LegControl]) -> None:
+        link, tracker = self.link, self.tracker
+        first_pose = len(tracker.poses_since(-math.inf))
+        controller = self._controller(run.request, legs)
+        commanded = {Leg.LEFT: legs[0], Leg.RIGHT: legs[1]}
+        integral, previous_error = 0.0, math.nan
+
+        def send(leg: Leg, control: LegControl, why: str) -> None:
+            link.set_leg(leg, control.psi0_deg, control.zeta0)
+            commanded[leg] = control
+            run.commands.append({"time": time.time(), "leg": leg.name.lower(), "psi0_deg": control.psi0_deg,
+                                 "zeta0": control.zeta0, "why": why})  # fmt: skip
+
+        def leg_for(k: int) -> LegControl:
+            # Detected touchdown k is the climb's touchdown k + 1: even climb touchdowns are the left leg's.
+            return run_controls[k] if k < len(run_controls) else commanded[Leg.LEFT if (k + 1) % 2 == 0 else Leg.RIGHT]
+
+        run_controls: list[LegControl] = []  # the controls each detected touchdown was made with
+        try:
+            send(Leg.LEFT, legs[0], "start")
+            send(Leg.RIGHT, legs[1], "start")
+            if link.state == LinkState.DISARMED:
+                link.arm()
+            link.start()
+            deadline = time.monotonic() + run.request.max_seconds
+            while True:
+                if run.stop_requested.is_set():
+                    run.end_reason = run.end_reason or "stopped"
+                elif link.state != LinkState.RUNNING:
+                    run.end_reason = {
+                        LinkState.DISCONNECTED: "link lost",
+                        LinkState.ESTOPPED: "e-stop",
+                    }.get(link.state, "robot disarmed (fell or timed out)")
+                elif time.monotonic() > deadline:
+                    run.end_reason = "time limit"
+                if run.end_reason is not None:
+                    break
+                poses = tracker.poses_since(-math.inf)[first_pose:]
+                if len(poses) > 1:
+                    times = np.array([p.time for p in poses])
+                    found = detect_touchdowns(times, np.array([p.x for p in poses]), np.array([p.y for p in poses]),
+                                              self.robot, leg_for)  # fmt: skip
+                    while len(run_controls) < len(found):
+                        run_controls.append(leg_for(len(run_controls)))
+                    for touchdown in found[len(run.touchdowns) :]:
+                        run.touchdowns.append(touchdown)
+                        if controller is not None:
+                            error = controller["target_m"] - touchdown.body_height
+                            command, integral = pid_step(error / self.robot.leg_length, previous_error, integral,
+                                                         *controller["law"])  # fmt: skip
+                            previous_error = error / self.robot.leg_length
+                            leg = Leg.LEFT if (touchdown.index + 2) % 2 == 0 else Leg.RIGHT
+                            send(
+                                leg, LegControl(commanded[leg].psi0, command), f"pid after touchdown {touchdown.index}"
+                            )
+                    if len(run.touchdowns) >= run.request.jumps:
+                        run.end_reason = "jumps done"
+                        break
+                if link.telemetry is not None and (not run.telemetry or run.telemetry[-1]["seq"] != link.telemetry.seq):
+                    run.telemetry.append({"time": time.time(), **_telemetry(link.telemetry)})
+                time.sleep(POLL)
+            if link.state in (LinkState.RUNNING, LinkState.ARMED):
+                link.disarm()
+        except (LinkError, ParameterError) as error:
+            run.end_reason = run.end_reason or f"error: {error}"
+        finally:
+            self._store(run, tracker, first_pose, run_controls, link)
+            run.done.set()
+
+    def _controller(self, body: RobotRunCreate, legs: list[LegControl]) -> dict | None:
+        loop = body.closed_loop
+        if loop is None:
+            return None
+        hover = find_in_place_zeta0(self.robot.to_model(), legs[0].psi0, zeta0_range=(loop.zeta0_min, loop.zeta0_max))
+        return {"target_m": loop.target_m, "law": (hover, loop.kp, loop.ki, loop.kd, loop.zeta0_min, loop.zeta0_max)}
+
+    def _store(self, run: LiveRun, tracker, first_pose: int, controls: list[LegControl], link) -> None:
+        poses = tracker.poses_since(-math.inf)[first_pose:]
+        frames = {name: np.array([getattr(p, name) for p in poses]) for name in ("time", "x", "y", "pitch")}
+        touchdowns = run.touchdowns
+        gains = height_gains(touchdowns, self.robot) if len(touchdowns) > 1 else np.empty(0)
+        model = self.robot.to_model()
+        prediction = None
+        if len(touchdowns) > 1:
+            schedule = ControlSchedule.of(*controls[: len(touchdowns)])
+            orbit = iterate_map(model, schedule, touchdowns[0].state, len(touchdowns) - 1)
+            prediction = orbit.to_dict()
+        results = {
+            "end_reason": run.end_reason,
+            "touchdowns": [vars(td) for td in touchdowns],
+            "states": [list(td.state) for td in touchdowns],
+            "rises": gains.tolist(),
+            "prediction": prediction,
+            "commands": run.commands,
+            "telemetry": run.telemetry,
+            "transitions": [
+                {"time": t.time, "from": t.before.value, "to": t.after.value, "reason": t.reason}
+                for t in link.transitions
+            ],
+            "tracker": {"frames": len(poses), "dropped": tracker.stats.dropped, "loss": tracker.stats.loss},
+            "closed_loop": None if run.request.closed_loop is None else run.request.closed_loop.model_dump(),
+        }
+        request = run.request
+        first = request.controls[0]
+        with self.sessions() as session:
+            stored = Run(
+                experiment_id=request.experiment_id,
+                kind="robot",
+                status="done" if run.end_reason in ("jumps done", "stopped", "time limit") else "failed",
+                duration_s=time.time() - run.started,
+                code_version=current_code_version(),
+                model=json_safe(asdict(model)),
+                controls=[[leg.psi0_deg, leg.zeta0] for leg in request.controls],
+                start_state=json_safe(list(touchdowns[0].state) if touchdowns else [math.nan, math.nan]),
+                jumps=request.jumps,
+                alpha=model.alpha,
+                psi0_deg=first.psi0_deg,
+                zeta0=first.zeta0,
+                failure_code=None,
+                jumps_completed=max(len(touchdowns) - 1, 0),
+                climb=float(np.sum(gains)),
+                results=json_safe(results),
+                trajectory=pack_trajectory(frames) if poses else None,
+            )
+            stored.run_tags = [RunTag(tag=tag) for tag in sorted(set(request.tags))]
+            session.add(stored)
+            session.commit()
+            run.stored_run_id = stored.id
+
+
+def _telemetry(telemetry) -> dict:
+    return {
+        "seq": telemetry.seq,
+        "state": telemetry.state.name.lower(),
+        "psi_servo_deg": list(telemetry.psi_servo_deg),
+        "zeta_servo": list(telemetry.zeta_servo),
+        "battery_mv": telemetry.battery_mv,
+        "faults": telemetry.faults,
+    }
