@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Annotated
 
 import fastapi_offline
-from fastapi import Depends, FastAPI, HTTPException, Query, Request, status
+from fastapi import Depends, FastAPI, HTTPException, Query, Request, WebSocket, WebSocketDisconnect, status
 from fastapi import Path as FastAPIPath
 from fastapi.encoders import jsonable_encoder
 from fastapi.openapi.docs import get_swagger_ui_html
@@ -369,6 +369,20 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
     @app.get("/api/v1/robot", tags=["robot"])
     def robot_status() -> dict:
         return robot.status()
+
+    @app.websocket("/api/v1/robot/live")
+    async def robot_live(
+        websocket: WebSocket, rate: Annotated[float, Query(gt=0, le=50, description="messages per second")] = 20
+    ):
+        """Live state for the panel: link state, telemetry, the latest tracked pose, the run's
+        newest touchdowns — ``rate`` messages per second until the client goes away."""
+        await websocket.accept()
+        try:
+            while True:
+                await websocket.send_json(await asyncio.to_thread(robot.live))
+                await asyncio.sleep(1.0 / rate)
+        except (WebSocketDisconnect, RuntimeError):
+            return
 
     @app.post("/api/v1/robot/connect", dependencies=AUTHORIZED, tags=["robot"])
     def robot_connect(body: schemas.RobotConnect) -> dict:

@@ -100,6 +100,7 @@ class PoseHistory:
         self.stale_after = stale_after
         self._poses: list[Pose] = []
         self._times: list[float] = []
+        self._arrived = -math.inf  # time.monotonic() of the newest pose's arrival
         self._lock = threading.Lock()
 
     def add(self, pose: Pose) -> None:
@@ -107,17 +108,18 @@ class PoseHistory:
         with self._lock:
             self._poses.append(Pose(pose.time, x, y, pose.pitch))
             self._times.append(pose.time)
+            self._arrived = time.monotonic()
             if len(self._poses) > HISTORY:
                 del self._poses[: len(self._poses) - HISTORY]
                 del self._times[: len(self._times) - HISTORY]
 
     def latest(self, now: float | None = None) -> Pose | None:
-        """The newest pose, or None if there is none or it is stale (older than ``stale_after``)."""
+        """The newest pose, or None if there is none or it is stale: it arrived more than
+        ``stale_after`` ago (``now`` on the ``time.monotonic()`` clock; the poses' own times are
+        the camera's clock, which the PC's need not match)."""
         with self._lock:
-            pose = self._poses[-1] if self._poses else None
-        if pose is None:
-            return None
-        if (time.time() if now is None else now) - pose.time > self.stale_after:
+            pose, arrived = (self._poses[-1] if self._poses else None), self._arrived
+        if pose is None or (time.monotonic() if now is None else now) - arrived > self.stale_after:
             return None
         return pose
 

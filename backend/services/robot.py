@@ -128,6 +128,16 @@ class RobotService:
             }
         )
 
+    def live(self) -> dict:
+        """What the live view shows, cheaply: status plus the run's last few touchdowns."""
+        status = self.status()
+        run = self.run
+        recent = [] if run is None else run.touchdowns[-5:]
+        status["recent_touchdowns"] = json_safe(
+            [{"index": td.index, "time": td.time, "wall": td.wall, "body_height": td.body_height} for td in recent]
+        )
+        return status
+
     # Commands --------------------------------------------------------------------------------
     def _connected(self) -> RobotLink:
         if self.link is None or self.link.state == LinkState.DISCONNECTED:

@@ -124,3 +124,20 @@ def test_closed_loop_live_run_holds_a_height(client, auth, connected):
 def test_only_serial_ports_and_robot_sockets_can_be_opened(client, auth, url):
     response = client.post("/api/v1/robot/connect", json={"url": url}, headers=auth)
     assert response.status_code == 422 and "url" in response.text
+
+
+def test_live_state_streams_over_websocket(client, auth, connected):
+    client.post("/api/v1/robot/runs", json={"controls": CONTROLS, "jumps": 6}, headers=auth)
+    heights, touchdowns = [], 0
+    with client.websocket_connect("/api/v1/robot/live?rate=50") as live:
+        for _ in range(200):
+            message = live.receive_json()
+            pose = message["tracker"]["latest"] if message["tracker"] else None
+            if pose is not None:
+                heights.append(pose["y"])
+            touchdowns = max(touchdowns, len(message["recent_touchdowns"]))
+            if message["run"] and not message["run"]["active"]:
+                break
+    assert len(heights) > 20 and max(heights) > min(heights) + 0.2, "the body climbs on the live view"
+    assert touchdowns >= 3
+    _finish(client)
