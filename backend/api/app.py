@@ -33,7 +33,7 @@ from sqlalchemy.orm import Session
 from backend import schemas
 from backend.robot.link import LinkError
 from backend.services import jobs, records, simulation
-from backend.services.robot import RobotService, RobotUnavailable
+from backend.services.robot import RobotService, RobotUnavailable, replay_run
 from backend.settings import Settings
 from backend.store.database import make_engine, migrate, session_factory
 from sim_core import FixedPointNotFound, ParameterError
@@ -292,6 +292,17 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
             raise records.NotFound("trajectory of run", run_id)
         columns = simulation.unpack_trajectory(run.trajectory)
         return {"units": "nondimensional", "columns": {name: values.tolist() for name, values in columns.items()}}
+
+    @app.post(
+        "/api/v1/runs/{run_id}/replay",
+        status_code=201,
+        dependencies=AUTHORIZED,
+        response_model=schemas.RunDetail,
+        tags=["runs"],
+    )
+    def replay(run_id: RecordId, db: Db):
+        """Analyse a robot run's recorded tracker frames again, stored as a run of kind replay."""
+        return _run_out(replay_run(db, run_id), detail=True)
 
     @app.patch("/api/v1/runs/{run_id}", dependencies=AUTHORIZED, response_model=schemas.RunOut, tags=["runs"])
     def update_run(run_id: RecordId, body: schemas.RunUpdate, db: Db):

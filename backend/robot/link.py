@@ -104,6 +104,8 @@ class RobotLink:
     # Connection -----------------------------------------------------------------------------
     def connect(self, timeout: float = 3.0) -> LinkState:
         """Open the port and wait for the robot's first telemetry."""
+        self.telemetry = None
+        self.parser = FrameParser()
         try:
             self._port = serial.serial_for_url(self.url, baudrate=self.baud, timeout=READ_TIMEOUT)
         except (serial.SerialException, ValueError, OSError) as error:
@@ -123,6 +125,12 @@ class RobotLink:
                 raise LinkError(f"no telemetry from the robot at {self.url} within {timeout:g} s")
             time.sleep(0.005)
         return self.state
+
+    def reconnect(self, timeout: float = 1.0) -> LinkState:
+        """Close what is left of a dropped link and connect again (the robot stays as it decided:
+        after silence it has disarmed itself)."""
+        self.close()
+        return self.connect(timeout)
 
     def close(self) -> None:
         self._stop.set()

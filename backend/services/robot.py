@@ -24,8 +24,8 @@ from backend.robot.messages import Leg
 from backend.robot.touchdown import Touchdown, detect_touchdowns, height_gains
 from backend.robot.tracker import UdpPoseSource
 from backend.schemas import RobotConnect, RobotRunCreate
-from backend.services.records import NotFound
-from backend.services.simulation import current_code_version, pack_trajectory
+from backend.services.records import Conflict, NotFound
+from backend.services.simulation import current_code_version, pack_trajectory, unpack_trajectory
 from backend.store.models import Run, RunTag
 from experiments.report import json_safe
 from sim_core import ControlSchedule, LegControl, ParameterError, get_preset, iterate_map
@@ -33,6 +33,7 @@ from sim_core.closed_loop import pid_step
 from sim_core.sweep import find_in_place_zeta0
 
 POLL = 0.005  # [s] how often a live run looks at new poses
+RECONNECT_PERIOD = 1.0  # [s] between attempts on a dropped link
 
 
 class RobotUnavailable(RuntimeError):
@@ -59,6 +60,7 @@ class RobotService:
         self.link: RobotLink | None = None
         self.tracker: UdpPoseSource | None = None
         self.run: LiveRun | None = None
+        self._wanted = False  # reconnect after a dropped link until disconnected by hand
         self._lock = threading.Lock()
 
     # Connection -------------------------------------------------------------------------------
@@ -75,12 +77,29 @@ class RobotService:
                 self.tracker = None
                 raise
             self.link = link
+            self._wanted = True
+            link.on_lost.append(self._on_lost)
         return self.status()
 
     def disconnect(self) -> dict:
         with self._lock:
+            self._wanted = False
             self._disconnect()
         return self.status()
+
+    def _on_lost(self, reason: str) -> None:
+        """A dropped link is retried every RECONNECT_PERIOD until it answers or is disconnected by hand.
+        A live run does not resume: it has ended, and the robot has disarmed itself."""
+        threading.Thread(target=self._reconnect, args=(self.link,), name="robot-reconnect", daemon=True).start()
+
+    def _reconnect(self, link: RobotLink) -> None:
+        while self._wanted and self.link is link:
+            try:
+                link.reconnect(timeout=RECONNECT_PERIOD)
+                link.on_lost[:] = [self._on_lost]
+                return
+            except LinkError:
+                time.sleep(RECONNECT_PERIOD)
 
     def _disconnect(self) -> None:
         if self.run is not None and not self.run.done.is_set():
@@ -280,6 +299,7 @@ class RobotService:
             "touchdowns": [vars(td) for td in touchdowns],
             "states": [list(td.state) for td in touchdowns],
             "rises": gains.tolist(),
+            "touchdown_controls": [[leg.psi0_deg, leg.zeta0] for leg in controls[: len(touchdowns)]],
             "prediction": prediction,
             "commands": run.commands,
             "telemetry": run.telemetry,
@@ -316,6 +336,62 @@ class RobotService:
             session.add(stored)
             session.commit()
             run.stored_run_id = stored.id
+
+
+def replay_run(session, run_id: int, robot=None) -> Run:
+    """A stored robot run's tracker frames analysed again (kind ``replay``): touchdowns, gains and
+    the model's prediction, with today's detection — e.g. after a calibration or detector change."""
+    robot = robot or get_preset("paper")
+    source = session.get(Run, run_id)
+    if source is None:
+        raise NotFound("run", run_id)
+    if source.kind != "robot" or source.trajectory is None:
+        raise Conflict(f"run {run_id} is a {source.kind} run without tracker frames; only robot runs can be replayed")
+    frames = unpack_trajectory(source.trajectory)
+    recorded = [LegControl.from_degrees(*pair) for pair in source.results.get("touchdown_controls", [])]
+    alternating = [LegControl.from_degrees(*pair) for pair in source.controls]
+
+    def leg_for(k: int) -> LegControl:
+        return recorded[k] if k < len(recorded) else alternating[(k + 1) % 2]
+
+    touchdowns = detect_touchdowns(frames["time"], frames["x"], frames["y"], robot, leg_for)
+    gains = height_gains(touchdowns, robot) if len(touchdowns) > 1 else np.empty(0)
+    model = robot.to_model()
+    prediction = None
+    if len(touchdowns) > 1:
+        schedule = ControlSchedule.of(*(leg_for(k) for k in range(len(touchdowns))))
+        prediction = iterate_map(model, schedule, touchdowns[0].state, len(touchdowns) - 1).to_dict()
+    replay = Run(
+        experiment_id=source.experiment_id,
+        kind="replay",
+        status="done",
+        duration_s=0.0,
+        code_version=current_code_version(),
+        model=source.model,
+        controls=source.controls,
+        start_state=json_safe(list(touchdowns[0].state) if touchdowns else [math.nan, math.nan]),
+        jumps=source.jumps,
+        alpha=source.alpha,
+        psi0_deg=source.psi0_deg,
+        zeta0=source.zeta0,
+        failure_code=None,
+        jumps_completed=max(len(touchdowns) - 1, 0),
+        climb=float(np.sum(gains)),
+        results=json_safe(
+            {
+                "source_run_id": run_id,
+                "touchdowns": [vars(td) for td in touchdowns],
+                "states": [list(td.state) for td in touchdowns],
+                "rises": gains.tolist(),
+                "prediction": prediction,
+            }
+        ),
+        trajectory=None,
+    )
+    replay.run_tags = [RunTag(tag=tag) for tag in sorted({*source.tags, "replay"})]
+    session.add(replay)
+    session.commit()
+    return replay
 
 
 def _telemetry(telemetry) -> dict:

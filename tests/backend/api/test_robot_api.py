@@ -141,3 +141,38 @@ def test_live_state_streams_over_websocket(client, auth, connected):
     assert len(heights) > 20 and max(heights) > min(heights) + 0.2, "the body climbs on the live view"
     assert touchdowns >= 3
     _finish(client)
+
+
+def test_the_link_comes_back_after_the_robot_restarts(client, auth, connected):
+    host, port = connected.address
+    connected.stop()
+    deadline = time.monotonic() + 10
+    while client.get("/api/v1/robot").json()["state"] != "disconnected":
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+    restarted = VirtualRobot(host, port).start()  # same address: the robot rebooted
+    try:
+        deadline = time.monotonic() + 10
+        while (status := client.get("/api/v1/robot").json())["state"] != "disarmed":
+            assert time.monotonic() < deadline, status
+            time.sleep(0.05)
+        reasons = [t["reason"] for t in status["transitions"]]
+        assert any("heartbeat" in r or "read failed" in r for r in reasons) and reasons[-1] == "telemetry"
+        assert client.post("/api/v1/robot/arm", headers=auth).json()["state"] == "armed"
+    finally:
+        client.post("/api/v1/robot/disconnect", headers=auth)
+        restarted.stop()
+
+
+def test_a_recorded_run_replays_to_the_same_touchdowns(client, auth, connected):
+    client.post("/api/v1/robot/runs", json={"controls": CONTROLS, "jumps": 6}, headers=auth)
+    live_id = _finish(client)["run"]["stored_run_id"]
+    replay = client.post(f"/api/v1/runs/{live_id}/replay", headers=auth)
+    assert replay.status_code == 201, replay.text
+    replayed, live = replay.json(), client.get(f"/api/v1/runs/{live_id}").json()
+    assert replayed["kind"] == "replay" and replayed["results"]["source_run_id"] == live_id
+    assert replayed["results"]["states"][:6] == live["results"]["states"][:6]
+    assert "replay" in replayed["tags"]
+    simulated = client.post("/api/v1/runs", json={"controls": CONTROLS[:1], "start": {"xdot": -0.9, "ydot": -0.2}},
+                            headers=auth).json()  # fmt: skip
+    assert client.post(f"/api/v1/runs/{simulated['id']}/replay", headers=auth).status_code == 409
