@@ -287,6 +287,12 @@ class RobotConnect(Strict):
     baud: Annotated[int, Field(ge=1200, le=1_000_000)] = 57_600
     tracker_host: Annotated[str, Field(max_length=100, pattern=r"^[\w.:-]+$")] = "127.0.0.1"
     tracker_port: Annotated[int, Field(ge=0, le=65535)] = 9751
+    calibration_origin: Annotated[list[Annotated[float, Field(ge=-1e4, le=1e4)]], Field(min_length=2, max_length=2)] = [
+        0.0,
+        0.0,
+    ]
+    calibration_angle: Annotated[float, Field(ge=-3.2, le=3.2, description="camera rotation [rad]")] = 0.0
+    calibration_scale: Annotated[float, Field(gt=0.0, le=1e4, description="metres per camera unit")] = 1.0
     psi0_limits_deg: Annotated[list[Psi0Deg], Field(min_length=2, max_length=2)] = [10.0, 60.0]
     zeta0_limits: Annotated[list[Zeta0], Field(min_length=2, max_length=2)] = [0.75, 0.98]
 

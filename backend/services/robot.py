@@ -22,7 +22,7 @@ from backend.robot.limits import ServoLimits
 from backend.robot.link import LinkError, LinkState, RobotLink
 from backend.robot.messages import Leg
 from backend.robot.touchdown import Touchdown, detect_touchdowns, height_gains
-from backend.robot.tracker import UdpPoseSource
+from backend.robot.tracker import Calibration, UdpPoseSource
 from backend.schemas import RobotConnect, RobotRunCreate
 from backend.services.records import Conflict, NotFound
 from backend.services.simulation import current_code_version, pack_trajectory, unpack_trajectory
@@ -68,7 +68,8 @@ class RobotService:
         with self._lock:
             self._disconnect()
             limits = ServoLimits(tuple(body.psi0_limits_deg), tuple(body.zeta0_limits))
-            self.tracker = UdpPoseSource(body.tracker_host, body.tracker_port)
+            calibration = Calibration(tuple(body.calibration_origin), body.calibration_angle, body.calibration_scale)
+            self.tracker = UdpPoseSource(body.tracker_host, body.tracker_port, calibration=calibration)
             link = RobotLink(body.url, baud=body.baud, limits=limits)
             try:
                 link.connect()
@@ -308,6 +309,7 @@ class RobotService:
                 for t in link.transitions
             ],
             "tracker": {"frames": len(poses), "dropped": tracker.stats.dropped, "loss": tracker.stats.loss},
+            "calibration": asdict(tracker.calibration),
             "closed_loop": None if run.request.closed_loop is None else run.request.closed_loop.model_dump(),
         }
         request = run.request

@@ -68,6 +68,7 @@ def test_open_loop_live_run_is_stored_with_the_model_beside_it(client, auth, con
         < 0.1
     )
     assert [c["why"] for c in results["commands"]] == ["start", "start"]
+    assert results["calibration"] == {"origin": [0.0, 0.0], "angle": 0.0, "scale": 1.0}
     frames = client.get(f"/api/v1/runs/{run['id']}/trajectory").json()["columns"]
     assert len(frames["time"]) > 100, "raw tracker frames are kept"
 
