@@ -19,11 +19,12 @@ from pathlib import Path
 from typing import Annotated
 
 import fastapi_offline
+import plotly
 from fastapi import Depends, FastAPI, HTTPException, Query, Request, WebSocket, WebSocketDisconnect, status
 from fastapi import Path as FastAPIPath
 from fastapi.encoders import jsonable_encoder
 from fastapi.openapi.docs import get_swagger_ui_html
-from fastapi.responses import HTMLResponse, JSONResponse, StreamingResponse
+from fastapi.responses import FileResponse, HTMLResponse, JSONResponse, RedirectResponse, StreamingResponse
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 from fastapi.staticfiles import StaticFiles
 from pydantic import Field
@@ -42,6 +43,10 @@ log = logging.getLogger("parkourlab.api")
 TOKEN_FILE = "api_token"
 EVENT_POLL_S = 0.25  # progress comes from committed chunks; a quarter second is live enough
 SWAGGER_ASSETS = Path(fastapi_offline.__file__).parent / "static"  # Swagger UI 5: reads OpenAPI 3.1
+PLOTLY_JS = Path(plotly.__file__).parent / "package_data" / "plotly.min.js"  # served locally: no CDN
+# The control panel's static files (frontend/panel): located, not imported — the frontend sits above
+# the backend in the layers, and the backend only serves its files.
+PANEL_DIR = Path(__file__).resolve().parents[2] / "frontend" / "panel"
 PageLimit = Annotated[int, Query(ge=1, le=records.MAX_PAGE, description="items per page")]
 bearer = HTTPBearer(auto_error=False)
 
@@ -139,6 +144,7 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
         redoc_url=None,
     )
     app.mount("/static/swagger", StaticFiles(directory=SWAGGER_ASSETS), name="swagger")
+    app.mount("/panel", StaticFiles(directory=PANEL_DIR, html=True), name="panel")
     app.state.settings = settings
     app.state.sessions = sessions
     app.state.token = token
@@ -178,9 +184,13 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
     async def no_fixed_point(_request, error):
         return JSONResponse({"detail": str(error)}, status_code=status.HTTP_422_UNPROCESSABLE_CONTENT)
 
-    @app.get("/", response_class=HTMLResponse, include_in_schema=False)
-    def index() -> str:
-        return _INDEX
+    @app.get("/", include_in_schema=False)
+    def index() -> RedirectResponse:
+        return RedirectResponse("/panel/")
+
+    @app.get("/static/plotly.min.js", include_in_schema=False)
+    def plotly_js() -> FileResponse:
+        return FileResponse(PLOTLY_JS, media_type="text/javascript")
 
     @app.get("/docs", include_in_schema=False)
     def docs() -> HTMLResponse:
@@ -505,18 +515,3 @@ def _finite(level: dict) -> dict:
     """JSON has no NaN: a level without trials yet reports mean 0 with trials 0."""
     mean = level["mean"]
     return level | {"mean": mean if mean == mean else 0.0}
-
-
-_INDEX = """<!doctype html>
-<html lang="en"><head><meta charset="utf-8"><title>ParkourLab</title>
-<style>body{font-family:system-ui,sans-serif;max-width:42rem;margin:3rem auto;line-height:1.5}</style></head>
-<body><h1>ParkourLab</h1>
-<p>The ParkourLab service is running. The control panel and the 3D view arrive with the next releases.</p>
-<ul>
-<li><a href="/docs">API documentation</a> (OpenAPI, try the calls)</li>
-<li><a href="/api/v1/health">Health</a> · <a href="/api/v1/experiments">Experiments</a> ·
-<a href="/api/v1/runs">Runs</a> · <a href="/api/v1/jobs">Jobs</a></li>
-</ul>
-<p>Changes need the bearer token stored in <code>api_token</code> in the data directory.</p>
-</body></html>
-"""

@@ -1,0 +1,160 @@
+"""The control panel in headless Chromium against the real running service (and the virtual robot).
+
+Set PARKOUR_SCREENSHOTS=1 to refresh docs/screenshots/ from this run.
+"""
+
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import httpx
+import pytest
+
+from backend.robot.virtual import VirtualRobot
+from sim_core.noise import NO_NOISE
+
+pytestmark = pytest.mark.slow  # a browser and a service: ~20 s
+
+ROOT = Path(__file__).resolve().parents[2]
+CHROMIUM = os.environ.get("PARKOUR_CHROMIUM") or shutil.which("chromium") or shutil.which("chromium-browser")
+if CHROMIUM is None:
+    pytest.skip("no Chromium: ./test.sh installs the Debian package; or set PARKOUR_CHROMIUM", allow_module_level=True)
+sync_api = pytest.importorskip("playwright.sync_api")
+
+
+def _free_port(kind=socket.SOCK_STREAM) -> int:
+    with socket.socket(socket.AF_INET, kind) as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+@pytest.fixture(scope="module")
+def service(tmp_path_factory):
+    data, port = tmp_path_factory.mktemp("panel") / "data", _free_port()
+    command = [sys.executable, "-m", "backend.cli.app", "serve", "--data-dir", str(data), "--port", str(port)]
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    base = f"http://127.0.0.1:{port}"
+    deadline = time.monotonic() + 60
+    while True:
+        try:
+            if httpx.get(f"{base}/api/v1/health", timeout=1).status_code == 200:
+                break
+        except httpx.HTTPError:
+            pass
+        assert time.monotonic() < deadline, "the service did not start"
+        time.sleep(0.2)
+    yield base, (data / "api_token").read_text().strip()
+    process.terminate()
+    process.wait(30)
+
+
+@pytest.fixture(scope="module")
+def page(service):
+    base, token = service
+    with sync_api.sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+        context = browser.new_context(viewport={"width": 1360, "height": 900})
+        view = context.new_page()
+        errors = []
+        view.on("pageerror", lambda error: errors.append(str(error)))
+        view.on(
+            "requestfailed",
+            # Closing a finished job's event stream aborts it on purpose.
+            lambda request: "ERR_ABORTED" in (request.failure or "") or errors.append(f"failed {request.url}"),
+        )
+        view.goto(f"{base}/")
+        view.fill("#token", token)
+        view.dispatch_event("#token", "change")
+        yield view
+        assert not errors, errors
+        browser.close()
+
+
+def _shot(page, name):
+    target = ROOT / "docs" / "screenshots" if os.environ.get("PARKOUR_SCREENSHOTS") else Path("/tmp")
+    page.screenshot(path=str(target / f"{name}.png"), full_page=False)
+
+
+def test_simulate_shows_plots_and_the_gait(page):
+    assert page.title() == "ParkourLab control panel"
+    page.click("#run-sim")
+    page.wait_for_selector("#path-plot .main-svg", timeout=20_000)
+    page.wait_for_selector("#height-plot .main-svg")
+    page.click("#find-gait")
+    page.wait_for_function("document.querySelector('#gait-readout').textContent.includes('stable')", timeout=20_000)
+    assert "Period 2" in page.inner_text("#gait-readout")
+    _shot(page, "simulate")
+
+
+def test_bad_input_shows_the_field_and_range(page):
+    page.fill("input[name=zetaL]", "1.5")
+    page.click("#find-gait")
+    page.wait_for_selector(".message.error")
+    assert "zeta0" in page.inner_text(".message.error")
+    page.fill("input[name=zetaL]", "0.87")
+
+
+def test_a_job_runs_to_completion_with_progress(page):
+    page.click("nav [data-tab=jobs]")
+    page.fill("input[name=trials]", "30")
+    page.fill("input[name=cap]", "200")
+    page.click("#submit-job")
+    page.wait_for_selector("#job-table tbody tr .state", timeout=10_000)
+    page.wait_for_function(
+        "[...document.querySelectorAll('#job-table .state')].some(cell => cell.textContent === 'done')", timeout=60_000
+    )
+    page.click("#job-table .show")
+    page.wait_for_selector("#job-plot .main-svg", timeout=10_000)
+    _shot(page, "jobs")
+
+
+def test_history_compares_and_exports(page, service):
+    base, token = service
+    for zeta0 in (0.88, 0.92):
+        body = {
+            "controls": [{"psi0_deg": 30, "zeta0": zeta0}],
+            "start": {"xdot": -0.93, "ydot": -0.2},
+            "tags": ["panel"],
+        }
+        httpx.post(f"{base}/api/v1/runs", json=body, headers={"Authorization": f"Bearer {token}"}).raise_for_status()
+    page.click("nav [data-tab=history]")
+    page.wait_for_selector("#run-table tbody tr")
+    boxes = page.query_selector_all("#run-table tbody input[type=checkbox]")
+    assert len(boxes) >= 2
+    boxes[0].check()
+    boxes[1].check()
+    page.click("#compare")
+    page.wait_for_selector("#compare-table")
+    assert "leg0.zeta0" in page.inner_text("#compare-table")
+    exported = page.request.get(base + page.get_attribute("#export-csv", "href"))
+    assert exported.ok and exported.text().startswith("id,")
+    _shot(page, "history")
+
+
+def test_emergency_stop_reaches_the_robot(page):
+    tracker_port = _free_port(socket.SOCK_DGRAM)
+    robot = VirtualRobot(tracker_to=("127.0.0.1", tracker_port), noise=NO_NOISE, speed=3.0).start()
+    try:
+        page.click("nav [data-tab=robot]")
+        page.fill("input[name=url]", robot.url)
+        page.fill("input[name=tracker_port]", str(tracker_port))
+        page.click("#connect")
+        page.wait_for_function("document.querySelector('#robot-status').textContent.includes('disarmed')")
+        page.click("#live-run")
+        page.wait_for_function(
+            "document.querySelector('#robot-status').textContent.includes('running')", timeout=10_000
+        )
+        time.sleep(1.5)
+        page.wait_for_selector("#live-plot .main-svg", timeout=10_000)
+        _shot(page, "robot")
+        page.click("#estop")
+        page.wait_for_function(
+            "document.querySelector('.message')?.textContent.includes('Emergency stop acknowledged')"
+        )
+        assert robot.firmware.state.name == "ESTOPPED"
+    finally:
+        robot.stop()
