@@ -21,13 +21,13 @@ from numba import prange
 
 from sim_core._jit import kernel, parallel_kernel
 from sim_core.chunks import ChunkMap, Progress, chunk_slices, in_process
-from sim_core.controls import PSI0_COLUMN, ZETA0_COLUMN, ControlSchedule
+from sim_core.controls import ControlSchedule
 from sim_core.failures import OK, Failure
 from sim_core.fixed_points import FixedPoint
 from sim_core.integrate import STATE_SIZE
 from sim_core.params import ModelParams
 from sim_core.poincare import check_jumps
-from sim_core.stride import jump
+from sim_core.stride import scheduled_jump
 from sim_core.validation import ParameterError, check_range
 
 DEFAULT_TOLERANCE = 0.02  # [sqrt(g l0)]: inside the linear region of a stable gait, far above integrator noise
@@ -265,25 +265,10 @@ def converge(xdot, ydot, schedule, orbit, tolerance, max_jumps, alpha, d_hat, c_
     if _near_orbit(xdot, ydot, 0, period, orbit, tolerance):
         return 0, OK, 0
     for k in range(max_jumps):
-        this = k % period
-        following = (k + 1) % period
-        status, xdot, ydot, _, _, _, _ = jump(
-            xdot,
-            ydot,
-            schedule[this, PSI0_COLUMN],
-            schedule[this, ZETA0_COLUMN],
-            schedule[following, PSI0_COLUMN],
-            schedule[following, ZETA0_COLUMN],
-            alpha,
-            d_hat,
-            c_zeta,
-            c_psi,
-            mu,
-            no_record,
-        )
+        status, xdot, ydot, _ = scheduled_jump(xdot, ydot, schedule, k, alpha, d_hat, c_zeta, c_psi, mu, no_record)
         if status != OK:
             return NOT_CONVERGED, status, k + 1
-        if _near_orbit(xdot, ydot, following, period, orbit, tolerance):
+        if _near_orbit(xdot, ydot, (k + 1) % period, period, orbit, tolerance):
             return k + 1, OK, k + 1
     return NOT_CONVERGED, OK, max_jumps
 

@@ -80,6 +80,32 @@ def jump(xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c
 
 
 @kernel
+def scheduled_jump(xdot, ydot, schedule, k, alpha, d_hat, c_zeta, c_psi, mu, no_record):
+    """Jump ``k`` of a cyclic schedule (rows ``k`` and ``k + 1`` mod its length); ``no_record`` is
+    an empty (0, STATE_SIZE) array, allocated once by the caller's loop.
+
+    Returns ``(status, next_xdot, next_ydot, rise)``.
+    """
+    period = schedule.shape[0]
+    this, following = k % period, (k + 1) % period
+    status, xdot, ydot, rise, _, _, _ = jump(
+        xdot,
+        ydot,
+        schedule[this, PSI0_COLUMN],
+        schedule[this, ZETA0_COLUMN],
+        schedule[following, PSI0_COLUMN],
+        schedule[following, ZETA0_COLUMN],
+        alpha,
+        d_hat,
+        c_zeta,
+        c_psi,
+        mu,
+        no_record,
+    )
+    return status, xdot, ydot, rise
+
+
+@kernel
 def orbit(xdot, ydot, schedule, first_jump, alpha, d_hat, c_zeta, c_psi, mu, states, rises):
     """Iterate the map ``rises.shape[0]`` times with a cyclic control schedule.
 
@@ -94,28 +120,14 @@ def orbit(xdot, ydot, schedule, first_jump, alpha, d_hat, c_zeta, c_psi, mu, sta
         ``(status, jumps_completed)``; on failure jump ``jumps_completed`` (0-based) failed.
     """
     jumps = rises.shape[0]
-    period = schedule.shape[0]
     no_record = np.empty((0, STATE_SIZE))
     states[:, :] = math.nan
     rises[:] = math.nan
     states[0, 0] = xdot
     states[0, 1] = ydot
     for k in range(jumps):
-        this = (first_jump + k) % period
-        following = (first_jump + k + 1) % period
-        status, xdot, ydot, rise, _, _, _ = jump(
-            xdot,
-            ydot,
-            schedule[this, PSI0_COLUMN],
-            schedule[this, ZETA0_COLUMN],
-            schedule[following, PSI0_COLUMN],
-            schedule[following, ZETA0_COLUMN],
-            alpha,
-            d_hat,
-            c_zeta,
-            c_psi,
-            mu,
-            no_record,
+        status, xdot, ydot, rise = scheduled_jump(
+            xdot, ydot, schedule, first_jump + k, alpha, d_hat, c_zeta, c_psi, mu, no_record
         )
         if status != OK:
             return status, k

@@ -22,7 +22,7 @@ from sqlalchemy import func, select, update
 from sqlalchemy.orm import Session, sessionmaker
 
 from backend.schemas import JOB_KINDS, MJTFJobCreate
-from backend.services.records import NotFound, get_experiment
+from backend.services.records import NotFound, get_experiment, page
 from backend.services.simulation import KERNEL_LOCK, current_code_version, locked_chunk_map, model_params, run_study
 from backend.store.models import Job, Trial, utcnow
 from experiments.cluster import as_completed_results, chunk_map_for, dask_client
@@ -69,8 +69,7 @@ def list_jobs(session: Session, *, state: str | None, limit: int, cursor: int | 
         query = query.where(Job.state == state)
     if cursor is not None:
         query = query.where(Job.id < cursor)
-    rows = list(session.scalars(query))
-    return (rows[:limit], rows[limit - 1].id) if len(rows) > limit else (rows, None)
+    return page(list(session.scalars(query)), limit)
 
 
 def cancel_job(session: Session, job_id: int) -> Job:

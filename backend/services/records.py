@@ -74,7 +74,7 @@ def list_experiments(session: Session, *, limit: int, cursor: int | None) -> tup
     if cursor is not None:
         query = query.where(Experiment.id < cursor)
     rows = list(session.scalars(query))
-    return _page(rows, limit)
+    return page(rows, limit)
 
 
 def create_run(session: Session, body: RunCreate) -> Run:
@@ -138,7 +138,7 @@ def list_runs(
     if sort.lstrip("-") == "id":
         if cursor is not None:
             query = query.where(Run.id < cursor if descending else Run.id > cursor)
-        return _page(list(session.scalars(query)), limit)
+        return page(list(session.scalars(query)), limit)
     rows = list(session.scalars(query.offset(offset)))
     return rows[:limit], (offset + limit if len(rows) > limit else None)
 
@@ -268,7 +268,8 @@ def aggregate_runs(session: Session, where: RunFilter, by: str) -> list[dict]:
     return groups
 
 
-def _page(rows: list, limit: int) -> tuple[list, int | None]:
+def page(rows: list, limit: int) -> tuple[list, int | None]:
+    """A keyset page from ``limit + 1`` rows fetched newest first: the rows and the next cursor."""
     if len(rows) > limit:
         return rows[:limit], rows[limit - 1].id
     return rows, None
