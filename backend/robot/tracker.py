@@ -123,6 +123,16 @@ class PoseHistory:
             return None
         return pose
 
+    def count(self) -> int:
+        """Poses received so far (an index for :meth:`poses_from`)."""
+        with self._lock:
+            return len(self._poses)
+
+    def poses_from(self, index: int) -> list[Pose]:
+        """Poses from the ``index``-th received on (no copy of the older ones)."""
+        with self._lock:
+            return self._poses[index:]
+
     def poses_since(self, since: float) -> list[Pose]:
         with self._lock:
             return self._poses[bisect.bisect_left(self._times, since) :]

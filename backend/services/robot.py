@@ -139,12 +139,7 @@ class RobotService:
                     "end_reason": run.end_reason,
                     "stored_run_id": run.stored_run_id,
                 },
-                "transitions": []
-                if link is None
-                else [
-                    {"time": t.time, "from": t.before.value, "to": t.after.value, "reason": t.reason}
-                    for t in link.transitions[-20:]
-                ],
+                "transitions": [] if link is None else _transitions(link.transitions[-20:]),
             }
         )
 
@@ -210,10 +205,11 @@ class RobotService:
 
     def _execute(self, run: LiveRun, legs: list[LegControl]) -> None:
         link, tracker = self.link, self.tracker
-        first_pose = len(tracker.poses_since(-math.inf))
+        first_pose = tracker.count()
         controller = self._controller(run.request, legs)
         commanded = {Leg.LEFT: legs[0], Leg.RIGHT: legs[1]}
         integral, previous_error = 0.0, math.nan
+        seen_poses = first_pose
 
         def send(leg: Leg, control: LegControl, why: str) -> None:
             link.set_leg(leg, control.psi0_deg, control.zeta0)
@@ -245,7 +241,13 @@ class RobotService:
                     run.end_reason = "time limit"
                 if run.end_reason is not None:
                     break
-                poses = tracker.poses_since(-math.inf)[first_pose:]
+                if link.telemetry is not None and (not run.telemetry or run.telemetry[-1]["seq"] != link.telemetry.seq):
+                    run.telemetry.append({"time": time.time(), **_telemetry(link.telemetry)})
+                if tracker.count() == seen_poses:
+                    time.sleep(POLL)  # nothing new to analyse
+                    continue
+                seen_poses = tracker.count()
+                poses = tracker.poses_from(first_pose)
                 if len(poses) > 1:
                     times = np.array([p.time for p in poses])
                     found = detect_touchdowns(times, np.array([p.x for p in poses]), np.array([p.y for p in poses]),
@@ -266,8 +268,6 @@ class RobotService:
                     if len(run.touchdowns) >= run.request.jumps:
                         run.end_reason = "jumps done"
                         break
-                if link.telemetry is not None and (not run.telemetry or run.telemetry[-1]["seq"] != link.telemetry.seq):
-                    run.telemetry.append({"time": time.time(), **_telemetry(link.telemetry)})
                 time.sleep(POLL)
             if link.state in (LinkState.RUNNING, LinkState.ARMED):
                 link.disarm()
@@ -285,29 +285,18 @@ class RobotService:
         return {"target_m": loop.target_m, "law": (hover, loop.kp, loop.ki, loop.kd, loop.zeta0_min, loop.zeta0_max)}
 
     def _store(self, run: LiveRun, tracker, first_pose: int, controls: list[LegControl], link) -> None:
-        poses = tracker.poses_since(-math.inf)[first_pose:]
+        poses = tracker.poses_from(first_pose)
         frames = {name: np.array([getattr(p, name) for p in poses]) for name in ("time", "x", "y", "pitch")}
         touchdowns = run.touchdowns
-        gains = height_gains(touchdowns, self.robot) if len(touchdowns) > 1 else np.empty(0)
         model = self.robot.to_model()
-        prediction = None
-        if len(touchdowns) > 1:
-            schedule = ControlSchedule.of(*controls[: len(touchdowns)])
-            orbit = iterate_map(model, schedule, touchdowns[0].state, len(touchdowns) - 1)
-            prediction = orbit.to_dict()
+        analysis = touchdown_results(touchdowns, controls, self.robot)
         results = {
             "end_reason": run.end_reason,
-            "touchdowns": [vars(td) for td in touchdowns],
-            "states": [list(td.state) for td in touchdowns],
-            "rises": gains.tolist(),
+            **analysis,
             "touchdown_controls": [[leg.psi0_deg, leg.zeta0] for leg in controls[: len(touchdowns)]],
-            "prediction": prediction,
             "commands": run.commands,
             "telemetry": run.telemetry,
-            "transitions": [
-                {"time": t.time, "from": t.before.value, "to": t.after.value, "reason": t.reason}
-                for t in link.transitions
-            ],
+            "transitions": _transitions(link.transitions),
             "tracker": {"frames": len(poses), "dropped": tracker.stats.dropped, "loss": tracker.stats.loss},
             "calibration": asdict(tracker.calibration),
             "closed_loop": None if run.request.closed_loop is None else run.request.closed_loop.model_dump(),
@@ -330,7 +319,7 @@ class RobotService:
                 zeta0=first.zeta0,
                 failure_code=None,
                 jumps_completed=max(len(touchdowns) - 1, 0),
-                climb=float(np.sum(gains)),
+                climb=float(np.sum(analysis["rises"])),
                 results=json_safe(results),
                 trajectory=pack_trajectory(frames) if poses else None,
             )
@@ -338,6 +327,26 @@ class RobotService:
             session.add(stored)
             session.commit()
             run.stored_run_id = stored.id
+
+
+def touchdown_results(touchdowns: list[Touchdown], controls: list[LegControl], robot) -> dict:
+    """What a robot or replay run stores about its touchdowns: each touchdown, its section state,
+    the height gains, and the model's prediction from the first touchdown with the same controls."""
+    gains = height_gains(touchdowns, robot) if len(touchdowns) > 1 else np.empty(0)
+    prediction = None
+    if len(touchdowns) > 1:
+        schedule = ControlSchedule.of(*controls[: len(touchdowns)])
+        prediction = iterate_map(robot.to_model(), schedule, touchdowns[0].state, len(touchdowns) - 1).to_dict()
+    return {
+        "touchdowns": [vars(td) for td in touchdowns],
+        "states": [list(td.state) for td in touchdowns],
+        "rises": gains.tolist(),
+        "prediction": prediction,
+    }
+
+
+def _transitions(transitions) -> list[dict]:
+    return [{"time": t.time, "from": t.before.value, "to": t.after.value, "reason": t.reason} for t in transitions]
 
 
 def replay_run(session, run_id: int, robot=None) -> Run:
@@ -357,12 +366,7 @@ def replay_run(session, run_id: int, robot=None) -> Run:
         return recorded[k] if k < len(recorded) else alternating[(k + 1) % 2]
 
     touchdowns = detect_touchdowns(frames["time"], frames["x"], frames["y"], robot, leg_for)
-    gains = height_gains(touchdowns, robot) if len(touchdowns) > 1 else np.empty(0)
-    model = robot.to_model()
-    prediction = None
-    if len(touchdowns) > 1:
-        schedule = ControlSchedule.of(*(leg_for(k) for k in range(len(touchdowns))))
-        prediction = iterate_map(model, schedule, touchdowns[0].state, len(touchdowns) - 1).to_dict()
+    analysis = touchdown_results(touchdowns, [leg_for(k) for k in range(len(touchdowns))], robot)
     replay = Run(
         experiment_id=source.experiment_id,
         kind="replay",
@@ -378,16 +382,8 @@ def replay_run(session, run_id: int, robot=None) -> Run:
         zeta0=source.zeta0,
         failure_code=None,
         jumps_completed=max(len(touchdowns) - 1, 0),
-        climb=float(np.sum(gains)),
-        results=json_safe(
-            {
-                "source_run_id": run_id,
-                "touchdowns": [vars(td) for td in touchdowns],
-                "states": [list(td.state) for td in touchdowns],
-                "rises": gains.tolist(),
-                "prediction": prediction,
-            }
-        ),
+        climb=float(np.sum(analysis["rises"])),
+        results=json_safe({"source_run_id": run_id, **analysis}),
         trajectory=None,
     )
     replay.run_tags = [RunTag(tag=tag) for tag in sorted({*source.tags, "replay"})]
