@@ -317,5 +317,22 @@ class RobotRunCreate(Strict):
     tags: Annotated[list[Label], Field(max_length=32)] = []
 
 
+class ViewReplay(Strict):
+    """Show a stored run in the 3D view, optionally with a second run as a ghost beside it."""
+
+    run_id: RecordRef
+    overlay_run_id: RecordRef | None = None
+
+
+class ViewOut(BaseModel):
+    available: bool
+    port: int | None = None
+    mode: str | None = None
+    run_id: int | None = None
+    updates_per_s: float | None = None
+    clients: int | None = None
+    reason: str | None = None
+
+
 def finite_or_none(value: float) -> float | None:
     return value if math.isfinite(value) else None

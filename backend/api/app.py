@@ -35,6 +35,7 @@ from backend import schemas
 from backend.robot.link import LinkError
 from backend.services import jobs, records, simulation
 from backend.services.robot import RobotService, RobotUnavailable, replay_run
+from backend.services.view import ViewContext, ViewFactory
 from backend.settings import Settings
 from backend.store.database import make_engine, migrate, session_factory
 from sim_core import FixedPointNotFound, ParameterError
@@ -116,8 +117,9 @@ def api_token(data_dir: Path) -> tuple[str, bool]:
     return token, True
 
 
-def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
-    """The service. ``run_jobs=False`` leaves queued jobs alone (for tools that only read)."""
+def create_app(settings: Settings, *, run_jobs: bool = True, view_factory: ViewFactory | None = None) -> FastAPI:
+    """The service. ``run_jobs=False`` leaves queued jobs alone (for tools that only read);
+    ``view_factory`` builds the 3D view at start-up (``frontend.serve`` passes the viser one)."""
     settings.data_dir.mkdir(parents=True, exist_ok=True)
     engine = make_engine(settings.database_url)
     sessions = session_factory(engine)
@@ -126,11 +128,15 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
     robot = RobotService(sessions)
 
     @contextlib.asynccontextmanager
-    async def lifespan(_app: FastAPI):
+    async def lifespan(app: FastAPI):
         migrate(engine)
         if run_jobs:
             runner.start()
+        if view_factory is not None:
+            app.state.view = view_factory(ViewContext(sessions=sessions, robot_service=robot))
         yield
+        if app.state.view is not None:
+            app.state.view.close()
         robot.disconnect()
         runner.stop()
         engine.dispose()
@@ -148,6 +154,7 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
     app.state.settings = settings
     app.state.sessions = sessions
     app.state.token = token
+    app.state.view = None
 
     @app.middleware("http")
     async def limit_request_size(request: Request, call_next):
@@ -390,6 +397,36 @@ def create_app(settings: Settings, *, run_jobs: bool = True) -> FastAPI:
     @app.get("/api/v1/robot", tags=["robot"])
     def robot_status() -> dict:
         return robot.status()
+
+    # The 3D view
+    def scene_view():
+        if app.state.view is None:
+            raise HTTPException(
+                status.HTTP_503_SERVICE_UNAVAILABLE, "the 3D view is not running (it starts with `parkour serve`)"
+            )
+        return app.state.view
+
+    @app.get("/api/v1/view", response_model=schemas.ViewOut, tags=["view"])
+    def view_info():
+        """Where the 3D view is (its own port on this host) and what it shows."""
+        if app.state.view is None:
+            return {"available": False, "reason": "the 3D view is not running (it starts with `parkour serve`)"}
+        return app.state.view.info()
+
+    @app.post("/api/v1/view/replay", dependencies=AUTHORIZED, response_model=schemas.ViewOut, tags=["view"])
+    def view_replay(body: schemas.ViewReplay):
+        """Show a stored run in the 3D view (replay mode), optionally with another as a ghost."""
+        return scene_view().open_run(body.run_id, body.overlay_run_id)
+
+    @app.get("/api/v1/runs/{run_id}/share.html", response_class=HTMLResponse, tags=["view"])
+    def share_run(
+        run_id: RecordId,
+        overlay_run_id: Annotated[int | None, Query(ge=1, le=schemas.MAX_ID)] = None,
+    ) -> HTMLResponse:
+        """The run's 3D replay as one standalone HTML file: it plays offline, from disk, in any browser."""
+        html = scene_view().share_html(run_id, overlay_run_id)
+        disposition = f'attachment; filename="parkourlab-run-{run_id}.html"'
+        return HTMLResponse(html, headers={"Content-Disposition": disposition})
 
     @app.websocket("/api/v1/robot/live")
     async def robot_live(

@@ -4,13 +4,16 @@ Every command takes the model options ``--preset`` (default ``paper``) and the
 nondimensional overrides ``--alpha --d-hat --c-zeta --c-psi --mu``; ``--json`` prints the
 machine-readable form scripts rely on (keep it stable: extend, never break). Errors a user
 can fix print one line and exit with code 2.
+
+``parkour serve`` joins these in ``frontend.cli`` (the console script's entry): the service it
+starts includes the control panel and the 3D view, which sit above the backend.
 """
 
 from __future__ import annotations
 
 import typer
 
-from backend.cli import analyses, bench, gaits, reproduce, robot, serve, simulate
+from backend.cli import analyses, bench, gaits, reproduce, robot, simulate
 
 app = typer.Typer(
     name="parkour",
@@ -20,7 +23,7 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     rich_markup_mode=None,
 )
-for sub_app in (serve.app, simulate.app, gaits.app, analyses.app, reproduce.app, robot.app, bench.app):
+for sub_app in (simulate.app, gaits.app, analyses.app, reproduce.app, robot.app, bench.app):
     app.add_typer(sub_app)
 
 

@@ -61,8 +61,11 @@ for (const tab of document.querySelectorAll("nav [role=tab]")) {
     if (tab.dataset.tab === "history") loadRuns();
     if (tab.dataset.tab === "jobs") loadJobs();
     if (tab.dataset.tab === "robot") refreshRobot();
+    if (tab.dataset.tab === "view3d") showView();
   });
 }
+
+function selectTab(name) { $(`nav [data-tab=${name}]`).click(); }
 
 // Simulate -----------------------------------------------------------------------------------
 function simControls() {
@@ -190,12 +193,25 @@ async function loadRuns() {
     const controls = run.controls.map((c) => `${c[0]}°/${c[1]}`).join(", ");
     row.innerHTML = `<td><input type="checkbox" value="${run.id}" aria-label="select run ${run.id}"></td><td>${run.id}</td><td>${run.kind}</td>` +
       `<td>${controls}</td><td>${run.jumps_completed}/${run.jumps}</td><td>${run.climb.toFixed(3)}</td>` +
-      `<td>${run.failure_code ?? ""}</td><td>${run.tags.join(" ")}</td><td>${new Date(run.created_at).toLocaleString()}</td>`;
+      `<td>${run.failure_code ?? ""}</td><td>${run.tags.join(" ")}</td><td>${new Date(run.created_at).toLocaleString()}</td>` +
+      `<td class="actions"><button type="button" class="open-3d" data-run="${run.id}" aria-label="open run ${run.id} in the 3D view">3D</button> ` +
+      `<a href="${API}/runs/${run.id}/share.html" download aria-label="share run ${run.id} as a standalone HTML file">share</a></td>`;
     return row;
   }));
 }
 
 on("#history-form", "submit", (event) => { event.preventDefault(); loadRuns(); });
+
+// "3D" on a run: replay it in the 3D view (with the other selected run, if one, as a ghost).
+on("#run-table", "click", async (event) => {
+  const button = event.target.closest("button.open-3d");
+  if (!button) return;
+  const runId = Number(button.dataset.run);
+  const others = [...document.querySelectorAll("#run-table input:checked")].map((box) => Number(box.value)).filter((id) => id !== runId);
+  await call("POST", "/view/replay", { run_id: runId, overlay_run_id: others[0] ?? null });
+  selectTab("view3d");
+  say(`Run ${runId} is on the 3D view's timeline${others.length ? ` with run ${others[0]} as a ghost` : ""}.`);
+});
 
 on("#compare", "click", async () => {
   const ids = [...document.querySelectorAll("#run-table input:checked")].map((box) => box.value);
@@ -260,3 +276,17 @@ on("#estop", "click", async () => {
   showStatus(result);
   say(`Emergency stop acknowledged by the robot in ${result.latency_ms.toFixed(1)} ms.`);
 });
+
+// 3D view ------------------------------------------------------------------------------------
+// viser serves the view on its own port of this host; the frame loads it once and keeps it.
+async function showView() {
+  const info = await call("GET", "/view");
+  if (!info.available) {
+    $("#view-status").textContent = info.reason;
+    return;
+  }
+  const url = `${location.protocol}//${location.hostname}:${info.port}/`;
+  $("#view-open").href = url;
+  if ($("#view-frame").src !== url) $("#view-frame").src = url;
+  $("#view-status").textContent = `Mode: ${info.mode}${info.run_id ? `, run ${info.run_id}` : ""} · ${info.updates_per_s} updates/s · the scene is shared by everyone viewing it.`;
+}

@@ -1,0 +1,68 @@
+"""``parkour serve``: the service — REST API, experiment store, batch jobs, the control panel and
+the 3D view.
+
+This is where the parts meet: the backend's FastAPI application, with the viser view built by
+``frontend.viewer`` plugged in through ``create_app(view_factory=...)``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from backend.cli.options import handles_errors, note
+from backend.settings import DEFAULT_HOST, DEFAULT_PORT, Settings
+
+DEFAULT_VIEW_PORT = 8001
+
+app = typer.Typer(rich_markup_mode=None)
+
+
+@app.command("serve")
+@handles_errors
+def serve_command(
+    data_dir: Annotated[
+        Path | None,
+        typer.Option("--data-dir", help="Where the database and token live; default $PARKOUR_DATA_DIR or ./data."),
+    ] = None,
+    host: Annotated[
+        str, typer.Option("--host", help="Interface to bind (the 3D view's too); 0.0.0.0 exposes them to the network.")
+    ] = DEFAULT_HOST,
+    port: Annotated[
+        int, typer.Option("--port", help="TCP port of the API and panel.", min=1, max=65535)
+    ] = DEFAULT_PORT,
+    view_port: Annotated[
+        int,
+        typer.Option(
+            "--view-port",
+            help="TCP port of the 3D view; the next free one if busy, any free one if 0.",
+            min=0,
+            max=65535,
+        ),
+    ] = DEFAULT_VIEW_PORT,
+    view: Annotated[bool, typer.Option("--view/--no-view", help="Start the 3D view.")] = True,
+) -> None:
+    """Start the service (SQLite in the data directory unless DATABASE_URL says otherwise)."""
+    import uvicorn
+
+    from backend.api.app import api_token, create_app
+
+    settings = Settings.from_environment(data_dir)
+    token, created = api_token(settings.data_dir)
+    base = f"http://{host}:{port}"
+
+    def climb_view(context):
+        from frontend.viewer.app import ClimbView
+
+        scene_view = ClimbView(context, host=host, port=view_port, panel_url=f"{base}/panel/")
+        note(f"3D view on http://{host}:{scene_view.server.get_port()}/")
+        return scene_view
+
+    application = create_app(settings, view_factory=climb_view if view else None)
+    note(f"ParkourLab on {base}/  (API docs: {base}/docs)")
+    note(f"data: {settings.data_dir}  database: {settings.database_url.split('://')[0]}")
+    if created:
+        note(f"API token for changes (shown once; kept in {settings.data_dir / 'api_token'}): {token}")
+    uvicorn.run(application, host=host, port=port, log_level="info")

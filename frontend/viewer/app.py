@@ -1,0 +1,160 @@
+"""The 3D view: a viser server inside the service process, its GUI, and the frame loop.
+
+:class:`ClimbView` runs viser's web server in viser's own thread on its own port (viser moves to
+the next port when the one asked for is busy; :meth:`ClimbView.info` says which) and one loop
+thread that draws a frame of the current mode :data:`FRAME_RATE` times a second. The scene and
+GUI are shared by everyone who opens the view, like a monitor on the lab wall. The view only
+reads: it never commands the robot.
+
+The service talks to it through ``backend.services.view.SceneView`` (info, replay a stored run,
+share a run as standalone HTML); ``frontend.serve`` plugs it in.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+
+import numpy as np
+import viser
+
+from backend.services.view import ViewContext
+from frontend.viewer.modes import LiveMode, ReplayMode, SimulateMode, show_frame
+from frontend.viewer.recordings import load_recording
+from frontend.viewer.scene import ChuteScene
+from sim_core import get_preset
+
+log = logging.getLogger("parkourlab.view")
+FRAME_RATE = 60.0  # frames drawn per second (the floor the issue sets is 30)
+READOUT_PERIOD = 0.25  # [s] between readout updates: text need not move at frame rate
+EXPORT_RATE = 30.0  # frames per second of a shared (exported) replay
+MAX_EXPORT_SECONDS = 600.0
+CAMERA_POSITION = (0.0, -1.25, 0.6)  # [m] level with the robot, in front of the chute
+CAMERA_LOOK_AT = (0.0, 0.0, 0.6)
+
+
+def _place_camera(server: viser.ViserServer) -> None:
+    server.initial_camera.position = CAMERA_POSITION
+    server.initial_camera.look_at = CAMERA_LOOK_AT
+    server.initial_camera.up = (0.0, 0.0, 1.0)
+
+
+class ClimbView:
+    """The service's 3D view of the chute.
+
+    Args:
+        host: interface viser binds (the service's own, localhost unless told otherwise).
+        port: viser's port; 0 lets the system pick a free one.
+        context: the service's database sessions and robot (for replay and live modes).
+        panel_url: where the control panel is, for the link back.
+    """
+
+    def __init__(self, context: ViewContext, *, host: str = "127.0.0.1", port: int = 0, panel_url: str = "/"):
+        self.context = context
+        self.robot = get_preset("paper")
+        self.server = viser.ViserServer(host=host, port=port, label="ParkourLab · 3D view", verbose=False)
+        _place_camera(self.server)
+        self.scene = ChuteScene(self.server.scene, self.robot)
+        gui = self.server.gui
+        gui.add_markdown(f"[← Control panel]({panel_url}) · walls {self.robot.wall_distance:.2f} m apart")
+        self.gui_mode = gui.add_dropdown("Mode", ("simulate", "live", "replay"), initial_value="simulate")
+        self.lock = threading.RLock()  # the loop and GUI callbacks take turns on the modes
+        self.modes = {
+            "simulate": SimulateMode(self.server, self.scene, self.lock, self.robot),
+            "live": LiveMode(self.server, self.scene, self.lock, context.robot_service),
+            "replay": ReplayMode(self.server, self.scene, self.lock, context.sessions),
+        }
+        self.modes["replay"].share = self.share_html
+        self.mode = self.modes["simulate"]
+        self.gui_mode.on_update(lambda _event: self.set_mode(self.gui_mode.value))
+        self.updates_per_s = 0.0
+        self.frames = 0
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._loop, name="view-loop", daemon=True)
+        self._thread.start()
+
+    # What the service asks --------------------------------------------------------------------
+    def info(self) -> dict:
+        return {
+            "available": True,
+            "port": self.server.get_port(),
+            "mode": self.mode.name,
+            "run_id": None if self.modes["replay"].recording is None else self.modes["replay"].recording.run_id,
+            "updates_per_s": round(self.updates_per_s, 1),
+            "clients": len(self.server.get_clients()),
+        }
+
+    def open_run(self, run_id: int, overlay_run_id: int | None = None) -> dict:
+        """Replay stored run ``run_id`` (records.NotFound / records.Conflict when it cannot be)."""
+        self.modes["replay"].load(run_id, overlay_run_id)
+        self.set_mode("replay")
+        return self.info()
+
+    def share_html(self, run_id: int, overlay_run_id: int | None = None) -> str:
+        """A standalone HTML file that plays stored run ``run_id`` (viser's client with the recorded
+        scene inside: it opens offline, from a file, in any browser)."""
+        recording = load_recording(self.context.sessions, run_id)
+        overlay = None if overlay_run_id is None else load_recording(self.context.sessions, overlay_run_id)
+        server = viser.ViserServer(host="127.0.0.1", port=0, label=recording.label, verbose=False)
+        try:
+            _place_camera(server)
+            scene = ChuteScene(server.scene, recording.robot)
+            serializer = server.get_scene_serializer()
+            end = min(max(recording.duration, overlay.duration if overlay else 0.0), MAX_EXPORT_SECONDS)
+            shown = 0
+            for t in np.arange(0.0, end + 1.0 / EXPORT_RATE, 1.0 / EXPORT_RATE):
+                show_frame(scene, recording, overlay, float(t), shown)
+                shown = int(np.searchsorted(recording.touchdowns[:, 0], t, side="right"))
+                serializer.insert_sleep(1.0 / EXPORT_RATE)
+            return serializer.as_html()
+        finally:
+            server.stop()
+
+    def close(self) -> None:
+        self._stop.set()
+        self._thread.join(timeout=2.0)
+        self.server.stop()
+
+    # Modes and the loop -----------------------------------------------------------------------
+    def set_mode(self, name: str) -> None:
+        with self.lock:
+            if name == self.mode.name:
+                return
+            self.mode.deactivate()
+            self.mode = self.modes[name]
+            self.scene.clear_history()
+            self.scene.show_ghost(None)
+            if name != "replay":
+                self.scene.robot = self.robot
+            self.mode.activate()
+            if self.gui_mode.value != name:
+                self.gui_mode.value = name  # its callback comes back here and returns at once
+
+    def _loop(self) -> None:
+        period = 1.0 / FRAME_RATE
+        last = next_tick = time.monotonic()
+        window_start, window_frames, last_readout = last, 0, 0.0
+        failing = False
+        while not self._stop.wait(max(0.0, next_tick - time.monotonic())):
+            now = time.monotonic()
+            dt, last = min(now - last, 0.1), now  # a stall does not make the robot jump ahead
+            try:
+                with self.lock, self.server.atomic():
+                    self.mode.frame(dt)
+                    if now - last_readout >= READOUT_PERIOD:
+                        self.mode.gui_readout.content = self.mode.readout(self.updates_per_s)
+                        last_readout = now
+                failing = False
+            except Exception:  # one bad frame must not end the view; say it once per streak
+                if not failing:
+                    log.exception("3D view: drawing a frame failed")
+                failing = True
+            self.frames += 1
+            window_frames += 1
+            if now - window_start >= 1.0:
+                self.updates_per_s = window_frames / (now - window_start)
+                window_start, window_frames = now, 0
+            next_tick += period
+            if next_tick < now:
+                next_tick = now + period

@@ -1,0 +1,493 @@
+"""The 3D view's three modes, each a GUI folder plus a ``frame(dt)`` the view's loop calls.
+
+- :class:`SimulateMode` — the model climbs in real time; sliders act from the next touchdown;
+- :class:`LiveMode` — the body follows the robot's tracker stream, the model's prediction of
+  the jump under way beside it as a ghost;
+- :class:`ReplayMode` — a stored run on a timeline, optionally with a second run as a ghost.
+
+GUI handles are named ``gui_*``. Setting a handle's value from Python runs its callbacks
+(viser calls them synchronously), so code that sets values does it inside ``self._quietly()``
+and the callbacks ignore what happens there: no feedback loops.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import contextlib
+import math
+from dataclasses import replace
+
+import numpy as np
+import viser
+
+from backend.services import records
+from frontend.viewer.motion import STANCE, Controls, JumpPlan, PathClip, SimulatedClimb, model_jump
+from frontend.viewer.recordings import Recording, load_recording
+from frontend.viewer.scene import ChuteScene
+from sim_core import ControlSchedule, FixedPoint, LegControl, PhysicalParams, search_gaits
+from sim_core.fixed_points import FixedPointNotFound, find_fixed_point
+
+# The paper's gaits (Fig. 7): psi0 [deg] and zeta0 [l0] of the left and right legs.
+GAIT_PRESETS = {
+    "period 1 · 30° · 0.90": ((30.0, 0.90), (30.0, 0.90)),
+    "period 2 · 30°/30° · 0.87/0.90": ((30.0, 0.87), (30.0, 0.90)),
+    "period 4 · 30°/35° · 0.90/0.9505": ((30.0, 0.90), (35.0, 0.9505)),
+}
+CUSTOM = "custom"
+DEFAULT_START = (-0.93, -0.17)  # section state when the controls have no stable gait to start on
+TRAIL_STRIDE = 3  # every third sample of the jump under way is enough for a smooth trail
+GAIT_SEARCH_PERIOD = 4  # the readout looks for gaits of period 1, 2 and 4 (the paper's)
+
+
+class _Mode:
+    """``lock`` is the view's: the loop holds it for each frame, callbacks for each change."""
+
+    def __init__(self, server: viser.ViserServer, scene: ChuteScene, lock):
+        self.server, self.scene, self.lock = server, scene, lock
+        self._quiet = False
+
+    @contextlib.contextmanager
+    def _quietly(self):
+        self._quiet, before = True, self._quiet
+        try:
+            yield
+        finally:
+            self._quiet = before
+
+    def activate(self) -> None:
+        self.folder.visible = True
+
+    def deactivate(self) -> None:
+        self.folder.visible = False
+
+
+class SimulateMode(_Mode):
+    """The model climbing in real time with the sliders' controls."""
+
+    name = "simulate"
+
+    def __init__(self, server: viser.ViserServer, scene: ChuteScene, lock, robot: PhysicalParams):
+        super().__init__(server, scene, lock)
+        self.base_robot = robot
+        gui = server.gui
+        (left, right) = next(iter(GAIT_PRESETS.values()))
+        with gui.add_folder("Simulate") as self.folder:
+            self.gui_preset = gui.add_dropdown(
+                "Gait preset", [*GAIT_PRESETS, CUSTOM], initial_value=next(iter(GAIT_PRESETS))
+            )
+            self.gui_symmetric = gui.add_checkbox(
+                "Symmetric (R = L)", initial_value=True, hint="both legs use the left leg's controls"
+            )
+            self.gui_psi0_left = gui.add_slider("psi0 L [°]", 15.0, 60.0, 0.5, left[0])
+            self.gui_zeta0_left = gui.add_slider("zeta0 L [l0]", 0.80, 0.99, 0.0005, left[1])
+            self.gui_psi0_right = gui.add_slider("psi0 R [°]", 15.0, 60.0, 0.5, right[0], disabled=True)
+            self.gui_zeta0_right = gui.add_slider("zeta0 R [l0]", 0.80, 0.99, 0.0005, right[1], disabled=True)
+            self.gui_gravity = gui.add_slider(
+                "gravity [m/s²]", 0.3, 9.81, 0.01, robot.gravity, hint="the air table's tilt"
+            )
+            self.gui_damping = gui.add_slider("damping [N·s/m]", 0.0, 3.0, 0.05, robot.c_zeta, hint="leg and pivot")
+            self.gui_playback = gui.add_button_group("Playback", ("Play", "Pause", "Step jump", "Restart"))
+            self.gui_speed = gui.add_slider("speed [×]", 0.1, 4.0, 0.1, 1.0)
+            self.gui_readout = gui.add_markdown("")
+        for handle in (self.gui_psi0_left, self.gui_zeta0_left, self.gui_psi0_right, self.gui_zeta0_right,
+                       self.gui_gravity, self.gui_damping):  # fmt: skip
+            handle.on_update(self._on_control)
+        self.gui_symmetric.on_update(self._on_control)
+        self.gui_preset.on_update(self._on_preset)
+        self.gui_playback.on_click(self._on_playback)
+        self.playing = True
+        self.time = 0.0
+        self.gait: FixedPoint | None = None
+        self.gait_note = "searching…"
+        self._gait_worker = concurrent.futures.ThreadPoolExecutor(max_workers=1, thread_name_prefix="gait")
+        self._gait_generation = 0
+        self.climb = SimulatedClimb(self.controls(), DEFAULT_START)
+        self._shown = 0  # jumps whose touchdown marker and trail are drawn
+        self._find_gait(restart=True)
+
+    # Controls -----------------------------------------------------------------------------------
+    def controls(self) -> Controls:
+        left = LegControl.from_degrees(self.gui_psi0_left.value, self.gui_zeta0_left.value)
+        if self.gui_symmetric.value:
+            right = left
+        else:
+            right = LegControl.from_degrees(self.gui_psi0_right.value, self.gui_zeta0_right.value)
+        damping = float(self.gui_damping.value)
+        robot = replace(self.base_robot, gravity=float(self.gui_gravity.value), c_zeta=damping, c_psi=damping)
+        return Controls(left, right, robot)
+
+    def set_preset(self, name: str) -> None:
+        """Put the sliders on one of :data:`GAIT_PRESETS` and restart there."""
+        (psi_l, zeta_l), (psi_r, zeta_r) = GAIT_PRESETS[name]
+        with self._quietly():
+            self.gui_preset.value = name
+            self.gui_symmetric.value = (psi_l, zeta_l) == (psi_r, zeta_r)
+            self.gui_psi0_left.value, self.gui_zeta0_left.value = psi_l, zeta_l
+            self.gui_psi0_right.value, self.gui_zeta0_right.value = psi_r, zeta_r
+            self.gui_gravity.value, self.gui_damping.value = self.base_robot.gravity, self.base_robot.c_zeta
+        self._controls_changed(restart=True)
+
+    def _on_preset(self, _event) -> None:
+        if not self._quiet and self.gui_preset.value != CUSTOM:
+            with self.lock:
+                self.set_preset(self.gui_preset.value)
+
+    def _on_control(self, _event) -> None:
+        if self._quiet:
+            return
+        with self.lock, self._quietly():
+            self.gui_preset.value = CUSTOM
+            symmetric = self.gui_symmetric.value
+            self.gui_psi0_right.disabled = self.gui_zeta0_right.disabled = symmetric
+            if symmetric:
+                self.gui_psi0_right.value, self.gui_zeta0_right.value = (
+                    self.gui_psi0_left.value,
+                    self.gui_zeta0_left.value,
+                )
+        with self.lock:
+            self._controls_changed(restart=False)
+
+    def _controls_changed(self, *, restart: bool) -> None:
+        self.gui_psi0_right.disabled = self.gui_zeta0_right.disabled = self.gui_symmetric.value
+        self.climb.set_controls(self.controls())
+        self._find_gait(restart=restart)
+
+    def _on_playback(self, event) -> None:
+        with self.lock:
+            self.playback(event.target.value)
+
+    def playback(self, choice: str) -> None:
+        """One of the Playback buttons: Play, Pause, Step jump, Restart."""
+        if choice == "Play":
+            self.playing = True
+        elif choice == "Pause":
+            self.playing = False
+        elif choice == "Step jump":
+            self.playing = False
+            self.time = self.climb.next_touchdown_time(self.time)
+        elif choice == "Restart":
+            self.restart()
+
+    def restart(self) -> None:
+        """Back to the floor, on the current controls' stable gait if there is one."""
+        with self.lock:
+            self._restart()
+
+    def _restart(self) -> None:
+        gait = self.gait
+        start = tuple(gait.state) if gait is not None and gait.stable else DEFAULT_START
+        self.climb.set_controls(self.controls())
+        self.climb.reset(start)
+        self.scene.clear_history()
+        self.time, self._shown, self.playing = 0.0, 0, True
+
+    # The fixed-point readout --------------------------------------------------------------------
+    def _find_gait(self, *, restart: bool) -> None:
+        """Look for the gait of the current controls in the background (the newest request wins)."""
+        self._gait_generation += 1
+        generation, controls = self._gait_generation, self.controls()
+        self.gait_note = "searching…"
+        guess = self.climb.current.state
+
+        def search() -> None:
+            gait, note = find_gait(controls, guess)
+            if generation != self._gait_generation:
+                return
+            self.gait, self.gait_note = gait, note
+            if restart:
+                self.restart()
+
+        self._gait_worker.submit(search)
+
+    # Per frame ----------------------------------------------------------------------------------
+    def frame(self, dt: float) -> None:
+        if self.playing:
+            self.time += dt * float(self.gui_speed.value)
+        pose = self.climb.pose_at(self.time)
+        plans = self.climb.plans
+        for plan in plans[self._shown : pose.jump + 1]:
+            self.scene.add_touchdown(plan.wall, float(plan.clip.foot_y[0]))
+            if plan.clip.start > 0.0:
+                previous = plans[plan.clip.jump[0] - 1]
+                self.scene.add_jump_trail(previous.clip.body_until(previous.clip.end)[::TRAIL_STRIDE])
+        self._shown = max(self._shown, pose.jump + 1)
+        plan = plans[pose.jump]
+        idle = plan.next_leg if pose.phase == STANCE else plan.leg
+        trail = plan.clip.body_until(self.time)[::TRAIL_STRIDE]
+        self.scene.show(pose, idle, trail, follow=True)
+        if plan.failure is not None and self.time >= plan.clip.end:
+            self.playing = False
+
+    def readout(self, updates_per_s: float) -> str:
+        t = self.time
+        pose = self.climb.pose_at(t)
+        plans = self.climb.plans
+        plan = plans[pose.jump]
+        done = [p for p in plans[: pose.jump] if p.failure is None]
+        last = f"{100 * done[-1].rise:.2f} cm" if done else "–"
+        failed = plan.failure is not None and t >= plan.clip.end
+        failure = f"**{plan.failure.code}** at jump {pose.jump + 1}: {plan.failure.message}" if failed else "none"
+        robot = self.climb.controls.robot
+        return (
+            f"**Jump** {pose.jump + 1} · **height** {pose.y:.3f} m · **climb/jump** {last}  \n"
+            f"**Failure:** {failure}  \n"
+            f"**Gait of these controls:** {self.gait_note}  \n"
+            f"alpha = {robot.to_model().alpha:.1f} · t = {t:.1f} s · {updates_per_s:.0f} updates/s"
+        )
+
+
+def find_gait(controls: Controls, guess) -> tuple[FixedPoint | None, str]:
+    """The gait (period 1, 2 or 4) of ``controls`` near ``guess``, or the best a grid search finds,
+    and a line describing it. Runs in the view's background worker (plain, non-parallel kernels)."""
+    model = controls.robot.to_model()
+    legs = (controls.left,) if controls.left == controls.right else (controls.left, controls.right)
+    schedule = ControlSchedule.of(*legs)
+    try:
+        gait = find_fixed_point(model, schedule, GAIT_SEARCH_PERIOD, guess)
+        if not gait.stable:
+            raise FixedPointNotFound("unstable")
+    except FixedPointNotFound:
+        gaits = search_gaits(model, schedule, GAIT_SEARCH_PERIOD, grid=(4, 4))
+        if not gaits:
+            return None, "none found (a grid search of period 1, 2 and 4 found no gait)"
+        gait = gaits[0]
+    climb_cm = 100 * gait.climb_per_period / gait.period * controls.robot.leg_length
+    stability = "stable" if gait.stable else "**unstable**"
+    state = ", ".join(f"{v:.3f}" for v in gait.state)
+    return gait, (
+        f"period {gait.period}, {stability}, max|λ| = {gait.max_abs_eigenvalue:.3f}, "
+        f"{gait.motion} {climb_cm:+.2f} cm/jump, fixed point ({state})"
+    )
+
+
+class LiveMode(_Mode):
+    """The robot as the tracker sees it, and the model's prediction of the jump under way."""
+
+    name = "live"
+    TRAIL_SECONDS = 3.0
+
+    def __init__(self, server: viser.ViserServer, scene: ChuteScene, lock, robot_service):
+        super().__init__(server, scene, lock)
+        self.robot_service = robot_service
+        gui = server.gui
+        with gui.add_folder("Live", visible=False) as self.folder:
+            self.gui_ghost = gui.add_checkbox(
+                "Model ghost", initial_value=True, hint="the model's jump from each touchdown"
+            )
+            self.gui_readout = gui.add_markdown("")
+        self._ghosts: dict[int, JumpPlan] = {}
+        self._marked = 0
+        self._run = None
+        self.last_error: float | None = None
+
+    def _touchdowns(self):
+        run = self.robot_service.run if self.robot_service is not None else None
+        if run is not self._run:
+            self._run, self._ghosts, self._marked, self.last_error = run, {}, 0, None
+            self.scene.clear_history()
+        return [] if run is None else list(run.touchdowns)
+
+    def _ghost(self, touchdowns, k: int) -> JumpPlan | None:
+        if k in self._ghosts:
+            return self._ghosts[k]
+        run, robot = self._run, self.robot_service.robot
+        controls = list(getattr(run, "touchdown_controls", []))
+        if k >= len(controls):
+            return None
+        touchdown = touchdowns[k]
+        commanded = getattr(run, "commanded", {})
+        next_leg = commanded.get(-touchdown.wall, controls[k])
+        try:
+            plan = model_jump(robot, touchdown.state, controls[k], next_leg, wall=touchdown.wall,
+                              start_time=touchdown.time, start_height=touchdown.body_height)  # fmt: skip
+        except (ValueError, ArithmeticError):
+            plan = None
+        self._ghosts[k] = plan
+        return plan
+
+    def frame(self, dt: float) -> None:
+        service = self.robot_service
+        tracker = None if service is None else service.tracker
+        pose = None if tracker is None else tracker.latest()
+        touchdowns = self._touchdowns()
+        for touchdown in touchdowns[self._marked :]:
+            self.scene.add_touchdown(touchdown.wall, touchdown.foot_height)
+            previous = self._ghosts.get(touchdown.index - 1)
+            if previous is not None and previous.failure is None:
+                self.last_error = touchdown.body_height - previous.next_height
+        self._marked = len(touchdowns)
+        if pose is None:
+            return
+        recent = tracker.poses_since(pose.time - self.TRAIL_SECONDS)
+        trail = np.array([[p.x, p.y] for p in recent]).reshape(-1, 2)
+        body = PathClip.from_body([pose.time], [pose.x], [pose.y]).pose_at(pose.time)
+        self.scene.show(body, None, trail, follow=True)
+        ghost = self._ghost(touchdowns, len(touchdowns) - 1) if touchdowns and self.gui_ghost.value else None
+        if ghost is None:
+            self.scene.show_ghost(None)
+        else:
+            self.scene.show_ghost(ghost.clip.pose_at(pose.time), ghost.clip.body_until(pose.time)[::TRAIL_STRIDE])
+
+    def readout(self, updates_per_s: float) -> str:
+        service = self.robot_service
+        if service is None or service.tracker is None:
+            return "**No robot connected.** Connect in the control panel's Robot tab; this view follows its tracker."
+        status = service.status()
+        tracker = status["tracker"]
+        latest = tracker["latest"]
+        where = "no frames yet" if latest is None else f"body at ({latest['x']:.3f}, {latest['y']:.3f}) m"
+        error = "–" if self.last_error is None else f"{100 * self.last_error:+.1f} cm"
+        return (
+            f"**Link:** {status['state']} · **tracker:** {tracker['received']} frames, "
+            f"{100 * tracker['loss']:.1f}% lost · {where}  \n"
+            f"**Touchdowns this run:** {self._marked} · **model's touchdown height error (last jump):** {error}  \n"
+            f"{updates_per_s:.0f} updates/s"
+        )
+
+
+class ReplayMode(_Mode):
+    """A stored run on a timeline, with another run as a ghost if asked."""
+
+    name = "replay"
+
+    def __init__(self, server: viser.ViserServer, scene: ChuteScene, lock, sessions):
+        super().__init__(server, scene, lock)
+        self.sessions = sessions
+        gui = server.gui
+        with gui.add_folder("Replay", visible=False) as self.folder:
+            self.gui_run = gui.add_number("Run id", 1, min=1, step=1)
+            self.gui_overlay = gui.add_number("Overlay run id (0: none)", 0, min=0, step=1)
+            self.gui_load = gui.add_button("Load")
+            self.gui_time = gui.add_slider("Time [s]", 0.0, 1.0, 0.01, 0.0)
+            self.gui_playback = gui.add_button_group("Playback", ("Play", "Pause", "Start"))
+            self.gui_speed = gui.add_slider("speed [×]", 0.1, 4.0, 0.1, 1.0)
+            self.gui_share = gui.add_button("Share this run (HTML)", hint="a standalone file that plays this replay")
+            self.gui_readout = gui.add_markdown("Pick a run and press Load (History → “3D” does it for you).")
+        self.plot = None
+        self.recording: Recording | None = None
+        self.overlay: Recording | None = None
+        self.playing = False
+        self.time = 0.0
+        self._shown = 0
+        self.message = ""
+        self.share = None  # set by the view: run id -> standalone HTML
+        self.gui_load.on_click(self._on_load)
+        self.gui_time.on_update(self._on_scrub)
+        self.gui_playback.on_click(self._on_playback)
+        self.gui_share.on_click(self._on_share)
+
+    def _on_load(self, _event) -> None:
+        with contextlib.suppress(records.NotFound, records.Conflict):  # the readout says why
+            self.load(int(self.gui_run.value), int(self.gui_overlay.value) or None)
+
+    def load(self, run_id: int, overlay_id: int | None = None) -> None:
+        """Show stored run ``run_id`` (and ``overlay_id`` as a ghost) from its start, paused.
+        Raises records.NotFound or records.Conflict (nothing to replay), and says so in the readout."""
+        try:
+            recording = load_recording(self.sessions, run_id)
+            overlay = None if overlay_id is None else load_recording(self.sessions, overlay_id)
+        except (records.NotFound, records.Conflict) as error:
+            self.message = f"**Cannot replay:** {error}"
+            self.recording = None
+            raise
+        with self.lock:
+            self._show(run_id, overlay_id, recording, overlay)
+
+    def _show(self, run_id, overlay_id, recording: Recording, overlay: Recording | None) -> None:
+        self.recording, self.overlay = recording, overlay
+        duration = max(recording.duration, overlay.duration if overlay else 0.0)
+        with self._quietly():
+            self.gui_run.value = run_id
+            self.gui_overlay.value = overlay_id or 0
+            self.gui_time.max = round(max(duration, 0.01), 2)
+            self.gui_time.value = 0.0
+        self.time, self.playing, self._shown = 0.0, False, 0
+        self.scene.robot = recording.robot
+        self.scene.clear_history()
+        self._plot(recording, overlay)
+        self.message = f"**{recording.label}**" + (f" · ghost: {overlay.label}" if overlay else "")
+
+    def _plot(self, recording: Recording, overlay: Recording | None) -> None:
+        if self.plot is not None:
+            self.plot.remove()
+        clips = [recording.clip] + ([overlay.clip] if overlay else [])
+        end = max(clip.end for clip in clips)
+        grid = np.linspace(0.0, end, 400)
+        data = [grid] + [np.interp(grid, clip.time, clip.y, right=np.nan) for clip in clips]
+        series = [{"label": "t [s]"}, {"label": f"run {recording.run_id} height [m]", "stroke": "#23303c", "width": 2}]
+        if overlay:
+            series.append({"label": f"run {overlay.run_id} [m]", "stroke": "#50aae6", "width": 2})
+        with self.folder:
+            self.plot = self.server.gui.add_uplot(
+                tuple(data), tuple(series), title="Body height", aspect=1.6, order=self.gui_readout.order - 0.5
+            )
+
+    def _on_scrub(self, _event) -> None:
+        if self._quiet or self.recording is None:
+            return
+        with self.lock:
+            self.time = float(self.gui_time.value)
+            self._shown = 0
+            self.scene.clear_history()
+
+    def _on_playback(self, event) -> None:
+        with self.lock:
+            self.playback(event.target.value)
+
+    def playback(self, choice: str) -> None:
+        """One of the Playback buttons: Play, Pause, Start."""
+        if choice == "Play" and self.recording is not None:
+            if self.time >= self.gui_time.max:
+                self.time = 0.0
+            self.playing = True
+        elif choice == "Pause":
+            self.playing = False
+        elif choice == "Start":
+            self.time, self._shown, self.playing = 0.0, 0, False
+            self.scene.clear_history()
+
+    def _on_share(self, event) -> None:
+        if self.recording is None or event.client is None or self.share is None:
+            return
+        html = self.share(self.recording.run_id)
+        event.client.send_file_download(f"parkourlab-run-{self.recording.run_id}.html", html.encode())
+
+    def frame(self, dt: float) -> None:
+        recording = self.recording
+        if recording is None:
+            return
+        if self.playing:
+            self.time = min(self.time + dt * float(self.gui_speed.value), float(self.gui_time.max))
+            self.playing = self.time < self.gui_time.max
+            with self._quietly():
+                self.gui_time.value = round(self.time, 2)
+        show_frame(self.scene, recording, self.overlay, self.time, self._shown)
+        self._shown = int(np.searchsorted(recording.touchdowns[:, 0], self.time, side="right"))
+
+    def readout(self, updates_per_s: float) -> str:
+        if self.recording is None:
+            return self.message or "Pick a run and press Load."
+        pose = self.recording.clip.pose_at(self.time)
+        return f"{self.message}  \nt = {self.time:.2f} s · height {pose.y:.3f} m · {updates_per_s:.0f} updates/s"
+
+
+def show_frame(scene: ChuteScene, recording: Recording, overlay: Recording | None, t: float, shown: int) -> None:
+    """Draw ``recording`` at time ``t`` (and ``overlay`` as the ghost); touchdowns from ``shown`` on
+    are marked. Shared by the live replay and the exported HTML."""
+    clip = recording.clip
+    pose = clip.pose_at(t)
+    touchdowns = recording.touchdowns
+    for i in range(shown, len(touchdowns)):
+        time, wall, foot_height = touchdowns[i]
+        if time > t:
+            break
+        scene.add_touchdown(int(wall), float(foot_height))
+        if i > 0:
+            scene.add_jump_trail(clip.body_until(time, since=touchdowns[i - 1, 0])[::TRAIL_STRIDE])
+    since = recording.touchdowns[shown - 1, 0] if 0 < shown <= len(recording.touchdowns) else -math.inf
+    trail = clip.body_until(t, since=min(since, t))[::TRAIL_STRIDE]
+    scene.show(pose, recording.idle_leg(pose.leg_wall), trail, follow=True)
+    if overlay is None:
+        scene.show_ghost(None)
+    else:
+        scene.show_ghost(overlay.clip.pose_at(t), overlay.clip.body_until(t)[::TRAIL_STRIDE])

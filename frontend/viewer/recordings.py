@@ -1,0 +1,136 @@
+"""Stored runs as the 3D view replays them: a :class:`Recording` per run.
+
+- ``sim`` runs: the stored sampled path, or, when the run kept none, the same path simulated
+  again from its stored model, controls and start state (the simulator is deterministic);
+- ``robot`` runs: the tracker frames (body only: the camera does not see the legs) and the
+  touchdowns found live;
+- ``replay`` runs: their source robot run's frames with the touchdowns found again.
+
+Simulated runs are nondimensional; they are shown at the paper robot's size (its ``l0``, mass
+and ``g``), with the first touchdown at :data:`START_HEIGHT` above the floor.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from backend.services import records
+from backend.services.simulation import unpack_trajectory
+from backend.store.models import Run
+from frontend.viewer.motion import LEFT, RIGHT, START_HEIGHT, PathClip
+from sim_core import ControlSchedule, LegControl, ModelParams, PhysicalParams, get_preset, simulate_trajectory
+from sim_core.trajectory import STANCE
+
+REPLAY_SAMPLE_RATE = 200.0  # per sqrt(l0/g), when a stored sim run has no path of its own
+
+
+@dataclass(frozen=True)
+class Recording:
+    """A stored run ready to show.
+
+    Attributes:
+        run_id, kind, label: which run, and a line that names it.
+        clip: the path, time from 0 at the start of the run.
+        robot: the robot it is shown at (walls, leg length, energy colours).
+        legs: the left and right legs' controls (the idle leg's pose), or None for tracker data.
+        touchdowns: shape (n, 3): time [s], wall (-1 left, +1 right), foot height [m].
+    """
+
+    run_id: int
+    kind: str
+    label: str
+    clip: PathClip
+    robot: PhysicalParams
+    legs: tuple[LegControl, LegControl] | None
+    touchdowns: np.ndarray
+
+    @property
+    def duration(self) -> float:
+        return self.clip.end
+
+    def idle_leg(self, leg_wall: int) -> LegControl | None:
+        """Controls of the leg not drawn by the pose (it reaches for the other wall)."""
+        if self.legs is None:
+            return None
+        return self.legs[0] if -leg_wall == LEFT else self.legs[1]
+
+
+def load_recording(sessions, run_id: int) -> Recording:
+    """The stored run ``run_id`` as a :class:`Recording`.
+
+    Raises records.NotFound when there is no such run, records.Conflict when it has nothing to show.
+    """
+    with sessions() as session:
+        run = records.get_run(session, run_id)
+        if run.kind == "sim":
+            return _sim_recording(run)
+        source = run
+        if run.kind == "replay":
+            source = records.get_run(session, int(run.results.get("source_run_id", 0)) or run_id)
+        if source.trajectory is None:
+            raise records.Conflict(f"run {run_id} has no tracker frames to replay")
+        return _tracker_recording(run, unpack_trajectory(source.trajectory))
+
+
+def _model_of(run: Run) -> ModelParams:
+    fields = {name: value for name, value in run.model.items() if name in ModelParams.__dataclass_fields__}
+    if fields.get("mu") is None:
+        fields["mu"] = math.inf
+    return ModelParams(**fields)
+
+
+def _legs(run: Run) -> tuple[LegControl, LegControl]:
+    pairs = [LegControl.from_degrees(*pair) for pair in run.controls]
+    return pairs[0], pairs[1 % len(pairs)]
+
+
+def _label(run: Run) -> str:
+    controls = ", ".join(f"{psi:g}°:{zeta:g}" for psi, zeta in run.controls)
+    return f"run {run.id} ({run.kind}, {controls})"
+
+
+def _sim_recording(run: Run) -> Recording:
+    paper = get_preset("paper")
+    robot = PhysicalParams.from_model(
+        _model_of(run), mass=paper.mass, leg_length=paper.leg_length, gravity=paper.gravity
+    )
+    if run.trajectory is not None:
+        columns = unpack_trajectory(run.trajectory)
+    else:
+        schedule = ControlSchedule.from_degrees(run.controls)
+        columns = simulate_trajectory(
+            robot.to_model(), schedule, run.start_state, run.jumps, sample_rate=REPLAY_SAMPLE_RATE
+        ).columns()
+    if columns["time"].size == 0:
+        raise records.Conflict(f"run {run.id} failed at its first touchdown: there is no path to show")
+    length, time_scale = robot.scales.length, robot.scales.time
+    jump, phase = columns["jump"].astype(int), columns["phase"].astype(int)
+    # The drawn leg reaches for the stance wall in stance and for the next wall in flight.
+    leg_wall = np.where((jump + (phase != STANCE)) % 2 == 0, LEFT, RIGHT)
+    clip = PathClip(
+        time=columns["time"] * time_scale,
+        x=columns["x"] * length,
+        y=START_HEIGHT + columns["y"] * length,
+        foot_x=columns["foot_x"] * length,
+        foot_y=START_HEIGHT + columns["foot_y"] * length,
+        zeta=columns["zeta"] * length,
+        phase=phase,
+        leg_wall=leg_wall,
+        jump=jump,
+    )
+    stance_starts = np.flatnonzero((phase == STANCE) & np.r_[True, np.diff(jump) != 0])
+    touchdowns = np.column_stack([clip.time[stance_starts], clip.leg_wall[stance_starts], clip.foot_y[stance_starts]])
+    return Recording(run.id, run.kind, _label(run), clip, robot, _legs(run), touchdowns)
+
+
+def _tracker_recording(run: Run, frames: dict[str, np.ndarray]) -> Recording:
+    if frames["time"].size == 0:
+        raise records.Conflict(f"run {run.id} has no tracker frames to replay")
+    t0 = float(frames["time"][0])
+    clip = PathClip.from_body(frames["time"] - t0, frames["x"], frames["y"])
+    found = run.results.get("touchdowns", [])
+    touchdowns = np.array([[td["time"] - t0, td["wall"], td["foot_height"]] for td in found]).reshape(-1, 3)
+    return Recording(run.id, run.kind, _label(run), clip, get_preset("paper"), None, touchdowns)

@@ -1,0 +1,100 @@
+"""The view's motion sources agree with the simulator's map, jump for jump."""
+
+import math
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from frontend.viewer.motion import LEFT, RIGHT, START_HEIGHT, Controls, PathClip, SimulatedClimb, model_jump
+from sim_core import ControlSchedule, LegControl, get_preset, iterate_map
+
+ROBOT = get_preset("paper")
+PERIOD_1 = LegControl.from_degrees(30, 0.90)
+START = (-0.9339, -0.1661)
+RTOL_MAP = 1e-9  # the view and the map run the same kernel: only sampling differs, not states
+
+
+def _climb(left=PERIOD_1, right=PERIOD_1) -> SimulatedClimb:
+    return SimulatedClimb(Controls(left, right, ROBOT), START)
+
+
+@pytest.mark.parametrize("right", [PERIOD_1, LegControl.from_degrees(30, 0.87)])
+def test_simulated_climb_follows_the_map(right):
+    climb = _climb(PERIOD_1, right)
+    climb.pose_at(6.0)
+    jumps = len(climb.plans) - 1
+    orbit = iterate_map(ROBOT.to_model(), ControlSchedule.of(PERIOD_1, right), START, jumps)
+    assert_allclose([plan.state for plan in climb.plans], orbit.states[: jumps + 1], rtol=RTOL_MAP, atol=1e-12)
+    rises = np.array([plan.rise for plan in climb.plans[:jumps]]) / ROBOT.leg_length
+    assert_allclose(rises, orbit.rises[:jumps], rtol=RTOL_MAP, err_msg="height gain per jump [l0]")
+
+
+def test_jumps_alternate_walls_and_feet_sit_on_them():
+    climb = _climb()
+    climb.pose_at(4.0)
+    half = 0.5 * ROBOT.wall_distance
+    for k, plan in enumerate(climb.plans):
+        assert plan.wall == (LEFT if k % 2 == 0 else RIGHT)
+        assert plan.clip.foot_x[0] == pytest.approx(plan.wall * half), f"jump {k} foot on its wall"
+    first = climb.plans[0].clip
+    assert first.y[0] == pytest.approx(START_HEIGHT)
+
+
+def test_the_body_moves_continuously_across_touchdowns():
+    climb = _climb()
+    times = np.arange(0.0, 5.0, 1 / 240)
+    body = np.array([(pose.x, pose.y) for pose in map(climb.pose_at, times)])
+    step = np.hypot(*np.diff(body, axis=0).T)
+    assert step.max() < 0.02, "no jumps in the drawn position between frames [m]"
+
+
+def test_a_control_change_shows_from_the_next_touchdown():
+    climb = _climb()
+    first = climb.plans[0]
+    during_stance = 0.5 * (first.clip.start + first.liftoff_time)
+    climb.pose_at(during_stance)
+    deeper = LegControl.from_degrees(30, 0.86)
+    climb.set_controls(Controls(deeper, deeper, ROBOT))
+    climb.pose_at(first.clip.end - 1e-6)
+    assert climb.plans[0].leg == PERIOD_1, "the stance under way keeps its controls"
+    assert climb.plans[0].next_leg == deeper, "the next leg is read at lift-off"
+    assert_allclose(climb.plans[0].clip.x[:10], first.clip.x[:10], err_msg="same stance")
+    climb.pose_at(climb.plans[0].clip.end + 0.01)
+    assert climb.plans[1].leg == deeper
+
+
+def test_a_change_after_liftoff_waits_for_the_jump_after():
+    climb = _climb()
+    first = climb.plans[0]
+    climb.pose_at(first.liftoff_time + 0.01)
+    deeper = LegControl.from_degrees(30, 0.86)
+    climb.set_controls(Controls(deeper, deeper, ROBOT))
+    climb.pose_at(climb.plans[0].clip.end + 0.01)
+    assert climb.plans[1].leg == PERIOD_1, "the leg in flight was set at lift-off"
+    assert climb.plans[1].next_leg == deeper
+
+
+def test_a_failing_climb_stops_and_says_why():
+    weak = LegControl.from_degrees(30, 0.985)  # too little energy to reach the other wall
+    climb = _climb(weak, weak)
+    pose = climb.pose_at(60.0)
+    assert climb.ended
+    assert climb.current.failure is not None
+    assert climb.pose_at(61.0) == pose, "the pose holds after the failure"
+
+
+def test_model_jump_mirrors_on_the_right_wall():
+    left = model_jump(ROBOT, START, PERIOD_1, PERIOD_1, wall=LEFT, start_time=0.0, start_height=0.0)
+    right = model_jump(ROBOT, START, PERIOD_1, PERIOD_1, wall=RIGHT, start_time=0.0, start_height=0.0)
+    assert_allclose(right.clip.x, -left.clip.x)
+    assert_allclose(right.clip.y, left.clip.y)
+
+
+def test_path_clip_interpolates_and_clamps():
+    clip = PathClip.from_body([0.0, 1.0, 2.0], [0.0, 1.0, 1.0], [0.0, 2.0, 4.0])
+    assert clip.pose_at(0.5).x == pytest.approx(0.5)
+    assert clip.pose_at(1.5).y == pytest.approx(3.0)
+    assert clip.pose_at(-1.0).y == 0.0 and clip.pose_at(9.0).y == 4.0
+    assert math.isnan(clip.pose_at(0.5).zeta), "tracker data has no legs"
+    assert clip.body_until(1.0).shape == (2, 2)

@@ -1,0 +1,128 @@
+"""The 3D view inside the service: its API, replay of stored runs, sharing, and the GUI's wiring.
+
+A real viser server on a free port, driven from Python as the GUI callbacks would drive it.
+"""
+
+import time
+
+import numpy as np
+import pytest
+from fastapi.testclient import TestClient
+
+from backend.api.app import create_app
+from backend.settings import Settings
+from backend.store.models import Run
+from frontend.viewer.app import ClimbView
+from frontend.viewer.modes import GAIT_PRESETS
+from frontend.viewer.recordings import load_recording
+from sim_core import get_preset
+
+ROBOT = get_preset("paper")
+RUN = {
+    "controls": [{"psi0_deg": 30, "zeta0": 0.87}, {"psi0_deg": 30, "zeta0": 0.9}],
+    "start": {"xdot": -0.8, "ydot": -0.15},
+    "jumps": 6,
+}
+
+
+@pytest.fixture
+def service(tmp_path):
+    settings = Settings.from_environment(tmp_path / "data")
+    app = create_app(settings, view_factory=lambda context: ClimbView(context, port=0))
+    with TestClient(app) as client:
+        token = (settings.data_dir / "api_token").read_text().strip()
+        yield client, {"Authorization": f"Bearer {token}"}, app.state.view
+
+
+def _wait_for(condition, timeout=10.0):
+    deadline = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < deadline, "timed out"
+        time.sleep(0.02)
+
+
+def test_the_view_reports_where_it_is_and_draws(service):
+    client, _auth, view = service
+    info = client.get("/api/v1/view").json()
+    assert info["available"] and info["port"] == view.server.get_port() and info["mode"] == "simulate"
+    frames = view.frames
+    _wait_for(lambda: view.frames > frames + 5)
+    assert view.modes["simulate"].climb.current.clip.end > 0
+
+
+def test_a_stored_run_replays_with_a_ghost_and_shares_as_html(service):
+    client, auth, view = service
+    stored = client.post("/api/v1/runs", json=RUN | {"trajectory_rate": 100}, headers=auth).json()
+    regenerated = client.post("/api/v1/runs", json=RUN, headers=auth).json()
+    assert client.post("/api/v1/view/replay", json={"run_id": stored["id"]}).status_code == 401
+    info = client.post(
+        "/api/v1/view/replay", json={"run_id": stored["id"], "overlay_run_id": regenerated["id"]}, headers=auth
+    ).json()
+    assert info["mode"] == "replay" and info["run_id"] == stored["id"]
+    replay = view.modes["replay"]
+    assert replay.overlay.run_id == regenerated["id"]
+    # A run stored without its path is simulated again: the same motion at the same instants.
+    recording, again = replay.recording, replay.overlay
+    times = np.linspace(0.0, min(recording.duration, again.duration), 50)
+    assert np.allclose(
+        [recording.clip.pose_at(t).y for t in times], [again.clip.pose_at(t).y for t in times], atol=2e-3
+    )
+    replay.playback("Play")
+    _wait_for(lambda: replay.time > 0.2)
+    html = client.get(f"/api/v1/runs/{stored['id']}/share.html")
+    assert html.status_code == 200 and "attachment" in html.headers["content-disposition"]
+    assert "window.__VISER_EMBED_DATA__" in html.text
+
+
+def test_replay_errors_name_the_problem(service, tmp_path):
+    client, auth, view = service
+    assert client.post("/api/v1/view/replay", json={"run_id": 999}, headers=auth).status_code == 404
+    assert client.post("/api/v1/view/replay", json={"run_id": 0}, headers=auth).status_code == 422
+    with view.context.sessions() as session:
+        run = Run(kind="robot", status="failed", code_version="test", model={}, controls=[[30, 0.9], [30, 0.9]],
+                  start_state=[0, 0], jumps=1, alpha=1, psi0_deg=30, zeta0=0.9, jumps_completed=0, climb=0,
+                  results={})  # fmt: skip
+        session.add(run)
+        session.commit()
+        robot_run = run.id
+    answer = client.post("/api/v1/view/replay", json={"run_id": robot_run}, headers=auth)
+    assert answer.status_code == 409 and "no tracker frames" in answer.json()["detail"]
+    assert client.get(f"/api/v1/runs/{robot_run}/share.html").status_code == 409
+
+
+def test_presets_and_sliders_do_not_feed_back(service):
+    _client, _auth, view = service
+    simulate = view.modes["simulate"]
+    name = list(GAIT_PRESETS)[2]
+    simulate.set_preset(name)
+    assert simulate.gui_preset.value == name, "setting the sliders from a preset does not mark it custom"
+    assert not simulate.gui_symmetric.value and simulate.gui_zeta0_right.value == pytest.approx(0.9505)
+    controls = simulate.controls()
+    assert (controls.left.zeta0, controls.right.zeta0, controls.right.psi0_deg) == (0.90, 0.9505, pytest.approx(35))
+    _wait_for(lambda: simulate.gait is not None and simulate.gait_note != "searching…")
+    assert simulate.gait.period == 4 and simulate.gait.stable, simulate.gait_note
+    simulate.gui_zeta0_left.value = 0.88  # as if a person moved it (the callback runs)
+    assert simulate.gui_preset.value == "custom"
+    simulate.gui_symmetric.value = True
+    assert simulate.gui_zeta0_right.value == 0.88 and simulate.gui_zeta0_right.disabled
+    assert simulate.climb.controls.right.zeta0 == 0.88
+
+
+def test_the_service_without_a_view_says_so(tmp_path):
+    settings = Settings.from_environment(tmp_path / "data")
+    with TestClient(create_app(settings)) as client:
+        assert client.get("/api/v1/view").json()["available"] is False
+        token = (settings.data_dir / "api_token").read_text().strip()
+        answer = client.post("/api/v1/view/replay", json={"run_id": 1}, headers={"Authorization": f"Bearer {token}"})
+        assert answer.status_code == 503 and "3D view" in answer.json()["detail"]
+
+
+def test_recordings_put_sim_runs_between_the_walls(service):
+    client, auth, view = service
+    run = client.post("/api/v1/runs", json=RUN | {"trajectory_rate": 200}, headers=auth).json()
+    recording = load_recording(view.context.sessions, run["id"])
+    half = 0.5 * ROBOT.wall_distance
+    assert set(np.unique(recording.touchdowns[:, 1])) == {-1, 1}
+    stance_feet = recording.clip.foot_x[recording.clip.phase == 0]
+    assert np.allclose(np.abs(stance_feet), half), "stance feet are on the walls"
+    assert np.all(np.abs(recording.clip.x) < half)
