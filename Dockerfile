@@ -9,5 +9,5 @@ COPY frontend frontend
 RUN pip install --no-cache-dir ".[postgres]"
 ENV PARKOUR_DATA_DIR=/data \
     PARKOUR_CACHE_DIR=/data/cache
-EXPOSE 8000 8786
+EXPOSE 8000 8001 8786
 CMD ["parkour", "serve", "--host", "0.0.0.0", "--data-dir", "/data"]

@@ -73,9 +73,11 @@ class ChuteScene:
         )
         self.ruler_labels: list = []
         self.body = scene.add_icosphere("/chute/body", radius=BODY_RADIUS, color=BODY_COLOR)
+        # The legs hang from the body (drawn relative to it): a client that repaints slowly moves
+        # them with the body at once, even while it is still rebuilding their shape.
         self.legs = {
             wall: scene.add_line_segments(
-                f"/chute/leg_{name}", points=np.zeros((1, 2, 3)), colors=(0, 0, 0), thickness=LEG_THICKNESS
+                f"/chute/body/leg_{name}", points=np.zeros((1, 2, 3)), colors=(0, 0, 0), thickness=LEG_THICKNESS
             )
             for name, wall in (("left", -1), ("right", 1))
         }
@@ -161,7 +163,8 @@ class ChuteScene:
 
     def _draw_leg(self, wall: int, hip, foot, zeta: float) -> None:
         leg = self.legs[wall]
-        segments = polyline_segments(bow_leg(hip, foot, self.robot.leg_length))
+        reach = (foot[0] - hip[0], foot[1] - hip[1])
+        segments = polyline_segments(bow_leg((0.0, 0.0), reach, self.robot.leg_length))
         leg.points = segments
         leg.colors = np.broadcast_to(np.array(energy_color(zeta, self.robot), dtype=np.uint8), segments.shape).copy()
 
