@@ -47,6 +47,10 @@ class LiveRun:
     touchdowns: list[Touchdown] = field(default_factory=list)
     commands: list[dict] = field(default_factory=list)
     telemetry: list[dict] = field(default_factory=list)
+    # The controls each detected touchdown was made with, and what each leg is commanded now
+    # (the 3D view's model ghost reads both).
+    touchdown_controls: list[LegControl] = field(default_factory=list)
+    commanded: dict[Leg, LegControl] = field(default_factory=dict)
     end_reason: str | None = None
     stored_run_id: int | None = None
     stop_requested: threading.Event = field(default_factory=threading.Event)
@@ -207,7 +211,8 @@ class RobotService:
         link, tracker = self.link, self.tracker
         first_pose = tracker.count()
         controller = self._controller(run.request, legs)
-        commanded = {Leg.LEFT: legs[0], Leg.RIGHT: legs[1]}
+        commanded = run.commanded
+        commanded.update({Leg.LEFT: legs[0], Leg.RIGHT: legs[1]})
         integral, previous_error = 0.0, math.nan
         seen_poses = first_pose
 
@@ -221,7 +226,7 @@ class RobotService:
             # Detected touchdown k is the climb's touchdown k + 1: even climb touchdowns are the left leg's.
             return run_controls[k] if k < len(run_controls) else commanded[Leg.LEFT if (k + 1) % 2 == 0 else Leg.RIGHT]
 
-        run_controls: list[LegControl] = []  # the controls each detected touchdown was made with
+        run_controls = run.touchdown_controls
         try:
             send(Leg.LEFT, legs[0], "start")
             send(Leg.RIGHT, legs[1], "start")

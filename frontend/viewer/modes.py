@@ -20,8 +20,9 @@ from dataclasses import replace
 import numpy as np
 import viser
 
+from backend.robot.messages import Leg
 from backend.services import records
-from frontend.viewer.motion import STANCE, Controls, JumpPlan, PathClip, SimulatedClimb, model_jump
+from frontend.viewer.motion import LEFT, STANCE, Controls, JumpPlan, PathClip, SimulatedClimb, model_jump
 from frontend.viewer.recordings import Recording, load_recording
 from frontend.viewer.scene import ChuteScene
 from sim_core import ControlSchedule, FixedPoint, LegControl, PhysicalParams, search_gaits
@@ -291,12 +292,12 @@ class LiveMode(_Mode):
         if k in self._ghosts:
             return self._ghosts[k]
         run, robot = self._run, self.robot_service.robot
-        controls = list(getattr(run, "touchdown_controls", []))
+        controls = list(run.touchdown_controls)
         if k >= len(controls):
             return None
         touchdown = touchdowns[k]
-        commanded = getattr(run, "commanded", {})
-        next_leg = commanded.get(-touchdown.wall, controls[k])
+        # The leg in flight after touchdown k reaches for the other wall: the one commanded now.
+        next_leg = run.commanded.get(Leg.RIGHT if touchdown.wall == LEFT else Leg.LEFT, controls[k])
         try:
             plan = model_jump(robot, touchdown.state, controls[k], next_leg, wall=touchdown.wall,
                               start_time=touchdown.time, start_height=touchdown.body_height)  # fmt: skip

@@ -3,6 +3,7 @@
 A real viser server on a free port, driven from Python as the GUI callbacks would drive it.
 """
 
+import socket
 import time
 
 import numpy as np
@@ -10,12 +11,14 @@ import pytest
 from fastapi.testclient import TestClient
 
 from backend.api.app import create_app
+from backend.robot.virtual import VirtualRobot
 from backend.settings import Settings
 from backend.store.models import Run
 from frontend.viewer.app import ClimbView
 from frontend.viewer.modes import GAIT_PRESETS
 from frontend.viewer.recordings import load_recording
 from sim_core import get_preset
+from sim_core.noise import NO_NOISE
 
 ROBOT = get_preset("paper")
 RUN = {
@@ -126,3 +129,29 @@ def test_recordings_put_sim_runs_between_the_walls(service):
     stance_feet = recording.clip.foot_x[recording.clip.phase == 0]
     assert np.allclose(np.abs(stance_feet), half), "stance feet are on the walls"
     assert np.all(np.abs(recording.clip.x) < half)
+
+
+def test_live_mode_follows_the_virtual_robot_with_the_model_beside_it(service):
+    client, auth, view = service
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    robot = VirtualRobot(tracker_to=("127.0.0.1", port), noise=NO_NOISE, speed=4.0, seed=2).start()
+    try:
+        answer = client.post("/api/v1/robot/connect", json={"url": robot.url, "tracker_port": port}, headers=auth)
+        assert answer.status_code == 200, answer.text
+        view.set_mode("live")
+        live = view.modes["live"]
+        controls = [{"psi0_deg": 30, "zeta0": 0.87}, {"psi0_deg": 30, "zeta0": 0.9}]
+        assert (
+            client.post("/api/v1/robot/runs", json={"controls": controls, "jumps": 6}, headers=auth).status_code == 202
+        )
+        _wait_for(lambda: not client.get("/api/v1/robot").json()["run"]["active"], timeout=30)
+        _wait_for(lambda: live._marked >= 6)
+        assert view.scene.ghost.visible, "the model's jump from the last touchdown is drawn"
+        # Without noise the robot is the model: the ghost lands where the robot touched down.
+        assert abs(live.last_error) < 0.01, f"model's touchdown height error {live.last_error:+.4f} m"
+        assert "Touchdowns this run:** 6" in live.readout(60.0)
+    finally:
+        client.post("/api/v1/robot/disconnect", headers=auth)
+        robot.stop()
