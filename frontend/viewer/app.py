@@ -104,8 +104,7 @@ class ClimbView:
             end = min(max(recording.duration, overlay.duration if overlay else 0.0), MAX_EXPORT_SECONDS)
             shown = 0
             for t in np.arange(0.0, end + 1.0 / EXPORT_RATE, 1.0 / EXPORT_RATE):
-                show_frame(scene, recording, overlay, float(t), shown)
-                shown = int(np.searchsorted(recording.touchdowns[:, 0], t, side="right"))
+                shown = show_frame(scene, recording, overlay, float(t), shown)
                 serializer.insert_sleep(1.0 / EXPORT_RATE)
             return serializer.as_html()
         finally:

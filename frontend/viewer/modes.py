@@ -138,9 +138,7 @@ class SimulateMode(_Mode):
             return
         with self.lock, self._quietly():
             self.gui_preset.value = CUSTOM
-            symmetric = self.gui_symmetric.value
-            self.gui_psi0_right.disabled = self.gui_zeta0_right.disabled = symmetric
-            if symmetric:
+            if self.gui_symmetric.value:
                 self.gui_psi0_right.value, self.gui_zeta0_right.value = (
                     self.gui_psi0_left.value,
                     self.gui_zeta0_left.value,
@@ -206,11 +204,11 @@ class SimulateMode(_Mode):
             self.time += dt * float(self.gui_speed.value)
         pose = self.climb.pose_at(self.time)
         plans = self.climb.plans
-        for plan in plans[self._shown : pose.jump + 1]:
-            self.scene.add_touchdown(plan.wall, float(plan.clip.foot_y[0]))
-            if plan.clip.start > 0.0:
-                previous = plans[plan.clip.jump[0] - 1]
-                self.scene.add_jump_trail(previous.clip.body_until(previous.clip.end)[::TRAIL_STRIDE])
+        for k in range(self._shown, pose.jump + 1):
+            self.scene.add_touchdown(plans[k].wall, float(plans[k].clip.foot_y[0]))
+            if k > 0:
+                previous = plans[k - 1].clip
+                self.scene.add_jump_trail(previous.body_until(previous.end)[::TRAIL_STRIDE])
         self._shown = max(self._shown, pose.jump + 1)
         plan = plans[pose.jump]
         idle = plan.next_leg if pose.phase == STANCE else plan.leg
@@ -462,8 +460,7 @@ class ReplayMode(_Mode):
             self.playing = self.time < self.gui_time.max
             with self._quietly():
                 self.gui_time.value = round(self.time, 2)
-        show_frame(self.scene, recording, self.overlay, self.time, self._shown)
-        self._shown = int(np.searchsorted(recording.touchdowns[:, 0], self.time, side="right"))
+        self._shown = show_frame(self.scene, recording, self.overlay, self.time, self._shown)
 
     def readout(self, updates_per_s: float) -> str:
         if self.recording is None:
@@ -472,9 +469,9 @@ class ReplayMode(_Mode):
         return f"{self.message}  \nt = {self.time:.2f} s · height {pose.y:.3f} m · {updates_per_s:.0f} updates/s"
 
 
-def show_frame(scene: ChuteScene, recording: Recording, overlay: Recording | None, t: float, shown: int) -> None:
+def show_frame(scene: ChuteScene, recording: Recording, overlay: Recording | None, t: float, shown: int) -> int:
     """Draw ``recording`` at time ``t`` (and ``overlay`` as the ghost); touchdowns from ``shown`` on
-    are marked. Shared by the live replay and the exported HTML."""
+    are marked. Returns how many touchdowns are marked now. Shared by the replay and the export."""
     clip = recording.clip
     pose = clip.pose_at(t)
     touchdowns = recording.touchdowns
@@ -492,3 +489,4 @@ def show_frame(scene: ChuteScene, recording: Recording, overlay: Recording | Non
         scene.show_ghost(None)
     else:
         scene.show_ghost(overlay.clip.pose_at(t), overlay.clip.body_until(t)[::TRAIL_STRIDE])
+    return int(np.searchsorted(touchdowns[:, 0], t, side="right"))

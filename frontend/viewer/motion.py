@@ -280,11 +280,6 @@ class SimulatedClimb:
         self.pose_at(t)
         return self.current.clip.end
 
-    def completed(self, t: float) -> list[JumpPlan]:
-        """The jumps finished by time ``t``."""
-        with self._lock:
-            return [plan for plan in self.plans if plan.clip.end <= t and plan.failure is None]
-
     def _plan(self, state, *, start_time: float, start_height: float, leg: LegControl | None = None) -> None:
         k = len(self.plans)
         wall = LEFT if k % 2 == 0 else RIGHT
