@@ -149,6 +149,8 @@ def stance(zeta0, psi0, zeta_dot0, psi_dot0, alpha, c_zeta, c_psi, mu, final, re
     psi_limit = math.atan(mu)  # |tan psi| > mu  <=>  |psi| > atan(mu) on (-pi/2, pi/2)
     if abs(psi0) >= psi_limit:
         return SLIP, rows
+    if zeta0 <= COLLAPSE_ZETA:  # touched down already collapsed: no step would start inside
+        return COLLAPSE, rows
     rate = rates(state, alpha, c_zeta, c_psi, TIME)
     h = FIRST_STEP / math.sqrt(1.0 + alpha)
     for _ in range(MAX_STEPS):
@@ -183,6 +185,8 @@ def stance(zeta0, psi0, zeta_dot0, psi_dot0, alpha, c_zeta, c_psi, mu, final, re
             else:
                 continue
             landed, end = _land(state, independent, target, alpha, c_zeta, c_psi)
+            # A landing behind the step's start would mean the surface was crossed before it.
+            landed = landed and end[TIME] >= state[TIME]
             if landed and (status == INVALID_STATE or end[TIME] < best[TIME]):
                 best = end
                 status = code

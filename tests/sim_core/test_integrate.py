@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from sim_core.failures import OK
-from sim_core.integrate import PSI, PSI_DOT, STATE_SIZE, TIME, ZETA, ZETA_DOT, stance
+from sim_core.failures import COLLAPSE, OK
+from sim_core.integrate import COLLAPSE_ZETA, PSI, PSI_DOT, STATE_SIZE, TIME, ZETA, ZETA_DOT, stance
 from sim_core.stride import touchdown_polar_state
 
 STANCE_ENERGY_RTOL = 1e-9
@@ -47,3 +47,16 @@ def test_damping_dissipates_energy():
     assert status == OK
     energy = _energy(record[:rows], 77.6)
     assert np.all(np.diff(energy) < 0)
+
+
+@pytest.mark.parametrize("zeta0", [1e-5, COLLAPSE_ZETA])
+def test_touchdown_already_collapsed_fails_at_once(zeta0):
+    """Found by the API fuzzer: a leg retracted below the collapse length used to "land" the
+    collapse event behind the touchdown, so the recorded stance ran backwards in time."""
+    psi0 = math.radians(30.0)
+    zeta_dot, psi_dot = touchdown_polar_state(-0.93, -0.17, psi0, zeta0)
+    record = np.empty((50, STATE_SIZE))
+    final = np.empty(STATE_SIZE)
+    status, rows = stance(zeta0, psi0, zeta_dot, psi_dot, 77.6, 0.0, 0.0, math.inf, final, record)
+    assert status == COLLAPSE
+    assert rows == 1 and final[TIME] == 0.0

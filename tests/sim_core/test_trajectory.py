@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from sim_core import get_preset, iterate_map, simulate_trajectory
+from sim_core import ControlSchedule, get_preset, iterate_map, simulate_trajectory
 from sim_core.trajectory import FLIGHT, STANCE
 
 
@@ -61,3 +61,10 @@ def test_failure_ends_the_trajectory(paper, symmetric):
     trajectory = simulate_trajectory(paper, symmetric, (-0.3, 5.0), 5)
     assert trajectory.failure is not None and trajectory.failed_jump == 1
     assert trajectory.rises.size == 0 and trajectory.time.size > 0, "the failed stance is still drawn"
+
+
+def test_collapsed_touchdown_is_a_failure_not_an_error(paper):
+    schedule = ControlSchedule.from_degrees([(30.0, 1e-5)])
+    trajectory = simulate_trajectory(paper, schedule, (-0.93, -0.17), 3)
+    assert trajectory.failure is not None and trajectory.failure.code == "collapse"
+    assert np.all(np.diff(trajectory.time) >= 0)
