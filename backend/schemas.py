@@ -68,9 +68,10 @@ class RunCreate(Strict):
 
 
 class RunUpdate(Strict):
-    """Runs are records of what happened: only their labels change."""
+    """Runs are records of what happened: only their labels and notes change. Fields left out stay."""
 
-    tags: Annotated[list[Label], Field(max_length=32)]
+    tags: Annotated[list[Label], Field(max_length=32)] | None = None
+    notes: Annotated[str, Field(max_length=100_000)] | None = None
 
 
 class RunOut(BaseModel):
@@ -89,6 +90,7 @@ class RunOut(BaseModel):
     failure_code: str | None
     climb: float
     tags: list[str]
+    notes: str
     has_trajectory: bool
 
 

@@ -323,7 +323,7 @@ def create_app(settings: Settings, *, run_jobs: bool = True, view_factory: ViewF
 
     @app.patch("/api/v1/runs/{run_id}", dependencies=AUTHORIZED, response_model=schemas.RunOut, tags=["runs"])
     def update_run(run_id: RecordId, body: schemas.RunUpdate, db: Db):
-        return _run_out(records.update_run_tags(db, run_id, body.tags))
+        return _run_out(records.update_run(db, run_id, tags=body.tags, notes=body.notes))
 
     @app.delete("/api/v1/runs/{run_id}", status_code=204, dependencies=AUTHORIZED, tags=["runs"])
     def delete_run(run_id: RecordId, db: Db) -> None:
@@ -524,6 +524,7 @@ def _run_out(run, *, detail: bool = False) -> dict:
         "failure_code": run.failure_code,
         "climb": run.climb,
         "tags": run.tags,
+        "notes": run.notes,
         "has_trajectory": run.trajectory is not None,
     }
     if detail:

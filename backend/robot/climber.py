@@ -5,7 +5,8 @@ controls plus the imperfections the paper reports (:class:`sim_core.noise.NoiseM
 asymmetry, control noise, pitch drift offsetting the leg angles, noisy section states), and the
 body's path is streamed as tracker datagrams in real time (or ``speed`` times faster), with
 position noise and dropped frames. A failing jump (slip, no flight, ...) ends the climb: the
-robot falls and reports it.
+robot falls and reports it. So does reaching the chute's floor (the body below the first foot's
+height, ``FLOOR``): the model alone would let a descending gait fall forever.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from sim_core.trajectory import STANCE
 from sim_core.validation import check_range
 
 FRAME_RATE = 100.0  # [Hz] the FLEX V100's
+FLOOR = 0.0  # [m] the chute's floor: where the first foot touches
 LAUNCH_GUESS = (-0.93, -0.2)
 
 
@@ -111,9 +113,10 @@ class Climber:
                 self.model, ControlSchedule.of(this, this), state, 1, sample_rate=rate, start_height=height
             ).to_si(self.robot)
             in_stance = stance.phase == STANCE
-            self._stream(
+            if self._stream_to_floor(
                 clock + stance.time[in_stance], side * stance.x[in_stance], stance.y[in_stance], pitch, started
-            )
+            ):
+                return
             if not self.running() or self._stop.is_set():
                 return
             drift = math.radians(self.noise.pitch_drift_deg)
@@ -124,7 +127,10 @@ class Climber:
             )
             si = path.to_si(self.robot)
             in_flight = si.phase != STANCE
-            self._stream(clock + si.time[in_flight], side * si.x[in_flight], si.y[in_flight], pitch, started)
+            if self._stream_to_floor(
+                clock + si.time[in_flight], side * si.x[in_flight], si.y[in_flight], pitch, started
+            ):
+                return
             if path.failure is not None:
                 self.fell()
                 return
@@ -136,6 +142,18 @@ class Climber:
             this, pitch = following, next_pitch
             jump += 1
             self.jumps += 1
+
+    def _stream_to_floor(self, times, xs, ys, pitch: float, started: float) -> bool:
+        """Stream the samples above the floor; True (and the robot has fallen) if it was reached."""
+        below = np.flatnonzero(ys < FLOOR)
+        if below.size == 0:
+            self._stream(times, xs, ys, pitch, started)
+            return False
+        end = below[0]
+        self._stream(times[:end], xs[:end], ys[:end], pitch, started)
+        if self.running():
+            self.fell()
+        return True
 
     def _stream(self, times, xs, ys, pitch: float, started: float) -> None:
         for t, x, y in zip(times, xs, ys, strict=True):

@@ -95,9 +95,13 @@ def get_run(session: Session, run_id: int) -> Run:
     return run
 
 
-def update_run_tags(session: Session, run_id: int, tags: list[str]) -> Run:
+def update_run(session: Session, run_id: int, *, tags: list[str] | None = None, notes: str | None = None) -> Run:
+    """Relabel a run or rewrite its notes; ``None`` leaves a field as it is."""
     run = get_run(session, run_id)
-    run.run_tags = [RunTag(tag=tag) for tag in sorted(set(tags))]
+    if tags is not None:
+        run.run_tags = [RunTag(tag=tag) for tag in sorted(set(tags))]
+    if notes is not None:
+        run.notes = notes
     session.commit()
     return run
 
@@ -180,6 +184,7 @@ def run_row(run: Run) -> dict:
         "duration_s": run.duration_s,
         "code_version": run.code_version,
         "tags": " ".join(run.tags),
+        "notes": run.notes,
         "jumps": run.jumps,
         "jumps_completed": run.jumps_completed,
         "failure_code": run.failure_code,

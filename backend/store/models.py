@@ -82,6 +82,7 @@ class Run(Base):
     climb: Mapped[float]  # total height gain [l0]
     results: Mapped[dict]  # section states, rises, failure, fixed point
     trajectory: Mapped[bytes | None] = mapped_column(LargeBinary)  # zlib'd .npz of the sampled path
+    notes: Mapped[str] = mapped_column(Text, default="", server_default="")  # the one thing that changes, with tags
 
     experiment: Mapped[Experiment | None] = relationship(back_populates="runs")
     run_tags: Mapped[list[RunTag]] = relationship(cascade="all, delete-orphan", lazy="selectin")

@@ -101,6 +101,12 @@ on("#sim-form", "submit", async (event) => {
   say(`${spec.jumps} jumps simulated${failure}.`);
 });
 
+on("#save-run", "click", async () => {
+  const spec = simControls();
+  const run = await call("POST", "/runs", { ...spec, trajectory_rate: 60, tags: ["panel"] });
+  say(`Run ${run.id} stored: ${run.jumps_completed}/${run.jumps} jumps, climb ${run.climb.toFixed(3)} l0. It is in History (tag "panel").`);
+});
+
 on("#find-gait", "click", async () => {
   const spec = simControls();
   const gait = await call("POST", "/sim/fixed-point", { controls: spec.controls, guess: spec.start });
@@ -113,48 +119,155 @@ on("#find-gait", "click", async () => {
     `max |λ| = ${gait.max_abs_eigenvalue.toFixed(4)} (${gait.stable ? "stable" : "unstable"}), climb ${gait.climb_per_period.toFixed(4)} l0 per period.`;
 });
 
+// Analyses: basins and sweeps are jobs (stored, with progress and cancel); the Simulate tab
+// schedules small ones and draws them when done. --------------------------------------------
+function plotSweep(target, result, title) {
+  const points = result.points.filter((p) => p.found);
+  const stable = points.filter((p) => p.stable);
+  const unstable = points.filter((p) => !p.stable);
+  const traces = [
+    { x: points.map((p) => p.zeta0), y: points.map((p) => p.climb_per_jump), mode: "lines", name: "climb per jump [l0]", line: { color: "#2c6fb7" } },
+    { x: stable.map((p) => p.zeta0), y: stable.map((p) => p.max_abs_eigenvalue), mode: "markers", name: "max |λ|, stable", yaxis: "y2", marker: { color: "#2a9d4b", size: 7 } },
+    { x: unstable.map((p) => p.zeta0), y: unstable.map((p) => p.max_abs_eigenvalue), mode: "markers", name: "max |λ|, unstable", yaxis: "y2", marker: { color: "#d61f1f", size: 7, symbol: "circle-open" } },
+  ];
+  const largest = Math.max(...points.map((p) => p.basin_area ?? 0));
+  if (largest > 0) {  // dimensionless like |λ|, so it shares the right axis
+    traces.push({ x: points.map((p) => p.zeta0), y: points.map((p) => p.basin_area / largest), mode: "lines", name: `basin area ÷ ${largest.toFixed(2)} g l0`,
+      yaxis: "y2", line: { color: "#9467bd", dash: "dot" } });
+  }
+  const inPlace = result.in_place_zeta0.map((z) => ({ type: "line", x0: z, x1: z, yref: "paper", y0: 0, y1: 1, line: { color: "#888", dash: "dash" } }));
+  const unit = { type: "line", xref: "paper", x0: 0, x1: 1, yref: "y2", y0: 1, y1: 1, line: { color: "#d61f1f", width: 1, dash: "dot" } };
+  Plotly.react(target, traces, layout(title, "zeta0 [l0] (smaller: more energy)", "climb per jump [l0]", {
+    yaxis2: { title: { text: "max |λ|, basin area" }, overlaying: "y", side: "right", range: [0, 1.15], dtick: 0.25, showgrid: false },
+    shapes: [...inPlace, unit], legend: { orientation: "h", y: -0.32 }, margin: { l: 55, r: 55, t: 40, b: 105 },
+  }), { responsive: true });
+}
+
+function plotBasin(target, result, title, start) {
+  const [x0, x1] = result.xdot_range, [y0, y1] = result.ydot_range, n = result.grid;
+  const axis = (low, high) => Array.from({ length: n }, (_, i) => low + (high - low) * i / (n - 1));
+  const codes = result.failure_codes;
+  const failed = result.failure.map((row) => row.map((code) => (code ? code : null)));
+  const converged = result.jumps_to_converge.map((row) => row.map((jumps) => (jumps < 0 ? null : jumps)));
+  const traces = [
+    { type: "heatmap", x: axis(x0, x1), y: axis(y0, y1), z: failed, showscale: false, name: "fails",
+      colorscale: [[0, "#6b7280"], [1, "#d1d5db"]], text: result.failure.map((row) => row.map((code) => codes[String(code)] ?? "")),
+      hovertemplate: "xdot %{x:.3f}, ydot %{y:.3f}: fails (%{text})<extra></extra>" },
+    { type: "heatmap", x: axis(x0, x1), y: axis(y0, y1), z: converged, colorscale: "Viridis", reversescale: true, name: "converges",
+      colorbar: { title: { text: "jumps to<br>converge" } }, hovertemplate: "xdot %{x:.3f}, ydot %{y:.3f}: %{z} jumps<extra></extra>" },
+    { x: [result.gait.state[0]], y: [result.gait.state[1]], mode: "markers", name: `period-${result.gait.period} gait`, marker: { symbol: "x", size: 12, color: "#d61f1f" } },
+  ];
+  if (start) traces.push({ x: [start.xdot], y: [start.ydot], mode: "markers", name: "start", marker: { symbol: "circle-open", size: 12, color: "#111" } });
+  Plotly.react(target, traces, layout(`${title}: ${(100 * result.fraction).toFixed(1)} % converge (grey: fails)`, "xdot at the section [sqrt(g l0)]", "ydot [sqrt(g l0)]",
+    { legend: { orientation: "h", y: -0.32 }, margin: { l: 55, r: 15, t: 40, b: 105 } }), { responsive: true });
+}
+
+const jobStatus = (job) => `${job.kind} job ${job.id}: ${job.state}${job.total ? `, ${job.completed}/${job.total}` : ""}${job.error ? ` — ${job.error}` : ""}`;
+
+// Schedule a job from the Simulate tab, show its progress there, draw its result when done.
+async function analyse(spec, draw) {
+  const job = await call("POST", "/jobs", spec);
+  const status = $("#analysis-status");
+  status.textContent = jobStatus(job);
+  watch(job, async (final) => {
+    status.textContent = jobStatus(final);
+    if (final.state === "done") draw((await call("GET", `/jobs/${final.id}/results`)).result);
+  }, (update) => { status.textContent = jobStatus(update); });
+}
+
+on("#run-basin", "click", async () => {
+  const spec = simControls();
+  await analyse({ kind: "basin", controls: spec.controls, guess: spec.start, grid: 80, jumps: 60 },
+    (result) => plotBasin("basin-plot", result, "Basin of attraction", spec.start));
+});
+
+on("#run-sweep", "click", async () => {
+  const psi0 = simControls().controls[0].psi0_deg;
+  await analyse({ kind: "sweep", psi0_deg: psi0, zeta0_low: 0.8, zeta0_high: 0.97, steps: 35, basin_grid: 20 },
+    (result) => plotSweep("sweep-plot", result, `Symmetric gait at psi0 = ${psi0}° over zeta0`));
+});
+
 // Jobs ---------------------------------------------------------------------------------------
 const streams = new Map();
+const FINAL = ["done", "cancelled", "failed"];
+
+function describeJob(job) {
+  const spec = job.spec || {};
+  if (job.kind === "mjtf") return `psi0 ${spec.psi0_deg}°, zeta0 ${(spec.zeta0s || []).join(", ")} × ${spec.trials} trials`;
+  if (job.kind === "sweep") return `psi0 ${spec.psi0_deg}°, zeta0 ${spec.zeta0_low}–${spec.zeta0_high}, ${spec.steps} steps`;
+  const legs = (spec.controls || []).map((leg) => `${leg.psi0_deg}°/${leg.zeta0}`).join(", ");
+  return job.kind === "basin" ? `${legs}, ${spec.grid}² start states` : legs;
+}
 
 function jobRow(job) {
   const row = document.createElement("tr");
   row.id = `job-${job.id}`;
   const progress = `<progress max="1" value="${job.progress}" aria-label="job ${job.id} progress"></progress> ${job.completed}/${job.total}`;
-  row.innerHTML = `<td>${job.id}</td><td>${job.kind}</td><td class="state">${job.state}</td><td class="progress">${progress}</td>` +
-    `<td><button class="show" data-id="${job.id}">Show</button></td>` +
+  row.innerHTML = `<td>${job.id}</td><td>${job.kind}</td><td class="what"></td><td class="state"></td><td class="progress">${progress}</td>` +
+    `<td><button class="show" data-id="${job.id}" data-kind="${job.kind}">Show</button></td>` +
     `<td>${["queued", "running"].includes(job.state) ? `<button class="cancel" data-id="${job.id}">Cancel</button>` : ""}</td>`;
+  $(".what", row).textContent = describeJob(job);
+  $(".state", row).textContent = job.state;
+  if (job.error) $(".state", row).title = job.error;
   return row;
 }
 
-function watch(job) {
-  if (streams.has(job.id) || !["queued", "running", "cancelling"].includes(job.state)) return;
-  const source = new EventSource(`${API}/jobs/${job.id}/events`);
-  streams.set(job.id, source);
-  source.addEventListener("progress", (event) => {
-    const update = JSON.parse(event.data);
-    $(`#job-${update.id}`)?.replaceWith(jobRow(update));
-    if (["done", "cancelled", "failed"].includes(update.state)) {
-      source.close();
-      streams.delete(update.id);
-      say(`Job ${update.id} ${update.state}.`, update.state === "failed" ? "error" : "ok");
-    }
-  });
+// Follow a job's event stream: its row in the Jobs table, and the callbacks of whoever asked.
+function watch(job, onFinal, onProgress) {
+  if (FINAL.includes(job.state)) { if (onFinal) onFinal(job); return; }
+  let entry = streams.get(job.id);
+  if (!entry) {
+    entry = { source: new EventSource(`${API}/jobs/${job.id}/events`), finals: [], progresses: [] };
+    streams.set(job.id, entry);
+    entry.source.addEventListener("progress", (event) => {
+      const update = JSON.parse(event.data);
+      $(`#job-${update.id}`)?.replaceWith(jobRow(update));
+      entry.progresses.forEach((callback) => callback(update));
+      if (FINAL.includes(update.state)) {
+        entry.source.close();
+        streams.delete(update.id);
+        say(`Job ${update.id} ${update.state}${update.error ? `: ${update.error}` : ""}.`, update.state === "failed" ? "error" : "ok");
+        entry.finals.forEach((callback) => Promise.resolve(callback(update)).catch(() => {}));
+      }
+    });
+  }
+  if (onFinal) entry.finals.push(onFinal);
+  if (onProgress) entry.progresses.push(onProgress);
 }
 
 async function loadJobs() {
   const page = await call("GET", "/jobs?limit=20");
   $("#job-table tbody").replaceChildren(...page.items.map(jobRow));
-  page.items.forEach(watch);
+  page.items.forEach((job) => watch(job));
+}
+
+on("#job-kind", "change", (event) => {
+  for (const fieldset of document.querySelectorAll("#job-form fieldset[data-kind]")) {
+    fieldset.hidden = fieldset.dataset.kind !== event.target.value;
+    fieldset.disabled = fieldset.hidden;  // hidden fields are neither validated nor sent
+  }
+});
+$("#job-kind").dispatchEvent(new Event("change"));  // also after the browser restores a form
+
+function jobSpec(form) {
+  const number = (name) => Number(form.get(name));
+  const kind = form.get("kind");
+  if (kind === "mjtf") {
+    return { kind, psi0_deg: number("psi0"), trials: number("trials"), cap: number("cap"), seed: number("seed"),
+      zeta0s: String(form.get("zeta0s")).split(",").map((v) => Number(v.trim())) };
+  }
+  if (kind === "sweep") {
+    return { kind, psi0_deg: number("sweep_psi0"), zeta0_low: number("zeta0_low"), zeta0_high: number("zeta0_high"),
+      steps: number("steps"), basin_grid: number("basin_grid") };
+  }
+  const sim = simControls();
+  return { kind, controls: sim.controls, guess: sim.start, grid: number("grid"), jumps: number("basin_jumps"), tolerance: number("tolerance") };
 }
 
 on("#job-form", "submit", async (event) => {
   event.preventDefault();
-  const form = new FormData(event.target);
-  const job = await call("POST", "/jobs", {
-    kind: "mjtf", psi0_deg: Number(form.get("psi0")), trials: Number(form.get("trials")), cap: Number(form.get("cap")),
-    seed: Number(form.get("seed")), zeta0s: String(form.get("zeta0s")).split(",").map((v) => Number(v.trim())),
-  });
-  say(`Job ${job.id} scheduled: ${job.total} trials.`);
+  const job = await call("POST", "/jobs", jobSpec(new FormData(event.target)));
+  say(`Job ${job.id} scheduled: ${describeJob(job)}.`);
   await loadJobs();
 });
 
@@ -166,11 +279,21 @@ on("#job-table", "click", async (event) => {
     return loadJobs();
   }
   const results = await call("GET", `/jobs/${id}/results`);
+  const job = results.job;
   if (results.levels) {
     Plotly.react("job-plot", [{
       x: results.levels.map((l) => l.zeta0), y: results.levels.map((l) => l.mean), mode: "lines+markers", name: "MJTF",
       error_y: { type: "data", array: results.levels.map((l) => l.std), visible: true },
     }], layout(`Job ${id}: Mean Jumps To Failure`, "zeta0 [l0]", "jumps to failure"), { responsive: true });
+  } else if (!results.result) {
+    say(`Job ${id} is ${job.state}: no result${job.error ? ` (${job.error})` : " yet"}.`, job.state === "failed" ? "error" : "ok");
+  } else if (job.kind === "sweep") {
+    plotSweep("job-plot", results.result, `Job ${id}: symmetric gait at psi0 = ${job.spec.psi0_deg}° over zeta0`);
+  } else if (job.kind === "basin") {
+    plotBasin("job-plot", results.result, `Job ${id}: basin of attraction`);
+  } else {
+    const gaits = results.result.gaits || [];
+    say(`Job ${id}: ${gaits.length} gait(s): ${gaits.map((g) => `period ${g.period} at (${g.state.map((v) => v.toFixed(3)).join(", ")}), max |λ| ${g.max_abs_eigenvalue.toFixed(3)}`).join("; ")}.`);
   }
 });
 
@@ -182,25 +305,70 @@ function runQuery() {
   return params;
 }
 
+const shownRuns = new Map();  // id -> the run as last listed: what the editor starts from
+
+function runRow(run) {
+  const row = document.createElement("tr");
+  row.id = `run-${run.id}`;
+  const controls = run.controls.map((c) => `${c[0]}°/${c[1]}`).join(", ");
+  row.innerHTML = `<td><input type="checkbox" value="${run.id}" aria-label="select run ${run.id}"></td><td>${run.id}</td><td>${run.kind}</td>` +
+    `<td>${controls}</td><td>${run.jumps_completed}/${run.jumps}</td><td>${run.climb.toFixed(3)}</td>` +
+    `<td>${run.failure_code ?? ""}</td><td class="tags"></td><td class="notes"></td><td>${new Date(run.created_at).toLocaleString()}</td>` +
+    `<td class="actions"><button type="button" class="edit-run" data-run="${run.id}" aria-label="edit the tags and notes of run ${run.id}">edit</button> ` +
+    `<button type="button" class="open-3d" data-run="${run.id}" aria-label="open run ${run.id} in the 3D view">3D</button> ` +
+    `<a href="${API}/runs/${run.id}/share.html" download aria-label="share run ${run.id} as a standalone HTML file">share</a></td>`;
+  // User text goes in as text, never as markup.
+  $(".tags", row).textContent = run.tags.join(" ");
+  $(".notes", row).textContent = run.notes.length > 60 ? `${run.notes.slice(0, 60)}…` : run.notes;
+  $(".notes", row).title = run.notes;
+  return row;
+}
+
 async function loadRuns() {
   const params = runQuery();
   const sort = new FormData($("#history-form")).get("sort");
   const page = await call("GET", `/runs?limit=100&sort=${sort}&${params}`);
   $("#export-csv").href = `${API}/runs/export?format=csv&${params}`;
   $("#export-json").href = `${API}/runs/export?format=json&${params}`;
-  $("#run-table tbody").replaceChildren(...page.items.map((run) => {
-    const row = document.createElement("tr");
-    const controls = run.controls.map((c) => `${c[0]}°/${c[1]}`).join(", ");
-    row.innerHTML = `<td><input type="checkbox" value="${run.id}" aria-label="select run ${run.id}"></td><td>${run.id}</td><td>${run.kind}</td>` +
-      `<td>${controls}</td><td>${run.jumps_completed}/${run.jumps}</td><td>${run.climb.toFixed(3)}</td>` +
-      `<td>${run.failure_code ?? ""}</td><td>${run.tags.join(" ")}</td><td>${new Date(run.created_at).toLocaleString()}</td>` +
-      `<td class="actions"><button type="button" class="open-3d" data-run="${run.id}" aria-label="open run ${run.id} in the 3D view">3D</button> ` +
-      `<a href="${API}/runs/${run.id}/share.html" download aria-label="share run ${run.id} as a standalone HTML file">share</a></td>`;
-    return row;
-  }));
+  shownRuns.clear();
+  page.items.forEach((run) => shownRuns.set(run.id, run));
+  $("#run-table tbody").replaceChildren(...page.items.map(runRow));
 }
 
 on("#history-form", "submit", (event) => { event.preventDefault(); loadRuns(); });
+
+// Tags and notes: the only things about a run that change after it is stored.
+on("#run-table", "click", (event) => {
+  const button = event.target.closest("button.edit-run");
+  if (!button) return;
+  const run = shownRuns.get(Number(button.dataset.run));
+  const editor = $("#run-editor");
+  editor.dataset.run = run.id;
+  $("#run-editor-title").textContent = `Run ${run.id}: tags and notes`;
+  $("#run-editor-form").elements.tags.value = run.tags.join(" ");
+  $("#run-editor-form").elements.notes.value = run.notes;
+  editor.returnValue = "";  // Escape keeps the last returnValue: start each edit from none
+  editor.showModal();
+});
+
+on("#run-editor", "close", async () => {
+  const editor = $("#run-editor");
+  const choice = editor.returnValue;
+  editor.returnValue = "";
+  if (choice !== "save") return;
+  const form = $("#run-editor-form").elements;
+  const id = Number(editor.dataset.run);
+  const tags = form.tags.value.split(/[\s,]+/).filter(Boolean);
+  try {
+    const run = await call("PATCH", `/runs/${id}`, { tags, notes: form.notes.value });
+    shownRuns.set(run.id, run);
+    $(`#run-${run.id}`)?.replaceWith(runRow(run));
+    say(`Run ${run.id} saved.`);
+  } catch (error) {
+    editor.showModal();  // keep what was typed; the message above says which field to fix
+    throw error;
+  }
+});
 
 // "3D" on a run: replay it in the 3D view (with the other selected run, if one, as a ghost).
 on("#run-table", "click", async (event) => {
@@ -226,6 +394,7 @@ on("#compare", "click", async () => {
 // Robot --------------------------------------------------------------------------------------
 const heights = { t: [], y: [] };
 let live = null;
+let heldHeight = null;  // the closed-loop run's target height [m], drawn on the live plot
 
 function showStatus(status) {
   const telemetry = status.telemetry || {};
@@ -251,8 +420,9 @@ function openLive() {
       heights.t.push(pose.time); heights.y.push(pose.y);
       if (heights.t.length > 600) { heights.t.shift(); heights.y.shift(); }
       // New arrays each time: Plotly.react redraws only what it sees change.
+      const shapes = heldHeight === null ? [] : [{ type: "line", xref: "paper", x0: 0, x1: 1, y0: heldHeight, y1: heldHeight, line: { color: "#d61f1f", dash: "dash" } }];
       Plotly.react("live-plot", [{ x: heights.t.slice(), y: heights.y.slice(), mode: "lines", name: "height" }],
-        layout("Live height", "time [s]", "y [m]"), { responsive: true });
+        layout(heldHeight === null ? "Live height" : `Live height (target ${heldHeight} m, dashed)`, "time [s]", "y [m]", { shapes }), { responsive: true });
     }
   };
   live.onclose = () => { live = null; };
@@ -267,10 +437,28 @@ on("#connect-form", "submit", async (event) => {
 });
 on("#arm", "click", async () => showStatus(await call("POST", "/robot/arm")));
 on("#reset", "click", async () => showStatus(await call("POST", "/robot/reset")));
-on("#live-run", "click", async () => {
-  showStatus(await call("POST", "/robot/runs", { controls: simControls().controls, jumps: 20 }));
-  openLive();
+
+on("#closed-loop", "change", (event) => {
+  for (const name of ["target_m", "kp", "ki", "kd"]) $("#robot-run-form").elements[name].disabled = !event.target.checked;
 });
+$("#closed-loop").dispatchEvent(new Event("change"));
+
+on("#robot-run-form", "submit", async (event) => {
+  event.preventDefault();
+  const form = new FormData(event.target);
+  const number = (name) => Number(form.get(name));
+  const controls = [{ psi0_deg: number("psiL"), zeta0: number("zetaL") }, { psi0_deg: number("psiR"), zeta0: number("zetaR") }];
+  const body = { controls, jumps: number("jumps"), max_seconds: number("max_seconds") };
+  heldHeight = null;
+  if (form.get("closed_loop")) {
+    body.closed_loop = { target_m: number("target_m"), kp: number("kp"), ki: number("ki"), kd: number("kd") };
+    heldHeight = body.closed_loop.target_m;
+  }
+  showStatus(await call("POST", "/robot/runs", body));
+  openLive();
+  say(`Run started: ${body.jumps} jumps at most, ${body.max_seconds} s at most${heldHeight === null ? "" : `, holding ${heldHeight} m`}.`);
+});
+on("#stop-run", "click", async () => showStatus(await call("POST", "/robot/runs/stop")));
 on("#estop", "click", async () => {
   const result = await call("POST", "/robot/estop");
   showStatus(result);

@@ -105,6 +105,24 @@ def test_simulate_shows_plots_and_the_gait(page):
     page.wait_for_function("document.querySelector('#gait-readout').textContent.includes('stable')", timeout=20_000)
     assert "Period 2" in page.inner_text("#gait-readout")
     _shot(page, "simulate")
+    page.click("#save-run")
+    page.wait_for_function("document.querySelector('.message.ok')?.textContent.includes('stored')")
+    run_id = page.inner_text(".message.ok").split()[1]
+    page.click("nav [data-tab=history]")
+    page.wait_for_selector(f"#run-{run_id}")
+    assert "panel" in page.inner_text(f"#run-{run_id} .tags")
+    page.click("nav [data-tab=simulate]")
+
+
+def test_basin_and_sweep_are_jobs_drawn_in_simulate(page):
+    page.click("#run-basin")
+    page.wait_for_selector("#basin-plot .heatmaplayer image", timeout=60_000)
+    assert "% converge" in page.inner_text("#basin-plot")
+    page.click("#run-sweep")
+    page.wait_for_selector("#sweep-plot .scatterlayer .trace", timeout=60_000)
+    assert page.inner_text("#analysis-status").startswith("sweep job") and "done" in page.inner_text("#analysis-status")
+    page.locator("#sweep-plot").scroll_into_view_if_needed()
+    _shot(page, "simulate_analyses")
 
 
 def test_bad_input_shows_the_field_and_range(page):
@@ -121,12 +139,39 @@ def test_a_job_runs_to_completion_with_progress(page):
     page.fill("input[name=cap]", "200")
     page.click("#submit-job")
     page.wait_for_selector("#job-table tbody tr .state", timeout=10_000)
+    # The Simulate tab's analyses are jobs too: follow this MJTF job's own row to the end.
     page.wait_for_function(
-        "[...document.querySelectorAll('#job-table .state')].some(cell => cell.textContent === 'done')", timeout=60_000
+        "document.querySelector('#job-table tbody tr:first-child td:nth-child(2)').textContent === 'mjtf'"
+        " && document.querySelector('#job-table tbody tr:first-child .state').textContent === 'done'",
+        timeout=60_000,
     )
-    page.click("#job-table .show")
-    page.wait_for_selector("#job-plot .main-svg", timeout=10_000)
+    page.click("#job-table tbody tr:first-child .show")
+    page.wait_for_function("document.querySelector('#job-plot').textContent.includes('Mean Jumps To Failure')")
     _shot(page, "jobs")
+
+
+def test_sweep_and_basin_grid_jobs_from_the_jobs_tab(page):
+    page.click("nav [data-tab=jobs]")
+    page.select_option("#job-kind", "sweep")
+    assert page.is_hidden("input[name=trials]"), "only the chosen kind's fields show"
+    page.fill("input[name=steps]", "12")
+    page.fill("input[name=basin_grid]", "0")
+    page.click("#submit-job")
+    page.select_option("#job-kind", "basin")
+    page.fill("input[name=grid]", "30")
+    page.click("#submit-job")
+    # Newest first: the basin job just scheduled, then the sweep (the Simulate tab's jobs are older).
+    row = "document.querySelector('#job-table tbody tr:nth-child({n}) {cell}').textContent"
+    newest = [row.format(n=n, cell=cell) for n in (1, 2) for cell in ("td:nth-child(2)", ".state")]
+    page.wait_for_function(
+        f"{newest[0]} === 'basin' && {newest[1]} === 'done' && {newest[2]} === 'sweep' && {newest[3]} === 'done'",
+        timeout=60_000,
+    )
+    page.click("#job-table tbody tr:nth-child(1) .show")
+    page.wait_for_selector("#job-plot .heatmaplayer image", timeout=10_000)
+    page.click("#job-table tbody tr:nth-child(2) .show")
+    page.wait_for_function("document.querySelector('#job-plot').textContent.includes('max |λ|')", timeout=10_000)
+    page.select_option("#job-kind", "mjtf")
 
 
 def test_history_compares_and_exports(page, service):
@@ -150,6 +195,28 @@ def test_history_compares_and_exports(page, service):
     exported = page.request.get(base + page.get_attribute("#export-csv", "href"))
     assert exported.ok and exported.text().startswith("id,")
     _shot(page, "history")
+
+
+def test_tags_and_notes_are_edited_in_history(page, service):
+    base, _token = service
+    page.click("nav [data-tab=history]")
+    page.wait_for_selector("#run-table button.edit-run")
+    run_id = page.get_attribute("#run-table button.edit-run", "data-run")
+    page.click(f"#run-{run_id} button.edit-run")
+    page.fill("#run-editor input[name=tags]", "keep wet-wall")
+    page.fill("#run-editor textarea[name=notes]", "Left foot slipped on jump 3; try psi0 32.")
+    page.click("#run-editor-save")
+    page.wait_for_function(f"document.querySelector('#run-{run_id} .notes').textContent.includes('slipped')")
+    stored = httpx.get(f"{base}/api/v1/runs/{run_id}").json()
+    assert stored["tags"] == ["keep", "wet-wall"] and stored["notes"].startswith("Left foot slipped")
+    page.click(f"#run-{run_id} button.edit-run")
+    page.fill("#run-editor input[name=tags]", "not ok!")
+    page.click("#run-editor-save")
+    page.wait_for_selector(".message.error")
+    assert "tags" in page.inner_text(".message.error")
+    assert page.evaluate("document.querySelector('#run-editor').open"), "the editor stays open with the text"
+    page.keyboard.press("Escape")
+    assert httpx.get(f"{base}/api/v1/runs/{run_id}").json()["tags"] == ["keep", "wet-wall"]
 
 
 def _canvas_is_drawn(frame) -> bool:
@@ -191,7 +258,8 @@ def test_a_run_opens_in_3d_and_shares_as_a_file(page, service, tmp_path):
         assert _canvas_is_drawn(offline.main_frame)
 
 
-def test_emergency_stop_reaches_the_robot(page):
+def test_closed_loop_run_then_emergency_stop(page, service):
+    base, _token = service
     tracker_port = _free_port(socket.SOCK_DGRAM)
     robot = VirtualRobot(tracker_to=("127.0.0.1", tracker_port), noise=NO_NOISE, speed=3.0).start()
     try:
@@ -200,13 +268,24 @@ def test_emergency_stop_reaches_the_robot(page):
         page.fill("input[name=tracker_port]", str(tracker_port))
         page.click("#connect")
         page.wait_for_function("document.querySelector('#robot-status').textContent.includes('disarmed')")
+        page.fill("#robot-run-form input[name=jumps]", "12")
+        page.check("#closed-loop")
+        page.click("#live-run")
+        page.wait_for_function(
+            "document.querySelector('#robot-status').textContent.includes('jumps done')", timeout=30_000
+        )
+        stored = httpx.get(f"{base}/api/v1/runs?kind=robot&limit=1").json()["items"][0]
+        commands = httpx.get(f"{base}/api/v1/runs/{stored['id']}").json()["results"]["commands"]
+        assert sum(command["why"].startswith("pid") for command in commands) >= 8, "the PID set the legs"
+        page.wait_for_selector("#live-plot .main-svg", timeout=10_000)
+        _shot(page, "robot")
+        page.uncheck("#closed-loop")
+        page.fill("#robot-run-form input[name=jumps]", "200")
         page.click("#live-run")
         page.wait_for_function(
             "document.querySelector('#robot-status').textContent.includes('running')", timeout=10_000
         )
-        time.sleep(1.5)
-        page.wait_for_selector("#live-plot .main-svg", timeout=10_000)
-        _shot(page, "robot")
+        time.sleep(1.0)
         page.click("#estop")
         page.wait_for_function(
             "document.querySelector('.message')?.textContent.includes('Emergency stop acknowledged')"

@@ -301,3 +301,9 @@ def test_run_with_fixed_point_and_retagging(client, auth):
     retagged = client.patch(f"/api/v1/runs/{run['id']}", json={"tags": ["keep", "keep", "best"]}, headers=auth)
     assert retagged.json()["tags"] == ["best", "keep"]
     assert client.patch(f"/api/v1/runs/{run['id']}", json={"climb": 9}, headers=auth).status_code == 422
+    assert run["notes"] == ""
+    noted = client.patch(f"/api/v1/runs/{run['id']}", json={"notes": "left foot slipped once"}, headers=auth).json()
+    assert noted["notes"] == "left foot slipped once" and noted["tags"] == ["best", "keep"], "tags left out stay"
+    assert client.get(f"/api/v1/runs/{run['id']}").json()["notes"] == "left foot slipped once"
+    too_long = client.patch(f"/api/v1/runs/{run['id']}", json={"notes": "x" * 100_001}, headers=auth)
+    assert too_long.status_code == 422 and "notes" in too_long.text

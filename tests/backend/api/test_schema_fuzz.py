@@ -14,6 +14,7 @@ from backend.store.database import make_engine, migrate
 
 pytestmark = pytest.mark.slow  # a few hundred generated requests
 
+EXAMPLES = int(os.environ.get("PARKOUR_FUZZ_EXAMPLES", "20"))  # per endpoint; 300 for a deep pass
 _DATA = Path(tempfile.mkdtemp(prefix="parkourlab-fuzz-"))
 _SETTINGS = Settings.from_environment(_DATA)
 migrate(make_engine(_SETTINGS.database_url))
@@ -29,7 +30,7 @@ schema = schemathesis.openapi.from_asgi("/openapi.json", create_app(_SETTINGS, r
 
 
 @schema.parametrize()
-@settings(max_examples=int(os.environ.get("PARKOUR_FUZZ_EXAMPLES", "20")), deadline=None, suppress_health_check=list(HealthCheck))
+@settings(max_examples=EXAMPLES, deadline=None, suppress_health_check=list(HealthCheck))
 def test_no_server_errors(case):
     response = case.call(headers={"Authorization": f"Bearer {_TOKEN}"})
     assert response.status_code < 500, (

@@ -4,6 +4,7 @@ import time
 
 import numpy as np
 
+from backend.robot.climber import FLOOR
 from backend.robot.link import LinkState, RobotLink
 from backend.robot.messages import Fault, Leg
 from backend.robot.touchdown import detect_touchdowns, height_gains
@@ -16,13 +17,13 @@ LEGS = {Leg.LEFT: (30.0, 0.87), Leg.RIGHT: (30.0, 0.9)}
 ROBOT = get_preset("paper")
 
 
-def _run(noise, jumps, *, speed=6.0, seed=1):
+def _run(noise, jumps, *, speed=6.0, seed=1, legs=LEGS):
     tracker = UdpPoseSource()
     robot = VirtualRobot(tracker_to=tracker.address, noise=noise, speed=speed, seed=seed).start()
     link = RobotLink(robot.url)
     try:
         link.connect()
-        for leg, (psi0, zeta0) in LEGS.items():
+        for leg, (psi0, zeta0) in legs.items():
             link.set_leg(leg, psi0, zeta0)
         link.arm()
         link.start()
@@ -68,3 +69,13 @@ def test_noisy_robot_eventually_falls_and_says_so():
     _tracker, robot, link, state = _run(noise, jumps=400, speed=20.0, seed=3)
     assert state == LinkState.DISARMED, "a failing jump disarms the robot"
     assert link.telemetry.faults & Fault.FELL and robot.climber.jumps < 400
+
+
+def test_a_descending_robot_stops_at_the_floor():
+    """Beyond the in-place zeta0 (0.964 at 30°) the gait descends: the body reaches the floor and
+    the robot reports a fall, instead of the model descending for ever."""
+    descending = {Leg.LEFT: (30.0, 0.98), Leg.RIGHT: (30.0, 0.98)}
+    tracker, robot, link, state = _run(NO_NOISE, jumps=200, speed=20.0, legs=descending)
+    assert state == LinkState.DISARMED and link.telemetry.faults & Fault.FELL
+    assert robot.climber.jumps < 200
+    assert tracker.as_arrays()["y"].min() > FLOOR - 0.01, "nothing is tracked below the floor (1 mm noise)"

@@ -37,3 +37,18 @@ def test_upgrade_from_the_previous_revision_keeps_the_data(tmp_path):
     with engine.connect() as connection:
         row = connection.exec_driver_sql("SELECT kind, total, code_version, result FROM jobs").one()
     assert tuple(row) == ("mjtf", 8, "old", None)
+
+
+def test_runs_stored_before_notes_get_empty_notes(tmp_path):
+    engine = make_engine(sqlite_url(tmp_path))
+    migrate(engine, "0003")
+    with engine.begin() as connection:
+        connection.exec_driver_sql(
+            "INSERT INTO runs (kind, status, created_at, duration_s, code_version, model, controls, start_state, "
+            "jumps, alpha, psi0_deg, zeta0, jumps_completed, climb, results) VALUES ('sim', 'done', "
+            "'2026-01-01 00:00:00', 0.1, 'old', '{}', '[[30, 0.9]]', '[-0.9, -0.2]', 4, 77.6, 30, 0.9, 4, 1.2, '{}')"
+        )
+    migrate(engine)
+    with engine.connect() as connection:
+        row = connection.exec_driver_sql("SELECT code_version, climb, notes FROM runs").one()
+    assert tuple(row) == ("old", 1.2, "")
