@@ -58,7 +58,7 @@ for (const tab of document.querySelectorAll("nav [role=tab]")) {
   on(tab, "click", () => {
     for (const other of document.querySelectorAll("nav [role=tab]")) other.setAttribute("aria-selected", String(other === tab));
     for (const panel of document.querySelectorAll("main [role=tabpanel]")) panel.hidden = panel.id !== tab.dataset.tab;
-    if (tab.dataset.tab === "history") loadRuns();
+    if (tab.dataset.tab === "history") loadExperiments().then(loadRuns).catch(() => {});
     if (tab.dataset.tab === "jobs") loadJobs();
     if (tab.dataset.tab === "robot") refreshRobot();
     if (tab.dataset.tab === "view3d") showView();
@@ -301,7 +301,7 @@ on("#job-table", "click", async (event) => {
 function runQuery() {
   const form = new FormData($("#history-form"));
   const params = new URLSearchParams();
-  for (const name of ["kind", "tag"]) if (form.get(name)) params.set(name, form.get(name));
+  for (const name of ["experiment_id", "kind", "tag"]) if (form.get(name)) params.set(name, form.get(name));
   return params;
 }
 
@@ -336,6 +336,40 @@ async function loadRuns() {
 }
 
 on("#history-form", "submit", (event) => { event.preventDefault(); loadRuns(); });
+
+// Experiments group runs (and jobs) under a name; picking one filters the runs below.
+async function loadExperiments() {
+  const page = await call("GET", "/experiments?limit=100");
+  const filter = $("#experiment-filter");
+  const chosen = filter.value;
+  filter.replaceChildren(new Option("any", ""), ...page.items.map((e) => new Option(`${e.id}: ${e.name}`, String(e.id))));
+  filter.value = page.items.some((e) => String(e.id) === chosen) ? chosen : "";
+  $("#experiment-table tbody").replaceChildren(...page.items.map((experiment) => {
+    const row = document.createElement("tr");
+    row.innerHTML = `<td>${experiment.id}</td><td><button type="button" class="show-experiment" data-experiment="${experiment.id}"></button></td>` +
+      `<td class="description"></td><td>${experiment.runs}</td><td class="tags"></td><td>${new Date(experiment.created_at).toLocaleString()}</td>`;
+    $(".show-experiment", row).textContent = experiment.name;
+    $(".description", row).textContent = experiment.description;
+    $(".tags", row).textContent = experiment.tags.join(" ");
+    return row;
+  }));
+}
+
+on("#experiment-table", "click", async (event) => {
+  const button = event.target.closest("button.show-experiment");
+  if (!button) return;
+  $("#experiment-filter").value = button.dataset.experiment;
+  await loadRuns();
+});
+
+on("#experiment-form", "submit", async (event) => {
+  event.preventDefault();
+  const form = new FormData(event.target);
+  const experiment = await call("POST", "/experiments", { name: String(form.get("name")), description: String(form.get("description")) });
+  event.target.reset();
+  await loadExperiments();
+  say(`Experiment ${experiment.id} "${experiment.name}" created; runs and jobs join it through experiment_id.`);
+});
 
 // Tags and notes: the only things about a run that change after it is stored.
 on("#run-table", "click", (event) => {

@@ -197,6 +197,30 @@ def test_history_compares_and_exports(page, service):
     _shot(page, "history")
 
 
+def test_experiments_group_runs_in_history(page, service):
+    base, token = service
+    page.click("nav [data-tab=history]")
+    page.click("#experiments-box summary")
+    page.fill("#experiment-form input[name=name]", "wet wall")
+    page.fill("#experiment-form input[name=description]", "does a damp chute change MJTF?")
+    page.click("#create-experiment")
+    page.wait_for_selector("#experiment-table button.show-experiment:text-is('wet wall')")
+    experiment_id = int(page.get_attribute("#experiment-table button.show-experiment", "data-experiment"))
+    body = {
+        "experiment_id": experiment_id,
+        "controls": [{"psi0_deg": 30, "zeta0": 0.9}],
+        "start": {"xdot": -0.93, "ydot": -0.2},
+    }
+    run = httpx.post(f"{base}/api/v1/runs", json=body, headers={"Authorization": f"Bearer {token}"}).json()
+    page.click("#experiment-table button.show-experiment")
+    page.wait_for_function(
+        f"document.querySelectorAll('#run-table tbody tr').length === 1 && !!document.querySelector('#run-{run['id']}')"
+    )
+    page.select_option("#experiment-filter", "")
+    page.click("#history-form button[type=submit]")
+    page.wait_for_function("document.querySelectorAll('#run-table tbody tr').length > 1")
+
+
 def test_tags_and_notes_are_edited_in_history(page, service):
     base, _token = service
     page.click("nav [data-tab=history]")
