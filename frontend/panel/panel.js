@@ -67,18 +67,20 @@ for (const tab of document.querySelectorAll("nav [role=tab]")) {
 
 function selectTab(name) { $(`nav [data-tab=${name}]`).click(); }
 
+// Forms --------------------------------------------------------------------------------------
+const numberField = (form) => (name) => Number(form.get(name));
+
+// [left, right] legs from a form's psiL/zetaL/psiR/zetaR fields (the Simulate and Robot forms).
+function legsOf(form) {
+  const number = numberField(form);
+  return [{ psi0_deg: number("psiL"), zeta0: number("zetaL") }, { psi0_deg: number("psiR"), zeta0: number("zetaR") }];
+}
+
 // Simulate -----------------------------------------------------------------------------------
 function simControls() {
   const form = new FormData($("#sim-form"));
-  const number = (name) => Number(form.get(name));
-  return {
-    controls: [
-      { psi0_deg: number("psiL"), zeta0: number("zetaL") },
-      { psi0_deg: number("psiR"), zeta0: number("zetaR") },
-    ],
-    start: { xdot: number("xdot"), ydot: number("ydot") },
-    jumps: number("jumps"),
-  };
+  const number = numberField(form);
+  return { controls: legsOf(form), start: { xdot: number("xdot"), ydot: number("ydot") }, jumps: number("jumps") };
 }
 
 const layout = (title, x, y, extra = {}) => ({
@@ -250,7 +252,7 @@ on("#job-kind", "change", (event) => {
 $("#job-kind").dispatchEvent(new Event("change"));  // also after the browser restores a form
 
 function jobSpec(form) {
-  const number = (name) => Number(form.get(name));
+  const number = numberField(form);
   const kind = form.get("kind");
   if (kind === "mjtf") {
     return { kind, psi0_deg: number("psi0"), trials: number("trials"), cap: number("cap"), seed: number("seed"),
@@ -480,9 +482,8 @@ $("#closed-loop").dispatchEvent(new Event("change"));
 on("#robot-run-form", "submit", async (event) => {
   event.preventDefault();
   const form = new FormData(event.target);
-  const number = (name) => Number(form.get(name));
-  const controls = [{ psi0_deg: number("psiL"), zeta0: number("zetaL") }, { psi0_deg: number("psiR"), zeta0: number("zetaR") }];
-  const body = { controls, jumps: number("jumps"), max_seconds: number("max_seconds") };
+  const number = numberField(form);
+  const body = { controls: legsOf(form), jumps: number("jumps"), max_seconds: number("max_seconds") };
   heldHeight = null;
   if (form.get("closed_loop")) {
     body.closed_loop = { target_m: number("target_m"), kp: number("kp"), ki: number("ki"), kd: number("kd") };
