@@ -1,4 +1,4 @@
-"""Imports flow one way (style.md): sim_core <- experiments <- backend <- frontend, and sim_core
+"""Imports flow one way (style.md): sim_core <- experiments <- backend <- frontend <- cli, and sim_core
 stays free of web, database and plotting code. Checked with import-linter's contracts in
 pyproject.toml."""
 

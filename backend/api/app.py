@@ -119,7 +119,7 @@ def api_token(data_dir: Path) -> tuple[str, bool]:
 
 def create_app(settings: Settings, *, run_jobs: bool = True, view_factory: ViewFactory | None = None) -> FastAPI:
     """The service. ``run_jobs=False`` leaves queued jobs alone (for tools that only read);
-    ``view_factory`` builds the 3D view at start-up (``frontend.serve`` passes the viser one)."""
+    ``view_factory`` builds the 3D view at start-up (``cli.serve`` passes the viser one)."""
     settings.data_dir.mkdir(parents=True, exist_ok=True)
     engine = make_engine(settings.database_url)
     sessions = session_factory(engine)

@@ -7,7 +7,7 @@ GUI are shared by everyone who opens the view, like a monitor on the lab wall. T
 reads: it never commands the robot.
 
 The service talks to it through ``backend.services.view.SceneView`` (info, replay a stored run,
-share a run as standalone HTML); ``frontend.serve`` plugs it in.
+share a run as standalone HTML); ``cli.serve`` plugs it in.
 """
 
 from __future__ import annotations

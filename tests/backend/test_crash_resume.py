@@ -34,7 +34,7 @@ def _start(data_dir: Path, port: int) -> subprocess.Popen:
     command = [
         sys.executable,
         "-m",
-        "frontend.cli",
+        "cli",
         "serve",
         "--data-dir",
         str(data_dir),

@@ -78,7 +78,7 @@ def test_scheduler_address_from_option_or_environment(monkeypatch):
 def test_cli_basin_on_the_cluster_matches_in_process(scheduler):
     from typer.testing import CliRunner
 
-    from backend.cli.app import app
+    from cli.app import app
 
     args = ["basin", "--guess", "-0.9", "-0.2", "--grid", "12", "--jumps", "30", "--json"]
     runner = CliRunner()

@@ -5,7 +5,7 @@ import json
 import pytest
 from typer.testing import CliRunner
 
-from backend.cli.app import app
+from cli.app import app
 from experiments.reproduce import FIGURES, figure_names, reproduce
 from sim_core import ParameterError, get_preset
 

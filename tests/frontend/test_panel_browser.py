@@ -41,7 +41,7 @@ def service(tmp_path_factory):
     command = [
         sys.executable,
         "-m",
-        "frontend.cli",
+        "cli",
         "serve",
         "--data-dir",
         str(data),

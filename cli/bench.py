@@ -8,7 +8,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from backend.cli.options import JsonOption, handles_errors, note, print_json
+from cli.options import JsonOption, handles_errors, note, print_json
 from sim_core.bench import run_benchmark
 
 app = typer.Typer(rich_markup_mode=None)

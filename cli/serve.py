@@ -12,8 +12,8 @@ from typing import Annotated
 
 import typer
 
-from backend.cli.options import handles_errors, note
 from backend.settings import DEFAULT_HOST, DEFAULT_PORT, Settings
+from cli.options import handles_errors, note
 
 DEFAULT_VIEW_PORT = 8001
 

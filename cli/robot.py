@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from backend.cli.options import handles_errors, note
+from cli.options import handles_errors, note
 from sim_core import ParameterError
 
 app = typer.Typer(rich_markup_mode=None)

@@ -7,8 +7,8 @@ from typing import Annotated
 
 import typer
 
-from backend.cli.analyses import SchedulerOption
-from backend.cli.options import JsonOption, ModelSetup, handles_errors, note, print_json, progress_bar, with_model
+from cli.analyses import SchedulerOption
+from cli.options import JsonOption, ModelSetup, handles_errors, note, print_json, progress_bar, with_model
 from experiments.cluster import chunk_map_for, scheduler_address
 from experiments.reproduce import FIGURES, figure_names, reproduce
 

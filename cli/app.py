@@ -5,15 +5,14 @@ nondimensional overrides ``--alpha --d-hat --c-zeta --c-psi --mu``; ``--json`` p
 machine-readable form scripts rely on (keep it stable: extend, never break). Errors a user
 can fix print one line and exit with code 2.
 
-``parkour serve`` joins these in ``frontend.cli`` (the console script's entry): the service it
-starts includes the control panel and the 3D view, which sit above the backend.
+``parkour serve`` starts the service with the control panel and the 3D view.
 """
 
 from __future__ import annotations
 
 import typer
 
-from backend.cli import analyses, bench, gaits, reproduce, robot, simulate
+from cli import analyses, bench, gaits, reproduce, robot, serve, simulate
 
 app = typer.Typer(
     name="parkour",
@@ -23,7 +22,7 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     rich_markup_mode=None,
 )
-for sub_app in (simulate.app, gaits.app, analyses.app, reproduce.app, robot.app, bench.app):
+for sub_app in (simulate.app, gaits.app, analyses.app, reproduce.app, robot.app, bench.app, serve.app):
     app.add_typer(sub_app)
 
 

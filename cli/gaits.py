@@ -8,7 +8,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from backend.cli.options import (
+from cli.options import (
     ControlsOption,
     JsonOption,
     ModelSetup,

@@ -6,7 +6,7 @@ import json
 import pytest
 from typer.testing import CliRunner
 
-from backend.cli.app import app
+from cli.app import app
 
 runner = CliRunner()
 

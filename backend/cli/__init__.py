@@ -1,1 +1,0 @@
-"""The ``parkour`` command: one typer sub-app per file, each a thin layer over one library call."""
