@@ -334,6 +334,7 @@ class ViewOut(BaseModel):
     updates_per_s: float | None = None
     clients: int | None = None
     reason: str | None = None
+    starting: bool = False  # not available yet: it is being built in the background
 
 
 def finite_or_none(value: float) -> float | None:

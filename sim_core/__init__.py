@@ -1,4 +1,4 @@
-"""ParkourLab's numerical core: the ParkourBot bipedal SLIP model (see model.md).
+"""ParkourLab's numerical core: the ParkourBot bipedal SLIP model (see docs/model.md).
 
 Data flows parameters -> simulate -> analyse:
 
@@ -9,47 +9,52 @@ Data flows parameters -> simulate -> analyse:
 - :mod:`sim_core.basin`, :mod:`sim_core.sweep`, :mod:`sim_core.mjtf`,
   :mod:`sim_core.closed_loop` (with :mod:`sim_core.noise`) — the lab's studies (docs/analyses.md).
 
-No web, database or plotting imports here.
+No web, database or plotting imports here. The names below load on first use (PEP 562): importing
+``sim_core`` or a light module such as :mod:`sim_core.controls` does not load numba or scipy, so a
+command that only needs its options starts at once.
 """
 
-from sim_core.controls import ControlSchedule, LegControl
-from sim_core.failures import Failure
-from sim_core.fixed_points import (
-    FixedPoint,
-    FixedPointNotFound,
-    characterize,
-    find_fixed_point,
-    map_jacobian,
-    minimal_period,
-    search_gaits,
-)
-from sim_core.params import ModelParams, PhysicalParams, Scales
-from sim_core.poincare import Orbit, OrbitBatch, iterate_map, iterate_map_batch
-from sim_core.presets import PRESETS, get_preset
-from sim_core.trajectory import Trajectory, simulate_trajectory
-from sim_core.validation import ParameterError
+from __future__ import annotations
 
-__all__ = [
-    "PRESETS",
-    "ControlSchedule",
-    "Failure",
-    "FixedPoint",
-    "FixedPointNotFound",
-    "LegControl",
-    "ModelParams",
-    "Orbit",
-    "OrbitBatch",
-    "ParameterError",
-    "PhysicalParams",
-    "Scales",
-    "Trajectory",
-    "characterize",
-    "find_fixed_point",
-    "get_preset",
-    "iterate_map",
-    "iterate_map_batch",
-    "map_jacobian",
-    "minimal_period",
-    "search_gaits",
-    "simulate_trajectory",
-]
+import importlib
+
+# Public name -> the module that defines it.
+_EXPORTS = {
+    "ControlSchedule": "controls",
+    "LegControl": "controls",
+    "Failure": "failures",
+    "ParameterError": "errors",
+    "FixedPointNotFound": "errors",
+    "FixedPoint": "fixed_points",
+    "characterize": "fixed_points",
+    "find_fixed_point": "fixed_points",
+    "map_jacobian": "fixed_points",
+    "minimal_period": "fixed_points",
+    "search_gaits": "fixed_points",
+    "ModelParams": "params",
+    "PhysicalParams": "params",
+    "Scales": "params",
+    "Orbit": "poincare",
+    "OrbitBatch": "poincare",
+    "iterate_map": "poincare",
+    "iterate_map_batch": "poincare",
+    "PRESETS": "presets",
+    "get_preset": "presets",
+    "Trajectory": "trajectory",
+    "simulate_trajectory": "trajectory",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str):
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'sim_core' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"sim_core.{module}"), name)
+    globals()[name] = value  # later lookups skip this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_EXPORTS})

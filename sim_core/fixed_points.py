@@ -16,6 +16,7 @@ from scipy.optimize import least_squares
 
 from sim_core import stride
 from sim_core.controls import ControlSchedule
+from sim_core.errors import FixedPointNotFound
 from sim_core.failures import OK, Failure
 from sim_core.params import ModelParams
 from sim_core.poincare import check_section_state, iterate_map
@@ -26,10 +27,6 @@ PERIOD_TOL = 1e-7  # |P^p(q) - q| below which p is a period of a found fixed poi
 JACOBIAN_STEP = 1e-3  # central-difference step, relative to max(1, |q_i|)
 IN_PLACE_TOL = 1e-6  # |climb per jump| [l0] below which a gait jumps in place
 _FAILED_RESIDUAL = 1e3  # residual of a trial point whose orbit fails: LM rejects the step
-
-
-class FixedPointNotFound(RuntimeError):
-    """Levenberg–Marquardt did not converge to a fixed point from the given guess."""
 
 
 @dataclass(frozen=True)

@@ -8,17 +8,9 @@ from __future__ import annotations
 
 import math
 
+from sim_core.errors import ParameterError
 
-class ParameterError(ValueError):
-    """A parameter, control or state is outside its allowed range.
-
-    ``field`` is the name the user knows (``"zeta0"``, ``"alpha"``); the message says the
-    allowed range and the value received.
-    """
-
-    def __init__(self, field: str, message: str):
-        super().__init__(f"{field}: {message}")
-        self.field = field
+__all__ = ["ParameterError", "check_range"]
 
 
 def check_range(

@@ -35,7 +35,7 @@ from backend import schemas
 from backend.robot.link import LinkError
 from backend.services import jobs, records, simulation
 from backend.services.robot import RobotService, RobotUnavailable, replay_run
-from backend.services.view import ViewContext, ViewFactory
+from backend.services.view import ViewContext, ViewFactory, ViewStarter
 from backend.settings import Settings
 from backend.store.database import make_engine, migrate, session_factory
 from sim_core import FixedPointNotFound, ParameterError
@@ -119,7 +119,8 @@ def api_token(data_dir: Path) -> tuple[str, bool]:
 
 def create_app(settings: Settings, *, run_jobs: bool = True, view_factory: ViewFactory | None = None) -> FastAPI:
     """The service. ``run_jobs=False`` leaves queued jobs alone (for tools that only read);
-    ``view_factory`` builds the 3D view at start-up (``cli.serve`` passes the viser one)."""
+    ``view_factory`` builds the 3D view at start-up, in the background (``cli.serve`` passes the
+    viser one); ``app.state.view_starter`` holds it once built."""
     settings.data_dir.mkdir(parents=True, exist_ok=True)
     engine = make_engine(settings.database_url)
     sessions = session_factory(engine)
@@ -133,10 +134,11 @@ def create_app(settings: Settings, *, run_jobs: bool = True, view_factory: ViewF
         if run_jobs:
             runner.start()
         if view_factory is not None:
-            app.state.view = view_factory(ViewContext(sessions=sessions, robot_service=robot))
+            context = ViewContext(sessions=sessions, robot_service=robot)
+            app.state.view_starter = ViewStarter(view_factory, context).start()
         yield
-        if app.state.view is not None:
-            app.state.view.close()
+        if app.state.view_starter is not None:
+            app.state.view_starter.close()
         robot.disconnect()
         runner.stop()
         engine.dispose()
@@ -154,7 +156,7 @@ def create_app(settings: Settings, *, run_jobs: bool = True, view_factory: ViewF
     app.state.settings = settings
     app.state.sessions = sessions
     app.state.token = token
-    app.state.view = None
+    app.state.view_starter = None
 
     @app.middleware("http")
     async def limit_request_size(request: Request, call_next):
@@ -399,19 +401,26 @@ def create_app(settings: Settings, *, run_jobs: bool = True, view_factory: ViewF
         return robot.status()
 
     # The 3D view
+    not_started = "the 3D view is not running (it starts with `parkour serve`)"
+
+    def unavailable_reason() -> str:
+        starter = app.state.view_starter
+        return not_started if starter is None else starter.unavailable_reason
+
     def scene_view():
-        if app.state.view is None:
-            raise HTTPException(
-                status.HTTP_503_SERVICE_UNAVAILABLE, "the 3D view is not running (it starts with `parkour serve`)"
-            )
-        return app.state.view
+        view = None if app.state.view_starter is None else app.state.view_starter.view
+        if view is None:
+            raise HTTPException(status.HTTP_503_SERVICE_UNAVAILABLE, unavailable_reason())
+        return view
 
     @app.get("/api/v1/view", response_model=schemas.ViewOut, tags=["view"])
     def view_info():
         """Where the 3D view is (its own port on this host) and what it shows."""
-        if app.state.view is None:
-            return {"available": False, "reason": "the 3D view is not running (it starts with `parkour serve`)"}
-        return app.state.view.info()
+        try:
+            return scene_view().info()
+        except HTTPException:
+            starting = app.state.view_starter is not None and app.state.view_starter.starting
+            return {"available": False, "reason": unavailable_reason(), "starting": starting}
 
     @app.post("/api/v1/view/replay", dependencies=AUTHORIZED, response_model=schemas.ViewOut, tags=["view"])
     def view_replay(body: schemas.ViewReplay):

@@ -3,10 +3,14 @@
 The view (``frontend.viewer``) sits above the backend in the layers, so the service does not
 import it: ``create_app`` takes a factory that builds one from a :class:`ViewContext`, and the
 routes under ``/api/v1/view`` talk to whatever it built through :class:`SceneView`.
+:class:`ViewStarter` builds it off the start-up path, so the API answers while viser and the
+simulator load.
 """
 
 from __future__ import annotations
 
+import logging
+import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
@@ -39,3 +43,57 @@ class SceneView(Protocol):
 
 
 ViewFactory = Callable[[ViewContext], SceneView]
+
+log = logging.getLogger("parkourlab.view")
+CLOSE_WAIT_S = 30.0  # a view still starting at shutdown is waited for, then closed
+
+
+class ViewStarter:
+    """Builds the 3D view in a thread of its own and owns it from then on.
+
+    The view is written once, by the starting thread; readers get it (or None) through
+    :attr:`view` and, while there is none, the reason through :attr:`unavailable_reason`.
+    """
+
+    def __init__(self, factory: ViewFactory, context: ViewContext):
+        self._factory, self._context = factory, context
+        self._view: SceneView | None = None
+        self._error: str | None = None
+        self._done = threading.Event()
+        self._thread = threading.Thread(target=self._start, name="view-start", daemon=True)
+
+    def start(self) -> ViewStarter:
+        self._thread.start()
+        return self
+
+    def _start(self) -> None:
+        try:
+            self._view = self._factory(self._context)
+        except Exception as error:  # the API keeps running without a view, and says why
+            log.exception("the 3D view did not start")
+            self._error = f"the 3D view did not start: {error}"
+        finally:
+            self._done.set()
+
+    @property
+    def view(self) -> SceneView | None:
+        return self._view
+
+    @property
+    def starting(self) -> bool:
+        return not self._done.is_set()
+
+    @property
+    def unavailable_reason(self) -> str:
+        if self._error is not None:
+            return self._error
+        return "the 3D view is starting; try again in a moment" if not self._done.is_set() else "no 3D view"
+
+    def wait(self, timeout: float | None = None) -> SceneView | None:
+        """The view once its start has ended (None if it failed or ``timeout`` [s] passed)."""
+        self._done.wait(timeout)
+        return self._view
+
+    def close(self) -> None:
+        if self.wait(CLOSE_WAIT_S) is not None:
+            self._view.close()

@@ -506,6 +506,7 @@ async function showView() {
   const info = await call("GET", "/view");
   if (!info.available) {
     $("#view-status").textContent = info.reason;
+    if (info.starting) setTimeout(showView, 1000); // built in the background at start-up
     return;
   }
   const url = `${location.protocol}//${location.hostname}:${info.port}/`;

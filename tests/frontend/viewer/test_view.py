@@ -34,7 +34,9 @@ def service(tmp_path):
     app = create_app(settings, view_factory=lambda context: ClimbView(context, port=0))
     with TestClient(app) as client:
         token = (settings.data_dir / "api_token").read_text().strip()
-        yield client, {"Authorization": f"Bearer {token}"}, app.state.view
+        view = app.state.view_starter.wait(60)  # built in the background, after start-up
+        assert view is not None, app.state.view_starter.unavailable_reason
+        yield client, {"Authorization": f"Bearer {token}"}, view
 
 
 def _wait_for(condition, timeout=10.0):
