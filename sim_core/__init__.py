@@ -1,4 +1,4 @@
-"""ParkourLab's numerical core: the ParkourBot bipedal SLIP model (see model.md).
+"""ParkourLab's numerical core: the ParkourBot bipedal SLIP model (see docs/model.md).
 
 Data flows parameters -> simulate -> analyse:
 

@@ -1,4 +1,4 @@
-"""One jump of the Poincaré map and orbits of many jumps, compiled (model.md §2, §4).
+"""One jump of the Poincaré map and orbits of many jumps, compiled (docs/model.md §2, §4).
 
 A jump starts at the section — touchdown on the left wall, after the coordinate flip — with
 section state ``(xdot, ydot)`` (``xdot < 0``: the body flies toward the left wall). It runs
@@ -24,7 +24,7 @@ from sim_core.integrate import PSI, PSI_DOT, STATE_SIZE, TIME, ZETA_DOT, stance
 
 @kernel
 def touchdown_polar_state(xdot, ydot, psi0, zeta0):
-    """Leg-frame rates at touchdown: ``(zeta_dot, psi_dot)`` from the body velocity (model.md §2)."""
+    """Leg-frame rates at touchdown: ``(zeta_dot, psi_dot)`` from the body velocity (docs/model.md §2)."""
     cos_psi = math.cos(psi0)
     sin_psi = math.sin(psi0)
     zeta_dot = xdot * cos_psi + ydot * sin_psi
@@ -34,7 +34,7 @@ def touchdown_polar_state(xdot, ydot, psi0, zeta0):
 
 @kernel
 def liftoff_velocity(psi, zeta_dot, psi_dot):
-    """Body velocity ``(xdot, ydot)`` at lift-off (``zeta = 1``) from the leg-frame rates (model.md §2)."""
+    """Body velocity ``(xdot, ydot)`` at lift-off (``zeta = 1``) from the leg-frame rates (docs/model.md §2)."""
     cos_psi = math.cos(psi)
     sin_psi = math.sin(psi)
     return zeta_dot * cos_psi - psi_dot * sin_psi, zeta_dot * sin_psi + psi_dot * cos_psi
