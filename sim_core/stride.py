@@ -6,7 +6,8 @@ the stance (:func:`sim_core.integrate.stance`), the closed-form flight to the ri
 flips coordinates so the next touchdown is again on the left wall.
 
 These are kernels: floats and arrays in, a status out, no validation beyond what keeps them
-from producing garbage. Call them through :mod:`sim_core.poincare`.
+from producing garbage. The validated entry point is :mod:`sim_core.poincare`; trajectories and
+the studies' own compiled loops (basins, MJTF, the closed loop) call :func:`jump` directly.
 """
 
 from __future__ import annotations
@@ -49,7 +50,7 @@ def jump(xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c
         psi0, zeta0: this jump's leg controls [rad, l0]; they set the touchdown just made.
         next_psi0, next_zeta0: the next jump's controls; they set where this flight ends.
         alpha, d_hat, c_zeta, c_psi, mu: nondimensional model parameters.
-        record: stance nodes, see :func:`sim_core.integrate.stance` (shape (0, 5) for none).
+        record: stance nodes, see :func:`sim_core.integrate.stance` (shape (0, STATE_SIZE) for none).
 
     Returns:
         ``(status, next_xdot, next_ydot, rise, stance_time, flight_time, rows_recorded)``.
