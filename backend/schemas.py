@@ -31,7 +31,7 @@ class LegIn(Strict):
 
 
 class ModelIn(Strict):
-    """The ``paper`` preset with optional nondimensional overrides (model.md §1)."""
+    """The ``paper`` preset with optional nondimensional overrides (docs/model.md §1)."""
 
     preset: Literal["paper"] = "paper"
     alpha: Annotated[float, Field(gt=0.0, le=1e4)] | None = None

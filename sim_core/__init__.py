@@ -6,8 +6,10 @@ Data flows parameters -> simulate -> analyse:
 - :mod:`sim_core.integrate`, :mod:`sim_core.stride` — compiled kernels (stance, one jump, orbits);
 - :mod:`sim_core.poincare`, :mod:`sim_core.trajectory` — the validated map and full paths;
 - :mod:`sim_core.fixed_points` — periodic gaits, their stability, a gait search;
-- :mod:`sim_core.basin`, :mod:`sim_core.sweep`, :mod:`sim_core.mjtf`,
-  :mod:`sim_core.closed_loop` (with :mod:`sim_core.noise`) — the lab's studies (docs/analyses.md).
+- :mod:`sim_core.basin`, :mod:`sim_core.sweep`, :mod:`sim_core.atlas`, :mod:`sim_core.mjtf`,
+  :mod:`sim_core.closed_loop` (with :mod:`sim_core.noise`) — the lab's studies (docs/analyses.md),
+  split into chunks by :mod:`sim_core.chunks`;
+- :mod:`sim_core.reference`, :mod:`sim_core.bench` — the scipy baseline and ``parkour bench``.
 
 No web, database or plotting imports here. The names below load on first use (PEP 562): importing
 ``sim_core`` or a light module such as :mod:`sim_core.controls` does not load numba or scipy, so a

@@ -1,4 +1,4 @@
-"""Basins of attraction of a gait over a grid of section states (model.md §4, paper Fig. 8).
+"""Basins of attraction of a gait over a grid of section states (docs/model.md §4, paper Fig. 8).
 
 Every cell of a grid over ``(xdot, ydot)`` is a start state; the map is iterated from it until
 the orbit comes within ``tolerance`` of the gait's orbit (the cell is in the basin), a jump

@@ -1,6 +1,6 @@
 """Big studies as lists of independent chunks, and the one hook that executes them.
 
-A study (a basin, the trials of MJTF, the basins of a sweep) is split into chunk calls
+A study (a basin, the trials of MJTF, the basins of a sweep, the orbits of a gait atlas) is split into chunk calls
 ``function(*arguments)`` of module-level sim_core functions with picklable arguments, and a
 *chunk map* runs them, returning the results in order:
 

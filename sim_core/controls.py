@@ -1,4 +1,4 @@
-"""Controls per leg and cyclic control schedules (model.md §1, §4).
+"""Controls per leg and cyclic control schedules (docs/model.md §1, §4).
 
 A jump is set by its leg's touchdown angle ``psi0`` and touchdown length ``zeta0``. A
 :class:`ControlSchedule` is the cyclic list of those pairs: one pair is the symmetric case,

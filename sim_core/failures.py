@@ -1,4 +1,4 @@
-"""Failure modes of a jump (model.md §3).
+"""Failure modes of a jump (docs/model.md §3).
 
 The compiled kernels return small integers (they cannot raise); everything outside the
 kernels speaks :class:`Failure`, whose ``code`` strings are the stable names used in JSON

@@ -1,4 +1,4 @@
-"""Stance phase: a compiled DOP853 integrator with exact event location (model.md §2, §3).
+"""Stance phase: a compiled DOP853 integrator with exact event location (docs/model.md §2, §3).
 
 The stance is integrated in polar coordinates about the foot (paper eq. 3,
 :mod:`sim_core.stance_equations`) with the 8th-order Dormand–Prince method and scipy's
@@ -133,7 +133,7 @@ def stance(zeta0, psi0, zeta_dot0, psi_dot0, alpha, c_zeta, c_psi, mu, final, re
     Args:
         zeta0, psi0, zeta_dot0, psi_dot0: touchdown state in polar coordinates about the foot
             [l0, rad, l0/sqrt(l0/g), rad/sqrt(l0/g)].
-        alpha, c_zeta, c_psi, mu: nondimensional model parameters (model.md §1).
+        alpha, c_zeta, c_psi, mu: nondimensional model parameters (docs/model.md §1).
         final: output, shape (STATE_SIZE,): the state at the end of stance (time in TIME).
         record: output, shape (K, STATE_SIZE): touchdown, every accepted step and the end state
             are written while rows last (K = 0 records nothing).

@@ -1,4 +1,4 @@
-"""Mean Jumps To Failure: Monte-Carlo robustness of a gait under noise (paper Fig. 11, model.md §5).
+"""Mean Jumps To Failure: Monte-Carlo robustness of a gait under noise (paper Fig. 11, docs/model.md §5).
 
 A trial starts on the gait's fixed point and jumps with the disturbances of
 :mod:`sim_core.noise` until a jump fails or ``cap`` jumps succeed. Per energy level (zeta0),

@@ -1,4 +1,4 @@
-"""Model parameters: dimensional (SI) and nondimensional, with conversion both ways (model.md §1).
+"""Model parameters: dimensional (SI) and nondimensional, with conversion both ways (docs/model.md §1).
 
 The simulation runs in nondimensional units: length ``l0``, time ``sqrt(l0/g)``, velocity
 ``sqrt(g l0)``, energy ``m g l0``. :class:`PhysicalParams` holds the robot as measured;
@@ -21,7 +21,7 @@ from sim_core.validation import check_range
 
 @dataclass(frozen=True, slots=True)
 class ModelParams:
-    """Nondimensional ParkourBot model (model.md §1).
+    """Nondimensional ParkourBot model (docs/model.md §1).
 
     Attributes:
         alpha: ``k l0 / (m g)``, spring force at full compression over weight, > 0.
@@ -61,7 +61,7 @@ class Scales:
 
 @dataclass(frozen=True, slots=True)
 class PhysicalParams:
-    """ParkourBot physical parameters in SI units (paper Table I, model.md §1).
+    """ParkourBot physical parameters in SI units (paper Table I, docs/model.md §1).
 
     Attributes:
         mass: body mass m [kg].
@@ -70,7 +70,7 @@ class PhysicalParams:
         wall_distance: distance between the walls d [m].
         gravity: effective gravity g [m/s^2] (reduced on the tilted air table).
         c_zeta: radial damping [N s/m].
-        c_psi: pivot damping [N s], normalised like c_zeta (model.md §1).
+        c_psi: pivot damping [N s], normalised like c_zeta (docs/model.md §1).
         mu: foot-wall friction coefficient [-]; ``inf`` disables slipping.
     """
 

@@ -1,4 +1,4 @@
-"""The Poincaré map, validated and typed (model.md §4).
+"""The Poincaré map, validated and typed (docs/model.md §4).
 
 The section is touchdown on the left wall after the coordinate flip; its state is
 ``q = (xdot, ydot)`` in units of ``sqrt(g l0)``, with ``xdot < 0`` (flying toward the wall).

@@ -1,4 +1,4 @@
-"""The stance equations of motion (paper eq. 3, model.md §2) on the integrator's state.
+"""The stance equations of motion (paper eq. 3, docs/model.md §2) on the integrator's state.
 
 The state is a tuple ``(zeta, psi, zeta_dot, psi_dot, cos psi, sin psi, t)`` indexed by the
 names below. Carrying ``cos psi`` and ``sin psi`` (with ``d cos psi/dt = -sin psi psi_dot``)
@@ -26,7 +26,7 @@ def rates(state, alpha, c_zeta, c_psi, independent):
     """Derivative of ``state`` with respect to ``state[independent]`` (``TIME``: the usual d/dt).
 
     Units are nondimensional: lengths in l0, time in sqrt(l0/g); ``alpha``, ``c_zeta`` and
-    ``c_psi`` as in model.md §1. Another independent variable ``s`` is Hénon's trick,
+    ``c_psi`` as in docs/model.md §1. Another independent variable ``s`` is Hénon's trick,
     ``d/ds = (d/dt) / (ds/dt)``; it is infinite or NaN where ``ds/dt = 0``, which the callers
     treat as a failed step.
     """

@@ -1,4 +1,4 @@
-"""One jump of the Poincaré map and orbits of many jumps, compiled (model.md §2, §4).
+"""One jump of the Poincaré map and orbits of many jumps, compiled (docs/model.md §2, §4).
 
 A jump starts at the section — touchdown on the left wall, after the coordinate flip — with
 section state ``(xdot, ydot)`` (``xdot < 0``: the body flies toward the left wall). It runs
@@ -6,7 +6,8 @@ the stance (:func:`sim_core.integrate.stance`), the closed-form flight to the ri
 flips coordinates so the next touchdown is again on the left wall.
 
 These are kernels: floats and arrays in, a status out, no validation beyond what keeps them
-from producing garbage. Call them through :mod:`sim_core.poincare`.
+from producing garbage. The validated entry point is :mod:`sim_core.poincare`; trajectories and
+the studies' own compiled loops (basins, MJTF, the closed loop) call :func:`jump` directly.
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ from sim_core.integrate import PSI, PSI_DOT, STATE_SIZE, TIME, ZETA_DOT, stance
 
 @kernel
 def touchdown_polar_state(xdot, ydot, psi0, zeta0):
-    """Leg-frame rates at touchdown: ``(zeta_dot, psi_dot)`` from the body velocity (model.md §2)."""
+    """Leg-frame rates at touchdown: ``(zeta_dot, psi_dot)`` from the body velocity (docs/model.md §2)."""
     cos_psi = math.cos(psi0)
     sin_psi = math.sin(psi0)
     zeta_dot = xdot * cos_psi + ydot * sin_psi
@@ -34,7 +35,7 @@ def touchdown_polar_state(xdot, ydot, psi0, zeta0):
 
 @kernel
 def liftoff_velocity(psi, zeta_dot, psi_dot):
-    """Body velocity ``(xdot, ydot)`` at lift-off (``zeta = 1``) from the leg-frame rates (model.md §2)."""
+    """Body velocity ``(xdot, ydot)`` at lift-off (``zeta = 1``) from the leg-frame rates (docs/model.md §2)."""
     cos_psi = math.cos(psi)
     sin_psi = math.sin(psi)
     return zeta_dot * cos_psi - psi_dot * sin_psi, zeta_dot * sin_psi + psi_dot * cos_psi
@@ -49,7 +50,7 @@ def jump(xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c
         psi0, zeta0: this jump's leg controls [rad, l0]; they set the touchdown just made.
         next_psi0, next_zeta0: the next jump's controls; they set where this flight ends.
         alpha, d_hat, c_zeta, c_psi, mu: nondimensional model parameters.
-        record: stance nodes, see :func:`sim_core.integrate.stance` (shape (0, 5) for none).
+        record: stance nodes, see :func:`sim_core.integrate.stance` (shape (0, STATE_SIZE) for none).
 
     Returns:
         ``(status, next_xdot, next_ydot, rise, stance_time, flight_time, rows_recorded)``.

@@ -1,4 +1,4 @@
-"""Energy sweeps: a gait followed over leg retraction zeta0 (paper Fig. 8, model.md §5).
+"""Energy sweeps: a gait followed over leg retraction zeta0 (paper Fig. 8, docs/model.md §5).
 
 For each zeta0 of a sweep the fixed point is solved by continuation — seeded from the
 neighbour's solution — and characterised: max |eigenvalue|, stability, climb per jump, and

@@ -1,7 +1,7 @@
 """Full trajectories in wall coordinates, for display and for comparison with the robot.
 
 The Poincaré map works in the flipped frame (every stance on the left wall). Here the flips
-are undone jump by jump (model.md §2): jump 0's stance is on the left wall, jump 1's on the
+are undone jump by jump (docs/model.md §2): jump 0's stance is on the left wall, jump 1's on the
 right, and so on. Stance is sampled by cubic Hermite interpolation between the integrator's
 own steps (positions and rates are both known there, error ~1e-6 l0); flight is closed form.
 

@@ -1,4 +1,4 @@
-"""Shared fixtures: the paper's model and the gaits the paper reports (model.md §5)."""
+"""Shared fixtures: the paper's model and the gaits the paper reports (docs/model.md §5)."""
 
 import pytest
 

@@ -1,2 +1,12 @@
-"""The robot link: the XBee API-frame codec, ParkourLab's application messages, and (next) the
-link, tracker input and the virtual robot. The protocol is written down in docs/protocol.md."""
+"""The robot link, written down in docs/protocol.md.
+
+- :mod:`~backend.robot.xbee` — XBee API frames (escaped mode) and a resynchronising parser;
+- :mod:`~backend.robot.messages` — ParkourLab's application messages (protocol v1);
+- :mod:`~backend.robot.limits` — the servo limits every leg command is checked against;
+- :mod:`~backend.robot.link` — the PC's side: a pyserial URL, heartbeats, safety, reconnects;
+- :mod:`~backend.robot.tracker` — body poses from the overhead camera (UDP datagrams, replays);
+- :mod:`~backend.robot.touchdown` — touchdowns, section states and height gains from poses;
+- the virtual robot: :mod:`~backend.robot.virtual` (its radio over TCP),
+  :mod:`~backend.robot.firmware` (the robot's state machine) and :mod:`~backend.robot.climber`
+  (its body, the model climbing in real time, streamed as tracker datagrams).
+"""

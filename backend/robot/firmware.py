@@ -71,7 +71,7 @@ class Firmware:
         return out
 
     def fell(self) -> None:
-        """A jump failed: the robot is down, disarmed, and says so."""
+        """A jump failed or the body reached the chute's floor: the robot is down, disarmed, and says so."""
         if self.state == RobotState.RUNNING:
             self.state = RobotState.DISARMED
             self.faults |= Fault.FELL

@@ -1,13 +1,16 @@
-"""Batch jobs: MJTF studies that live in the database and survive crashes.
+"""Batch jobs: MJTF studies, energy sweeps, basins and gait searches that live in the database.
 
-A job is a row; its trials are rows with the idempotent key ``(job, level, index)``. The
-runner (one background thread) works through a job in chunks of trials: it computes the
-trials still missing, runs the chunks — in this process, or on the Dask cluster named by
-``PARKOUR_DASK_ADDRESS`` — and commits each chunk's trials and the progress in one
-transaction as it finishes. Killed mid-job, the service finds the job at the next start, recomputes only
-the missing trials — their seeds depend on ``(seed, level, index)`` alone — and ends with
-exactly the trials asked for, none lost and none duplicated (the unique key refuses a second
-copy). Cancelling marks the job; the runner stops before its next chunk.
+A job is a row. An MJTF job survives crashes trial by trial: its trials are rows with the
+idempotent key ``(job, level, index)``. The runner (one background thread) works through a
+job in chunks of trials: it computes the trials still missing, runs the chunks — in this
+process, or on the Dask cluster named by ``PARKOUR_DASK_ADDRESS`` — and commits each chunk's
+trials and the progress in one transaction as it finishes. Killed mid-job, the service finds
+the job at the next start, recomputes only the missing trials — their seeds depend on
+``(seed, level, index)`` alone — and ends with exactly the trials asked for, none lost and none
+duplicated (the unique key refuses a second copy). Sweeps, basins and gait searches are
+deterministic: they run whole through the chunk map, report progress per chunk, and store
+their result on the job when done; a restart recomputes them. Cancelling marks the job; the
+runner stops before its next chunk.
 """
 
 from __future__ import annotations

@@ -1,4 +1,5 @@
-"""The stored records (SQLAlchemy 2.x, typed): experiments contain runs; jobs contain trials.
+"""The stored records (SQLAlchemy 2.x, typed): experiments contain runs; MJTF jobs contain trials,
+the other kinds of job keep their result as JSON.
 
 Filterable run attributes (kind, status, the first leg's controls, alpha, failure) are columns
 with indexes; the full parameters, schedule and results are JSON, and trajectories a
@@ -104,7 +105,8 @@ class RunTag(Base):
 
 
 class Job(Base):
-    """A batch of trials; it lives here, not in memory, so a restart resumes it."""
+    """A batch job (MJTF trials, a sweep, a basin or a gait search); it lives here, not in memory,
+    so a restart resumes it."""
 
     __tablename__ = "jobs"
 

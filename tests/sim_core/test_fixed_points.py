@@ -1,4 +1,4 @@
-"""Gaits and stability against the paper's qualitative results (model.md §5)."""
+"""Gaits and stability against the paper's qualitative results (docs/model.md §5)."""
 
 import numpy as np
 import pytest

@@ -19,7 +19,7 @@ def sweep(paper):
 
 
 def test_more_retraction_is_more_stable_and_climbs_faster(sweep):
-    """Paper Fig. 8 / model.md §5: smaller zeta0 -> smaller max |λ|, faster climbing, larger basin."""
+    """Paper Fig. 8 / docs/model.md §5: smaller zeta0 -> smaller max |λ|, faster climbing, larger basin."""
     assert all(point.gait is not None for point in sweep.points)
     assert np.all(np.diff(sweep.max_abs_eigenvalue) > 0)
     assert np.all(np.diff(sweep.climb_per_jump) < 0)
