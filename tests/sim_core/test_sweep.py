@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from sim_core import ControlSchedule, LegControl, ParameterError, find_fixed_point
-from sim_core.basin import BasinGrid
+from sim_core.basin_grid import BasinGrid
 from sim_core.sweep import energy_sweep, zeta0_values
 
 PSI0 = math.radians(30.0)
