@@ -10,8 +10,6 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from backend.store.database import sqlite_url
-
 DEFAULT_HOST = "127.0.0.1"  # localhost only unless told otherwise: the robot is real hardware
 DEFAULT_PORT = 8000
 MAX_REQUEST_BYTES = 1_000_000
@@ -26,6 +24,8 @@ class Settings:
 
     @classmethod
     def from_environment(cls, data_dir: Path | None = None, database_url: str | None = None) -> Settings:
+        from backend.store.database import sqlite_url  # SQLAlchemy loads here, not when the CLI lists options
+
         directory = Path(data_dir or os.environ.get("PARKOUR_DATA_DIR") or Path.cwd() / "data").resolve()
         url = database_url or os.environ.get("DATABASE_URL") or sqlite_url(directory)
         return cls(data_dir=directory, database_url=url, dask_address=os.environ.get("PARKOUR_DASK_ADDRESS") or None)
