@@ -25,7 +25,7 @@ from sqlalchemy import func, select, update
 from sqlalchemy.orm import Session, sessionmaker
 
 from backend.schemas import JOB_KINDS, MJTFJobCreate
-from backend.services.records import NotFound, get_experiment, page
+from backend.services.records import fetch, get_experiment, newest_first, page
 from backend.services.simulation import KERNEL_LOCK, current_code_version, locked_chunk_map, model_params, run_study
 from backend.store.models import Job, Trial, utcnow
 from experiments.cluster import as_completed_results, chunk_map_for, dask_client
@@ -60,18 +60,13 @@ def create_job(session: Session, body) -> Job:
 
 
 def get_job(session: Session, job_id: int) -> Job:
-    job = session.get(Job, job_id)
-    if job is None:
-        raise NotFound("job", job_id)
-    return job
+    return fetch(session, Job, job_id, "job")
 
 
 def list_jobs(session: Session, *, state: str | None, limit: int, cursor: int | None) -> tuple[list[Job], int | None]:
-    query = select(Job).order_by(Job.id.desc()).limit(limit + 1)
+    query = newest_first(Job, limit, cursor)
     if state is not None:
         query = query.where(Job.state == state)
-    if cursor is not None:
-        query = query.where(Job.id < cursor)
     return page(list(session.scalars(query)), limit)
 
 

@@ -14,7 +14,7 @@ import math
 from collections.abc import Iterator
 from dataclasses import dataclass
 
-from sqlalchemy import func, select
+from sqlalchemy import Select, func, select
 from sqlalchemy.orm import Session
 
 from backend.schemas import ExperimentCreate, ExperimentUpdate, RunCreate
@@ -42,10 +42,7 @@ def create_experiment(session: Session, body: ExperimentCreate) -> Experiment:
 
 
 def get_experiment(session: Session, experiment_id: int) -> Experiment:
-    experiment = session.get(Experiment, experiment_id)
-    if experiment is None:
-        raise NotFound("experiment", experiment_id)
-    return experiment
+    return fetch(session, Experiment, experiment_id, "experiment")
 
 
 def update_experiment(session: Session, experiment_id: int, body: ExperimentUpdate) -> Experiment:
@@ -70,11 +67,7 @@ def run_count(session: Session, experiment_id: int) -> int:
 
 
 def list_experiments(session: Session, *, limit: int, cursor: int | None) -> tuple[list[Experiment], int | None]:
-    query = select(Experiment).order_by(Experiment.id.desc()).limit(limit + 1)
-    if cursor is not None:
-        query = query.where(Experiment.id < cursor)
-    rows = list(session.scalars(query))
-    return page(rows, limit)
+    return page(list(session.scalars(newest_first(Experiment, limit, cursor))), limit)
 
 
 def create_run(session: Session, body: RunCreate) -> Run:
@@ -89,10 +82,7 @@ def create_run(session: Session, body: RunCreate) -> Run:
 
 
 def get_run(session: Session, run_id: int) -> Run:
-    run = session.get(Run, run_id)
-    if run is None:
-        raise NotFound("run", run_id)
-    return run
+    return fetch(session, Run, run_id, "run")
 
 
 def update_run(session: Session, run_id: int, *, tags: list[str] | None = None, notes: str | None = None) -> Run:
@@ -271,6 +261,20 @@ def aggregate_runs(session: Session, where: RunFilter, by: str) -> list[dict]:
             }
         groups.append(group)
     return groups
+
+
+def fetch(session: Session, model: type, identifier: int, what: str):
+    """The row of ``model`` with primary key ``identifier``; :class:`NotFound` names ``what`` if none."""
+    row = session.get(model, identifier)
+    if row is None:
+        raise NotFound(what, identifier)
+    return row
+
+
+def newest_first(model: type, limit: int, cursor: int | None) -> Select:
+    """The query for one keyset page of ``model`` by ``id``, newest first (``limit + 1`` rows: see :func:`page`)."""
+    query = select(model).order_by(model.id.desc()).limit(limit + 1)
+    return query if cursor is None else query.where(model.id < cursor)
 
 
 def page(rows: list, limit: int) -> tuple[list, int | None]:
