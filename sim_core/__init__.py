@@ -6,12 +6,15 @@ Data flows parameters -> simulate -> analyse:
 - :mod:`sim_core.integrate`, :mod:`sim_core.stride` — compiled kernels (stance, one jump, orbits);
 - :mod:`sim_core.poincare`, :mod:`sim_core.trajectory` — the validated map and full paths;
 - :mod:`sim_core.fixed_points` — periodic gaits, their stability, a gait search;
+- :mod:`sim_core.walls`, :mod:`sim_core.climb` — left and right, and the climb jump after jump
+  (the sequencer the 3D view and the virtual robot drive, with the noise and the chute's floor);
 - :mod:`sim_core.basin`, :mod:`sim_core.sweep`, :mod:`sim_core.mjtf`,
   :mod:`sim_core.closed_loop` (with :mod:`sim_core.noise`) — the lab's studies (docs/analyses.md).
 
 No web, database or plotting imports here.
 """
 
+from sim_core.climb import ClimbEnd, ClimbSetup
 from sim_core.controls import ControlSchedule, LegControl
 from sim_core.failures import Failure
 from sim_core.fixed_points import (
@@ -28,9 +31,12 @@ from sim_core.poincare import Orbit, OrbitBatch, iterate_map, iterate_map_batch
 from sim_core.presets import PRESETS, get_preset
 from sim_core.trajectory import Trajectory, simulate_trajectory
 from sim_core.validation import ParameterError
+from sim_core.walls import Wall, wall_of
 
 __all__ = [
     "PRESETS",
+    "ClimbEnd",
+    "ClimbSetup",
     "ControlSchedule",
     "Failure",
     "FixedPoint",
@@ -43,6 +49,7 @@ __all__ = [
     "PhysicalParams",
     "Scales",
     "Trajectory",
+    "Wall",
     "characterize",
     "find_fixed_point",
     "get_preset",
@@ -52,4 +59,5 @@ __all__ = [
     "minimal_period",
     "search_gaits",
     "simulate_trajectory",
+    "wall_of",
 ]
