@@ -6,6 +6,8 @@ Data flows parameters -> simulate -> analyse:
 - :mod:`sim_core.integrate`, :mod:`sim_core.stride` — compiled kernels (stance, one jump, orbits);
 - :mod:`sim_core.poincare`, :mod:`sim_core.trajectory` — the validated map and full paths;
 - :mod:`sim_core.fixed_points` — periodic gaits, their stability, a gait search;
+- :mod:`sim_core.walls`, :mod:`sim_core.climb` — left and right, and the climb jump after jump
+  (the sequencer the 3D view and the virtual robot drive, with the noise and the chute's floor);
 - :mod:`sim_core.basin`, :mod:`sim_core.sweep`, :mod:`sim_core.atlas`, :mod:`sim_core.mjtf`,
   :mod:`sim_core.closed_loop` (with :mod:`sim_core.noise`) — the lab's studies (docs/analyses.md),
   split into chunks by :mod:`sim_core.chunks`;
@@ -22,6 +24,8 @@ import importlib
 
 # Public name -> the module that defines it.
 _EXPORTS = {
+    "ClimbEnd": "climb",
+    "ClimbSetup": "climb",
     "ControlSchedule": "controls",
     "LegControl": "controls",
     "Failure": "failures",
@@ -44,6 +48,8 @@ _EXPORTS = {
     "get_preset": "presets",
     "Trajectory": "trajectory",
     "simulate_trajectory": "trajectory",
+    "Wall": "walls",
+    "wall_of": "walls",
 }
 
 __all__ = sorted(_EXPORTS)

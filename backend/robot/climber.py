@@ -1,17 +1,18 @@
 """The virtual robot's body: the SLIP model climbing in real time, seen by a 100 Hz tracker.
 
+A thin, threaded driver of :mod:`sim_core.climb` (the climb sequencer the 3D view runs too).
 While the firmware says ``running``, jump after jump is simulated with the legs' current
-controls plus the imperfections the paper reports (:class:`sim_core.noise.NoiseModel`: L/R
-asymmetry, control noise, pitch drift offsetting the leg angles, noisy section states), and the
-body's path is streamed as tracker datagrams in real time (or ``speed`` times faster), with
-position noise and dropped frames. A failing jump (slip, no flight, ...) ends the climb: the
-robot falls and reports it. So does reaching the chute's floor (the body below the first foot's
-height, ``FLOOR``): the model alone would let a descending gait fall forever.
+controls plus the imperfections the paper reports (:mod:`sim_core.noise`: L/R asymmetry, control
+noise, pitch drift offsetting the leg angles, noisy section states), and the body's path is
+streamed as tracker datagrams in real time (or ``speed`` times faster), with position noise and
+dropped frames. Each stance is streamed before the next leg is read, as the real robot positions
+that leg during the stance. The climb ends when a jump fails (slip, no flight, ...) or the body
+reaches the chute's floor (:data:`sim_core.climb.FLOOR`, where the first foot touches): the
+robot falls and reports it, and :attr:`Climber.end` says why.
 """
 
 from __future__ import annotations
 
-import math
 import socket
 import threading
 import time
@@ -21,14 +22,14 @@ import numpy as np
 
 from backend.robot.messages import Leg
 from backend.robot.tracker import Pose, encode_datagram
-from sim_core import ControlSchedule, LegControl, PhysicalParams, find_fixed_point, get_preset, simulate_trajectory
+from sim_core import ControlSchedule, LegControl, PhysicalParams, climb, find_fixed_point, get_preset
+from sim_core.climb import ClimbSetup, End, Samples
 from sim_core.fixed_points import FixedPointNotFound
-from sim_core.noise import NoiseModel
-from sim_core.trajectory import STANCE
+from sim_core.noise import NoiseModel, NoiseSampler
 from sim_core.validation import check_range
+from sim_core.walls import Wall
 
 FRAME_RATE = 100.0  # [Hz] the FLEX V100's
-FLOOR = 0.0  # [m] the chute's floor: where the first foot touches
 LAUNCH_GUESS = (-0.93, -0.2)
 
 
@@ -55,7 +56,11 @@ class Climber:
         self.tracker_noise = check_range("tracker_noise", tracker_noise, 0.0, 0.1, low_open=False)
         self.drop_rate = check_range("drop_rate", drop_rate, 0.0, 1.0, low_open=False)
         self.speed = check_range("speed", speed, 0.0, 100.0)
-        self.rng = np.random.default_rng(seed)
+        # Two streams: the climb's noise does not depend on how many frames were streamed.
+        climb_seed, tracker_seed = np.random.SeedSequence(seed).spawn(2)
+        self._climb_rng = np.random.default_rng(climb_seed)
+        self.rng = np.random.default_rng(tracker_seed)  # tracker noise and dropped frames
+        self.end: End | None = None  # why the last climb ended (a failure or the floor)
         self.frames_sent = 0
         self.frames_dropped = 0
         self.jumps = 0
@@ -79,84 +84,51 @@ class Climber:
             else:
                 self._stop.wait(0.01)
 
-    def _controls(self, jump: int, pitch: float) -> LegControl:
-        """Jump ``jump``'s leg with the robot's imperfections (noise.py's conventions)."""
-        leg = Leg.LEFT if jump % 2 == 0 else Leg.RIGHT
-        psi0_deg, zeta0 = self.legs()[leg]
-        noise = self.noise
-        psi0 = math.radians(psi0_deg) + (pitch if leg == Leg.LEFT else -pitch)
-        if leg == Leg.RIGHT:
-            psi0 += math.radians(noise.asymmetry_psi0_deg)
-            zeta0 += noise.asymmetry_zeta0
-        psi0 += self.rng.normal(0.0, math.radians(noise.psi0_deg)) if noise.psi0_deg else 0.0
-        zeta0 += self.rng.normal(0.0, noise.zeta0) if noise.zeta0 else 0.0
-        return LegControl(min(max(psi0, 1e-3), math.radians(89.0)), min(max(zeta0, 0.05), 0.995))
+    def _commanded(self, wall: Wall) -> LegControl:
+        """What the firmware holds for the leg on ``wall`` now."""
+        return LegControl.from_degrees(*self.legs()[Leg.of(wall)])
 
     def _climb(self) -> None:
-        """One climb from launch until stopped or fallen."""
-        pitch = 0.0
-        this = self._controls(0, pitch)
+        """One climb from launch until stopped, failed or at the floor."""
+        setup = ClimbSetup(self.robot, sample_rate=FRAME_RATE * self.robot.scales.time)
+        sampler = NoiseSampler(self.noise, self._climb_rng)
+        first = self._commanded(Wall.LEFT)
         try:
-            state = find_fixed_point(self.model, ControlSchedule.of(this), 1, LAUNCH_GUESS).state
+            state = find_fixed_point(self.model, ControlSchedule.of(first), 1, LAUNCH_GUESS).state
         except FixedPointNotFound:
             state = np.array(LAUNCH_GUESS)
-        height = this.zeta0 * math.sin(this.psi0)
-        clock = 0.0  # robot time [s] of the current touchdown
+        start = climb.launch(setup, first, state, sampler)
         started = time.monotonic()
-        jump = 0
-        while self.running() and not self._stop.is_set():
-            # Stance does not depend on the next leg: stream it first, then read the next leg's
-            # controls at lift-off — as the real robot positions that leg during this stance.
-            rate = FRAME_RATE * self.robot.scales.time
-            side = 1.0 if jump % 2 == 0 else -1.0  # the wall frame alternates: odd jumps start on the right
-            stance = simulate_trajectory(
-                self.model, ControlSchedule.of(this, this), state, 1, sample_rate=rate, start_height=height
-            ).to_si(self.robot)
-            in_stance = stance.phase == STANCE
-            if self._stream_to_floor(
-                clock + stance.time[in_stance], side * stance.x[in_stance], stance.y[in_stance], pitch, started
-            ):
+        self.end = None
+        while self._active():
+            stance = climb.stance(setup, start)
+            self._stream(stance.samples, start.pitch, started)
+            if not self._active():
                 return
-            if not self.running() or self._stop.is_set():
+            if stance.end is not None:
+                self._fall(stance.end)
                 return
-            drift = math.radians(self.noise.pitch_drift_deg)
-            next_pitch = pitch + (self.rng.normal(0.0, drift) if drift else 0.0)
-            following = self._controls(jump + 1, next_pitch)
-            path = simulate_trajectory(
-                self.model, ControlSchedule.of(this, following), state, 1, sample_rate=rate, start_height=height
-            )
-            si = path.to_si(self.robot)
-            in_flight = si.phase != STANCE
-            if self._stream_to_floor(
-                clock + si.time[in_flight], side * si.x[in_flight], si.y[in_flight], pitch, started
-            ):
+            # Read at lift-off: the robot positioned this leg during the stance just streamed.
+            next_leg = climb.read_next_leg(start, self._commanded(start.wall.other), sampler)
+            jump = climb.jump(setup, start, next_leg)
+            self._stream(jump.flight, start.pitch, started)
+            if not self._active():
                 return
-            if path.failure is not None:
-                self.fell()
+            if jump.end is not None:
+                self._fall(jump.end)
                 return
-            clock += si.touchdown_times[-1]
-            state = path.section_states[-1] + (
-                self.rng.normal(0.0, self.noise.velocity, 2) if self.noise.velocity else 0.0
-            )
-            height = float(si.y[-1]) / self.robot.leg_length
-            this, pitch = following, next_pitch
-            jump += 1
+            start = climb.touchdown_after(setup, jump, sampler)
             self.jumps += 1
 
-    def _stream_to_floor(self, times, xs, ys, pitch: float, started: float) -> bool:
-        """Stream the samples above the floor; True (and the robot has fallen) if it was reached."""
-        below = np.flatnonzero(ys < FLOOR)
-        if below.size == 0:
-            self._stream(times, xs, ys, pitch, started)
-            return False
-        end = below[0]
-        self._stream(times[:end], xs[:end], ys[:end], pitch, started)
-        if self.running():
-            self.fell()
-        return True
+    def _active(self) -> bool:
+        return self.running() and not self._stop.is_set()
 
-    def _stream(self, times, xs, ys, pitch: float, started: float) -> None:
-        for t, x, y in zip(times, xs, ys, strict=True):
+    def _fall(self, end: End) -> None:
+        self.end = end
+        self.fell()
+
+    def _stream(self, samples: Samples, pitch: float, started: float) -> None:
+        for t, x, y in zip(samples.time, samples.x, samples.y, strict=True):
             delay = started + t / self.speed - time.monotonic()
             if delay > 0 and self._stop.wait(delay):
                 return

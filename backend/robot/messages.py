@@ -19,6 +19,8 @@ import struct
 from dataclasses import dataclass
 from enum import IntEnum
 
+from sim_core.walls import Wall
+
 VERSION = 1
 HEADER = struct.Struct(">BBH")
 
@@ -40,8 +42,21 @@ class Kind(IntEnum):
 
 
 class Leg(IntEnum):
+    """A leg as the wire encodes it (one byte: 0 left, 1 right). Outside the codec, speak
+    :class:`sim_core.walls.Wall`: ``Leg.of(wall)`` and ``leg.wall`` convert."""
+
     LEFT = 0
     RIGHT = 1
+
+    @classmethod
+    def of(cls, wall: Wall) -> Leg:
+        """The leg that stands on ``wall``."""
+        return cls.LEFT if Wall(wall) == Wall.LEFT else cls.RIGHT
+
+    @property
+    def wall(self) -> Wall:
+        """The wall this leg stands on."""
+        return Wall.LEFT if self == Leg.LEFT else Wall.RIGHT
 
 
 class Result(IntEnum):

@@ -19,6 +19,7 @@ import numpy as np
 
 from sim_core.controls import LegControl
 from sim_core.params import PhysicalParams
+from sim_core.walls import Wall
 
 MIN_FIT_POSES = 4
 
@@ -29,7 +30,7 @@ class Touchdown:
 
     index: int  # 0-based touchdown number
     time: float  # [s]
-    wall: int  # -1 left, +1 right
+    wall: Wall  # the wall the foot met
     state: tuple[float, float]  # (xdot, ydot) [sqrt(g l0)], flipped to the left wall
     body_height: float  # [m]
     foot_height: float  # [m]
@@ -58,7 +59,7 @@ def detect_touchdowns(
             continue
         if flight_start is None:
             continue
-        wall = 1 if x[i] > 0 else -1
+        wall = Wall.RIGHT if x[i] > 0 else Wall.LEFT
         leg = leg_for(len(touchdowns))
         line = wall * (half - leg.zeta0 * robot.leg_length * math.cos(leg.psi0))
         if wall * x[i] < wall * line:

@@ -31,6 +31,7 @@ from experiments.report import json_safe
 from sim_core import ControlSchedule, LegControl, ParameterError, get_preset, iterate_map
 from sim_core.closed_loop import pid_step
 from sim_core.sweep import find_in_place_zeta0
+from sim_core.walls import wall_of
 
 POLL = 0.005  # [s] how often a live run looks at new poses
 RECONNECT_PERIOD = 1.0  # [s] between attempts on a dropped link
@@ -224,7 +225,7 @@ class RobotService:
 
         def leg_for(k: int) -> LegControl:
             # Detected touchdown k is the climb's touchdown k + 1: even climb touchdowns are the left leg's.
-            return run_controls[k] if k < len(run_controls) else commanded[Leg.LEFT if (k + 1) % 2 == 0 else Leg.RIGHT]
+            return run_controls[k] if k < len(run_controls) else commanded[Leg.of(wall_of(k + 1))]
 
         run_controls = run.touchdown_controls
         try:
@@ -266,7 +267,7 @@ class RobotService:
                             command, integral = pid_step(error / self.robot.leg_length, previous_error, integral,
                                                          *controller["law"])  # fmt: skip
                             previous_error = error / self.robot.leg_length
-                            leg = Leg.LEFT if (touchdown.index + 2) % 2 == 0 else Leg.RIGHT
+                            leg = Leg.of(wall_of(touchdown.index + 2))  # the next touchdown's (climb numbering)
                             send(
                                 leg, LegControl(commanded[leg].psi0, command), f"pid after touchdown {touchdown.index}"
                             )

@@ -22,11 +22,12 @@ import viser
 
 from backend.robot.messages import Leg
 from backend.services import records
-from frontend.viewer.motion import LEFT, STANCE, Controls, JumpPlan, PathClip, SimulatedClimb, model_jump
+from frontend.viewer.motion import STANCE, Controls, JumpPlan, PathClip, SimulatedClimb, model_jump
 from frontend.viewer.recordings import Recording, load_recording
 from frontend.viewer.scene import ChuteScene
 from sim_core import ControlSchedule, FixedPoint, LegControl, PhysicalParams, search_gaits
 from sim_core.fixed_points import FixedPointNotFound, find_fixed_point
+from sim_core.walls import Wall
 
 # The paper's gaits (Fig. 7): psi0 [deg] and zeta0 [l0] of the left and right legs.
 GAIT_PRESETS = {
@@ -295,7 +296,7 @@ class LiveMode(_Mode):
             return None
         touchdown = touchdowns[k]
         # The leg in flight after touchdown k reaches for the other wall: the one commanded now.
-        next_leg = run.commanded.get(Leg.RIGHT if touchdown.wall == LEFT else Leg.LEFT, controls[k])
+        next_leg = run.commanded.get(Leg.of(Wall(touchdown.wall).other), controls[k])
         try:
             plan = model_jump(robot, touchdown.state, controls[k], next_leg, wall=touchdown.wall,
                               start_time=touchdown.time, start_height=touchdown.body_height)  # fmt: skip

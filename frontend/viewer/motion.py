@@ -1,16 +1,17 @@
 """What the 3D view shows, frame by frame: sampled paths and the sources that produce them.
 
 No viser here: these are plain objects over numpy arrays, tested on their own. Everything is in SI
-wall coordinates, the ones the tracker reports (model.md §2): ``x`` [m] across the chute, 0 on its
-centre line, positive toward the right wall; ``y`` [m] up, 0 at the first touchdown's body height
-for simulations and at the floor for tracker data; ``time`` [s].
+wall coordinates, the ones the tracker reports (docs/model.md §2): ``x`` [m] across the chute, 0 on
+its centre line, positive toward the right wall; ``y`` [m] up from the chute's floor
+(:data:`sim_core.climb.FLOOR`); ``time`` [s].
 
 - :class:`PathClip` — a sampled stretch of motion (one jump, or a whole stored run) and the pose
   at any instant in it;
-- :func:`model_jump` — one jump of the model from a touchdown, as a clip (the one call of the
-  simulator the view makes: ``sim_core.simulate_trajectory``);
+- :func:`model_jump` — one jump of the model from a touchdown, as a clip (by
+  :func:`sim_core.climb.jump`, the sequencer the virtual robot runs too);
 - :class:`SimulatedClimb` — the model climbing in real time, each jump with the controls of the
-  moment it starts, the next leg read at lift-off as the robot does.
+  moment it starts, the next leg read at lift-off as the robot does, ending at a failing jump or
+  at the chute's floor (:mod:`sim_core.climb`).
 """
 
 from __future__ import annotations
@@ -21,21 +22,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim_core import ControlSchedule, LegControl, PhysicalParams, simulate_trajectory
-from sim_core.failures import Failure
-from sim_core.trajectory import FLIGHT, STANCE
+from sim_core import LegControl, PhysicalParams, climb
+from sim_core.climb import ClimbSetup, End, Jump, JumpStart, NextLeg
+from sim_core.trajectory import STANCE
+from sim_core.walls import Wall
 
-LEFT, RIGHT = -1, +1  # walls, as backend.robot.touchdown numbers them (the left wall is at x < 0)
 UNKNOWN_PHASE = -1  # tracker data: the body is seen, its legs are not
-SAMPLES_PER_TIME_UNIT = 200.0  # path samples per sqrt(l0/g): ~2.4 ms for the paper's robot
-START_HEIGHT = 0.15  # [m] body height at a simulation's first touchdown, above the floor
 
 
 @dataclass(frozen=True)
 class Pose:
     """The robot at one instant: the body and the leg to draw.
 
-    ``leg_wall`` is the wall the drawn leg reaches for (LEFT or RIGHT): the stance leg in stance,
+    ``leg_wall`` is the wall the drawn leg reaches for (a :class:`Wall`): the stance leg in stance,
     the next leg, held at its touchdown controls, in flight. ``foot_*`` and ``zeta`` [m] are NaN
     when the legs are unknown (tracker data).
     """
@@ -47,7 +46,7 @@ class Pose:
     foot_y: float
     zeta: float
     phase: int
-    leg_wall: int
+    leg_wall: Wall
     jump: int
 
 
@@ -90,7 +89,7 @@ class PathClip:
             foot_y=nan,
             zeta=nan,
             phase=np.full(time.shape, UNKNOWN_PHASE),
-            leg_wall=np.where(np.asarray(x) < 0, RIGHT, LEFT),
+            leg_wall=np.where(np.asarray(x) < 0, Wall.RIGHT, Wall.LEFT),
             jump=np.zeros(time.shape, dtype=int) if jump is None else np.asarray(jump),
         )
 
@@ -112,7 +111,7 @@ class PathClip:
             foot_y=at(self.foot_y),
             zeta=at(self.zeta),
             phase=int(self.phase[i]),
-            leg_wall=int(self.leg_wall[i]),
+            leg_wall=Wall(int(self.leg_wall[i])),
             jump=int(self.jump[i]),
         )
 
@@ -125,36 +124,71 @@ class PathClip:
 
 @dataclass(frozen=True)
 class JumpPlan:
-    """One simulated jump: its clip and what it leads to.
+    """One simulated jump (:class:`sim_core.climb.Jump`) and its clip, for drawing.
 
     Attributes:
-        clip: the jump's samples, touchdown to the next touchdown (or to the failure).
+        jump: the sequencer's jump: its touchdown, the leg in flight, how it ended.
         robot: the robot the jump was simulated for (the sliders' at its touchdown).
-        leg, next_leg: the controls of the stance leg and of the leg reaching for the next wall.
-        wall: the stance wall, LEFT or RIGHT.
-        state: the section state at this jump's touchdown (nondimensional, flipped frame).
-        next_state: the section state at the next touchdown; None after a failure.
-        liftoff_time: [s] the first flight sample (the end for a failed stance).
-        rise: [m] foot height gained (NaN after a failure).
-        failure: why the jump failed, or None.
+        clip: the jump's samples, touchdown to the next touchdown (or to the end of the climb).
     """
 
-    clip: PathClip
+    jump: Jump
     robot: PhysicalParams
-    leg: LegControl
-    next_leg: LegControl
-    wall: int
-    state: tuple[float, float]
-    start_height: float
-    next_state: tuple[float, float] | None
-    liftoff_time: float
-    rise: float
-    failure: Failure | None
+    clip: PathClip
+
+    @classmethod
+    def of(cls, jump: Jump, robot: PhysicalParams) -> JumpPlan:
+        samples, wall = jump.samples, jump.wall
+        clip = PathClip(
+            time=samples.time,
+            x=samples.x,
+            y=samples.y,
+            foot_x=samples.foot_x,
+            foot_y=samples.foot_y,
+            zeta=samples.zeta,
+            phase=samples.phase,
+            leg_wall=np.where(samples.phase == STANCE, wall, wall.other),
+            jump=np.full(samples.time.shape, jump.start.jump),
+        )
+        return cls(jump, robot, clip)
+
+    @property
+    def wall(self) -> Wall:
+        return self.jump.wall
+
+    @property
+    def leg(self) -> LegControl:
+        return self.jump.start.leg
+
+    @property
+    def next_leg(self) -> LegControl:
+        return self.jump.next.leg
+
+    @property
+    def state(self) -> tuple[float, float]:
+        """The section state at this jump's touchdown (nondimensional, flipped frame)."""
+        return self.jump.start.state
+
+    @property
+    def liftoff_time(self) -> float:
+        return self.jump.liftoff_time
+
+    @property
+    def rise(self) -> float:
+        """[m] foot height gained (NaN when the climb ended in this jump)."""
+        return self.jump.rise
+
+    @property
+    def failure(self) -> End | None:
+        """Why the climb ended in this jump (a ``Failure`` or ``ClimbEnd.FLOOR``), or None."""
+        return self.jump.end
 
     @property
     def next_height(self) -> float:
-        """[m] body height at the next touchdown."""
-        return self.clip.y[-1]
+        """[m] body height at the next touchdown (the last sample's after an end)."""
+        if self.jump.end is not None:
+            return float(self.clip.y[-1])
+        return climb.touchdown_after(ClimbSetup(self.robot), self.jump).body_height
 
 
 def model_jump(
@@ -163,7 +197,7 @@ def model_jump(
     leg: LegControl,
     next_leg: LegControl,
     *,
-    wall: int,
+    wall: Wall,
     start_time: float,
     start_height: float,
     jump_index: int = 0,
@@ -171,44 +205,11 @@ def model_jump(
     """One jump of the model from a touchdown on ``wall`` with section state ``state``.
 
     Args:
-        state: ``(xdot, ydot)`` at touchdown, nondimensional and flipped (model.md §2).
+        state: ``(xdot, ydot)`` at touchdown, nondimensional and flipped (docs/model.md §2).
         start_time: [s] the touchdown's time; start_height: [m] the body height there.
     """
-    path = simulate_trajectory(
-        robot.to_model(),
-        ControlSchedule.of(leg, next_leg),
-        state,
-        1,
-        sample_rate=SAMPLES_PER_TIME_UNIT,
-        start_height=start_height / robot.leg_length,
-    ).to_si(robot)
-    mirror = -1.0 if wall == RIGHT else 1.0  # the simulator puts the first stance on the left wall
-    clip = PathClip(
-        time=start_time + path.time,
-        x=mirror * path.x,
-        y=path.y,
-        foot_x=mirror * path.foot_x,
-        foot_y=path.foot_y,
-        zeta=path.zeta,
-        phase=path.phase.astype(int),
-        leg_wall=np.where(path.phase == STANCE, wall, -wall),
-        jump=np.full(path.time.shape, jump_index),
-    )
-    flight = np.flatnonzero(path.phase == FLIGHT)
-    completed = path.failure is None
-    return JumpPlan(
-        clip=clip,
-        robot=robot,
-        leg=leg,
-        next_leg=next_leg,
-        wall=wall,
-        state=(float(state[0]), float(state[1])),
-        start_height=start_height,
-        next_state=tuple(path.section_states[-1] / robot.scales.velocity) if completed else None,
-        liftoff_time=float(clip.time[flight[0]]) if flight.size else clip.end,
-        rise=float(path.rises[0]) if completed else math.nan,
-        failure=path.failure,
-    )
+    start = JumpStart(jump_index, Wall(wall), start_time, start_height, (float(state[0]), float(state[1])), leg)
+    return JumpPlan.of(climb.jump(ClimbSetup(robot), start, NextLeg(next_leg)), robot)
 
 
 @dataclass(frozen=True)
@@ -219,17 +220,18 @@ class Controls:
     right: LegControl
     robot: PhysicalParams
 
-    def leg_for(self, wall: int) -> LegControl:
-        return self.left if wall == LEFT else self.right
+    def leg_for(self, wall: Wall) -> LegControl:
+        return self.left if wall == Wall.LEFT else self.right
 
 
 class SimulatedClimb:
-    """The model climbing between the walls in real time.
+    """The model climbing between the walls in real time: a driver of :mod:`sim_core.climb`.
 
-    Jump ``k`` (from 0, the first on the left wall) is simulated when the playback reaches its
-    touchdown, with the controls and robot of that moment; the leg reaching for the next wall is
-    read again at lift-off, as the robot's firmware does, so a slider moved mid-jump shows at the
-    next touchdown. ``pose_at`` is called from the view's loop, ``set_controls`` from GUI callbacks.
+    Jump ``k`` is simulated when the playback reaches its touchdown, with the controls and robot
+    of that moment; the leg reaching for the next wall is read again at lift-off, as the robot's
+    firmware does, so a slider moved mid-jump shows at the next touchdown. The climb ends at a
+    failing jump or when the body reaches the floor. ``pose_at`` is called from the view's loop,
+    ``set_controls`` from GUI callbacks.
     """
 
     def __init__(self, controls: Controls, state: tuple[float, float]):
@@ -239,12 +241,13 @@ class SimulatedClimb:
         self.reset(state)
 
     def reset(self, state: tuple[float, float] | None = None) -> None:
-        """Back to the floor: touchdown 0 on the left wall at START_HEIGHT and time 0."""
+        """Back to the floor: touchdown 0 on the left wall, the foot at the floor, at time 0."""
         with self._lock:
             self._start_state = state or self._start_state
+            controls = self._controls
+            start = climb.launch(ClimbSetup(controls.robot), controls.leg_for(Wall.LEFT), self._start_state)
             self.plans: list[JumpPlan] = []
-            self._next_leg_read = False
-            self._plan(self._start_state, start_time=0.0, start_height=START_HEIGHT)
+            self._plan(start)
 
     @property
     def controls(self) -> Controls:
@@ -273,46 +276,26 @@ class SimulatedClimb:
                 if plan.failure is not None or t < plan.clip.end:
                     return plan.clip.pose_at(t)
                 # The leg that touches down is the one that flew: its controls were fixed at lift-off.
-                self._plan(plan.next_state, start_time=plan.clip.end, start_height=plan.next_height, leg=plan.next_leg)
+                self._plan(climb.touchdown_after(ClimbSetup(plan.robot), plan.jump))
 
     def next_touchdown_time(self, t: float) -> float:
         """[s] when the jump under way at ``t`` ends (for stepping one jump)."""
         self.pose_at(t)
         return self.current.clip.end
 
-    def _plan(self, state, *, start_time: float, start_height: float, leg: LegControl | None = None) -> None:
-        k = len(self.plans)
-        wall = LEFT if k % 2 == 0 else RIGHT
+    def _plan(self, start: JumpStart) -> None:
+        """Jump ``start`` planned with the next leg's controls of now (read again at lift-off)."""
         controls = self._controls
-        self.plans.append(
-            model_jump(
-                controls.robot,
-                state,
-                leg or controls.leg_for(wall),
-                controls.leg_for(-wall),
-                wall=wall,
-                start_time=start_time,
-                start_height=start_height,
-                jump_index=k,
-            )
-        )
+        setup = ClimbSetup(controls.robot)
+        next_leg = climb.read_next_leg(start, controls.leg_for(start.wall.other))
+        self.plans.append(JumpPlan.of(climb.jump(setup, start, next_leg), controls.robot))
         self._next_leg_read = False
 
     def _read_next_leg(self) -> None:
         """At lift-off the flight toward the other wall takes that leg's controls of now."""
         self._next_leg_read = True
         plan = self.current
-        next_leg = self._controls.leg_for(-plan.wall)
-        if next_leg == plan.next_leg or plan.liftoff_time == plan.clip.end:  # unchanged, or never left the wall
-            return
-        # The stance is the same (it does not depend on the next leg); the flight ends elsewhere.
-        self.plans[-1] = model_jump(
-            plan.robot,
-            plan.state,
-            plan.leg,
-            next_leg,
-            wall=plan.wall,
-            start_time=plan.clip.start,
-            start_height=plan.start_height,
-            jump_index=len(self.plans) - 1,
-        )
+        next_leg = climb.read_next_leg(plan.jump.start, self._controls.leg_for(plan.wall.other))
+        replanned = climb.replan(ClimbSetup(plan.robot), plan.jump, next_leg)
+        if replanned is not plan.jump:
+            self.plans[-1] = JumpPlan.of(replanned, plan.robot)

@@ -7,7 +7,8 @@
 - ``replay`` runs: their source robot run's frames with the touchdowns found again.
 
 Simulated runs are nondimensional; they are shown at the paper robot's size (its ``l0``, mass
-and ``g``), with the first touchdown at :data:`START_HEIGHT` above the floor.
+and ``g``), heights from the chute's floor as every climb has them (:mod:`sim_core.climb`): the
+first foot touches at the floor.
 """
 
 from __future__ import annotations
@@ -20,9 +21,11 @@ import numpy as np
 from backend.services import records
 from backend.services.simulation import unpack_trajectory
 from backend.store.models import Run
-from frontend.viewer.motion import LEFT, RIGHT, START_HEIGHT, PathClip
+from frontend.viewer.motion import PathClip
 from sim_core import ControlSchedule, LegControl, ModelParams, PhysicalParams, get_preset, simulate_trajectory
+from sim_core.climb import start_height
 from sim_core.trajectory import STANCE
+from sim_core.walls import Wall, walls_of
 
 REPLAY_SAMPLE_RATE = 200.0  # per sqrt(l0/g), when a stored sim run has no path of its own
 
@@ -36,7 +39,7 @@ class Recording:
         clip: the path, time from 0 at the start of the run.
         robot: the robot it is shown at (walls, leg length, energy colours).
         legs: the left and right legs' controls (the idle leg's pose), or None for tracker data.
-        touchdowns: shape (n, 3): time [s], wall (-1 left, +1 right), foot height [m].
+        touchdowns: shape (n, 3): time [s], wall (a :class:`Wall` value: -1 left, +1 right), foot height [m].
     """
 
     run_id: int
@@ -51,11 +54,11 @@ class Recording:
     def duration(self) -> float:
         return self.clip.end
 
-    def idle_leg(self, leg_wall: int) -> LegControl | None:
+    def idle_leg(self, leg_wall: Wall) -> LegControl | None:
         """Controls of the leg not drawn by the pose (it reaches for the other wall)."""
         if self.legs is None:
             return None
-        return self.legs[0] if -leg_wall == LEFT else self.legs[1]
+        return self.legs[0] if Wall(leg_wall).other == Wall.LEFT else self.legs[1]
 
 
 def load_recording(sessions, run_id: int) -> Recording:
@@ -109,13 +112,14 @@ def _sim_recording(run: Run) -> Recording:
     length, time_scale = robot.scales.length, robot.scales.time
     jump, phase = columns["jump"].astype(int), columns["phase"].astype(int)
     # The drawn leg reaches for the stance wall in stance and for the next wall in flight.
-    leg_wall = np.where((jump + (phase != STANCE)) % 2 == 0, LEFT, RIGHT)
+    leg_wall = walls_of(jump + (phase != STANCE))
+    first = start_height(_legs(run)[0], robot)  # the stored path has y = 0 at the first touchdown
     clip = PathClip(
         time=columns["time"] * time_scale,
         x=columns["x"] * length,
-        y=START_HEIGHT + columns["y"] * length,
+        y=first + columns["y"] * length,
         foot_x=columns["foot_x"] * length,
-        foot_y=START_HEIGHT + columns["foot_y"] * length,
+        foot_y=first + columns["foot_y"] * length,
         zeta=columns["zeta"] * length,
         phase=phase,
         leg_wall=leg_wall,

@@ -17,6 +17,7 @@ from backend.robot.messages import (
     decode,
     encode,
 )
+from sim_core.walls import Wall
 
 
 def test_set_leg_bytes():
@@ -76,3 +77,10 @@ def test_unencodable_values_are_refused():
         encode(SetLeg(1, Leg.LEFT, 400.0, 0.9))
     with pytest.raises(ValueError, match="leg length"):
         encode(SetLeg(1, Leg.LEFT, 30.0, -0.1))
+
+
+@pytest.mark.parametrize("wall", list(Wall))
+def test_legs_convert_to_and_from_walls(wall):
+    leg = Leg.of(wall)
+    assert leg.wall is wall
+    assert int(leg) == (0 if wall is Wall.LEFT else 1), "the wire values stay 0 (left), 1 (right)"

@@ -4,14 +4,15 @@ import time
 
 import numpy as np
 
-from backend.robot.climber import FLOOR
 from backend.robot.link import LinkState, RobotLink
 from backend.robot.messages import Fault, Leg
 from backend.robot.touchdown import detect_touchdowns, height_gains
 from backend.robot.tracker import UdpPoseSource
 from backend.robot.virtual import VirtualRobot
 from sim_core import ControlSchedule, LegControl, get_preset, iterate_map
+from sim_core.climb import FLOOR, ClimbEnd
 from sim_core.noise import NO_NOISE, NoiseModel
+from sim_core.walls import wall_of
 
 LEGS = {Leg.LEFT: (30.0, 0.87), Leg.RIGHT: (30.0, 0.9)}
 ROBOT = get_preset("paper")
@@ -44,7 +45,7 @@ def _run(noise, jumps, *, speed=6.0, seed=1, legs=LEGS):
 
 def _leg_for(k: int) -> LegControl:
     # Detected touchdown k is the climb's touchdown k + 1; even touchdowns are the left leg's.
-    return LegControl.from_degrees(*LEGS[Leg.LEFT if (k + 1) % 2 == 0 else Leg.RIGHT])
+    return LegControl.from_degrees(*LEGS[Leg.of(wall_of(k + 1))])
 
 
 def test_open_loop_climb_follows_the_map():
@@ -69,6 +70,7 @@ def test_noisy_robot_eventually_falls_and_says_so():
     _tracker, robot, link, state = _run(noise, jumps=400, speed=20.0, seed=3)
     assert state == LinkState.DISARMED, "a failing jump disarms the robot"
     assert link.telemetry.faults & Fault.FELL and robot.climber.jumps < 400
+    assert robot.climber.end is not None, f"it says why: {robot.climber.end}"
 
 
 def test_a_descending_robot_stops_at_the_floor():
@@ -77,5 +79,5 @@ def test_a_descending_robot_stops_at_the_floor():
     descending = {Leg.LEFT: (30.0, 0.98), Leg.RIGHT: (30.0, 0.98)}
     tracker, robot, link, state = _run(NO_NOISE, jumps=200, speed=20.0, legs=descending)
     assert state == LinkState.DISARMED and link.telemetry.faults & Fault.FELL
-    assert robot.climber.jumps < 200
+    assert robot.climber.jumps < 200 and robot.climber.end is ClimbEnd.FLOOR
     assert tracker.as_arrays()["y"].min() > FLOOR - 0.01, "nothing is tracked below the floor (1 mm noise)"

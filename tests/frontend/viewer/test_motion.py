@@ -6,8 +6,10 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from frontend.viewer.motion import LEFT, RIGHT, START_HEIGHT, Controls, PathClip, SimulatedClimb, model_jump
+from frontend.viewer.motion import Controls, PathClip, SimulatedClimb, model_jump
 from sim_core import ControlSchedule, LegControl, get_preset, iterate_map
+from sim_core.climb import FLOOR, ClimbEnd, start_height
+from sim_core.walls import Wall, wall_of
 
 ROBOT = get_preset("paper")
 PERIOD_1 = LegControl.from_degrees(30, 0.90)
@@ -35,10 +37,11 @@ def test_jumps_alternate_walls_and_feet_sit_on_them():
     climb.pose_at(4.0)
     half = 0.5 * ROBOT.wall_distance
     for k, plan in enumerate(climb.plans):
-        assert plan.wall == (LEFT if k % 2 == 0 else RIGHT)
+        assert plan.wall is wall_of(k)
         assert plan.clip.foot_x[0] == pytest.approx(plan.wall * half), f"jump {k} foot on its wall"
     first = climb.plans[0].clip
-    assert first.y[0] == pytest.approx(START_HEIGHT)
+    assert first.y[0] == pytest.approx(start_height(PERIOD_1, ROBOT)), "the first foot touches at the floor"
+    assert first.foot_y[0] == pytest.approx(FLOOR, abs=1e-12)
 
 
 def test_the_body_moves_continuously_across_touchdowns():
@@ -84,9 +87,19 @@ def test_a_failing_climb_stops_and_says_why():
     assert climb.pose_at(61.0) == pose, "the pose holds after the failure"
 
 
+def test_a_descending_climb_stops_at_the_floor_and_names_it():
+    weak = LegControl.from_degrees(30, 0.99)  # beyond jumping in place: the gait descends
+    climb = _climb(weak, weak)
+    pose = climb.pose_at(120.0)
+    assert climb.ended and climb.current.failure is ClimbEnd.FLOOR
+    assert len(climb.plans) > 1 and all(plan.rise < 0 for plan in climb.plans[:-1]), "it descended"
+    assert pose.y == pytest.approx(FLOOR), "it stops where the body meets the floor"
+    assert min(plan.clip.y.min() for plan in climb.plans) >= FLOOR, "never below it"
+
+
 def test_model_jump_mirrors_on_the_right_wall():
-    left = model_jump(ROBOT, START, PERIOD_1, PERIOD_1, wall=LEFT, start_time=0.0, start_height=0.0)
-    right = model_jump(ROBOT, START, PERIOD_1, PERIOD_1, wall=RIGHT, start_time=0.0, start_height=0.0)
+    left = model_jump(ROBOT, START, PERIOD_1, PERIOD_1, wall=Wall.LEFT, start_time=0.0, start_height=0.2)
+    right = model_jump(ROBOT, START, PERIOD_1, PERIOD_1, wall=Wall.RIGHT, start_time=0.0, start_height=0.2)
     assert_allclose(right.clip.x, -left.clip.x)
     assert_allclose(right.clip.y, left.clip.y)
 

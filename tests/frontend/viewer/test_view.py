@@ -18,6 +18,7 @@ from frontend.viewer.app import ClimbView
 from frontend.viewer.modes import GAIT_PRESETS
 from frontend.viewer.recordings import load_recording
 from sim_core import get_preset
+from sim_core.climb import ClimbEnd
 from sim_core.noise import NO_NOISE
 
 ROBOT = get_preset("paper")
@@ -111,6 +112,24 @@ def test_presets_and_sliders_do_not_feed_back(service):
     simulate.gui_symmetric.value = True
     assert simulate.gui_zeta0_right.value == 0.88 and simulate.gui_zeta0_right.disabled
     assert simulate.climb.controls.right.zeta0 == 0.88
+
+
+def test_simulate_mode_stops_a_descending_climb_at_the_floor_and_says_so(service):
+    _client, _auth, view = service
+    simulate = view.modes["simulate"]
+    _wait_for(lambda: simulate.gait_note != "searching…")  # the first search, which restarts the climb
+    simulate.gui_psi0_left.value = 30.0
+    simulate.gui_zeta0_left.value = 0.99  # beyond jumping in place: the gait descends
+    _wait_for(lambda: simulate.gait_note != "searching…")
+    with view.lock:
+        simulate.restart()
+        simulate.playback("Pause")
+        simulate.time = 300.0
+        simulate.frame(0.0)
+        readout = simulate.readout(60.0)
+    assert simulate.climb.current.failure is ClimbEnd.FLOOR
+    assert "**Failure:** **floor** at jump" in readout and "the body reached the chute's floor" in readout, readout
+    assert "height** 0.000 m" in readout, readout
 
 
 def test_the_service_without_a_view_says_so(tmp_path):

@@ -1,0 +1,350 @@
+"""The climb: jump after jump between the walls, as the 3D view and the virtual robot run it.
+
+One sequencer for every real-time climb (docs/model.md §2, §4, §5): jump ``k`` stands on
+:func:`sim_core.walls.wall_of` ``(k)`` with that wall's leg; the leg reaching for the next wall is
+read at lift-off (the robot positions it during the stance), so a jump runs in two parts —
+:func:`stance`, which does not depend on the next leg, then :func:`jump` with the next leg from
+:func:`read_next_leg` — or is planned whole and planned again at lift-off. Noise, when a
+:class:`sim_core.noise.NoiseSampler` is given, follows :mod:`sim_core.noise`'s rules in its
+order: at lift-off a pitch step and the next leg's controls, after the jump the section state.
+No threads, clocks or sockets here: callers stream the samples at their own pace.
+
+Units and frame (SI, the tracker's): ``x`` [m] across the chute, 0 on its centre line, positive
+toward the right wall; ``time`` [s] from the first touchdown. Each jump is simulated in the
+flipped frame (stance on the left wall) and mirrored back here for right-wall jumps.
+
+Heights: ``y`` [m] up from the chute's floor, :data:`FLOOR` = 0, as the tracker reports them.
+The first foot touches the left wall at the floor's height, so the body's first touchdown is
+``zeta0 l0 sin(psi0)`` above it (:func:`start_height`; 0.100 m at 30°, 0.90 on the paper's robot).
+The model alone would let a descending gait fall for ever: a climb also ends, with
+:attr:`ClimbEnd.FLOOR`, when the body reaches the floor; no sample lies below it. (One
+convention for the 3D view and the virtual robot; the view used to start the body 0.15 m up.)
+``ClimbEnd`` is not a :class:`sim_core.failures.Failure`: those are the kernels' status codes, and
+MJTF's outcome histogram lists every one of them.
+
+Calls: :func:`launch` (jump 0), then per jump :func:`stance` (optional), :func:`read_next_leg`,
+:func:`jump` (or :func:`replan` at lift-off), :func:`touchdown_after`; :func:`simulate_climb`
+runs that loop at once.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from enum import Enum
+
+import numpy as np
+
+from sim_core.controls import ControlSchedule, LegControl
+from sim_core.failures import Failure
+from sim_core.noise import NoiseSampler
+from sim_core.params import PhysicalParams
+from sim_core.trajectory import FLIGHT, STANCE, simulate_trajectory
+from sim_core.walls import Wall, wall_of
+
+FLOOR = 0.0  # [m] the chute's floor: the height of the first foot's touchdown
+SAMPLE_RATE = 200.0  # path samples per sqrt(l0/g): ~2.4 ms for the paper's robot
+
+
+class ClimbEnd(Enum):
+    """Why a climb ended other than a failing jump (:class:`sim_core.failures.Failure`)."""
+
+    FLOOR = "floor"
+
+    @property
+    def code(self) -> str:
+        return self.value
+
+    @property
+    def message(self) -> str:
+        return _MESSAGES[self]
+
+
+_MESSAGES = {ClimbEnd.FLOOR: "the body reached the chute's floor"}
+
+End = Failure | ClimbEnd
+
+
+@dataclass(frozen=True)
+class ClimbSetup:
+    """What every jump of a climb shares: the robot, the sampling and the floor."""
+
+    robot: PhysicalParams
+    sample_rate: float = SAMPLE_RATE  # per sqrt(l0/g)
+    floor: float = FLOOR  # [m]
+
+
+@dataclass(frozen=True)
+class JumpStart:
+    """A touchdown, where jump ``jump`` begins.
+
+    Attributes:
+        jump: 0-based jump index; wall: the stance wall (``wall_of(jump)`` in a climb).
+        time: [s]; body_height: [m] above the floor.
+        state: ``(xdot, ydot)`` section state, nondimensional, flipped (docs/model.md §4).
+        leg: the stance leg's controls as realised (noise included); pitch: body pitch [rad].
+    """
+
+    jump: int
+    wall: Wall
+    time: float
+    body_height: float
+    state: tuple[float, float]
+    leg: LegControl
+    pitch: float = 0.0
+
+
+@dataclass(frozen=True)
+class NextLeg:
+    """The leg reaching for the next wall, as read at lift-off: realised controls and the pitch [rad]."""
+
+    leg: LegControl
+    pitch: float = 0.0
+
+
+@dataclass(frozen=True)
+class Samples:
+    """Sampled motion in SI wall coordinates, columns of one length in time order.
+
+    ``foot_*`` [m] are the stance foot in stance and the next leg's foot in flight; ``zeta`` [m]
+    the drawn leg's length; ``phase`` is STANCE or FLIGHT.
+    """
+
+    time: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    foot_x: np.ndarray
+    foot_y: np.ndarray
+    zeta: np.ndarray
+    phase: np.ndarray
+
+    COLUMNS = ("time", "x", "y", "foot_x", "foot_y", "zeta", "phase")
+
+    def __len__(self) -> int:
+        return int(self.time.size)
+
+    def take(self, rows) -> Samples:
+        """The rows ``rows`` (a slice, mask or index array) of every column."""
+        return Samples(**{name: getattr(self, name)[rows] for name in self.COLUMNS})
+
+
+@dataclass(frozen=True)
+class Stance:
+    """The stance part of a jump: its samples, and how the climb ended if it did there."""
+
+    start: JumpStart
+    samples: Samples
+    end: End | None
+
+
+@dataclass(frozen=True)
+class Jump:
+    """One jump, touchdown to the next touchdown (or to the end of the climb).
+
+    Attributes:
+        start, next: this jump's touchdown and the leg that flies to the next wall.
+        samples: the whole jump; ``liftoff`` indexes its first flight sample (its length if none).
+        end: why the climb ended in this jump (a jump failure or the floor), or None.
+        rise: [m] foot height gained; duration: [s] to the next touchdown (NaN after an end).
+        arrival: section state at the next touchdown, before process noise; None after an end.
+    """
+
+    start: JumpStart
+    next: NextLeg
+    samples: Samples
+    liftoff: int
+    end: End | None
+    rise: float
+    duration: float
+    arrival: tuple[float, float] | None
+
+    @property
+    def wall(self) -> Wall:
+        return self.start.wall
+
+    @property
+    def stance(self) -> Samples:
+        return self.samples.take(slice(0, self.liftoff))
+
+    @property
+    def flight(self) -> Samples:
+        return self.samples.take(slice(self.liftoff, None))
+
+    @property
+    def liftoff_time(self) -> float:
+        """[s] the first flight sample (the last sample when the climb ended in stance)."""
+        index = min(self.liftoff, len(self.samples) - 1)
+        return float(self.samples.time[index])
+
+
+def start_height(leg: LegControl, robot: PhysicalParams, floor: float = FLOOR) -> float:
+    """[m] body height at the first touchdown: the foot at the floor, the leg at ``leg``'s controls."""
+    return floor + leg.zeta0 * robot.leg_length * math.sin(leg.psi0)
+
+
+def foot_height(start: JumpStart, robot: PhysicalParams) -> float:
+    """[m] the stance foot's height at touchdown ``start``."""
+    return start.body_height - start.leg.zeta0 * robot.leg_length * math.sin(start.leg.psi0)
+
+
+def launch(setup: ClimbSetup, commanded: LegControl, state, sampler: NoiseSampler | None = None) -> JumpStart:
+    """Jump 0: the left leg, commanded ``commanded`` (noisy if ``sampler``), touches down from the floor.
+
+    ``state`` is the section state ``(xdot, ydot)`` of that touchdown (nondimensional).
+    """
+    wall = wall_of(0)
+    leg = commanded if sampler is None else sampler.controls(commanded, wall, 0.0)
+    return JumpStart(
+        jump=0,
+        wall=wall,
+        time=0.0,
+        body_height=start_height(leg, setup.robot, setup.floor),
+        state=(float(state[0]), float(state[1])),
+        leg=leg,
+    )
+
+
+def read_next_leg(start: JumpStart, commanded: LegControl, sampler: NoiseSampler | None = None) -> NextLeg:
+    """At lift-off of jump ``start``: the next wall's leg, commanded ``commanded``, with noise if ``sampler``."""
+    if sampler is None:
+        return NextLeg(commanded, start.pitch)
+    pitch = sampler.pitch_step(start.pitch)
+    return NextLeg(sampler.controls(commanded, start.wall.other, pitch), pitch)
+
+
+def stance(setup: ClimbSetup, start: JumpStart) -> Stance:
+    """The stance of jump ``start`` up to lift-off, or to the failure or floor that ends the climb.
+
+    The stance does not depend on the next leg; a lift-off without flight (``no_flight``) is
+    judged by :func:`jump`, once the next leg is known.
+    """
+    samples, failure, _, _ = _simulate(setup, start, start.leg)
+    in_stance = samples.take(samples.phase == STANCE)
+    in_stance, floor = _above_floor(in_stance, setup.floor)
+    end = ClimbEnd.FLOOR if floor else (None if failure in (None, Failure.NO_FLIGHT) else failure)
+    return Stance(start, in_stance, end)
+
+
+def jump(setup: ClimbSetup, start: JumpStart, next_leg: NextLeg) -> Jump:
+    """Jump ``start`` with ``next_leg`` flying to the other wall: samples, and how it ends."""
+    samples, failure, path, si = _simulate(setup, start, next_leg.leg)
+    samples, floor = _above_floor(samples, setup.floor)
+    completed = failure is None and not floor
+    rise = float(si.rises[0]) if completed else math.nan
+    robot = setup.robot
+    if completed and _next_body_height(start, next_leg, rise, robot) < setup.floor:
+        completed, floor = False, True  # reached between the last sample and the touchdown
+    flight = np.flatnonzero(samples.phase == FLIGHT)
+    return Jump(
+        start=start,
+        next=next_leg,
+        samples=samples,
+        liftoff=int(flight[0]) if flight.size else len(samples),
+        end=ClimbEnd.FLOOR if floor else failure,
+        rise=rise if completed else math.nan,
+        duration=float(si.touchdown_times[-1]) if completed else math.nan,
+        arrival=(float(path.section_states[-1, 0]), float(path.section_states[-1, 1])) if completed else None,
+    )
+
+
+def touchdown_after(setup: ClimbSetup, done: Jump, sampler: NoiseSampler | None = None) -> JumpStart:
+    """The touchdown that ends jump ``done`` (process noise on its state if ``sampler``): the next jump's start."""
+    if done.end is not None:
+        raise ValueError(f"jump {done.start.jump + 1} ended the climb ({done.end.code}): there is no next touchdown")
+    state = done.arrival if sampler is None else sampler.state(done.arrival)
+    start = done.start
+    return JumpStart(
+        jump=start.jump + 1,
+        wall=start.wall.other,  # wall_of(jump + 1) in a climb from launch()
+        time=start.time + done.duration,
+        body_height=_next_body_height(start, done.next, done.rise, setup.robot),
+        state=state,
+        leg=done.next.leg,
+        pitch=done.next.pitch,
+    )
+
+
+def replan(setup: ClimbSetup, planned: Jump, next_leg: NextLeg) -> Jump:
+    """``planned`` with another leg in flight (the stance is the same); ``planned`` if unchanged."""
+    if next_leg == planned.next or planned.liftoff >= len(planned.samples):
+        return planned
+    return jump(setup, planned.start, next_leg)
+
+
+def simulate_climb(
+    setup: ClimbSetup,
+    commanded: Callable[[Wall], LegControl],
+    state,
+    jumps: int,
+    sampler: NoiseSampler | None = None,
+) -> list[Jump]:
+    """Up to ``jumps`` jumps from the floor, all at once: the loop the real-time drivers run at their pace.
+
+    Args:
+        commanded: the controls each wall's leg is commanded at the moment they are read (jump 0's
+            at launch, each next leg's at lift-off).
+        state: section state ``(xdot, ydot)`` of the first touchdown (nondimensional).
+
+    Returns:
+        The jumps; the last one has an ``end`` when the climb ended before ``jumps``.
+    """
+    start = launch(setup, commanded(wall_of(0)), state, sampler)
+    done: list[Jump] = []
+    while len(done) < jumps:
+        done.append(jump(setup, start, read_next_leg(start, commanded(start.wall.other), sampler)))
+        if done[-1].end is not None:
+            break
+        start = touchdown_after(setup, done[-1], sampler)
+    return done
+
+
+def _next_body_height(start: JumpStart, next_leg: NextLeg, rise: float, robot: PhysicalParams) -> float:
+    leg = next_leg.leg
+    return foot_height(start, robot) + rise + leg.zeta0 * robot.leg_length * math.sin(leg.psi0)
+
+
+def _simulate(setup: ClimbSetup, start: JumpStart, next_leg: LegControl):
+    """One jump by ``sim_core.simulate_trajectory``: ``(samples, failure, path, si)``; the samples in SI
+    wall coordinates, ``path`` nondimensional (its section states exact), ``si`` the same in SI."""
+    robot = setup.robot
+    path = simulate_trajectory(
+        robot.to_model(),
+        ControlSchedule.of(start.leg, next_leg),
+        start.state,
+        1,
+        sample_rate=setup.sample_rate,
+        start_height=start.body_height / robot.leg_length,
+    )
+    si = path.to_si(robot)
+    mirror = -float(start.wall)  # the simulator puts the stance on the left wall (x < 0)
+    samples = Samples(
+        time=start.time + si.time,
+        x=mirror * si.x,
+        y=si.y,
+        foot_x=mirror * si.foot_x,
+        foot_y=si.foot_y,
+        zeta=si.zeta,
+        phase=si.phase.astype(int),
+    )
+    return samples, path.failure, path, si
+
+
+def _above_floor(samples: Samples, floor: float) -> tuple[Samples, bool]:
+    """The samples before the body first goes below ``floor``, ending on it; and whether it did."""
+    below = np.flatnonzero(samples.y < floor)
+    if below.size == 0:
+        return samples, False
+    i = int(below[0])
+    if i == 0:
+        kept = samples.take(slice(0, 1))
+        return replace(kept, y=np.array([floor])), True
+    # The last sample is where the body meets the floor, between samples i - 1 and i.
+    w = (samples.y[i - 1] - floor) / (samples.y[i - 1] - samples.y[i])
+    columns = {}
+    for name in ("time", "x", "foot_x", "foot_y", "zeta"):
+        before, after = getattr(samples, name)[i - 1 : i + 1]
+        columns[name] = np.append(getattr(samples, name)[:i], before + w * (after - before))
+    return Samples(
+        **columns, y=np.append(samples.y[:i], floor), phase=np.append(samples.phase[:i], samples.phase[i - 1])
+    ), True
