@@ -1,4 +1,4 @@
-"""The two walls, and which one jump ``k`` stands on (model.md §2, §4).
+"""The two walls, and which one jump ``k`` stands on (docs/model.md §2, §4).
 
 One vocabulary for left and right everywhere outside the radio codec: a :class:`Wall` is
 ``LEFT = -1`` (the wall at ``x = -d/2``) or ``RIGHT = +1`` (at ``x = +d/2``), so ``wall * d/2`` is
