@@ -20,7 +20,7 @@ import typer
 from rich.console import Console
 from rich.progress import Progress, TimeElapsedColumn
 
-from experiments.report import json_safe
+from experiments.manifest import json_safe
 from sim_core import (
     ControlSchedule,
     FixedPoint,

@@ -12,7 +12,7 @@ from dataclasses import asdict, replace
 import numpy as np
 
 from backend.schemas import FixedPointIn, LegIn, MapIn, ModelIn, RunCreate, TrajectoryIn
-from experiments.report import code_version, json_safe
+from experiments.manifest import code_version, json_safe
 from sim_core import ControlSchedule, FixedPointNotFound, ModelParams, get_preset, iterate_map, simulate_trajectory
 from sim_core.basin import BasinGrid, compute_basin
 from sim_core.fixed_points import find_fixed_point, search_gaits
