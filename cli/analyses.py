@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated
 
@@ -14,7 +15,6 @@ from cli.options import (
     ControlsOption,
     JsonOption,
     ModelSetup,
-    default_gait,
     handles_errors,
     note,
     parse_controls,
@@ -24,7 +24,7 @@ from cli.options import (
 )
 from experiments.atlas_map import save_atlas
 from experiments.cluster import SCHEDULER_ENV, chunk_map_for, scheduler_address
-from sim_core import ControlSchedule, LegControl, ParameterError, find_fixed_point
+from sim_core import ControlSchedule, LegControl, ParameterError
 from sim_core.atlas import gait_atlas
 from sim_core.basin import DEFAULT_JUMPS, DEFAULT_TOLERANCE, BasinGrid, check_convergence_test, compute_basin
 from sim_core.closed_loop import HeightController, closed_loop_climb
@@ -79,17 +79,15 @@ def basin_command(
     as_json: JsonOption = False,
 ) -> None:
     """Basin of attraction of a gait over a grid of section states (xdot, ydot)."""
+    from sim_core.fixed_points import gait_of
+
     schedule = parse_controls(controls)
     period = period or len(schedule)
     # The whole spec is checked before the (slow) gait search; placeholders stand in for default ranges.
     BasinGrid(xdot_range or (-2.0, -1.0), ydot_range or (-1.0, 1.0), grid)
     check_convergence_test(jumps, tolerance)
     with chunk_map_for(scheduler_address(scheduler)) as chunk_map:
-        gait = (
-            default_gait(setup.model, schedule, period)
-            if guess is None
-            else find_fixed_point(setup.model, schedule, period, guess)
-        )
+        gait = gait_of(setup.model, schedule, period, guess)
         default = BasinGrid.around(gait.state, grid)
         cells = BasinGrid(xdot_range or default.xdot_range, ydot_range or default.ydot_range, grid)
         with progress_bar(f"basin: {grid}x{grid} cells") as progress:
@@ -145,21 +143,18 @@ def sweep_command(
     fixed = _fixed_leg(fixed_leg)
     grid = None if basin_grid == 0 else BasinGrid(*DEFAULT_BASIN_WINDOW, basin_grid)
     check_convergence_test(basin_jumps, DEFAULT_TOLERANCE)
-    with (
-        chunk_map_for(scheduler_address(scheduler)) as chunk_map,
-        progress_bar(f"sweeping {steps} zeta0 values") as progress,
-    ):
-        sweep = energy_sweep(
-            setup.model,
-            LegControl.from_degrees(psi0, zeta0s[0]).psi0,
-            zeta0s,
-            fixed_leg=fixed,
-            guess=guess,
-            basin_grid=grid,
-            basin_jumps=basin_jumps,
-            chunk_map=chunk_map,
-            progress=progress,
-        )
+    sweep = _over_zeta0(
+        energy_sweep,
+        f"sweeping {steps} zeta0 values",
+        scheduler,
+        setup,
+        psi0,
+        zeta0s,
+        fixed,
+        guess,
+        basin_grid=grid,
+        basin_jumps=basin_jumps,
+    )
     if as_json:
         print_json(sweep.to_dict())
         return
@@ -193,6 +188,8 @@ AsymZeta0 = Annotated[float, typer.Option("--asymmetry-zeta0", help="Right leg's
 SeedOption = Annotated[int, typer.Option("--seed", help="Seed >= 0; the same seed gives the same numbers.")]
 
 
+# Typer reads options from each signature: mjtf's and pid's (noise) and sweep's look alike in shape
+# but carry their own help and defaults; the shared ones are the aliases above.
 @app.command("mjtf")
 @handles_errors
 @with_model
@@ -223,24 +220,20 @@ def mjtf_command(
     noise = NoiseModel(noise_psi0, noise_zeta0, noise_velocity, pitch_drift, asymmetry_psi0, asymmetry_zeta0)
     zeta0s = zeta0_values(*zeta0_range, levels)
     check_trials(trials, cap)
-    fixed = _fixed_leg(fixed_leg)
-    with (
-        chunk_map_for(scheduler_address(scheduler)) as chunk_map,
-        progress_bar(f"MJTF: {levels} levels x {trials} trials") as progress,
-    ):
-        study = mjtf_study(
-            setup.model,
-            LegControl.from_degrees(psi0, zeta0s[0]).psi0,
-            zeta0s,
-            noise=noise,
-            trials=trials,
-            cap=cap,
-            seed=seed,
-            fixed_leg=fixed,
-            guess=guess,
-            chunk_map=chunk_map,
-            progress=progress,
-        )
+    study = _over_zeta0(
+        mjtf_study,
+        f"MJTF: {levels} levels x {trials} trials",
+        scheduler,
+        setup,
+        psi0,
+        zeta0s,
+        _fixed_leg(fixed_leg),
+        guess,
+        noise=noise,
+        trials=trials,
+        cap=cap,
+        seed=seed,
+    )
     if as_json:
         print_json(study.to_dict())
         return
@@ -290,6 +283,9 @@ def pid_command(
     as_json: JsonOption = False,
 ) -> None:
     """Closed-loop climb to a target height: a PID on the touchdown height sets the next zeta0."""
+    from sim_core.fixed_points import gait_of
+    from sim_core.presets import START_GUESS
+
     noise = NoiseModel(noise_psi0, noise_zeta0, noise_velocity, pitch_drift, asymmetry_psi0, asymmetry_zeta0)
     scales = setup.robot.scales
     target_l0 = check_range("target", target, 0.0, 1e3) / scales.length
@@ -298,7 +294,7 @@ def pid_command(
     check_jumps(jumps)
     hover = find_in_place_zeta0(setup.model, leg.psi0, zeta0_range=(zeta0_min, zeta0_max))
     controller = HeightController(target_l0, hover, kp, ki, kd, zeta0_min, zeta0_max)
-    start = find_fixed_point(setup.model, ControlSchedule.of(leg), 1, _START_GUESS).state
+    start = gait_of(setup.model, ControlSchedule.of(leg), guess=START_GUESS).state
     run = closed_loop_climb(
         setup.model,
         controller,
@@ -336,7 +332,33 @@ def pid_command(
     Console().print(table)
 
 
-_START_GUESS = (-0.93, -0.2)
+def _run_study(study: Callable, description: str, scheduler: str | None, *args, **kwargs):
+    """``study(*args, **kwargs, chunk_map=..., progress=...)``: on the Dask cluster ``scheduler``
+    names (else in-process), with a progress bar labelled ``description``."""
+    with (
+        chunk_map_for(scheduler_address(scheduler)) as chunk_map,
+        progress_bar(description) as progress,
+    ):
+        return study(*args, chunk_map=chunk_map, progress=progress, **kwargs)
+
+
+def _over_zeta0(
+    study: Callable,
+    description: str,
+    scheduler,
+    setup: ModelSetup,
+    psi0_deg: float,
+    zeta0s,
+    fixed_leg,
+    guess,
+    **options,
+):
+    """A study of the gait over zeta0 values (sweep, MJTF): ``study(model, psi0 [rad], zeta0s, ...)``
+    with one leg ``fixed_leg`` held (None: both legs swept) and the first gait from ``guess``."""
+    psi0 = LegControl.from_degrees(psi0_deg, zeta0s[0]).psi0
+    return _run_study(
+        study, description, scheduler, setup.model, psi0, zeta0s, fixed_leg=fixed_leg, guess=guess, **options
+    )
 
 
 def _fixed_leg(text: str | None) -> LegControl | None:
@@ -390,21 +412,18 @@ def atlas_command(
         ]
         labels = (f"zeta0_L [l0] (psi0_L {pair[0]:g}°)", f"zeta0_R [l0] (psi0_R {pair[1]:g}°)")
     check_jumps(transient)
-    with (
-        chunk_map_for(scheduler_address(scheduler)) as chunk_map,
-        progress_bar(f"atlas: {rows_count}x{columns_count} cells") as progress,
-    ):
-        atlas = gait_atlas(
-            setup.model,
-            schedules,
-            rows,
-            columns,
-            row_label=labels[0],
-            column_label=labels[1],
-            transient_jumps=transient,
-            chunk_map=chunk_map,
-            progress=progress,
-        )
+    atlas = _run_study(
+        gait_atlas,
+        f"atlas: {rows_count}x{columns_count} cells",
+        scheduler,
+        setup.model,
+        schedules,
+        rows,
+        columns,
+        row_label=labels[0],
+        column_label=labels[1],
+        transient_jumps=transient,
+    )
     if plot is not None:
         save_atlas(atlas, plot, "Gait atlas" + ("" if pair is None else f", psi0 {pair[0]:g}°/{pair[1]:g}°"))
         note(f"atlas map: {plot}")

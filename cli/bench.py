@@ -26,6 +26,7 @@ def bench_command(
     as_json: JsonOption = False,
 ) -> None:
     """Strides per second of the kernel vs scipy solve_ivp (DOP853, rtol=atol=1e-10), and their difference."""
+    # A thin command: its options go to the one library call as they are (name=name, as in the API's routes).
     result = run_benchmark(
         baseline_strides=baseline_strides,
         kernel_strides=kernel_strides,

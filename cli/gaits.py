@@ -12,13 +12,12 @@ from cli.options import (
     ControlsOption,
     JsonOption,
     ModelSetup,
-    default_gait,
     handles_errors,
     parse_controls,
     print_json,
     with_model,
 )
-from sim_core import FixedPoint, find_fixed_point, search_gaits
+from sim_core import FixedPoint
 
 app = typer.Typer(rich_markup_mode=None)
 
@@ -41,12 +40,10 @@ def fixed_point_command(
     as_json: JsonOption = False,
 ) -> None:
     """Find a period-n fixed point, its eigenvalues, stability and climb per period."""
+    from sim_core.fixed_points import gait_of
+
     schedule = parse_controls(controls)
-    period = period or len(schedule)
-    if guess is None:
-        gait = default_gait(setup.model, schedule, period)
-    else:
-        gait = find_fixed_point(setup.model, schedule, period, guess)
+    gait = gait_of(setup.model, schedule, period or len(schedule), guess)
     if as_json:
         print_json(gait.to_dict())
     else:
@@ -64,13 +61,13 @@ def gaits_command(
     as_json: JsonOption = False,
 ) -> None:
     """Search a grid of guesses for distinct period-n gaits (climbing, in place, descending)."""
+    from sim_core.fixed_points import search_gaits
+
     schedule = parse_controls(controls)
     period = period or len(schedule)
     gaits = search_gaits(setup.model, schedule, period, grid=(grid, grid))
     if as_json:
-        print_json(
-            {"gaits": [{**gait.to_dict(), "motion": gait.motion, "orbit": gait.orbit.tolist()} for gait in gaits]}
-        )
+        print_json({"gaits": [gait.to_dict() for gait in gaits]})
     elif gaits:
         _print_gaits(gaits, f"Period-{period} gaits, controls {controls}")
     else:

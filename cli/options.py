@@ -20,16 +20,14 @@ import typer
 from rich.console import Console
 from rich.progress import Progress, TimeElapsedColumn
 
-from experiments.report import json_safe
+from experiments.manifest import json_safe
 from sim_core import (
     ControlSchedule,
-    FixedPoint,
     FixedPointNotFound,
     ModelParams,
     ParameterError,
     PhysicalParams,
     get_preset,
-    search_gaits,
 )
 from sim_core.presets import DEFAULT_PRESET
 
@@ -135,16 +133,6 @@ def parse_controls(text: str) -> ControlSchedule:
                 "controls", f"expected PSI0:ZETA0[,PSI0:ZETA0...] (psi0 in degrees), got {text!r}"
             ) from None
     return ControlSchedule.from_degrees(pairs)
-
-
-def default_gait(model: ModelParams, schedule: ControlSchedule, period: int) -> FixedPoint:
-    """The most stable gait a search finds, for commands run without a starting state."""
-    gaits = search_gaits(model, schedule, period)
-    if not gaits:
-        raise FixedPointNotFound(
-            f"no period-{period} gait found for controls {schedule.describe()}; give a starting state explicitly"
-        )
-    return gaits[0]
 
 
 def print_json(payload: object) -> None:

@@ -17,7 +17,6 @@ from cli.options import (
     ControlsOption,
     JsonOption,
     ModelSetup,
-    default_gait,
     handles_errors,
     json_safe,
     note,
@@ -88,7 +87,9 @@ def trajectory_command(
         raise ParameterError("out", f"must end in .csv or .json, got {out.name!r}")
     schedule = parse_controls(controls)
     if state is None:
-        gait = default_gait(setup.model, schedule, len(schedule))
+        from sim_core.fixed_points import gait_of
+
+        gait = gait_of(setup.model, schedule)
         state = tuple(gait.state.tolist())
         note(f"starting on the {gait.motion} period-{gait.period} gait at state {list(state)}")
     sample_rate = rate * setup.robot.scales.time if units == "si" else rate

@@ -15,9 +15,10 @@ from experiments.report import Claim, new_figure
 from sim_core.chunks import ChunkMap, Progress, in_process
 from sim_core.closed_loop import ClosedLoopRun, HeightController, closed_loop_climb
 from sim_core.controls import ControlSchedule, LegControl
-from sim_core.fixed_points import find_fixed_point
+from sim_core.fixed_points import gait_of
 from sim_core.noise import NoiseModel
 from sim_core.params import PhysicalParams
+from sim_core.presets import START_GUESS
 from sim_core.sweep import find_in_place_zeta0
 from sim_core.trajectory import Trajectory, simulate_trajectory
 
@@ -66,7 +67,7 @@ def run(robot: PhysicalParams, config: Config, *, chunk_map: ChunkMap = in_proce
         config.zeta0_min,
         config.zeta0_max,
     )
-    start = find_fixed_point(model, ControlSchedule.of(LegControl(psi0, config.start_zeta0)), 1, (-0.93, -0.2)).state
+    start = gait_of(model, ControlSchedule.of(LegControl(psi0, config.start_zeta0)), guess=START_GUESS).state
     clean = closed_loop_climb(model, controller, psi0, start, config.jumps, start_zeta0=config.start_zeta0)
     # Replay the noise-free run's leg lengths to draw its path between the walls.
     schedule = ControlSchedule.of(*(LegControl(psi0, z) for z in clean.zeta0))

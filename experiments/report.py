@@ -1,5 +1,5 @@
 """What every figure study writes: the figure (PNG and SVG), its data (CSV and JSON with the
-parameters and the code version), and its part of the markdown report.
+manifest of :mod:`experiments.manifest`), and its part of the markdown report.
 
 A figure module (``experiments/fig*.py``) provides a frozen ``Config``, ``run(config, ...)``
 returning a result, ``plot(result)`` returning a matplotlib figure, ``table(result)`` returning
@@ -9,14 +9,14 @@ the CSV columns, and ``claims(result)`` comparing the paper's statements with ou
 from __future__ import annotations
 
 import csv
-import datetime
 import json
 import math
-import subprocess
-from dataclasses import asdict, dataclass, is_dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
+
+from experiments.manifest import json_safe
 
 STYLE = {
     "font.size": 10,
@@ -42,25 +42,6 @@ class Claim:
 
     def to_dict(self) -> dict:
         return asdict(self)
-
-
-def code_version() -> str:
-    """``git describe`` of the checkout (``-dirty`` with local changes), else the package version."""
-    root = Path(__file__).resolve().parent.parent
-    try:
-        described = subprocess.run(
-            ["git", "describe", "--always", "--dirty", "--tags"],
-            cwd=root,
-            capture_output=True,
-            text=True,
-            timeout=10,
-            check=True,
-        )
-        return described.stdout.strip()
-    except (OSError, subprocess.SubprocessError):
-        from importlib.metadata import version
-
-        return f"parkourlab {version('parkourlab')}"
 
 
 def pyplot():
@@ -106,33 +87,6 @@ def _csv_cell(value) -> str:
     if isinstance(value, float | np.floating):
         return "" if not math.isfinite(value) else repr(float(value))
     return str(value)
-
-
-def json_safe(value):
-    """``value`` as plain JSON types: dataclasses, arrays and numpy scalars converted, NaN and
-    infinities (not JSON) as None, recursively. The one sanitiser for every JSON we write."""
-    if is_dataclass(value) and not isinstance(value, type):
-        return json_safe(asdict(value))
-    if isinstance(value, dict):
-        return {str(key): json_safe(item) for key, item in value.items()}
-    if isinstance(value, list | tuple):
-        return [json_safe(item) for item in value]
-    if isinstance(value, np.ndarray):
-        return json_safe(value.tolist())
-    if isinstance(value, np.generic):
-        return json_safe(value.item())
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
-
-
-def metadata(model, config) -> dict:
-    return {
-        "config": config,
-        "model": model,
-        "code_version": code_version(),
-        "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
-    }
 
 
 def _cell(text: str) -> str:

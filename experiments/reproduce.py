@@ -13,7 +13,8 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from experiments import fig7, fig8, fig11, fig12
-from experiments.report import code_version, markdown_section, metadata, write_outputs
+from experiments.manifest import code_version, metadata
+from experiments.report import markdown_section, write_outputs
 from sim_core.chunks import ChunkMap, in_process
 from sim_core.params import PhysicalParams
 from sim_core.validation import ParameterError

@@ -5,7 +5,8 @@ Data flows parameters -> simulate -> analyse:
 - :mod:`sim_core.params`, :mod:`sim_core.presets`, :mod:`sim_core.controls` — what to simulate;
 - :mod:`sim_core.integrate`, :mod:`sim_core.stride` — compiled kernels (stance, one jump, orbits);
 - :mod:`sim_core.poincare`, :mod:`sim_core.trajectory` — the validated map and full paths;
-- :mod:`sim_core.fixed_points` — periodic gaits, their stability, a gait search;
+- :mod:`sim_core.fixed_points` — periodic gaits, their stability, a gait search, and
+  :func:`~sim_core.fixed_points.gait_of`, the gait of a control schedule;
 - :mod:`sim_core.walls`, :mod:`sim_core.climb` — left and right, and the climb jump after jump
   (the sequencer the 3D view and the virtual robot drive, with the noise and the chute's floor);
 - :mod:`sim_core.basin`, :mod:`sim_core.sweep`, :mod:`sim_core.atlas`, :mod:`sim_core.mjtf`,
@@ -37,6 +38,8 @@ _EXPORTS = {
     "map_jacobian": "fixed_points",
     "minimal_period": "fixed_points",
     "search_gaits": "fixed_points",
+    "gait_of": "fixed_points",
+    "NoGaitFound": "fixed_points",
     "ModelParams": "params",
     "PhysicalParams": "params",
     "Scales": "params",
@@ -45,6 +48,8 @@ _EXPORTS = {
     "iterate_map": "poincare",
     "iterate_map_batch": "poincare",
     "PRESETS": "presets",
+    "PAPER_GAITS": "presets",
+    "START_GUESS": "presets",
     "get_preset": "presets",
     "Trajectory": "trajectory",
     "simulate_trajectory": "trajectory",

@@ -21,9 +21,9 @@ import numpy as np
 from sim_core.basin import BasinGrid, compute_basin
 from sim_core.controls import ControlSchedule
 from sim_core.failures import OK
-from sim_core.fixed_points import find_fixed_point
+from sim_core.fixed_points import gait_of
 from sim_core.poincare import iterate_map_batch
-from sim_core.presets import get_preset
+from sim_core.presets import PAPER_GAITS, START_GUESS, get_preset
 from sim_core.reference import reference_jumps
 from sim_core.validation import check_range
 
@@ -74,9 +74,9 @@ def run_benchmark(
         check_range(name, value, 1, 10_000_000, low_open=False, high_open=False)
     say = progress or (lambda _stage: None)
     model = get_preset("paper").to_model()
-    schedule = ControlSchedule.from_degrees([(30.0, 0.9)])
+    schedule = ControlSchedule.from_degrees(PAPER_GAITS["period 1"])
     leg = schedule[0]
-    gait = find_fixed_point(model, schedule, 1, (-0.9, -0.2))
+    gait = gait_of(model, schedule, guess=START_GUESS)
     rng = np.random.default_rng(seed)
     states = gait.state + rng.uniform(-0.1, 0.1, size=(baseline_strides, 2))
 

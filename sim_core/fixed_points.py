@@ -1,5 +1,9 @@
 """Periodic gaits: fixed points of the Poincaré map, their stability and a gait search (model.md §4).
 
+:func:`gait_of` is "the gait of these controls" that every command, the service, the 3D view
+and the figures use: Levenberg–Marquardt from a guess when there is one, else the most stable
+gait a grid search finds.
+
 A period-n fixed point satisfies ``P^n(q) = q``; n must be a multiple of the schedule's
 length. It is found by Levenberg–Marquardt (MINPACK, as the paper) on ``P^n(q) - q``. Its
 Jacobian ``DP^n`` comes from 4th-order central differences (a 5-point stencil) instead of the
@@ -27,6 +31,22 @@ PERIOD_TOL = 1e-7  # |P^p(q) - q| below which p is a period of a found fixed poi
 JACOBIAN_STEP = 1e-3  # central-difference step, relative to max(1, |q_i|)
 IN_PLACE_TOL = 1e-6  # |climb per jump| [l0] below which a gait jumps in place
 _FAILED_RESIDUAL = 1e3  # residual of a trial point whose orbit fails: LM rejects the step
+DEFAULT_GRID = (6, 6)  # guesses per axis (xdot, ydot) of a gait search
+
+
+class NoGaitFound(FixedPointNotFound):
+    """A grid search found no gait at all (:func:`gait_of` without a usable guess).
+
+    Attributes:
+        schedule: the controls searched.
+        period: the period searched for [jumps].
+    """
+
+    def __init__(self, schedule: ControlSchedule, period: int):
+        super().__init__(
+            f"no period-{period} gait found for controls {schedule.describe()}; give a starting state explicitly"
+        )
+        self.schedule, self.period = schedule, period
 
 
 @dataclass(frozen=True)
@@ -74,7 +94,8 @@ class FixedPoint:
         return "climbing" if per_jump > 0 else "descending"
 
     def to_dict(self) -> dict:
-        """The ``parkour fixed-point --json`` contract."""
+        """The gait as JSON types: the ``parkour fixed-point --json`` contract, one gait of
+        ``parkour gaits --json`` and of the API's answers. ``orbit`` is a list of p pairs."""
         return {
             "state": self.state.tolist(),
             "period": self.period,
@@ -83,6 +104,8 @@ class FixedPoint:
             "stable": self.stable,
             "climb_per_period": self.climb_per_period,
             "residual": self.residual,
+            "motion": self.motion,
+            "orbit": self.orbit.tolist(),
         }
 
 
@@ -246,7 +269,7 @@ def search_gaits(
     *,
     xdot_range: tuple[float, float] = (-2.5, -0.25),
     ydot_range: tuple[float, float] = (-2.0, 2.0),
-    grid: tuple[int, int] = (6, 6),
+    grid: tuple[int, int] = DEFAULT_GRID,
 ) -> list[FixedPoint]:
     """Distinct fixed points of ``P^period`` found from a grid of guesses.
 
@@ -271,6 +294,48 @@ def search_gaits(
             if not any(_same_orbit(gait, known, len(schedule)) for known in found):
                 found.append(gait)
     return sorted(found, key=lambda gait: (not gait.stable, gait.max_abs_eigenvalue))
+
+
+def gait_of(
+    model: ModelParams,
+    schedule: ControlSchedule,
+    period: int | None = None,
+    guess=None,
+    *,
+    grid: tuple[int, int] = DEFAULT_GRID,
+    prefer_stable: bool = False,
+) -> FixedPoint:
+    """The gait of these controls: the one place that decides which fixed point a caller means.
+
+    Args:
+        period: n of ``P^n(q) = q`` [jumps], a multiple of the schedule's length; default: that
+            length. The gait found reports its minimal period, which may divide n.
+        guess: section state ``(xdot, ydot)`` [sqrt(g l0)] to start Levenberg–Marquardt from;
+            None searches a ``grid`` of guesses (:func:`search_gaits`) and takes the most stable.
+        grid: guesses per axis (xdot, ydot) of that search.
+        prefer_stable: if the gait from ``guess`` does not converge or is unstable, search the
+            grid instead (the 3D view: a person wants the gait the robot can walk). The grid's
+            most stable gait is returned even when it is unstable.
+
+    Raises:
+        FixedPointNotFound: Levenberg–Marquardt did not converge from ``guess`` (the message
+            says why); :class:`NoGaitFound` when a grid search found nothing.
+        ParameterError: a bad ``period``, ``guess`` or ``grid``, naming the field.
+    """
+    period = check_period(schedule, len(schedule) if period is None else period)
+    if guess is not None:
+        try:
+            gait = find_fixed_point(model, schedule, period, guess)
+        except FixedPointNotFound:
+            if not prefer_stable:
+                raise
+        else:
+            if gait.stable or not prefer_stable:
+                return gait
+    gaits = search_gaits(model, schedule, period, grid=grid)
+    if not gaits:
+        raise NoGaitFound(schedule, period)
+    return gaits[0]
 
 
 def _same_orbit(a: FixedPoint, b: FixedPoint, schedule_length: int, tol: float = 1e-6) -> bool:

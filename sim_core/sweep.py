@@ -23,7 +23,7 @@ from scipy.optimize import brentq
 from sim_core.basin import DEFAULT_JUMPS, DEFAULT_TOLERANCE, NOT_CONVERGED, BasinGrid, converge_states
 from sim_core.chunks import ChunkMap, Progress, in_process
 from sim_core.controls import ControlSchedule, LegControl
-from sim_core.fixed_points import FixedPoint, FixedPointNotFound, find_fixed_point, search_gaits
+from sim_core.fixed_points import FixedPoint, FixedPointNotFound, find_fixed_point, gait_of
 from sim_core.params import ModelParams
 from sim_core.validation import ParameterError, check_range
 
@@ -222,13 +222,10 @@ def find_in_place_zeta0(
 
 def _continue(model, schedule, period, seed) -> FixedPoint | None:
     """The gait from the neighbour's state; a gait search when there is no neighbour yet."""
-    if seed is not None:
-        try:
-            return find_fixed_point(model, schedule, period, seed)
-        except FixedPointNotFound:
-            return None
-    gaits = search_gaits(model, schedule, period)
-    return gaits[0] if gaits else None
+    try:
+        return gait_of(model, schedule, period, seed)
+    except FixedPointNotFound:
+        return None
 
 
 def _in_place_crossings(model, psi0, fixed_leg, points, period) -> list[float]:

@@ -29,7 +29,7 @@ from backend.services.records import fetch, get_experiment, newest_first, page
 from backend.services.simulation import KERNEL_LOCK, current_code_version, locked_chunk_map, model_params, run_study
 from backend.store.models import Job, Trial, utcnow
 from experiments.cluster import as_completed_results, chunk_map_for, dask_client
-from experiments.report import json_safe
+from experiments.manifest import json_safe
 from sim_core.chunks import Cancelled
 from sim_core.failures import OK, Failure
 from sim_core.mjtf import level_starts, run_trials

@@ -20,7 +20,7 @@ from sqlalchemy.orm import Session
 from backend.schemas import ExperimentCreate, ExperimentUpdate, RunCreate
 from backend.services.simulation import simulate_run
 from backend.store.models import Experiment, Run, RunTag
-from experiments.report import json_safe
+from experiments.manifest import json_safe
 
 MAX_PAGE = 500
 

@@ -27,7 +27,7 @@ from backend.schemas import RobotConnect, RobotRunCreate
 from backend.services.records import Conflict, NotFound
 from backend.services.simulation import current_code_version, pack_trajectory, unpack_trajectory
 from backend.store.models import Run, RunTag
-from experiments.report import json_safe
+from experiments.manifest import json_safe
 from sim_core import ControlSchedule, LegControl, ParameterError, get_preset, iterate_map
 from sim_core.closed_loop import pid_step
 from sim_core.sweep import find_in_place_zeta0

@@ -12,10 +12,10 @@ from dataclasses import asdict, replace
 import numpy as np
 
 from backend.schemas import FixedPointIn, LegIn, MapIn, ModelIn, RunCreate, TrajectoryIn
-from experiments.report import code_version, json_safe
+from experiments.manifest import code_version, json_safe
 from sim_core import ControlSchedule, FixedPointNotFound, ModelParams, get_preset, iterate_map, simulate_trajectory
 from sim_core.basin import BasinGrid, compute_basin
-from sim_core.fixed_points import find_fixed_point, search_gaits
+from sim_core.fixed_points import FixedPoint, NoGaitFound, gait_of, search_gaits
 from sim_core.sweep import DEFAULT_BASIN_WINDOW, energy_sweep, zeta0_values
 from sim_core.validation import ParameterError
 
@@ -65,16 +65,18 @@ def trajectory_columns(body: TrajectoryIn) -> dict:
 
 def fixed_point(body: FixedPointIn) -> dict:
     model, schedule = model_params(body.model), schedule_of(body.controls)
-    period = body.period or len(schedule)
     with KERNEL_LOCK:
-        if body.guess is None:
-            gaits = search_gaits(model, schedule, period)
-            if not gaits:
-                raise ParameterError("controls", f"no period-{period} gait found from a grid of guesses; give a guess")
-            gait = gaits[0]
-        else:
-            gait = find_fixed_point(model, schedule, period, (body.guess.xdot, body.guess.ydot))
-    return {**gait.to_dict(), "orbit": gait.orbit.tolist(), "motion": gait.motion}
+        return _gait_of(model, schedule, body.period, body.guess).to_dict()
+
+
+def _gait_of(model: ModelParams, schedule: ControlSchedule, period: int | None, guess) -> FixedPoint:
+    """:func:`sim_core.fixed_points.gait_of` for a request; a search that finds nothing is a 422
+    naming the controls. ``guess`` is the request's state (``xdot``, ``ydot``) or None."""
+    try:
+        return gait_of(model, schedule, period, None if guess is None else (guess.xdot, guess.ydot))
+    except NoGaitFound as error:
+        message = f"no period-{error.period} gait found from a grid of guesses; give a guess"
+        raise ParameterError("controls", message) from None
 
 
 def locked_chunk_map(function, arguments, progress=None) -> list:
@@ -108,19 +110,12 @@ def run_study(spec, chunk_map, progress) -> dict:
         )
         return sweep.to_dict()
     schedule = schedule_of(spec.controls)
-    period = spec.period or len(schedule)
     if spec.kind == "gaits":
-        gaits = search_gaits(model, schedule, period, grid=(spec.grid, spec.grid))
+        gaits = search_gaits(model, schedule, spec.period or len(schedule), grid=(spec.grid, spec.grid))
         progress(1, 1)
-        return {"gaits": [{**gait.to_dict(), "motion": gait.motion, "orbit": gait.orbit.tolist()} for gait in gaits]}
+        return {"gaits": [gait.to_dict() for gait in gaits]}
     # basin
-    if spec.guess is None:
-        gaits = search_gaits(model, schedule, period)
-        if not gaits:
-            raise ParameterError("controls", f"no period-{period} gait found from a grid of guesses; give a guess")
-        gait = gaits[0]
-    else:
-        gait = find_fixed_point(model, schedule, period, (spec.guess.xdot, spec.guess.ydot))
+    gait = _gait_of(model, schedule, spec.period, spec.guess)
     basin = compute_basin(
         model,
         schedule,
@@ -172,10 +167,10 @@ def _gait_near(model, schedule, start) -> dict:
     """The period-m gait nearest the start state (m: the schedule length), or why there is none."""
     try:
         with KERNEL_LOCK:
-            gait = find_fixed_point(model, schedule, len(schedule), start)
+            gait = gait_of(model, schedule, guess=start)
     except FixedPointNotFound as error:
         return {"found": False, "reason": str(error)}
-    return {"found": True, **gait.to_dict(), "orbit": gait.orbit.tolist(), "motion": gait.motion}
+    return {"found": True, **gait.to_dict()}
 
 
 def pack_trajectory(columns: dict[str, np.ndarray]) -> bytes:

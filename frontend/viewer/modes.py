@@ -25,18 +25,24 @@ from backend.services import records
 from frontend.viewer.motion import STANCE, Controls, JumpPlan, PathClip, SimulatedClimb, model_jump
 from frontend.viewer.recordings import Recording, load_recording
 from frontend.viewer.scene import ChuteScene
-from sim_core import ControlSchedule, FixedPoint, LegControl, PhysicalParams, search_gaits
-from sim_core.fixed_points import FixedPointNotFound, find_fixed_point
+from sim_core import ControlSchedule, FixedPoint, LegControl, PhysicalParams
+from sim_core.fixed_points import NoGaitFound, gait_of
+from sim_core.presets import PAPER_GAITS, START_GUESS
 from sim_core.walls import Wall
 
-# The paper's gaits (Fig. 7): psi0 [deg] and zeta0 [l0] of the left and right legs.
-GAIT_PRESETS = {
-    "period 1 · 30° · 0.90": ((30.0, 0.90), (30.0, 0.90)),
-    "period 2 · 30°/30° · 0.87/0.90": ((30.0, 0.87), (30.0, 0.90)),
-    "period 4 · 30°/35° · 0.90/0.9505": ((30.0, 0.90), (35.0, 0.9505)),
-}
+
+def _preset_label(name: str, pairs: tuple[tuple[float, float], ...]) -> str:
+    """``"period 2 · 30°/30° · 0.87/0.90"``: zeta0 with at least two decimals."""
+    angles = "/".join(f"{psi0:g}°" for psi0, _ in pairs)
+    lengths = "/".join(f"{zeta0:.2f}" if round(zeta0, 2) == zeta0 else f"{zeta0:g}" for _, zeta0 in pairs)
+    return f"{name} · {angles} · {lengths}"
+
+
+# The paper's gaits (Fig. 7, sim_core.presets.PAPER_GAITS): psi0 [deg] and zeta0 [l0] of the
+# left and right legs; a one-pair gait is both legs'.
+GAIT_PRESETS = {_preset_label(name, pairs): (pairs[0], pairs[-1]) for name, pairs in PAPER_GAITS.items()}
 CUSTOM = "custom"
-DEFAULT_START = (-0.93, -0.17)  # section state when the controls have no stable gait to start on
+DEFAULT_START = START_GUESS  # section state when the controls have no stable gait to start on
 TRAIL_STRIDE = 3  # every third sample of the jump under way is enough for a smooth trail
 GAIT_SEARCH_PERIOD = 4  # the readout looks for gaits of period 1, 2 and 4 (the paper's)
 
@@ -243,14 +249,9 @@ def find_gait(controls: Controls, guess) -> tuple[FixedPoint | None, str]:
     legs = (controls.left,) if controls.left == controls.right else (controls.left, controls.right)
     schedule = ControlSchedule.of(*legs)
     try:
-        gait = find_fixed_point(model, schedule, GAIT_SEARCH_PERIOD, guess)
-        if not gait.stable:
-            raise FixedPointNotFound("unstable")
-    except FixedPointNotFound:
-        gaits = search_gaits(model, schedule, GAIT_SEARCH_PERIOD, grid=(4, 4))
-        if not gaits:
-            return None, "none found (a grid search of period 1, 2 and 4 found no gait)"
-        gait = gaits[0]
+        gait = gait_of(model, schedule, GAIT_SEARCH_PERIOD, guess, grid=(4, 4), prefer_stable=True)
+    except NoGaitFound:
+        return None, "none found (a grid search of period 1, 2 and 4 found no gait)"
     climb_cm = 100 * gait.climb_per_period / gait.period * controls.robot.leg_length
     stability = "stable" if gait.stable else "**unstable**"
     state = ", ".join(f"{v:.3f}" for v in gait.state)

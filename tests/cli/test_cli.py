@@ -7,6 +7,8 @@ import pytest
 from typer.testing import CliRunner
 
 from cli.app import app
+from tests.sim_core.test_bench import CONTRACT as BENCH_CONTRACT
+from tests.sim_core.test_fixed_points import GAIT_KEYS  # one gait in fixed-point and gaits --json
 
 runner = CliRunner()
 
@@ -15,10 +17,15 @@ def invoke(*args: str):
     return runner.invoke(app, list(args))
 
 
-def test_map_json_contract():
-    result = invoke("map", "--controls", "30:0.9", "--state", "-0.93", "-0.17", "--jumps", "4", "--json")
+def json_of(*args: str):
+    """The command's JSON on stdout, after checking it succeeded."""
+    result = invoke(*args, "--json")
     assert result.exit_code == 0, result.output
-    payload = json.loads(result.stdout)
+    return json.loads(result.stdout)
+
+
+def test_map_json_contract():
+    payload = json_of("map", "--controls", "30:0.9", "--state", "-0.93", "-0.17", "--jumps", "4")
     assert set(payload) == {"states", "rises", "failure"}
     assert payload["states"][0] == [-0.93, -0.17] and len(payload["states"]) == 5
     assert len(payload["rises"]) == 4 and payload["failure"] is None
@@ -32,50 +39,40 @@ def test_map_json_reports_failure():
 
 
 def test_fixed_point_json_contract():
-    result = invoke(
-        "fixed-point", "--controls", "30:0.87,30:0.9", "--period", "2", "--guess", "-0.8", "-0.15", "--json"
-    )
-    assert result.exit_code == 0, result.output
-    payload = json.loads(result.stdout)
-    assert set(payload) == {
-        "state",
-        "period",
-        "eigenvalues",
-        "max_abs_eigenvalue",
-        "stable",
-        "climb_per_period",
-        "residual",
-    }
+    payload = json_of("fixed-point", "--controls", "30:0.87,30:0.9", "--period", "2", "--guess", "-0.8", "-0.15")
+    assert list(payload) == GAIT_KEYS, "orbit and motion joined the original seven keys, at the end"
     assert payload["period"] == 2 and payload["stable"] is True
+    assert len(payload["orbit"]) == 2 and payload["orbit"][0] == payload["state"] and payload["motion"] == "climbing"
     assert len(payload["eigenvalues"]) == 2 and all(len(pair) == 2 for pair in payload["eigenvalues"])
     assert payload["residual"] < 1e-9
 
 
 def test_fixed_point_without_guess_searches():
-    result = invoke("fixed-point", "--json")
-    assert result.exit_code == 0, result.output
-    assert json.loads(result.stdout)["stable"] is True
+    assert json_of("fixed-point")["stable"] is True
+
+
+def test_fixed_point_without_any_gait_says_so_in_one_line():
+    result = invoke("fixed-point", "--controls", "80:0.99")
+    assert result.exit_code == 2
+    assert result.stderr == "error: no period-1 gait found for controls 80°:0.99; give a starting state explicitly\n"
 
 
 def test_gaits_lists_motion():
-    result = invoke("gaits", "--controls", "30:0.98", "--grid", "3", "--json")
-    assert result.exit_code == 0, result.output
-    gaits = json.loads(result.stdout)["gaits"]
+    gaits = json_of("gaits", "--controls", "30:0.98", "--grid", "3")["gaits"]
     assert gaits and all(gait["motion"] in {"climbing", "in place", "descending"} for gait in gaits)
+    assert all(list(gait) == GAIT_KEYS for gait in gaits)
 
 
 def test_model_overrides_change_the_result():
-    base = json.loads(invoke("map", "--state", "-0.93", "-0.17", "--jumps", "1", "--json").stdout)
-    stiffer = json.loads(invoke("map", "--state", "-0.93", "-0.17", "--jumps", "1", "--alpha", "90", "--json").stdout)
+    base = json_of("map", "--state", "-0.93", "-0.17", "--jumps", "1")
+    stiffer = json_of("map", "--state", "-0.93", "-0.17", "--jumps", "1", "--alpha", "90")
     assert stiffer["states"][1] != base["states"][1]
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".json"])
 def test_trajectory_writes_file(tmp_path, suffix):
     out = tmp_path / f"path{suffix}"
-    result = invoke("trajectory", "--state", "-0.93", "-0.17", "--jumps", "3", "--out", str(out), "--json")
-    assert result.exit_code == 0, result.output
-    summary = json.loads(result.stdout)
+    summary = json_of("trajectory", "--state", "-0.93", "-0.17", "--jumps", "3", "--out", str(out))
     assert summary["jumps_completed"] == 3 and summary["units"] == "SI"
     if suffix == ".csv":
         rows = list(csv.DictReader(out.open()))
@@ -137,10 +134,8 @@ def test_bad_input_is_one_clear_line(args, field):
 
 def test_basin_json_contract():
     args = ["--controls", "30:0.9", "--guess", "-0.9", "-0.2", "--grid", "6", "--jumps", "20"]
-    result = invoke("basin", *args, "--json")
-    assert result.exit_code == 0, result.output
-    payload = json.loads(result.stdout)
-    assert set(payload) == {
+    payload = json_of("basin", *args)
+    assert set(payload) == {  # each command's keys spelled out (alike in shape only): the contract scripts read
         "gait",
         "xdot_range",
         "ydot_range",
@@ -161,9 +156,7 @@ def test_basin_json_contract():
 
 def test_sweep_json_contract():
     args = ["--psi0", "30", "--zeta0-range", "0.90", "0.97", "--steps", "3", "--guess", "-0.93", "-0.2"]
-    result = invoke("sweep", *args, "--basin-grid", "6", "--json")
-    assert result.exit_code == 0, result.output
-    payload = json.loads(result.stdout)
+    payload = json_of("sweep", *args, "--basin-grid", "6")
     assert set(payload) == {"psi0_deg", "fixed_leg", "points", "in_place_zeta0", "basin"}
     assert [point["zeta0"] for point in payload["points"]] == [0.9, 0.935, 0.97]
     assert set(payload["points"][0]) == {
@@ -195,21 +188,17 @@ def test_mjtf_json_contract():
         "-0.93",
         "-0.2",
     ]
-    result = invoke("mjtf", *args, "--seed", "3", "--json")
-    assert result.exit_code == 0, result.output
-    payload = json.loads(result.stdout)
+    payload = json_of("mjtf", *args, "--seed", "3")
     assert set(payload) == {"psi0_deg", "fixed_leg", "noise", "trials", "cap", "seed", "levels"}
     level = payload["levels"][0]
     assert set(level) == {"zeta0", "energy", "start", "trials", "mean", "std", "ci95", "outcomes", "jumps"}
     assert level["trials"] == 3 and sum(level["outcomes"].values()) == 3
-    again = json.loads(invoke("mjtf", *args, "--seed", "3", "--json").stdout)
+    again = json_of("mjtf", *args, "--seed", "3")
     assert again == payload, "seeded"
 
 
 def test_pid_json_contract():
-    result = invoke("pid", "--jumps", "40", "--json")
-    assert result.exit_code == 0, result.output
-    payload = json.loads(result.stdout)
+    payload = json_of("pid", "--jumps", "40")
     assert set(payload) >= {
         "target",
         "gains",
@@ -230,9 +219,7 @@ def test_pid_json_contract():
 def test_atlas_json_contract(tmp_path):
     plot = tmp_path / "atlas.png"
     args = ["--psi0-range", "25", "35", "--zeta0-range", "0.88", "0.97", "--grid", "2", "3", "--plot", str(plot)]
-    result = invoke("atlas", *args, "--json")
-    assert result.exit_code == 0, result.output
-    payload = json.loads(result.stdout)
+    payload = json_of("atlas", *args)
     assert set(payload) == {
         "row_label",
         "column_label",
@@ -250,13 +237,5 @@ def test_atlas_json_contract(tmp_path):
 
 def test_bench_json_contract():
     sizes = ["--baseline-strides", "3", "--kernel-strides", "20", "--batch-strides", "20", "--repeats", "1"]
-    result = invoke("bench", *sizes, "--basin-grid", "4", "--basin-jumps", "5", "--json")
-    assert result.exit_code == 0, result.output
-    assert set(json.loads(result.stdout)) >= {
-        "kernel_strides_per_s",
-        "baseline_strides_per_s",
-        "ratio",
-        "max_abs_diff",
-        "batch_strides_per_s",
-        "cores",
-    }
+    payload = json_of("bench", *sizes, "--basin-grid", "4", "--basin-jumps", "5")
+    assert set(payload) >= BENCH_CONTRACT
