@@ -68,7 +68,7 @@ _MODEL_PARAMETERS = [
         "preset",
         inspect.Parameter.KEYWORD_ONLY,
         default=DEFAULT_PRESET,
-        annotation=Annotated[str, typer.Option("--preset", help="Named parameter set (model.md §1).")],
+        annotation=Annotated[str, typer.Option("--preset", help="Named parameter set (docs/model.md §1).")],
     ),
     *(
         inspect.Parameter(

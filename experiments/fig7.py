@@ -1,6 +1,6 @@
 """Paper Fig. 7: stable gaits of period 1, 2 and 4 — paths over two cycles and fixed points.
 
-The extracted paper lost some controls. Period 1 and 2 use model.md §5's values (psi0 30°,
+The extracted paper lost some controls. Period 1 and 2 use docs/model.md §5's values (psi0 30°,
 zeta0 0.9; psi0 30°/30°, zeta0 0.87/0.90). For period 4 (psi0 30°/35°, zeta0_L = 0.9) the
 right leg's zeta0 is not given: we scan it, iterate the map to its attractor at each value,
 and take the middle of the band where the attractor has period 4. The scan is drawn as a

@@ -1,4 +1,4 @@
-"""Periodic gaits: fixed points of the Poincaré map, their stability and a gait search (model.md §4).
+"""Periodic gaits: fixed points of the Poincaré map, their stability and a gait search (docs/model.md §4).
 
 :func:`gait_of` is "the gait of these controls" that every command, the service, the 3D view
 and the figures use: Levenberg–Marquardt from a guess when there is one, else the most stable

@@ -2,9 +2,9 @@
 Presets are data: add one here and every command, the API and the GUI can use it by name.
 
 ``paper`` is Table I of the ICRA 2011 paper. The extracted text lost ``l0``; it keeps
-``d_hat = 2.42``, so ``l0 = d / 2.42`` (model.md §1).
+``d_hat = 2.42``, so ``l0 = d / 2.42`` (docs/model.md §1).
 
-:data:`PAPER_GAITS` are the stable gaits of period 1, 2 and 4 of the paper's Fig. 7 (model.md
+:data:`PAPER_GAITS` are the stable gaits of period 1, 2 and 4 of the paper's Fig. 7 (docs/model.md
 §5), each as the ``(psi0_deg, zeta0)`` pairs of its control schedule (one pair: both legs; two:
 L, R), the form :meth:`ControlSchedule.from_degrees` takes and JSON keeps. The paper does not
 give period 4's right-leg zeta0: 0.9505 is the middle of the band where ``experiments/fig7.py``'s

@@ -22,15 +22,15 @@ import numpy as np
 
 from backend.robot.messages import Leg
 from backend.robot.tracker import Pose, encode_datagram
-from sim_core import ControlSchedule, LegControl, PhysicalParams, climb, find_fixed_point, get_preset
+from sim_core import ControlSchedule, LegControl, PhysicalParams, climb, gait_of, get_preset
 from sim_core.climb import ClimbSetup, End, Samples
-from sim_core.fixed_points import FixedPointNotFound
+from sim_core.errors import FixedPointNotFound
 from sim_core.noise import NoiseModel, NoiseSampler
+from sim_core.presets import START_GUESS
 from sim_core.validation import check_range
 from sim_core.walls import Wall
 
 FRAME_RATE = 100.0  # [Hz] the FLEX V100's
-LAUNCH_GUESS = (-0.93, -0.2)
 
 
 class Climber:
@@ -94,9 +94,9 @@ class Climber:
         sampler = NoiseSampler(self.noise, self._climb_rng)
         first = self._commanded(Wall.LEFT)
         try:
-            state = find_fixed_point(self.model, ControlSchedule.of(first), 1, LAUNCH_GUESS).state
-        except FixedPointNotFound:
-            state = np.array(LAUNCH_GUESS)
+            state = gait_of(self.model, ControlSchedule.of(first), guess=START_GUESS).state
+        except FixedPointNotFound:  # launch anyway: the firmware's controls need not have a gait
+            state = np.array(START_GUESS)
         start = climb.launch(setup, first, state, sampler)
         started = time.monotonic()
         self.end = None
