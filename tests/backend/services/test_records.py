@@ -55,11 +55,10 @@ def test_an_experiment_with_runs_is_not_deleted(session, make_run):
     records.delete_experiment(session, experiment.id)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=IntegrityError,
-    reason="bug: delete_experiment checks runs but not jobs; the RESTRICT key on jobs raises IntegrityError",
-)
+JOBS_BLOCK_DELETE = "bug: delete_experiment checks runs but not jobs; the RESTRICT key on jobs raises IntegrityError"
+
+
+@pytest.mark.xfail(strict=True, raises=IntegrityError, reason=JOBS_BLOCK_DELETE)
 def test_an_experiment_with_jobs_is_not_deleted(session):
     experiment = records.create_experiment(session, ExperimentCreate(name="studies"))
     create_job(session, MJTFJobCreate(experiment_id=experiment.id, zeta0s=[0.9], trials=2))
@@ -206,12 +205,13 @@ def test_csv_export_streams_in_pieces():
     assert "".join(records.rows_as_csv(iter([]))) == ""
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=AssertionError,
-    reason="bug: rows_as_csv takes its columns from the first row and ignores the rest, so a "
-    "two-leg run exported after a one-leg run loses its leg1.* controls",
+CSV_DROPS_LEGS = (
+    "bug: rows_as_csv takes its columns from the first row and ignores the rest, "
+    "so a two-leg run exported after a one-leg run loses its leg1.* controls"
 )
+
+
+@pytest.mark.xfail(strict=True, raises=AssertionError, reason=CSV_DROPS_LEGS)
 def test_csv_export_keeps_every_runs_legs(sessions, make_run):
     make_run()
     make_run(controls=[LegIn(psi0_deg=30.0, zeta0=0.87), LegIn(psi0_deg=30.0, zeta0=0.9)])
