@@ -1,8 +1,12 @@
-"""Shared fixtures: the paper's model and the gaits the paper reports (docs/model.md §5)."""
+"""Shared fixtures: the paper's model, the gaits the paper reports (docs/model.md §5), the virtual robot."""
+
+import socket
 
 import pytest
 
 from sim_core import ControlSchedule, ModelParams, get_preset
+from sim_core.noise import NO_NOISE
+from tests.helpers import free_port
 
 
 @pytest.fixture(scope="session")
@@ -20,3 +24,15 @@ def symmetric() -> ControlSchedule:
 def alternating() -> ControlSchedule:
     """psi0 = 30°/30°, zeta0 = 0.87/0.90: the paper's stable period-2 gait."""
     return ControlSchedule.from_degrees([(30.0, 0.87), (30.0, 0.9)])
+
+
+@pytest.fixture
+def virtual():
+    """``(robot, tracker_port)``: a noiseless virtual robot at 4x speed streaming its tracker poses
+    to a free local UDP port; stopped afterwards."""
+    from backend.robot.virtual import VirtualRobot  # only the tests that use the robot load the backend
+
+    port = free_port(socket.SOCK_DGRAM)
+    robot = VirtualRobot(tracker_to=("127.0.0.1", port), noise=NO_NOISE, speed=4.0, seed=2).start()
+    yield robot, port
+    robot.stop()

@@ -4,11 +4,7 @@ trials asked for — none lost, none duplicated — and the same numbers as an u
 import math
 import os
 import signal
-import socket
-import subprocess
-import sys
 import time
-from pathlib import Path
 
 import httpx
 import numpy as np
@@ -18,46 +14,17 @@ from sqlalchemy import create_engine, text
 from sim_core import get_preset
 from sim_core.mjtf import mjtf_study
 from sim_core.noise import NoiseModel
+from tests.helpers import free_port, start_service
 
 pytestmark = pytest.mark.slow  # two service starts: ~15 s
 
 SPEC = {"zeta0s": [0.86, 0.9], "trials": 1200, "cap": 1500, "seed": 3, "guess": {"xdot": -0.93, "ydot": 0.1}}
 
 
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
-def _start(data_dir: Path, port: int) -> subprocess.Popen:
-    command = [
-        sys.executable,
-        "-m",
-        "cli",
-        "serve",
-        "--data-dir",
-        str(data_dir),
-        "--port",
-        str(port),
-        "--no-view",
-    ]
-    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline:
-        try:
-            if httpx.get(f"http://127.0.0.1:{port}/api/v1/health", timeout=1).status_code == 200:
-                return process
-        except httpx.HTTPError:
-            time.sleep(0.2)
-    process.kill()
-    pytest.fail("the service did not start within 60 s")
-
-
 def test_kill_nine_mid_job_resumes_exactly(tmp_path):
-    data_dir, port = tmp_path / "data", _free_port()
+    data_dir, port = tmp_path / "data", free_port()
     base = f"http://127.0.0.1:{port}/api/v1"
-    first = _start(data_dir, port)
+    first = start_service(data_dir, port, "--no-view")
     try:
         token = (data_dir / "api_token").read_text().strip()
         job = httpx.post(f"{base}/jobs", json=SPEC, headers={"Authorization": f"Bearer {token}"}).json()
@@ -72,7 +39,7 @@ def test_kill_nine_mid_job_resumes_exactly(tmp_path):
     assert 0 < completed < total, f"the kill must land mid-job (completed {completed} of {total})"
     print(f"SIGKILL with {completed} of {total} trials committed")
 
-    second = _start(data_dir, port)
+    second = start_service(data_dir, port, "--no-view")
     try:
         deadline = time.monotonic() + 120
         while (state := httpx.get(f"{base}/jobs/{job['id']}").json())["state"] != "done":

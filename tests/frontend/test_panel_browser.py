@@ -7,8 +7,6 @@ import io
 import os
 import shutil
 import socket
-import subprocess
-import sys
 import time
 from pathlib import Path
 
@@ -19,6 +17,7 @@ from PIL import Image
 
 from backend.robot.virtual import VirtualRobot
 from sim_core.noise import NO_NOISE
+from tests.helpers import free_port, start_service
 
 pytestmark = pytest.mark.slow  # a browser and a service: ~20 s
 
@@ -29,38 +28,11 @@ if CHROMIUM is None:
 sync_api = pytest.importorskip("playwright.sync_api")
 
 
-def _free_port(kind=socket.SOCK_STREAM) -> int:
-    with socket.socket(socket.AF_INET, kind) as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
 @pytest.fixture(scope="module")
 def service(tmp_path_factory):
-    data, port = tmp_path_factory.mktemp("panel") / "data", _free_port()
-    command = [
-        sys.executable,
-        "-m",
-        "cli",
-        "serve",
-        "--data-dir",
-        str(data),
-        "--port",
-        str(port),
-        "--view-port",
-        "0",
-    ]
-    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    data, port = tmp_path_factory.mktemp("panel") / "data", free_port()
+    process = start_service(data, port, "--view-port", "0")
     base = f"http://127.0.0.1:{port}"
-    deadline = time.monotonic() + 60
-    while True:
-        try:
-            if httpx.get(f"{base}/api/v1/health", timeout=1).status_code == 200:
-                break
-        except httpx.HTTPError:
-            pass
-        assert time.monotonic() < deadline, "the service did not start"
-        time.sleep(0.2)
     yield base, (data / "api_token").read_text().strip()
     process.terminate()
     process.wait(30)
@@ -284,7 +256,7 @@ def test_a_run_opens_in_3d_and_shares_as_a_file(page, service, tmp_path):
 
 def test_closed_loop_run_then_emergency_stop(page, service):
     base, _token = service
-    tracker_port = _free_port(socket.SOCK_DGRAM)
+    tracker_port = free_port(socket.SOCK_DGRAM)
     robot = VirtualRobot(tracker_to=("127.0.0.1", tracker_port), noise=NO_NOISE, speed=3.0).start()
     try:
         page.click("nav [data-tab=robot]")

@@ -1,11 +1,11 @@
-"""Parameters, presets and controls: conversions and clear errors."""
+"""Parameters and presets: conversions and clear errors (controls: test_controls.py)."""
 
 import math
 from dataclasses import replace
 
 import pytest
 
-from sim_core import ControlSchedule, LegControl, ModelParams, ParameterError, PhysicalParams, get_preset
+from sim_core import ModelParams, ParameterError, PhysicalParams, get_preset
 
 
 def test_paper_preset_matches_model_md():
@@ -58,31 +58,3 @@ def test_infinite_friction_is_allowed():
 def test_unknown_preset_lists_known_ones():
     with pytest.raises(ParameterError, match="known presets: paper"):
         get_preset("moon")
-
-
-@pytest.mark.parametrize(
-    ("psi0_deg", "zeta0", "field"),
-    [
-        (30.0, 1.0, "zeta0"),
-        (30.0, 1.2, "zeta0"),
-        (30.0, 0.0, "zeta0"),
-        (30.0, math.nan, "zeta0"),
-        (0.0, 0.9, "psi0"),
-        (90.0, 0.9, "psi0"),
-        (-10.0, 0.9, "psi0"),
-        (math.nan, 0.9, "psi0"),
-    ],
-)
-def test_controls_validation(psi0_deg, zeta0, field):
-    with pytest.raises(ParameterError) as error:
-        LegControl.from_degrees(psi0_deg, zeta0)
-    assert error.value.field == field
-
-
-def test_schedule_is_cyclic():
-    schedule = ControlSchedule.from_degrees([(30.0, 0.87), (35.0, 0.9)])
-    assert schedule[0] == schedule[2] and schedule[1] == schedule[5]
-    assert schedule.as_array().shape == (2, 2)
-    assert schedule.describe() == "30°:0.87, 35°:0.9"
-    with pytest.raises(ParameterError, match="controls"):
-        ControlSchedule(())

@@ -1,28 +1,12 @@
 """Live runs through the API against the virtual robot: recorded like simulated runs, safe to stop."""
 
-import socket
 import time
 
 import pytest
 
 from backend.robot.virtual import VirtualRobot
-from sim_core.noise import NO_NOISE
 
 CONTROLS = [{"psi0_deg": 30, "zeta0": 0.87}, {"psi0_deg": 30, "zeta0": 0.9}]
-
-
-def _free_udp_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
-@pytest.fixture
-def virtual():
-    port = _free_udp_port()
-    robot = VirtualRobot(tracker_to=("127.0.0.1", port), noise=NO_NOISE, speed=4.0, seed=2).start()
-    yield robot, port
-    robot.stop()
 
 
 @pytest.fixture
@@ -34,6 +18,13 @@ def connected(client, auth, virtual):
     assert response.json()["state"] == "disarmed"
     yield robot
     client.post("/api/v1/robot/disconnect", headers=auth)
+
+
+def _wait_for_touchdowns(client, count: int, timeout=20.0) -> None:
+    deadline = time.monotonic() + timeout
+    while client.get("/api/v1/robot").json()["run"]["touchdowns"] < count:
+        assert time.monotonic() < deadline, f"fewer than {count} touchdowns after {timeout} s"
+        time.sleep(0.02)
 
 
 def _finish(client, timeout=30.0):
@@ -75,10 +66,7 @@ def test_open_loop_live_run_is_stored_with_the_model_beside_it(client, auth, con
 
 def test_estop_during_a_run_ends_it_and_keeps_the_data(client, auth, connected):
     client.post("/api/v1/robot/runs", json={"controls": CONTROLS, "jumps": 1000}, headers=auth)
-    deadline = time.monotonic() + 20
-    while client.get("/api/v1/robot").json()["run"]["touchdowns"] < 3:
-        assert time.monotonic() < deadline
-        time.sleep(0.02)
+    _wait_for_touchdowns(client, 3)
     stopped = client.post("/api/v1/robot/estop", headers=auth).json()
     assert stopped["state"] == "estopped" and stopped["latency_ms"] < 100
     status = _finish(client)
@@ -92,10 +80,7 @@ def test_estop_during_a_run_ends_it_and_keeps_the_data(client, auth, connected):
 
 def test_losing_the_robot_aborts_the_run_with_the_data_kept(client, auth, connected):
     client.post("/api/v1/robot/runs", json={"controls": CONTROLS, "jumps": 1000}, headers=auth)
-    deadline = time.monotonic() + 20
-    while client.get("/api/v1/robot").json()["run"]["touchdowns"] < 2:
-        assert time.monotonic() < deadline
-        time.sleep(0.02)
+    _wait_for_touchdowns(client, 2)
     connected.stop()  # the robot goes silent
     status = _finish(client)
     assert status["run"]["end_reason"] == "link lost" and status["state"] == "disconnected"

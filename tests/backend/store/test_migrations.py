@@ -25,30 +25,31 @@ def test_sqlite_runs_in_wal_mode_with_foreign_keys(tmp_path):
         assert connection.exec_driver_sql("PRAGMA foreign_keys").scalar() == 1
 
 
-def test_upgrade_from_the_previous_revision_keeps_the_data(tmp_path):
+def _row_after_upgrade(tmp_path, revision: str, insert: str, select: str) -> tuple:
+    """Migrate an empty database to ``revision``, store a row the old way, upgrade to head, read it back."""
     engine = make_engine(sqlite_url(tmp_path))
-    migrate(engine, "0001")
+    migrate(engine, revision)
     with engine.begin() as connection:
-        connection.exec_driver_sql(
-            "INSERT INTO jobs (kind, spec, state, total, completed, code_version, created_at, updated_at) "
-            "VALUES ('mjtf', '{}', 'done', 8, 8, 'old', '2026-01-01 00:00:00', '2026-01-01 00:00:00')"
-        )
+        connection.exec_driver_sql(insert)
     migrate(engine)
     with engine.connect() as connection:
-        row = connection.exec_driver_sql("SELECT kind, total, code_version, result FROM jobs").one()
-    assert tuple(row) == ("mjtf", 8, "old", None)
+        return tuple(connection.exec_driver_sql(select).one())
+
+
+def test_upgrade_from_the_previous_revision_keeps_the_data(tmp_path):
+    insert = (
+        "INSERT INTO jobs (kind, spec, state, total, completed, code_version, created_at, updated_at) "
+        "VALUES ('mjtf', '{}', 'done', 8, 8, 'old', '2026-01-01 00:00:00', '2026-01-01 00:00:00')"
+    )
+    row = _row_after_upgrade(tmp_path, "0001", insert, "SELECT kind, total, code_version, result FROM jobs")
+    assert row == ("mjtf", 8, "old", None)
 
 
 def test_runs_stored_before_notes_get_empty_notes(tmp_path):
-    engine = make_engine(sqlite_url(tmp_path))
-    migrate(engine, "0003")
-    with engine.begin() as connection:
-        connection.exec_driver_sql(
-            "INSERT INTO runs (kind, status, created_at, duration_s, code_version, model, controls, start_state, "
-            "jumps, alpha, psi0_deg, zeta0, jumps_completed, climb, results) VALUES ('sim', 'done', "
-            "'2026-01-01 00:00:00', 0.1, 'old', '{}', '[[30, 0.9]]', '[-0.9, -0.2]', 4, 77.6, 30, 0.9, 4, 1.2, '{}')"
-        )
-    migrate(engine)
-    with engine.connect() as connection:
-        row = connection.exec_driver_sql("SELECT code_version, climb, notes FROM runs").one()
-    assert tuple(row) == ("old", 1.2, "")
+    insert = (
+        "INSERT INTO runs (kind, status, created_at, duration_s, code_version, model, controls, start_state, "
+        "jumps, alpha, psi0_deg, zeta0, jumps_completed, climb, results) VALUES ('sim', 'done', "
+        "'2026-01-01 00:00:00', 0.1, 'old', '{}', '[[30, 0.9]]', '[-0.9, -0.2]', 4, 77.6, 30, 0.9, 4, 1.2, '{}')"
+    )
+    row = _row_after_upgrade(tmp_path, "0003", insert, "SELECT code_version, climb, notes FROM runs")
+    assert row == ("old", 1.2, "")

@@ -3,7 +3,6 @@
 A real viser server on a free port, driven from Python as the GUI callbacks would drive it.
 """
 
-import socket
 import time
 
 import numpy as np
@@ -11,7 +10,6 @@ import pytest
 from fastapi.testclient import TestClient
 
 from backend.api.app import create_app
-from backend.robot.virtual import VirtualRobot
 from backend.settings import Settings
 from backend.store.models import Run
 from frontend.viewer.app import ClimbView
@@ -19,7 +17,6 @@ from frontend.viewer.modes import GAIT_PRESETS
 from frontend.viewer.recordings import load_recording
 from sim_core import get_preset
 from sim_core.climb import ClimbEnd
-from sim_core.noise import NO_NOISE
 
 ROBOT = get_preset("paper")
 RUN = {
@@ -152,12 +149,9 @@ def test_recordings_put_sim_runs_between_the_walls(service):
     assert np.all(np.abs(recording.clip.x) < half)
 
 
-def test_live_mode_follows_the_virtual_robot_with_the_model_beside_it(service):
+def test_live_mode_follows_the_virtual_robot_with_the_model_beside_it(service, virtual):
     client, auth, view = service
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
-    robot = VirtualRobot(tracker_to=("127.0.0.1", port), noise=NO_NOISE, speed=4.0, seed=2).start()
+    robot, port = virtual
     try:
         answer = client.post("/api/v1/robot/connect", json={"url": robot.url, "tracker_port": port}, headers=auth)
         assert answer.status_code == 200, answer.text
@@ -175,4 +169,3 @@ def test_live_mode_follows_the_virtual_robot_with_the_model_beside_it(service):
         assert "Touchdowns this run:** 6" in live.readout(60.0)
     finally:
         client.post("/api/v1/robot/disconnect", headers=auth)
-        robot.stop()

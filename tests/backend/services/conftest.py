@@ -1,0 +1,33 @@
+"""The services on a real, migrated SQLite file in a temporary directory; no app, no HTTP."""
+
+import pytest
+
+from backend.services import records
+from backend.store.database import make_engine, migrate, session_factory, sqlite_url
+from backend.store.models import Run
+from tests.backend.services.bodies import run_body
+
+
+@pytest.fixture
+def sessions(tmp_path):
+    """The session factory the service hands its parts (``sessionmaker``, expire_on_commit off)."""
+    engine = make_engine(sqlite_url(tmp_path))
+    migrate(engine)
+    yield session_factory(engine)
+    engine.dispose()
+
+
+@pytest.fixture
+def session(sessions):
+    with sessions() as session:
+        yield session
+
+
+@pytest.fixture
+def make_run(session):
+    """``make_run(zeta0=..., psi0_deg=..., **fields)``: a simulated run stored through the records service."""
+
+    def make(zeta0: float = 0.9, psi0_deg: float = 30.0, **fields) -> Run:
+        return records.create_run(session, run_body(zeta0, psi0_deg, **fields))
+
+    return make

@@ -1,0 +1,167 @@
+"""The simulation service called directly: request bodies in, sim_core's numbers out as JSON."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+from numpy.testing import assert_array_equal
+
+from backend.schemas import FixedPointIn, GaitSearchJobCreate, LegIn, MapIn, ModelIn, StateIn, TrajectoryIn
+from backend.services import simulation
+from sim_core import FixedPointNotFound, ParameterError, iterate_map, simulate_trajectory
+from tests.backend.services.bodies import START, run_body
+
+PERIOD_1 = [LegIn(psi0_deg=30.0, zeta0=0.9)]
+PERIOD_1_EIGENVALUE = 0.8486  # |lambda| of the paper's psi0 = 30°, zeta0 = 0.9 gait (test_fixed_points.py)
+EIGENVALUE_ATOL = 1e-4
+SLIPS = [LegIn(psi0_deg=60.0, zeta0=0.9)]  # slips on the first jump from START
+NO_GAIT = [LegIn(psi0_deg=80.0, zeta0=0.9)]  # no period-1 gait anywhere on the search grid
+
+
+def _strict_json(value) -> object:
+    """``value`` through strict JSON (no NaN/Infinity): what the API can send as is."""
+    return json.loads(json.dumps(value, allow_nan=False))
+
+
+def test_model_params_start_from_the_preset(paper):
+    assert simulation.model_params(ModelIn()) == paper
+    changed = simulation.model_params(ModelIn(alpha=40.0, mu=1.5))
+    assert (changed.alpha, changed.mu, changed.d_hat, changed.c_zeta) == (40.0, 1.5, paper.d_hat, paper.c_zeta)
+
+
+def test_schedule_of_keeps_the_legs_in_order(alternating):
+    legs = [LegIn(psi0_deg=30.0, zeta0=0.87), LegIn(psi0_deg=30.0, zeta0=0.9)]
+    assert simulation.schedule_of(legs) == alternating
+
+
+def test_map_orbit_is_the_maps_json(paper, symmetric):
+    body = MapIn(controls=PERIOD_1, start=START, jumps=5)
+    got = simulation.map_orbit(body)
+    assert got == iterate_map(paper, symmetric, (START.xdot, START.ydot), 5).to_dict()
+    assert got["failure"] is None and len(got["states"]) == 6 and len(got["rises"]) == 5
+
+
+def test_map_orbit_reports_the_failed_jump():
+    got = simulation.map_orbit(MapIn(controls=SLIPS, start=START, jumps=5))
+    assert got["failure"] == {"code": "slip", "jump": 1} and got["states"] == [[START.xdot, START.ydot]]
+
+
+def test_trajectory_columns_are_the_sampled_path(paper, symmetric):
+    body = TrajectoryIn(controls=PERIOD_1, start=START, jumps=2, rate=50.0)
+    got = simulation.trajectory_columns(body)
+    path = simulate_trajectory(paper, symmetric, (START.xdot, START.ydot), 2, sample_rate=50.0)
+    assert got == _strict_json(got), "plain JSON already"
+    assert got["units"] == "nondimensional" and got["failure"] is None
+    assert got["touchdown_times"] == path.touchdown_times.tolist() and len(got["touchdown_times"]) == 3
+    assert set(got["columns"]) == set(path.COLUMNS)
+    for name, column in path.columns().items():
+        assert_array_equal(np.array(got["columns"][name], dtype=float), column, err_msg=name)
+
+
+def test_trajectory_of_a_failing_climb_says_where_it_failed():
+    got = simulation.trajectory_columns(TrajectoryIn(controls=SLIPS, start=START, jumps=3))
+    assert got["failure"] == {"code": "slip", "jump": 1}
+    assert got == _strict_json(got)
+
+
+def test_fixed_point_from_a_guess():
+    gait = simulation.fixed_point(FixedPointIn(controls=PERIOD_1, guess=StateIn(xdot=-0.9, ydot=-0.2)))
+    assert gait["period"] == 1 and gait["stable"] and gait["motion"] == "climbing"
+    assert gait["max_abs_eigenvalue"] == pytest.approx(PERIOD_1_EIGENVALUE, abs=EIGENVALUE_ATOL)
+    assert gait["orbit"][0] == gait["state"] and gait == _strict_json(gait)
+
+
+def test_fixed_point_without_a_guess_searches(alternating):
+    searched = simulation.fixed_point(FixedPointIn(controls=PERIOD_1))
+    guessed = simulation.fixed_point(FixedPointIn(controls=PERIOD_1, guess=StateIn(xdot=-0.9, ydot=-0.2)))
+    assert searched["state"] == pytest.approx(guessed["state"], abs=1e-9), "one stable gait: the search finds it"
+    legs = [LegIn(psi0_deg=30.0, zeta0=0.87), LegIn(psi0_deg=30.0, zeta0=0.9)]
+    assert simulation.fixed_point(FixedPointIn(controls=legs))["period"] == len(alternating), "period defaults to m"
+
+
+def test_fixed_point_errors():
+    with pytest.raises(ParameterError) as error:
+        simulation.fixed_point(FixedPointIn(controls=NO_GAIT))
+    assert error.value.field == "controls" and "no period-1 gait" in str(error.value)
+    with pytest.raises(FixedPointNotFound):
+        simulation.fixed_point(FixedPointIn(controls=NO_GAIT, guess=StateIn(xdot=-0.9, ydot=-0.2)))
+    with pytest.raises(ParameterError) as error:
+        simulation.fixed_point(FixedPointIn(controls=PERIOD_1 * 2, period=3, guess=StateIn(xdot=-0.9, ydot=-0.2)))
+    assert error.value.field == "period"
+
+
+def test_simulate_run_gives_a_runs_fields(paper, symmetric):
+    fields = simulation.simulate_run(run_body(0.9, jumps=4, trajectory_rate=40.0))
+    orbit = iterate_map(paper, symmetric, (START.xdot, START.ydot), 4)
+    assert (fields["kind"], fields["status"], fields["failure_code"], fields["jumps_completed"]) == (
+        "sim",
+        "done",
+        None,
+        4,
+    )
+    assert fields["climb"] == pytest.approx(float(orbit.rises.sum()), rel=1e-12)
+    assert fields["results"] == _strict_json(orbit.to_dict()) and "fixed_point" not in fields["results"]
+    assert fields["model"]["alpha"] == paper.alpha and fields["code_version"] == simulation.current_code_version()
+    assert fields["duration_s"] >= 0 and fields["controls"] == [[30.0, 0.9]]
+    path = simulation.unpack_trajectory(fields["trajectory"])
+    assert set(path) == set(simulate_trajectory(paper, symmetric, (START.xdot, START.ydot), 4).COLUMNS)
+
+
+def test_simulate_run_stores_infinite_friction_as_null():
+    fields = simulation.simulate_run(run_body(model=ModelIn(mu=math.inf)))
+    assert fields["model"]["mu"] is None and fields["trajectory"] is None
+    assert fields["model"] == _strict_json(fields["model"])
+
+
+def test_simulate_run_with_the_gait_near_its_start():
+    found = simulation.simulate_run(run_body(fixed_point=True))["results"]["fixed_point"]
+    assert found["found"] and found["max_abs_eigenvalue"] == pytest.approx(PERIOD_1_EIGENVALUE, abs=EIGENVALUE_ATOL)
+    lost = simulation.simulate_run(run_body(fixed_point=True, start=StateIn(xdot=-0.3, ydot=5.0)))
+    assert lost["failure_code"] == "no_flight"
+    assert lost["results"]["fixed_point"]["found"] is False and lost["results"]["fixed_point"]["reason"]
+
+
+def test_trajectory_blob_round_trip():
+    columns = {
+        "time": np.linspace(0.0, 3.0, 500),
+        "phase": np.arange(500, dtype=np.int8) % 2,
+        "jump": np.repeat(np.arange(5, dtype=np.int64), 100),
+        "empty": np.empty(0),
+    }
+    blob = simulation.pack_trajectory(columns)
+    assert isinstance(blob, bytes) and len(blob) < sum(column.nbytes for column in columns.values())
+    back = simulation.unpack_trajectory(blob)
+    assert list(back) == list(columns)
+    for name, column in columns.items():
+        assert back[name].dtype == column.dtype, name
+        assert_array_equal(back[name], column, err_msg=name)
+
+
+def test_unpacking_is_a_copy_not_a_view_of_a_closed_file():
+    back = simulation.unpack_trajectory(simulation.pack_trajectory({"x": np.arange(3.0)}))
+    back["x"][0] = 7.0
+    assert back["x"].tolist() == [7.0, 1.0, 2.0]
+
+
+def test_locked_chunk_map_keeps_order_and_reports_progress():
+    seen = []
+    results = simulation.locked_chunk_map(lambda a, b: a * b, [(1, 2), (3, 4), (5, 6)], lambda *p: seen.append(p))
+    assert results == [2, 12, 30] and seen == [(1, 3), (2, 3), (3, 3)]
+    assert simulation.locked_chunk_map(pow, [(2, 3)]) == [8], "progress is optional"
+    assert not simulation.KERNEL_LOCK.locked()
+
+
+def test_run_study_gait_search(symmetric):
+    progress = []
+    spec = GaitSearchJobCreate(kind="gaits", controls=PERIOD_1, grid=2)
+    result = simulation.run_study(spec, simulation.locked_chunk_map, lambda *p: progress.append(p))
+    assert result == _strict_json(result) and progress[-1] == (1, 1)
+    gait = result["gaits"][0]
+    assert gait["period"] == len(symmetric) and gait["motion"] == "climbing"
+    assert gait["max_abs_eigenvalue"] == pytest.approx(PERIOD_1_EIGENVALUE, abs=EIGENVALUE_ATOL)
+
+
+def test_code_version_is_stable_and_fits_its_column():
+    version = simulation.current_code_version()
+    assert version == simulation.current_code_version() and 0 < len(version) <= 64
