@@ -71,13 +71,22 @@ def list_jobs(session: Session, *, state: str | None, limit: int, cursor: int | 
 
 
 def cancel_job(session: Session, job_id: int) -> Job:
-    """Queued jobs stop at once; running ones before their next chunk. Finished jobs are left as they are."""
+    """Queued jobs stop at once; running ones before their next chunk. Finished jobs are left as they are.
+
+    Each change is one conditional UPDATE, so a job that the runner finishes while this request
+    runs stays finished (reading the state and then writing it could overwrite "done").
+    """
     job = get_job(session, job_id)
-    if job.state == "queued":
-        job.state, job.finished_at = "cancelled", utcnow()
-    elif job.state == "running":
-        job.state = "cancelling"
+    for was, becomes in (
+        ("queued", {"state": "cancelled", "finished_at": utcnow()}),
+        ("running", {"state": "cancelling"}),
+    ):
+        session.execute(
+            update(Job).where(Job.id == job_id, Job.state == was).values(**becomes),
+            execution_options={"synchronize_session": False},
+        )
     session.commit()
+    session.refresh(job)
     return job
 
 

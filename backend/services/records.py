@@ -19,7 +19,7 @@ from sqlalchemy.orm import Session
 
 from backend.schemas import ExperimentCreate, ExperimentUpdate, RunCreate
 from backend.services.simulation import simulate_run
-from backend.store.models import Experiment, Run, RunTag
+from backend.store.models import Experiment, Job, Run, RunTag
 from experiments.manifest import json_safe
 
 MAX_PAGE = 500
@@ -58,6 +58,8 @@ def delete_experiment(session: Session, experiment_id: int) -> None:
     experiment = get_experiment(session, experiment_id)
     if run_count(session, experiment_id):
         raise Conflict(f"experiment {experiment_id} still has runs; delete them first")
+    if session.scalar(select(func.count()).select_from(Job).where(Job.experiment_id == experiment_id)):
+        raise Conflict(f"experiment {experiment_id} has jobs, which are kept as its record; it cannot be deleted")
     session.delete(experiment)
     session.commit()
 

@@ -6,7 +6,6 @@ import json
 import math
 
 import pytest
-from sqlalchemy.exc import IntegrityError
 
 from backend.schemas import ExperimentCreate, ExperimentUpdate, LegIn, MJTFJobCreate
 from backend.services import records
@@ -55,15 +54,13 @@ def test_an_experiment_with_runs_is_not_deleted(session, make_run):
     records.delete_experiment(session, experiment.id)
 
 
-JOBS_BLOCK_DELETE = "bug: delete_experiment checks runs but not jobs; the RESTRICT key on jobs raises IntegrityError"
-
-
-@pytest.mark.xfail(strict=True, raises=IntegrityError, reason=JOBS_BLOCK_DELETE)
 def test_an_experiment_with_jobs_is_not_deleted(session):
+    """Its jobs are its record (the foreign key restricts; it used to surface as an IntegrityError)."""
     experiment = records.create_experiment(session, ExperimentCreate(name="studies"))
     create_job(session, MJTFJobCreate(experiment_id=experiment.id, zeta0s=[0.9], trials=2))
-    with pytest.raises(Conflict):
+    with pytest.raises(Conflict, match="has jobs"):
         records.delete_experiment(session, experiment.id)
+    assert records.get_experiment(session, experiment.id).name == "studies"
 
 
 def test_experiments_page_newest_first(session):

@@ -4,6 +4,7 @@ The viser view itself is tested in tests/frontend/viewer/test_view.py; here a st
 """
 
 import inspect
+import threading
 
 import pytest
 from fastapi.testclient import TestClient
@@ -11,7 +12,7 @@ from fastapi.testclient import TestClient
 from backend.api.app import create_app
 from backend.services.records import list_experiments
 from backend.services.robot import RobotService
-from backend.services.view import SceneView, ViewContext
+from backend.services.view import SceneView, ViewContext, ViewStarter
 from backend.settings import Settings
 from frontend.viewer.app import ClimbView
 
@@ -53,8 +54,8 @@ def test_the_view_gets_the_services_sessions_and_robot_and_is_closed(settings):
     app = create_app(settings, run_jobs=False, view_factory=factory)
     assert built == [], "the view is built at start-up, not with the app"
     with TestClient(app):
-        (view,) = built
-        assert app.state.view is view and not view.closed
+        view = app.state.view_starter.wait(10)
+        assert built == [view] and not view.closed
         with view.context.sessions() as session:
             assert list_experiments(session, limit=5, cursor=None) == ([], None), "a migrated database"
         assert isinstance(view.context.robot_service, RobotService)
@@ -64,8 +65,66 @@ def test_the_view_gets_the_services_sessions_and_robot_and_is_closed(settings):
 
 def test_without_a_factory_there_is_no_view(settings):
     app = create_app(settings, run_jobs=False)
-    with TestClient(app):
-        assert app.state.view is None
+    with TestClient(app) as client:
+        assert app.state.view_starter is None
+        assert client.get("/api/v1/view").json() == {
+            "available": False,
+            "reason": "the 3D view is not running (it starts with `parkour serve`)",
+            "starting": False,
+            **dict.fromkeys(("port", "mode", "run_id", "updates_per_s", "clients")),
+        }
+
+
+def test_the_api_answers_while_the_view_is_starting(settings):
+    release = threading.Event()
+
+    def slow_factory(context: ViewContext) -> SceneView:
+        release.wait(10)
+        return StandInView(context)
+
+    app = create_app(settings, run_jobs=False, view_factory=slow_factory)
+    with TestClient(app) as client:
+        assert client.get("/api/v1/health").status_code == 200
+        info = client.get("/api/v1/view").json()
+        assert info["available"] is False and info["starting"] is True and "starting" in info["reason"]
+        assert client.post("/api/v1/view/replay", json={"run_id": 1}, headers=_auth(settings)).status_code == 503
+        release.set()
+        view = app.state.view_starter.wait(10)
+        assert client.get("/api/v1/view").json()["mode"] == "idle"
+    assert view.closed
+
+
+def test_a_view_that_fails_to_start_leaves_the_api_running_and_says_why(settings):
+    def broken(_context: ViewContext) -> SceneView:
+        raise OSError("port 8001 in use")
+
+    app = create_app(settings, run_jobs=False, view_factory=broken)
+    with TestClient(app) as client:
+        assert app.state.view_starter.wait(10) is None
+        info = client.get("/api/v1/view").json()
+        assert info["available"] is False and not info["starting"]
+        assert info["reason"] == "the 3D view did not start: port 8001 in use"
+        assert client.get("/api/v1/health").status_code == 200
+
+
+def test_a_view_still_starting_at_shutdown_is_closed_once_built():
+    release = threading.Event()
+    views = []
+
+    def slow_factory(context: ViewContext) -> SceneView:
+        release.wait(10)
+        views.append(StandInView(context))
+        return views[-1]
+
+    starter = ViewStarter(slow_factory, ViewContext(sessions=lambda: None, robot_service=None)).start()
+    assert starter.view is None and starter.starting
+    threading.Timer(0.05, release.set).start()
+    starter.close()  # waits for the start, then closes what it built
+    assert views[0].closed and not starter.starting
+
+
+def _auth(settings) -> dict:
+    return {"Authorization": f"Bearer {(settings.data_dir / 'api_token').read_text().strip()}"}
 
 
 @pytest.mark.parametrize("implementation", [ClimbView, StandInView])
