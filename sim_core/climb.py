@@ -38,7 +38,7 @@ import numpy as np
 
 from sim_core.controls import ControlSchedule, LegControl
 from sim_core.failures import Failure
-from sim_core.noise import NoiseSampler
+from sim_core.noise_rules import NoiseSampler
 from sim_core.params import PhysicalParams
 from sim_core.trajectory import FLIGHT, STANCE, simulate_trajectory
 from sim_core.walls import Wall, wall_of

@@ -27,7 +27,8 @@ from sim_core._jit import kernel
 from sim_core.controls import ControlSchedule, LegControl
 from sim_core.failures import OK, Failure
 from sim_core.integrate import STATE_SIZE
-from sim_core.noise import NO_NOISE, NoiseModel, disturbed_state, perturbed_controls, pitch_step, seed_trial
+from sim_core.noise import NO_NOISE, NoiseModel
+from sim_core.noise_rules import disturbed_state, perturbed_controls, pitch_step, seed_trial
 from sim_core.params import ModelParams
 from sim_core.poincare import check_jumps, check_section_state
 from sim_core.stride import jump

@@ -21,7 +21,8 @@ from sim_core.chunks import ChunkMap, Progress, chunk_slices, in_process
 from sim_core.controls import LegControl
 from sim_core.failures import OK, Failure
 from sim_core.integrate import STATE_SIZE
-from sim_core.noise import NoiseModel, disturbed_state, perturbed_controls, pitch_step, seed_trial, trial_seeds
+from sim_core.noise import NoiseModel, trial_seeds
+from sim_core.noise_rules import disturbed_state, perturbed_controls, pitch_step, seed_trial
 from sim_core.params import ModelParams
 from sim_core.stride import jump
 from sim_core.sweep import energy_sweep, sweep_schedule

@@ -25,7 +25,8 @@ from backend.robot.tracker import Pose, encode_datagram
 from sim_core import ControlSchedule, LegControl, PhysicalParams, climb, gait_of, get_preset
 from sim_core.climb import ClimbSetup, End, Samples
 from sim_core.errors import FixedPointNotFound
-from sim_core.noise import NoiseModel, NoiseSampler
+from sim_core.noise import NoiseModel
+from sim_core.noise_rules import NoiseSampler
 from sim_core.presets import START_GUESS
 from sim_core.validation import check_range
 from sim_core.walls import Wall

@@ -21,7 +21,8 @@ from sim_core.climb import (
     touchdown_after,
 )
 from sim_core.failures import Failure
-from sim_core.noise import NoiseModel, NoiseSampler
+from sim_core.noise import NoiseModel
+from sim_core.noise_rules import NoiseSampler
 from sim_core.trajectory import FLIGHT, STANCE
 from sim_core.walls import Wall, wall_of
 
