@@ -27,7 +27,8 @@ from experiments.cluster import SCHEDULER_ENV, chunk_map_for, scheduler_address
 from sim_core import ControlSchedule, LegControl, ParameterError
 from sim_core.atlas import gait_atlas
 from sim_core.basin import DEFAULT_JUMPS, DEFAULT_TOLERANCE, BasinGrid, check_convergence_test, compute_basin
-from sim_core.closed_loop import HeightController, closed_loop_climb
+from sim_core.closed_loop import closed_loop_climb
+from sim_core.height_controller import HeightController
 from sim_core.mjtf import CAPPED, check_trials, mjtf_study
 from sim_core.noise import NO_NOISE, NoiseModel
 from sim_core.poincare import check_jumps

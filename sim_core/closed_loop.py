@@ -26,42 +26,16 @@ import numpy as np
 from sim_core._jit import kernel
 from sim_core.controls import ControlSchedule, LegControl
 from sim_core.failures import OK, Failure
+from sim_core.height_controller import HeightController
 from sim_core.integrate import STATE_SIZE
 from sim_core.noise import NO_NOISE, NoiseModel
 from sim_core.noise_rules import disturbed_state, perturbed_controls, pitch_step, seed_trial
 from sim_core.params import ModelParams
 from sim_core.poincare import check_jumps, check_section_state
 from sim_core.stride import jump
-from sim_core.validation import ParameterError, check_range
+from sim_core.validation import check_range
 
 SETTLING_BAND = 0.02  # |error| within 2% of the climb to the target counts as settled
-
-
-@dataclass(frozen=True)
-class HeightController:
-    """PID on the touchdown height error; gains in zeta0 per l0 of error (per jump for ki, kd)."""
-
-    target: float  # [l0]
-    zeta0_hover: float  # feed-forward: zeta0 of jumping in place
-    # Defaults from a gain scan at psi0 = 35° (docs/analyses.md): settles in ~30 jumps without
-    # overshoot. The integral is off by default: the hover feed-forward already removes the
-    # model's steady error, and any ki > 0 we scanned settled later; raise it against bias
-    # such as leg asymmetry.
-    kp: float = 0.04
-    ki: float = 0.0
-    kd: float = 0.02
-    zeta0_min: float = 0.80
-    zeta0_max: float = 0.98
-
-    def __post_init__(self) -> None:
-        check_range("target", self.target, 0.0, 1e4)
-        for name in ("kp", "ki", "kd"):
-            check_range(name, getattr(self, name), 0.0, 10.0, low_open=False)
-        check_range("zeta0_min", self.zeta0_min, 0.0, 1.0)
-        check_range("zeta0_max", self.zeta0_max, 0.0, 1.0)
-        if not self.zeta0_min < self.zeta0_max:
-            raise ParameterError("zeta0_max", f"must exceed zeta0_min = {self.zeta0_min:g}, got {self.zeta0_max:g}")
-        check_range("zeta0_hover", self.zeta0_hover, self.zeta0_min, self.zeta0_max, low_open=False, high_open=False)
 
 
 @dataclass(frozen=True)
