@@ -6,12 +6,13 @@ import pytest
 from typer.testing import CliRunner
 
 from cli.app import app
-from experiments.reproduce import FIGURES, figure_names, reproduce
+from experiments.reproduce import FIGURES, figure_module, figure_names, reproduce
 from sim_core import ParameterError, get_preset
 
 
 def test_figure_names():
     assert figure_names(["all"]) == list(FIGURES)
+    assert all(hasattr(figure_module(name), "claims") for name in FIGURES)
     assert figure_names(["fig8", "fig8", "fig7"]) == ["fig8", "fig7"]
     with pytest.raises(ParameterError, match=r"^figure: must be one of"):
         figure_names(["fig9"])
