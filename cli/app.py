@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import typer
 
-from cli import analyses, bench, gaits, reproduce, robot, serve, simulate
+from cli import atlas, basin, bench, gaits, mjtf, pid, reproduce, robot, serve, simulate, sweep
 
 app = typer.Typer(
     name="parkour",
@@ -22,8 +22,9 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     rich_markup_mode=None,
 )
-for sub_app in (simulate.app, gaits.app, analyses.app, reproduce.app, robot.app, bench.app, serve.app):
-    app.add_typer(sub_app)
+COMMANDS = (simulate, gaits, basin, sweep, mjtf, pid, atlas, reproduce, robot, bench, serve)  # in the order of --help
+for command in COMMANDS:
+    app.add_typer(command.app)
 
 
 def main() -> None:

@@ -5,11 +5,8 @@ from __future__ import annotations
 from typing import Annotated
 
 import typer
-from rich.console import Console
-from rich.table import Table
 
 from cli.options import JsonOption, handles_errors, note, print_json
-from sim_core.bench import run_benchmark
 
 app = typer.Typer(rich_markup_mode=None)
 
@@ -26,6 +23,8 @@ def bench_command(
     as_json: JsonOption = False,
 ) -> None:
     """Strides per second of the kernel vs scipy solve_ivp (DOP853, rtol=atol=1e-10), and their difference."""
+    from sim_core.bench import run_benchmark
+
     # A thin command: its options go to the one library call as they are (name=name, as in the API's routes).
     result = run_benchmark(
         baseline_strides=baseline_strides,
@@ -39,6 +38,9 @@ def bench_command(
     if as_json:
         print_json(result.to_dict())
         return
+    from rich.console import Console
+    from rich.table import Table
+
     table = Table("measure", "value", title="parkour bench (paper preset, controls 30:0.9)")
     table.add_row("kernel, one core", f"{result.kernel_strides_per_s:,.0f} strides/s")
     table.add_row("scipy DOP853 baseline", f"{result.baseline_strides_per_s:,.0f} strides/s")

@@ -5,25 +5,20 @@ from __future__ import annotations
 from typing import Annotated
 
 import typer
-from rich.console import Console
-from rich.table import Table
 
 from cli.options import (
     ControlsOption,
+    GuessOption,
     JsonOption,
     ModelSetup,
+    PeriodOption,
     handles_errors,
     parse_controls,
     print_json,
     with_model,
 )
-from sim_core import FixedPoint
 
 app = typer.Typer(rich_markup_mode=None)
-
-PeriodOption = Annotated[
-    int | None, typer.Option("--period", help="Period n in jumps; a multiple of the schedule length (default: it).")
-]
 
 
 @app.command("fixed-point")
@@ -33,10 +28,7 @@ def fixed_point_command(
     setup: ModelSetup,
     controls: ControlsOption = "30:0.9",
     period: PeriodOption = None,
-    guess: Annotated[
-        tuple[float, float] | None,
-        typer.Option("--guess", help="Initial guess XDOT YDOT for Levenberg–Marquardt; default: search a grid."),
-    ] = None,
+    guess: GuessOption = None,
     as_json: JsonOption = False,
 ) -> None:
     """Find a period-n fixed point, its eigenvalues, stability and climb per period."""
@@ -74,7 +66,11 @@ def gaits_command(
         typer.echo(f"no period-{period} gait found from a {grid}x{grid} grid of guesses")
 
 
-def _print_gaits(gaits: list[FixedPoint], title: str) -> None:
+def _print_gaits(gaits: list, title: str) -> None:
+    """A table of gaits (``sim_core.FixedPoint``) for people."""
+    from rich.console import Console
+    from rich.table import Table
+
     table = Table("xdot", "ydot", "period", "max |λ|", "stable", "climb (l0)", "motion", title=title)
     for gait in gaits:
         table.add_row(

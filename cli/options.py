@@ -1,8 +1,13 @@
-"""What every ``parkour`` command shares: model options, controls, errors and JSON output.
+"""What every ``parkour`` command shares: options, controls, errors and JSON output.
 
 Model options (``--preset`` and nondimensional overrides) are added to a command by
-:func:`with_model`, which hands the command a :class:`ModelSetup`. Errors the user can fix
+:func:`with_model`, which hands the command a :class:`ModelSetup`; noise options by
+:func:`with_noise`, which hands it a :class:`~sim_core.noise.NoiseModel`. Errors the user can fix
 become one line on stderr and exit code 2 (:func:`handles_errors`).
+
+Light by design: this module and the command modules import typer and the light parts of
+``sim_core`` (parameters, controls, presets, errors) only; a command imports the kernels, the
+store or the service when it runs, so ``parkour --help`` starts at once (tests/cli/test_startup.py).
 """
 
 from __future__ import annotations
@@ -17,19 +22,14 @@ from dataclasses import dataclass, replace
 from typing import Annotated
 
 import typer
-from rich.console import Console
-from rich.progress import Progress, TimeElapsedColumn
 
+from experiments.cluster import SCHEDULER_ENV
 from experiments.manifest import json_safe
-from sim_core import (
-    ControlSchedule,
-    FixedPointNotFound,
-    ModelParams,
-    ParameterError,
-    PhysicalParams,
-    get_preset,
-)
-from sim_core.presets import DEFAULT_PRESET
+from sim_core.controls import ControlSchedule
+from sim_core.errors import FixedPointNotFound, ParameterError
+from sim_core.noise import NoiseModel
+from sim_core.params import ModelParams, PhysicalParams
+from sim_core.presets import DEFAULT_PRESET, get_preset
 
 EXIT_USAGE = 2
 
@@ -42,6 +42,26 @@ ControlsOption = Annotated[
     ),
 ]
 JsonOption = Annotated[bool, typer.Option("--json", help="Print machine-readable JSON.")]
+PeriodOption = Annotated[
+    int | None,
+    typer.Option("--period", help="Period n of the gait in jumps; a multiple of the schedule length (default: it)."),
+]
+GuessOption = Annotated[
+    tuple[float, float] | None,
+    typer.Option(
+        "--guess",
+        help="Initial guess XDOT YDOT for the gait (Levenberg–Marquardt); default: the most stable one a grid "
+        "search finds.",
+    ),
+]
+SchedulerOption = Annotated[
+    str | None,
+    typer.Option(
+        "--scheduler",
+        help=f"Dask scheduler (tcp://host:8786) to run on a cluster; default ${SCHEDULER_ENV}, else in-process.",
+    ),
+]
+SeedOption = Annotated[int, typer.Option("--seed", help="Seed >= 0; the same seed gives the same numbers.")]
 
 
 @dataclass(frozen=True)
@@ -90,16 +110,54 @@ _MODEL_PARAMETERS = [
 
 def with_model(command: Callable) -> Callable:
     """Add ``--preset --alpha --d-hat --c-zeta --c-psi --mu`` to ``command``; it receives ``setup``."""
+
+    def build(preset: str, **overrides: float | None) -> ModelSetup:
+        return build_setup(preset, **overrides)
+
+    return _with_options(command, "setup", _MODEL_PARAMETERS, build)
+
+
+_DEFAULT_NOISE = NoiseModel()
+_NOISE_OPTIONS = (  # parameter, NoiseModel field, flag, help
+    ("noise_psi0", "psi0_deg", "--noise-psi0", "Per-jump sigma of psi0 [deg]."),
+    ("noise_zeta0", "zeta0", "--noise-zeta0", "Per-jump sigma of zeta0."),
+    ("noise_velocity", "velocity", "--noise-velocity", "Per-jump sigma of xdot, ydot [sqrt(g l0)]."),
+    ("pitch_drift", "pitch_drift_deg", "--pitch-drift", "Sigma of the pitch random walk per jump [deg]."),
+    ("asymmetry_psi0", "asymmetry_psi0_deg", "--asymmetry-psi0", "Right leg's psi0 offset [deg]."),
+    ("asymmetry_zeta0", "asymmetry_zeta0", "--asymmetry-zeta0", "Right leg's zeta0 offset."),
+)
+_NOISE_PARAMETERS = [
+    inspect.Parameter(
+        name,
+        inspect.Parameter.KEYWORD_ONLY,
+        default=getattr(_DEFAULT_NOISE, field),
+        annotation=Annotated[float, typer.Option(flag, help=help_text)],
+    )
+    for name, field, flag, help_text in _NOISE_OPTIONS
+]
+
+
+def with_noise(command: Callable) -> Callable:
+    """Add the noise model's options (``--noise-psi0 ... --asymmetry-zeta0``, docs/model.md §5.1) to
+    ``command``; it receives ``noise``, a :class:`~sim_core.noise.NoiseModel`."""
+
+    def build(**values: float) -> NoiseModel:
+        return NoiseModel(**{field: values[name] for name, field, _flag, _help in _NOISE_OPTIONS})
+
+    return _with_options(command, "noise", _NOISE_PARAMETERS, build)
+
+
+def _with_options(command: Callable, name: str, options: list[inspect.Parameter], build: Callable) -> Callable:
+    """``command`` with its parameter ``name`` replaced by ``options``, from which ``build`` makes it."""
     signature = inspect.signature(command, eval_str=True)
-    kept = [p for p in signature.parameters.values() if p.name != "setup"]
+    kept = [p for p in signature.parameters.values() if p.name != name]
 
     @functools.wraps(command)
     def wrapper(*args, **kwargs):
-        values = {p.name: kwargs.pop(p.name) for p in _MODEL_PARAMETERS}
-        setup = build_setup(values.pop("preset"), **values)
-        return command(*args, setup=setup, **kwargs)
+        values = {p.name: kwargs.pop(p.name) for p in options}
+        return command(*args, **{name: build(**values)}, **kwargs)
 
-    parameters = [*kept, *_MODEL_PARAMETERS]
+    parameters = [*kept, *options]
     wrapper.__signature__ = signature.replace(parameters=parameters)
     wrapper.__annotations__ = {p.name: p.annotation for p in parameters}
     return wrapper
@@ -147,6 +205,9 @@ def progress_bar(description: str) -> Iterator[Callable[..., None]]:
     The callback also takes ``description=`` to relabel the bar. It draws only on a terminal,
     so piped ``--json`` output and logs stay clean.
     """
+    from rich.console import Console
+    from rich.progress import Progress, TimeElapsedColumn
+
     console = Console(stderr=True)
     columns = (*Progress.get_default_columns(), TimeElapsedColumn())
     with Progress(*columns, console=console, transient=True, disable=not console.is_terminal) as progress:

@@ -7,10 +7,17 @@ from typing import Annotated
 
 import typer
 
-from cli.analyses import SchedulerOption
-from cli.options import JsonOption, ModelSetup, handles_errors, note, print_json, progress_bar, with_model
-from experiments.cluster import chunk_map_for, scheduler_address
-from experiments.reproduce import FIGURES, figure_names, reproduce
+from cli.options import (
+    JsonOption,
+    ModelSetup,
+    SchedulerOption,
+    handles_errors,
+    note,
+    print_json,
+    progress_bar,
+    with_model,
+)
+from experiments.reproduce import FIGURES, figure_names
 
 app = typer.Typer(rich_markup_mode=None)
 
@@ -29,6 +36,9 @@ def reproduce_command(
     as_json: JsonOption = False,
 ) -> None:
     """Regenerate paper figures: PNG + SVG, CSV + JSON data, and report.md (paper vs ours)."""
+    from experiments.cluster import chunk_map_for, scheduler_address
+    from experiments.reproduce import reproduce
+
     names = figure_names(figures)
     with chunk_map_for(scheduler_address(scheduler)) as chunk_map, progress_bar("reproduce") as progress:
         written = reproduce(

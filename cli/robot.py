@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from cli.options import handles_errors, note
-from sim_core import ParameterError
+from sim_core.errors import ParameterError
 
 app = typer.Typer(rich_markup_mode=None)
 

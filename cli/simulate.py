@@ -8,10 +8,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Annotated, Literal
 
-import numpy as np
 import typer
-from rich.console import Console
-from rich.table import Table
 
 from cli.options import (
     ControlsOption,
@@ -24,8 +21,7 @@ from cli.options import (
     print_json,
     with_model,
 )
-from sim_core import iterate_map, simulate_trajectory
-from sim_core.validation import ParameterError
+from sim_core.errors import ParameterError
 
 app = typer.Typer(rich_markup_mode=None)
 
@@ -50,10 +46,15 @@ def map_command(
     as_json: JsonOption = False,
 ) -> None:
     """Apply the Poincaré map JUMPS times: section states and height gain per jump."""
+    from sim_core.poincare import iterate_map
+
     orbit = iterate_map(setup.model, parse_controls(controls), state, jumps)
     if as_json:
         print_json(orbit.to_dict())
         return
+    from rich.console import Console
+    from rich.table import Table
+
     table = Table("jump", "xdot", "ydot", "rise (l0)", title=f"Poincaré map, controls {controls}")
     table.add_row("0", f"{orbit.states[0, 0]:.9f}", f"{orbit.states[0, 1]:.9f}", "")
     for k, rise in enumerate(orbit.rises, start=1):
@@ -83,6 +84,8 @@ def trajectory_command(
     as_json: JsonOption = False,
 ) -> None:
     """Sample the full path in wall coordinates (un-flipped) and write it to a file."""
+    from sim_core.trajectory import simulate_trajectory
+
     if out.suffix not in (".csv", ".json"):
         raise ParameterError("out", f"must end in .csv or .json, got {out.name!r}")
     schedule = parse_controls(controls)
@@ -117,7 +120,7 @@ def trajectory_command(
         "out": str(out),
         "samples": int(trajectory.time.size),
         "jumps_completed": int(trajectory.rises.size),
-        "climb": float(np.sum(trajectory.rises)),
+        "climb": float(trajectory.rises.sum()),
         "units": trajectory.units,
         "failure": None if trajectory.failure is None else trajectory.failure.code,
     }

@@ -14,10 +14,11 @@ import numpy as np
 
 from experiments.report import Claim, new_figure
 from sim_core.basin import DEFAULT_JUMPS, BasinGrid, compute_basin
+from sim_core.basin_grid import DEFAULT_BASIN_WINDOW
 from sim_core.chunks import ChunkMap, Progress, in_process
 from sim_core.controls import ControlSchedule, LegControl
 from sim_core.params import PhysicalParams
-from sim_core.sweep import DEFAULT_BASIN_WINDOW, EnergySweep, energy_sweep, zeta0_values
+from sim_core.sweep import EnergySweep, energy_sweep, zeta0_values
 
 TITLE = "Fig. 8 — stability and basin vs leg retraction"
 

@@ -17,6 +17,7 @@ from sim_core.validation import ParameterError, check_range
 DEFAULT_TOLERANCE = 0.02  # [sqrt(g l0)]: inside the linear region of a stable gait, far above integrator noise
 DEFAULT_JUMPS = 60
 DEFAULT_HALF_WIDTH = 1.5  # [sqrt(g l0)]: default window half-width around the gait's state
+DEFAULT_BASIN_WINDOW = ((-3.0, -0.02), (-2.0, 2.0))  # [sqrt(g l0)]: a fixed window holding the paper gaits' basins
 MAX_CELLS = 4_000_000  # a 2000 x 2000 grid; larger grids are almost certainly a typo
 
 

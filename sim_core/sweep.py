@@ -20,7 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from sim_core.basin import DEFAULT_JUMPS, DEFAULT_TOLERANCE, NOT_CONVERGED, BasinGrid, converge_states
+from sim_core.basin import NOT_CONVERGED, converge_states
+from sim_core.basin_grid import DEFAULT_JUMPS, DEFAULT_TOLERANCE, BasinGrid
 from sim_core.chunks import ChunkMap, Progress, in_process
 from sim_core.controls import ControlSchedule, LegControl
 from sim_core.fixed_points import FixedPoint, FixedPointNotFound, find_fixed_point, gait_of
@@ -28,7 +29,6 @@ from sim_core.params import ModelParams
 from sim_core.validation import ParameterError, check_range
 
 MAX_STEPS = 10_000
-DEFAULT_BASIN_WINDOW = ((-3.0, -0.02), (-2.0, 2.0))  # [sqrt(g l0)]: holds the paper gaits' basins
 IN_PLACE_XTOL = 1e-9  # [l0 of zeta0]
 
 

@@ -15,8 +15,9 @@ from backend.schemas import FixedPointIn, LegIn, MapIn, ModelIn, RunCreate, Traj
 from experiments.manifest import code_version, json_safe
 from sim_core import ControlSchedule, FixedPointNotFound, ModelParams, get_preset, iterate_map, simulate_trajectory
 from sim_core.basin import BasinGrid, compute_basin
+from sim_core.basin_grid import DEFAULT_BASIN_WINDOW
 from sim_core.fixed_points import FixedPoint, NoGaitFound, gait_of, search_gaits
-from sim_core.sweep import DEFAULT_BASIN_WINDOW, energy_sweep, zeta0_values
+from sim_core.sweep import energy_sweep, zeta0_values
 from sim_core.validation import ParameterError
 
 _CODE_VERSION = None

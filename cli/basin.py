@@ -1,0 +1,92 @@
+"""``parkour basin``: the basin of attraction of a gait over a grid of section states."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+
+from cli.options import (
+    ControlsOption,
+    GuessOption,
+    JsonOption,
+    ModelSetup,
+    PeriodOption,
+    SchedulerOption,
+    handles_errors,
+    parse_controls,
+    print_json,
+    progress_bar,
+    with_model,
+)
+from sim_core.basin_grid import DEFAULT_JUMPS, DEFAULT_TOLERANCE, BasinGrid
+
+app = typer.Typer(rich_markup_mode=None)
+
+
+@app.command("basin")
+@handles_errors
+@with_model
+def basin_command(
+    setup: ModelSetup,
+    controls: ControlsOption = "30:0.9",
+    period: PeriodOption = None,
+    guess: GuessOption = None,
+    grid: Annotated[int, typer.Option("--grid", help="Cells per axis.")] = 100,
+    jumps: Annotated[int, typer.Option("--jumps", help="Jumps allowed to converge.")] = DEFAULT_JUMPS,
+    xdot_range: Annotated[
+        tuple[float, float] | None,
+        typer.Option("--xdot-range", help="LOW HIGH of xdot [sqrt(g l0)], below 0; default: gait ±1.5."),
+    ] = None,
+    ydot_range: Annotated[
+        tuple[float, float] | None,
+        typer.Option("--ydot-range", help="LOW HIGH of ydot [sqrt(g l0)]; default: gait ±1.5."),
+    ] = None,
+    tolerance: Annotated[
+        float, typer.Option("--tolerance", help="Distance to the gait's orbit that counts as converged.")
+    ] = DEFAULT_TOLERANCE,
+    summary: Annotated[bool, typer.Option("--summary", help="With --json: leave out the per-cell grids.")] = False,
+    scheduler: SchedulerOption = None,
+    as_json: JsonOption = False,
+) -> None:
+    """Basin of attraction of a gait over a grid of section states (xdot, ydot)."""
+    from experiments.cluster import chunk_map_for, scheduler_address
+    from sim_core.basin import check_convergence_test, compute_basin
+    from sim_core.fixed_points import gait_of
+
+    schedule = parse_controls(controls)
+    period = period or len(schedule)
+    # The whole spec is checked before the (slow) gait search; placeholders stand in for default ranges.
+    BasinGrid(xdot_range or (-2.0, -1.0), ydot_range or (-1.0, 1.0), grid)
+    check_convergence_test(jumps, tolerance)
+    with chunk_map_for(scheduler_address(scheduler)) as chunk_map:
+        gait = gait_of(setup.model, schedule, period, guess)
+        default = BasinGrid.around(gait.state, grid)
+        cells = BasinGrid(xdot_range or default.xdot_range, ydot_range or default.ydot_range, grid)
+        with progress_bar(f"basin: {grid}x{grid} cells") as progress:
+            basin = compute_basin(
+                setup.model,
+                schedule,
+                gait,
+                cells,
+                max_jumps=jumps,
+                tolerance=tolerance,
+                chunk_map=chunk_map,
+                progress=progress,
+            )
+    if as_json:
+        print_json(basin.to_dict(include_grids=not summary))
+        return
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table("measure", "value", title=f"Basin of the period-{gait.period} gait, controls {controls}")
+    table.add_row("gait state", f"({gait.state[0]:.5f}, {gait.state[1]:.5f}), max |λ| {gait.max_abs_eigenvalue:.4f}")
+    table.add_row("xdot range", f"{cells.xdot_range[0]:.3f} … {cells.xdot_range[1]:.3f}")
+    table.add_row("ydot range", f"{cells.ydot_range[0]:.3f} … {cells.ydot_range[1]:.3f}")
+    table.add_row("grid", f"{grid} x {grid}, {jumps} jumps, tolerance {tolerance:g}")
+    table.add_row("area (g l0)", f"{basin.area:.4f} ({basin.fraction:.1%} of the window)")
+    for outcome, count in basin.outcome_counts().items():
+        if count:
+            table.add_row(f"  {outcome}", f"{count:,} cells")
+    Console().print(table)

@@ -1,0 +1,88 @@
+"""``parkour mjtf``: Mean Jumps To Failure under noise, per energy level (paper Fig. 11)."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+
+from cli.options import (
+    GuessOption,
+    JsonOption,
+    ModelSetup,
+    SchedulerOption,
+    SeedOption,
+    handles_errors,
+    print_json,
+    with_model,
+    with_noise,
+)
+from cli.studies import fixed_leg_of, over_zeta0
+from sim_core.noise import NoiseModel
+
+app = typer.Typer(rich_markup_mode=None)
+
+
+@app.command("mjtf")
+@handles_errors
+@with_model
+@with_noise
+def mjtf_command(
+    setup: ModelSetup,
+    noise: NoiseModel,
+    psi0: Annotated[float, typer.Option("--psi0", help="Leg angle [degrees].")] = 30.0,
+    zeta0_range: Annotated[
+        tuple[float, float], typer.Option("--zeta0-range", help="LOW HIGH of zeta0 over the energy levels.")
+    ] = (0.84, 0.96),
+    levels: Annotated[int, typer.Option("--levels", help="Number of energy levels.")] = 10,
+    trials: Annotated[int, typer.Option("--trials", help="Trials per level.")] = 8,
+    cap: Annotated[int, typer.Option("--cap", help="Jumps after which a trial counts as survived.")] = 1000,
+    seed: SeedOption = 0,
+    fixed_leg: Annotated[
+        str | None, typer.Option("--fixed-leg", help="PSI0:ZETA0 of a leg held fixed; the other sweeps.")
+    ] = None,
+    guess: GuessOption = None,
+    scheduler: SchedulerOption = None,
+    as_json: JsonOption = False,
+) -> None:
+    """Mean Jumps To Failure under noise, per energy level (zeta0)."""
+    from sim_core.mjtf import CAPPED, check_trials, mjtf_study
+    from sim_core.sweep import zeta0_values
+
+    zeta0s = zeta0_values(*zeta0_range, levels)
+    check_trials(trials, cap)
+    study = over_zeta0(
+        mjtf_study,
+        f"MJTF: {levels} levels x {trials} trials",
+        scheduler,
+        setup,
+        psi0,
+        zeta0s,
+        fixed_leg_of(fixed_leg),
+        guess,
+        noise=noise,
+        trials=trials,
+        cap=cap,
+        seed=seed,
+    )
+    if as_json:
+        print_json(study.to_dict())
+        return
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table("zeta0", "E (m g l0)", "MJTF", "std", "95% CI", "capped", "failures", title=f"psi0 {psi0:g}°")
+    for level in study.levels:
+        outcomes = level.histogram()
+        capped = outcomes.pop(CAPPED)
+        low, high = level.ci95
+        table.add_row(
+            f"{level.zeta0:.4f}",
+            f"{level.energy:.3f}",
+            f"{level.mean:.1f}",
+            f"{level.std:.1f}",
+            f"{low:.1f} … {high:.1f}",
+            f"{capped}/{level.jumps.size}",
+            ", ".join(f"{code} {count}" for code, count in outcomes.items() if count),
+        )
+    Console().print(table)

@@ -1,0 +1,48 @@
+"""``parkour`` starts at once: listing commands and their options loads none of the heavy packages.
+
+Imports, not seconds, are asserted (the machines are shared and noisy); scripts/bench_startup.py
+measures the times, as ratios to the numpy import.
+"""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+# Loaded only when a command runs: the kernels, the optimiser, the store, the service, the cluster,
+# plotting and the 3D view.
+HEAVY = ("numba", "scipy", "sqlalchemy", "alembic", "dask", "distributed", "matplotlib", "viser", "fastapi", "uvicorn")
+COMMANDS = ("map", "trajectory", "fixed-point", "gaits", "basin", "sweep", "mjtf", "pid", "atlas", "reproduce")
+COMMANDS += ("robot-sim", "bench", "serve")
+
+
+def _imported_by(*argv: str) -> set[str]:
+    probe = (
+        "import json, runpy, sys\n"
+        "sys.argv = ['parkour', *sys.argv[1:]]\n"
+        "try:\n    runpy.run_module('cli', run_name='__main__')\n"
+        "except SystemExit as done:\n    assert done.code in (0, None), done.code\n"
+        "print(json.dumps(sorted(sys.modules)))"
+    )
+    result = subprocess.run([sys.executable, "-c", probe, *argv], capture_output=True, text=True, check=True)
+    return set(json.loads(result.stdout.splitlines()[-1]))
+
+
+def _heavy(modules: set[str]) -> list[str]:
+    return [name for name in HEAVY if name in modules]
+
+
+def test_the_command_list_loads_nothing_heavy():
+    assert _heavy(_imported_by("--help")) == []
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_a_commands_options_load_nothing_heavy(command):
+    assert _heavy(_imported_by(command, "--help")) == [], f"parkour {command} --help"
+
+
+def test_the_map_loads_the_kernels_but_not_the_optimiser_store_or_service():
+    modules = _imported_by("map", "--jumps", "2", "--state", "-0.93", "-0.17", "--json")
+    assert "numba" in modules and "sim_core.stride" in modules, "the probe really ran the map"
+    assert [name for name in ("scipy.optimize", *HEAVY[2:]) if name in modules] == []
