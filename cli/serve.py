@@ -60,7 +60,7 @@ def serve_command(
         note(f"3D view on http://{host}:{scene_view.server.get_port()}/")
         return scene_view
 
-    application = create_app(settings, view_factory=climb_view if view else None)
+    application = create_app(settings, view_factory=climb_view if view else None, warm_kernels=True)
     note(f"ParkourLab on {base}/  (API docs: {base}/docs)")
     note(f"data: {settings.data_dir}  database: {settings.database_url.split('://')[0]}")
     if created:

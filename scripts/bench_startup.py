@@ -1,20 +1,22 @@
 """How long ``parkour`` makes a person wait before it does anything: start-up, side by side with
 ``python -c "import numpy"`` timed in the same run.
 
-Figures (median of ``--repeats`` runs each, warm numba cache and OS file cache):
+Figures (median of ``--repeats`` runs each, with warm caches: numba's, the OS's, and Python's
+bytecode, which this script compiles once when the environment sets PYTHONDONTWRITEBYTECODE):
 
 - ``help``: ``parkour --help``;
 - ``map_help``: ``parkour map --help``, and which heavy packages it imported (it should import
   none of scipy.optimize, SQLAlchemy, Alembic, Dask, matplotlib, viser);
 - ``map``: ``parkour map --jumps 10 --state -0.93 -0.17 --json``;
-- ``serve``: ``parkour serve`` from launch to the first 200 from ``/api/v1/health`` (3D view on,
-  a fresh data directory per run, so migrations run each time as on a first start).
+- ``serve``: ``parkour serve`` from launch to the first 200 from ``/api/v1/health`` (3D view on),
+  on a data directory that exists, as on every start but the first;
+- ``serve_first``: the same on a new data directory each time (the schema is created first).
 
 Each is also reported as a ratio to the numpy import, which makes runs on a busy or a different
 machine comparable. ``--command`` times another checkout's entry point, e.g. an older commit:
 ``--command "python -m frontend.cli" --module frontend.cli`` with ``PYTHONPATH`` set to that tree.
 
-    python scripts/bench_startup.py [--repeats 5] [--json]
+    python scripts/bench_startup.py [--repeats 5] [--json]     (from the checkout's root)
 """
 
 from __future__ import annotations
@@ -62,27 +64,30 @@ def free_port() -> int:
         return probe.getsockname()[1]
 
 
-def serve_until_healthy(command: list[str]) -> float:
-    """Seconds from launching ``parkour serve`` to a 200 from /api/v1/health."""
+def serve_until_healthy(command: list[str], data_dir: str | None = None) -> float:
+    """Seconds from launching ``parkour serve`` to a 200 from /api/v1/health (a new data directory
+    unless ``data_dir``)."""
+    if data_dir is None:
+        with tempfile.TemporaryDirectory() as new:
+            return serve_until_healthy(command, new)
     port, view_port = free_port(), free_port()
-    with tempfile.TemporaryDirectory() as data_dir:
-        argv = [*command, "serve", "--data-dir", data_dir, "--port", str(port), "--view-port", str(view_port)]
-        start = time.perf_counter()
-        process = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        try:
-            while time.perf_counter() - start < SERVE_TIMEOUT_S:
-                if process.poll() is not None:
-                    raise RuntimeError(f"parkour serve exited with {process.returncode}")
-                try:
-                    with urllib.request.urlopen(f"http://127.0.0.1:{port}/api/v1/health", timeout=1) as reply:
-                        if reply.status == 200:
-                            return time.perf_counter() - start
-                except OSError:
-                    time.sleep(0.01)
-            raise RuntimeError(f"parkour serve was not healthy within {SERVE_TIMEOUT_S} s")
-        finally:
-            process.terminate()
-            process.wait(10)
+    argv = [*command, "serve", "--data-dir", data_dir, "--port", str(port), "--view-port", str(view_port)]
+    start = time.perf_counter()
+    process = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        while time.perf_counter() - start < SERVE_TIMEOUT_S:
+            if process.poll() is not None:
+                raise RuntimeError(f"parkour serve exited with {process.returncode}")
+            try:
+                with urllib.request.urlopen(f"http://127.0.0.1:{port}/api/v1/health", timeout=1) as reply:
+                    if reply.status == 200:
+                        return time.perf_counter() - start
+            except OSError:
+                time.sleep(0.01)
+        raise RuntimeError(f"parkour serve was not healthy within {SERVE_TIMEOUT_S} s")
+    finally:
+        process.terminate()
+        process.wait(10)
 
 
 def imported_by(module: str, argv: list[str]) -> list[str]:
@@ -95,16 +100,28 @@ def imported_by(module: str, argv: list[str]) -> list[str]:
     return [name for name in HEAVY if name in modules]
 
 
+def warm_caches(command: list[str], data_dir: str) -> None:
+    """Compile the project's bytecode (as any Python that may write it does on first import), fill
+    numba's cache and the OS file cache, and create the schema in ``data_dir``."""
+    packages = [name for name in ("cli", "sim_core", "experiments", "backend", "frontend") if Path(name).is_dir()]
+    subprocess.run([sys.executable, "-m", "compileall", "-q", *packages], check=True, stdout=subprocess.DEVNULL)
+    timed([*command, *MAP_ARGS])
+    serve_until_healthy(command, data_dir)
+
+
 def run(command: list[str], module: str, repeats: int) -> dict:
     numpy_import = [sys.executable, "-c", "import numpy"]
-    timed([*command, *MAP_ARGS])  # warm the numba cache and the OS file cache once
-    samples: dict[str, list[float]] = {"numpy_import": [], "help": [], "map_help": [], "map": [], "serve": []}
-    for _ in range(repeats):  # interleaved, so a burst of load hits every figure alike
-        samples["numpy_import"].append(timed(numpy_import))
-        samples["help"].append(timed([*command, "--help"]))
-        samples["map_help"].append(timed([*command, "map", "--help"]))
-        samples["map"].append(timed([*command, *MAP_ARGS]))
-        samples["serve"].append(serve_until_healthy(command))
+    names = ("numpy_import", "help", "map_help", "map", "serve", "serve_first")
+    samples: dict[str, list[float]] = {name: [] for name in names}
+    with tempfile.TemporaryDirectory() as data_dir:
+        warm_caches(command, data_dir)
+        for _ in range(repeats):  # interleaved, so a burst of load hits every figure alike
+            samples["numpy_import"].append(timed(numpy_import))
+            samples["help"].append(timed([*command, "--help"]))
+            samples["map_help"].append(timed([*command, "map", "--help"]))
+            samples["map"].append(timed([*command, *MAP_ARGS]))
+            samples["serve"].append(serve_until_healthy(command, data_dir))
+            samples["serve_first"].append(serve_until_healthy(command))
     medians = {name: statistics.median(values) for name, values in samples.items()}
     return {
         "command": shlex.join(command),

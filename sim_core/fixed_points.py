@@ -16,7 +16,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from sim_core import stride
 from sim_core.controls import ControlSchedule
@@ -178,6 +177,8 @@ def find_fixed_point(
     The returned gait reports its minimal period, which may divide ``period``.
     Raises :class:`FixedPointNotFound` with the reason when it does not converge.
     """
+    from scipy.optimize import least_squares  # a quarter second to import: loaded when first solved
+
     period = check_period(schedule, period)
     start = check_section_state(guess)
     power = _MapPower(model, schedule, period)

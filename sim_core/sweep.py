@@ -18,7 +18,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from sim_core.basin import NOT_CONVERGED, converge_states
 from sim_core.basin_grid import DEFAULT_JUMPS, DEFAULT_TOLERANCE, BasinGrid
@@ -230,6 +229,8 @@ def _continue(model, schedule, period, seed) -> FixedPoint | None:
 
 def _in_place_crossings(model, psi0, fixed_leg, points, period) -> list[float]:
     """Brent's method on ``climb(zeta0)`` between neighbours whose climbs differ in sign."""
+    from scipy.optimize import brentq  # loaded when first needed, as in fixed_points
+
     crossings = []
     for left, right in itertools.pairwise(points):
         if left.gait is None or right.gait is None:

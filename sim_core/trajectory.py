@@ -16,7 +16,6 @@ import math
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.interpolate import CubicHermiteSpline
 
 from sim_core import stride
 from sim_core.controls import ControlSchedule
@@ -159,6 +158,8 @@ def _sample_times(start: float, duration: float, rate: float) -> np.ndarray:
 
 
 def _stance_piece(nodes, clock, rate, side, half_width, foot_height, jump_index):
+    from scipy.interpolate import CubicHermiteSpline  # half a second to import: loaded when first sampled
+
     times = _sample_times(clock, nodes[-1, TIME], rate)
     local = np.clip(times - clock, 0.0, nodes[-1, TIME])
     zeta = CubicHermiteSpline(nodes[:, TIME], nodes[:, ZETA], nodes[:, ZETA_DOT])(local)

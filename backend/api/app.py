@@ -13,6 +13,7 @@ import datetime
 import json
 import logging
 import secrets
+import threading
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -117,8 +118,16 @@ def api_token(data_dir: Path) -> tuple[str, bool]:
     return token, True
 
 
-def create_app(settings: Settings, *, run_jobs: bool = True, view_factory: ViewFactory | None = None) -> FastAPI:
+def create_app(
+    settings: Settings,
+    *,
+    run_jobs: bool = True,
+    view_factory: ViewFactory | None = None,
+    warm_kernels: bool = False,
+) -> FastAPI:
     """The service. ``run_jobs=False`` leaves queued jobs alone (for tools that only read);
+    ``warm_kernels`` loads the simulation kernels in the background once the service is up, so
+    the first simulation does not wait for them (``parkour serve`` asks for it);
     ``view_factory`` builds the 3D view at start-up, in the background (``cli.serve`` passes the
     viser one); ``app.state.view_starter`` holds it once built."""
     settings.data_dir.mkdir(parents=True, exist_ok=True)
@@ -131,6 +140,8 @@ def create_app(settings: Settings, *, run_jobs: bool = True, view_factory: ViewF
     @contextlib.asynccontextmanager
     async def lifespan(app: FastAPI):
         migrate(engine)
+        if warm_kernels:
+            threading.Thread(target=simulation.warm_up, name="warm-kernels", daemon=True).start()
         if run_jobs:
             runner.start()
         if view_factory is not None:

@@ -32,8 +32,7 @@ from backend.robot.messages import (
     decode,
     encode,
 )
-from backend.robot.virtual import ROBOT_ADDRESS
-from backend.robot.xbee import FrameError, FrameParser, encode_frame, parse_rx_packet, tx_request
+from backend.robot.xbee import ROBOT_ADDRESS, FrameError, FrameParser, encode_frame, parse_rx_packet, tx_request
 
 HEARTBEAT_PERIOD = 0.2  # [s]
 HEARTBEAT_TIMEOUT = 1.0  # [s]

@@ -18,10 +18,9 @@ import time
 from backend.robot.climber import Climber
 from backend.robot.firmware import Firmware
 from backend.robot.messages import ProtocolError, RobotState, decode, encode
-from backend.robot.xbee import FrameError, FrameParser, encode_frame, parse_tx_request, rx_packet
+from backend.robot.xbee import ROBOT_ADDRESS, FrameError, FrameParser, encode_frame, parse_tx_request, rx_packet
 
 log = logging.getLogger("parkourlab.robot")
-ROBOT_ADDRESS = 0x0013A20040B0B0B0  # the robot radio's 64-bit address
 TICK = 0.02  # [s] watchdog and telemetry resolution
 
 

@@ -22,6 +22,10 @@ XOFF = 0x13
 SPECIAL = frozenset({START, ESCAPE, XON, XOFF})
 MAX_FRAME_DATA = 256  # far above our largest message; a longer length is corruption
 
+# The robot radio's 64-bit address (its XBee's SH:SL): the PC link addresses the robot by it, and
+# the virtual robot's radio answers from it.
+ROBOT_ADDRESS = 0x0013A20040B0B0B0
+
 TX_REQUEST = 0x10  # frame types used by the link
 RX_PACKET = 0x90
 TX_STATUS = 0x8B

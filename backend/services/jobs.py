@@ -32,7 +32,6 @@ from experiments.cluster import as_completed_results, chunk_map_for, dask_client
 from experiments.manifest import json_safe
 from sim_core.chunks import Cancelled
 from sim_core.failures import OK, Failure
-from sim_core.mjtf import level_starts, run_trials
 from sim_core.noise import NoiseModel, trial_seeds
 
 log = logging.getLogger("parkourlab.jobs")
@@ -172,6 +171,8 @@ class JobRunner:
         if kind != "mjtf":
             self._run_study(job_id, spec)
             return
+        from sim_core.mjtf import level_starts  # the kernels load with the first job (simulation.py says why)
+
         model = model_params(spec.model)
         noise = NoiseModel(**spec.noise.model_dump())
         guess = None if spec.guess is None else (spec.guess.xdot, spec.guess.ydot)
@@ -232,6 +233,8 @@ class JobRunner:
 
     def _execute(self, arguments: list[tuple]) -> Iterator[tuple[int, tuple[np.ndarray, np.ndarray]]]:
         """``(chunk index, result)`` as chunks finish: here in order, or on the Dask cluster."""
+        from sim_core.mjtf import run_trials
+
         if self.dask_address is None:
             for index, chunk in enumerate(arguments):
                 with KERNEL_LOCK:

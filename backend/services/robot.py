@@ -28,9 +28,9 @@ from backend.services.records import Conflict, NotFound
 from backend.services.simulation import current_code_version, pack_trajectory, unpack_trajectory
 from backend.store.models import Run, RunTag
 from experiments.manifest import json_safe
-from sim_core import ControlSchedule, LegControl, ParameterError, get_preset, iterate_map
-from sim_core.closed_loop import pid_step
-from sim_core.sweep import find_in_place_zeta0
+from sim_core.controls import ControlSchedule, LegControl
+from sim_core.errors import ParameterError
+from sim_core.presets import get_preset
 from sim_core.walls import wall_of
 
 POLL = 0.005  # [s] how often a live run looks at new poses
@@ -209,6 +209,8 @@ class RobotService:
         return self.status()
 
     def _execute(self, run: LiveRun, legs: list[LegControl]) -> None:
+        from sim_core.closed_loop import pid_step  # loaded before the first touchdown, not with the service
+
         link, tracker = self.link, self.tracker
         first_pose = tracker.count()
         controller = self._controller(run.request, legs)
@@ -284,6 +286,8 @@ class RobotService:
             run.done.set()
 
     def _controller(self, body: RobotRunCreate, legs: list[LegControl]) -> dict | None:
+        from sim_core.sweep import find_in_place_zeta0
+
         loop = body.closed_loop
         if loop is None:
             return None
@@ -338,6 +342,8 @@ class RobotService:
 def touchdown_results(touchdowns: list[Touchdown], controls: list[LegControl], robot) -> dict:
     """What a robot or replay run stores about its touchdowns: each touchdown, its section state,
     the height gains, and the model's prediction from the first touchdown with the same controls."""
+    from sim_core.poincare import iterate_map
+
     gains = height_gains(touchdowns, robot) if len(touchdowns) > 1 else np.empty(0)
     prediction = None
     if len(touchdowns) > 1:

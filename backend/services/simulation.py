@@ -1,4 +1,9 @@
-"""Simulations the service runs: translating request bodies into sim_core calls and back."""
+"""Simulations the service runs: translating request bodies into sim_core calls and back.
+
+The compiled kernels (numba, and scipy for the fixed points) load with the first simulation, not
+with the service, so ``parkour serve`` answers before they have loaded; :func:`warm_up` loads
+them in the background at start-up. Hence the imports inside the functions below.
+"""
 
 from __future__ import annotations
 
@@ -8,17 +13,20 @@ import threading
 import time
 import zlib
 from dataclasses import asdict, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from backend.schemas import FixedPointIn, LegIn, MapIn, ModelIn, RunCreate, TrajectoryIn
 from experiments.manifest import code_version, json_safe
-from sim_core import ControlSchedule, FixedPointNotFound, ModelParams, get_preset, iterate_map, simulate_trajectory
-from sim_core.basin import BasinGrid, compute_basin
-from sim_core.basin_grid import DEFAULT_BASIN_WINDOW
-from sim_core.fixed_points import FixedPoint, NoGaitFound, gait_of, search_gaits
-from sim_core.sweep import energy_sweep, zeta0_values
-from sim_core.validation import ParameterError
+from sim_core.basin_grid import DEFAULT_BASIN_WINDOW, BasinGrid
+from sim_core.controls import ControlSchedule
+from sim_core.errors import FixedPointNotFound, ParameterError
+from sim_core.params import ModelParams
+from sim_core.presets import START_GUESS, get_preset
+
+if TYPE_CHECKING:
+    from sim_core.fixed_points import FixedPoint
 
 _CODE_VERSION = None
 
@@ -43,13 +51,29 @@ def schedule_of(controls: list[LegIn]) -> ControlSchedule:
     return ControlSchedule.from_degrees([(leg.psi0_deg, leg.zeta0) for leg in controls])
 
 
+def warm_up() -> None:
+    """Load the kernels a first request needs (from numba's cache, or compiled once) and scipy's
+    solver: one short map, path and gait, off the request path."""
+    with KERNEL_LOCK:
+        from sim_core.fixed_points import gait_of
+        from sim_core.trajectory import simulate_trajectory
+
+        model, schedule = get_preset("paper").to_model(), ControlSchedule.from_degrees([(30.0, 0.9)])
+        gait = gait_of(model, schedule, guess=START_GUESS)
+        simulate_trajectory(model, schedule, gait.state, 1)
+
+
 def map_orbit(body: MapIn) -> dict:
+    from sim_core.poincare import iterate_map
+
     start = (body.start.xdot, body.start.ydot)
     with KERNEL_LOCK:
         return iterate_map(model_params(body.model), schedule_of(body.controls), start, body.jumps).to_dict()
 
 
 def trajectory_columns(body: TrajectoryIn) -> dict:
+    from sim_core.trajectory import simulate_trajectory
+
     start = (body.start.xdot, body.start.ydot)
     path = simulate_trajectory(
         model_params(body.model), schedule_of(body.controls), start, body.jumps, sample_rate=body.rate
@@ -73,6 +97,8 @@ def fixed_point(body: FixedPointIn) -> dict:
 def _gait_of(model: ModelParams, schedule: ControlSchedule, period: int | None, guess) -> FixedPoint:
     """:func:`sim_core.fixed_points.gait_of` for a request; a search that finds nothing is a 422
     naming the controls. ``guess`` is the request's state (``xdot``, ``ydot``) or None."""
+    from sim_core.fixed_points import NoGaitFound, gait_of
+
     try:
         return gait_of(model, schedule, period, None if guess is None else (guess.xdot, guess.ydot))
     except NoGaitFound as error:
@@ -94,6 +120,10 @@ def locked_chunk_map(function, arguments, progress=None) -> list:
 
 def run_study(spec, chunk_map, progress) -> dict:
     """A sweep, basin or gait-search job's computation; returns its JSON result."""
+    from sim_core.basin import compute_basin
+    from sim_core.fixed_points import search_gaits
+    from sim_core.sweep import energy_sweep, zeta0_values
+
     model = model_params(spec.model)
     if spec.kind == "sweep":
         psi0 = math.radians(spec.psi0_deg)
@@ -132,6 +162,9 @@ def run_study(spec, chunk_map, progress) -> dict:
 
 def simulate_run(body: RunCreate) -> dict:
     """Run the map (and the sampled path if asked); the fields of a stored run."""
+    from sim_core.poincare import iterate_map
+    from sim_core.trajectory import simulate_trajectory
+
     model, schedule = model_params(body.model), schedule_of(body.controls)
     start = (body.start.xdot, body.start.ydot)
     began = time.perf_counter()
@@ -166,6 +199,8 @@ def simulate_run(body: RunCreate) -> dict:
 
 def _gait_near(model, schedule, start) -> dict:
     """The period-m gait nearest the start state (m: the schedule length), or why there is none."""
+    from sim_core.fixed_points import gait_of
+
     try:
         with KERNEL_LOCK:
             gait = gait_of(model, schedule, guess=start)
