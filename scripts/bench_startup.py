@@ -8,6 +8,8 @@ bytecode, which this script compiles once when the environment sets PYTHONDONTWR
 - ``map_help``: ``parkour map --help``, and which heavy packages it imported (it should import
   none of scipy.optimize, SQLAlchemy, Alembic, Dask, matplotlib, viser);
 - ``map``: ``parkour map --jumps 10 --state -0.93 -0.17 --json``;
+- ``numba_floor``: a fresh interpreter calling a trivial cached ``@njit`` function — what numba's own
+  import and first dispatch cost before any of ParkourLab's work (the floor under ``map``);
 - ``serve``: ``parkour serve`` from launch to the first 200 from ``/api/v1/health`` (3D view on),
   on a data directory that exists, as on every start but the first;
 - ``serve_first``: the same on a new data directory each time (the schema is created first).
@@ -37,6 +39,7 @@ from pathlib import Path
 HEAVY = ("scipy.optimize", "sqlalchemy", "alembic", "dask", "distributed", "matplotlib", "viser", "fastapi")
 SERVE_TIMEOUT_S = 60.0
 MAP_ARGS = ("map", "--jumps", "10", "--state", "-0.93", "-0.17", "--json")
+TRIVIAL_KERNEL = "import numba\n\n\n@numba.njit(cache=True)\ndef one_more(x):\n    return x + 1.0\n"
 # The interpreter's view of what a command imported, printed at exit: run the entry point inside it.
 _PROBE = (
     "import atexit, sys, json, runpy; "
@@ -100,6 +103,13 @@ def imported_by(module: str, argv: list[str]) -> list[str]:
     return [name for name in HEAVY if name in modules]
 
 
+def numba_floor_command(directory: str) -> list[str]:
+    """A command that calls a trivial cached numba kernel, written into ``directory``."""
+    Path(directory, "trivial_kernel.py").write_text(TRIVIAL_KERNEL)
+    probe = f"import sys; sys.path.insert(0, {directory!r}); import trivial_kernel; trivial_kernel.one_more(1.0)"
+    return [sys.executable, "-c", probe]
+
+
 def warm_caches(command: list[str], data_dir: str) -> None:
     """Compile the project's bytecode (as any Python that may write it does on first import), fill
     numba's cache and the OS file cache, and create the schema in ``data_dir``."""
@@ -111,12 +121,15 @@ def warm_caches(command: list[str], data_dir: str) -> None:
 
 def run(command: list[str], module: str, repeats: int) -> dict:
     numpy_import = [sys.executable, "-c", "import numpy"]
-    names = ("numpy_import", "help", "map_help", "map", "serve", "serve_first")
+    names = ("numpy_import", "help", "map_help", "numba_floor", "map", "serve", "serve_first")
     samples: dict[str, list[float]] = {name: [] for name in names}
-    with tempfile.TemporaryDirectory() as data_dir:
+    with tempfile.TemporaryDirectory() as data_dir, tempfile.TemporaryDirectory() as kernel_dir:
+        numba_floor = numba_floor_command(kernel_dir)
+        timed(numba_floor)  # compiles and caches it
         warm_caches(command, data_dir)
         for _ in range(repeats):  # interleaved, so a burst of load hits every figure alike
             samples["numpy_import"].append(timed(numpy_import))
+            samples["numba_floor"].append(timed(numba_floor))
             samples["help"].append(timed([*command, "--help"]))
             samples["map_help"].append(timed([*command, "map", "--help"]))
             samples["map"].append(timed([*command, *MAP_ARGS]))
