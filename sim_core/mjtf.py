@@ -212,6 +212,10 @@ def run_trials(
     return jumps, status
 
 
+# The kernels' flat argument lists (noise as NoiseModel.kernel_args(), the model as
+# ModelParams.kernel_args(), the same order in trial, trials_batch and closed_loop.pid_loop) are
+# repeated on purpose: numba kernels take scalars, not dataclasses, and each list is checked by the
+# kernel's own tests against the Python wrappers that unpack the dataclasses.
 @kernel
 def trial(
     xdot,

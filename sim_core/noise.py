@@ -59,12 +59,10 @@ class NoiseModel:
     asymmetry_zeta0: float = 0.0
 
     def __post_init__(self) -> None:
-        check_range("noise.psi0_deg", self.psi0_deg, 0.0, 30.0, low_open=False)
-        check_range("noise.zeta0", self.zeta0, 0.0, 0.2, low_open=False)
-        check_range("noise.velocity", self.velocity, 0.0, 1.0, low_open=False)
-        check_range("noise.pitch_drift_deg", self.pitch_drift_deg, 0.0, 30.0, low_open=False)
-        check_range("noise.asymmetry_psi0_deg", self.asymmetry_psi0_deg, -30.0, 30.0)
-        check_range("noise.asymmetry_zeta0", self.asymmetry_zeta0, -0.5, 0.5)
+        for field, limit in (("psi0_deg", 30.0), ("zeta0", 0.2), ("velocity", 1.0), ("pitch_drift_deg", 30.0)):
+            check_range(f"noise.{field}", getattr(self, field), 0.0, limit, low_open=False)  # sigmas: [0, limit)
+        for field, limit in (("asymmetry_psi0_deg", 30.0), ("asymmetry_zeta0", 0.5)):
+            check_range(f"noise.{field}", getattr(self, field), -limit, limit)
 
     def kernel_args(self) -> tuple[float, ...]:
         """``(sigma_psi0, sigma_zeta0, sigma_velocity, sigma_pitch, asymmetry_psi0, asymmetry_zeta0)``, radians."""

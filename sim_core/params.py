@@ -40,9 +40,7 @@ class ModelParams:
     def __post_init__(self) -> None:
         check_range("alpha", self.alpha, 0.0)
         check_range("d_hat", self.d_hat, 0.0)
-        check_range("c_zeta", self.c_zeta, 0.0, low_open=False)
-        check_range("c_psi", self.c_psi, 0.0, low_open=False)
-        check_range("mu", self.mu, 0.0, math.inf, high_open=False, allow_inf=True)
+        _check_damping_and_friction(self)
 
     def kernel_args(self) -> tuple[float, float, float, float, float]:
         """``(alpha, d_hat, c_zeta, c_psi, mu)``, the order the compiled kernels take them in."""
@@ -86,9 +84,7 @@ class PhysicalParams:
     def __post_init__(self) -> None:
         for field in ("mass", "leg_length", "stiffness", "wall_distance", "gravity"):
             check_range(field, getattr(self, field), 0.0)
-        check_range("c_zeta", self.c_zeta, 0.0, low_open=False)
-        check_range("c_psi", self.c_psi, 0.0, low_open=False)
-        check_range("mu", self.mu, 0.0, math.inf, high_open=False, allow_inf=True)
+        _check_damping_and_friction(self)
 
     @property
     def scales(self) -> Scales:
@@ -128,3 +124,10 @@ class PhysicalParams:
             c_psi=model.c_psi * mass / time,
             mu=model.mu,
         )
+
+
+def _check_damping_and_friction(params: ModelParams | PhysicalParams) -> None:
+    """What both parameter sets require of the same fields: damping >= 0, friction > 0 (inf: no slip)."""
+    check_range("c_zeta", params.c_zeta, 0.0, low_open=False)
+    check_range("c_psi", params.c_psi, 0.0, low_open=False)
+    check_range("mu", params.mu, 0.0, math.inf, high_open=False, allow_inf=True)

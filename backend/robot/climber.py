@@ -103,23 +103,25 @@ class Climber:
         self.end = None
         while self._active():
             stance = climb.stance(setup, start)
-            self._stream(stance.samples, start.pitch, started)
-            if not self._active():
-                return
-            if stance.end is not None:
-                self._fall(stance.end)
+            if not self._streamed(stance.samples, stance.end, start.pitch, started):
                 return
             # Read at lift-off: the robot positioned this leg during the stance just streamed.
             next_leg = climb.read_next_leg(start, self._commanded(start.wall.other), sampler)
             jump = climb.jump(setup, start, next_leg)
-            self._stream(jump.flight, start.pitch, started)
-            if not self._active():
-                return
-            if jump.end is not None:
-                self._fall(jump.end)
+            if not self._streamed(jump.flight, jump.end, start.pitch, started):
                 return
             start = climb.touchdown_after(setup, jump, sampler)
             self.jumps += 1
+
+    def _streamed(self, samples, end, pitch: float, started: float) -> bool:
+        """Stream ``samples``; whether the climb goes on (False once stopped, or at ``end``, a fall)."""
+        self._stream(samples, pitch, started)
+        if not self._active():
+            return False
+        if end is not None:
+            self._fall(end)
+            return False
+        return True
 
     def _active(self) -> bool:
         return self.running() and not self._stop.is_set()

@@ -322,14 +322,11 @@ class RobotService:
                 code_version=current_code_version(),
                 model=json_safe(asdict(model)),
                 controls=[[leg.psi0_deg, leg.zeta0] for leg in request.controls],
-                start_state=json_safe(list(touchdowns[0].state) if touchdowns else [math.nan, math.nan]),
                 jumps=request.jumps,
                 alpha=model.alpha,
                 psi0_deg=first.psi0_deg,
                 zeta0=first.zeta0,
-                failure_code=None,
-                jumps_completed=max(len(touchdowns) - 1, 0),
-                climb=float(np.sum(analysis["rises"])),
+                **touchdown_columns(touchdowns, analysis),
                 results=json_safe(results),
                 trajectory=pack_trajectory(frames) if poses else None,
             )
@@ -337,6 +334,17 @@ class RobotService:
             session.add(stored)
             session.commit()
             run.stored_run_id = stored.id
+
+
+def touchdown_columns(touchdowns: list[Touchdown], analysis: dict) -> dict:
+    """The stored run's columns its touchdowns decide (a robot run or its replay): the first
+    section state, the jumps between touchdowns and their climb; a tracked run has no failure code."""
+    return {
+        "start_state": json_safe(list(touchdowns[0].state) if touchdowns else [math.nan, math.nan]),
+        "failure_code": None,
+        "jumps_completed": max(len(touchdowns) - 1, 0),
+        "climb": float(np.sum(analysis["rises"])),
+    }
 
 
 def touchdown_results(touchdowns: list[Touchdown], controls: list[LegControl], robot) -> dict:
@@ -387,14 +395,11 @@ def replay_run(session, run_id: int, robot=None) -> Run:
         code_version=current_code_version(),
         model=source.model,
         controls=source.controls,
-        start_state=json_safe(list(touchdowns[0].state) if touchdowns else [math.nan, math.nan]),
         jumps=source.jumps,
         alpha=source.alpha,
         psi0_deg=source.psi0_deg,
         zeta0=source.zeta0,
-        failure_code=None,
-        jumps_completed=max(len(touchdowns) - 1, 0),
-        climb=float(np.sum(analysis["rises"])),
+        **touchdown_columns(touchdowns, analysis),
         results=json_safe({"source_run_id": run_id, **analysis}),
         trajectory=None,
     )

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim_core import LegControl, PhysicalParams, climb
-from sim_core.climb import ClimbSetup, End, Jump, JumpStart, NextLeg
+from sim_core.climb import ClimbSetup, End, Jump, JumpStart, NextLeg, Samples
 from sim_core.trajectory import STANCE
 from sim_core.walls import Wall
 
@@ -51,16 +51,11 @@ class Pose:
 
 
 @dataclass(frozen=True)
-class PathClip:
-    """Sampled motion, columns of one length in time order (SI; see the module doc)."""
+class PathClip(Samples):
+    """Sampled motion (the sequencer's :class:`~sim_core.climb.Samples`: SI, see the module doc)
+    with what the view needs beside it: per sample, the wall the drawn leg reaches for
+    (``leg_wall``) and the jump (``jump``)."""
 
-    time: np.ndarray
-    x: np.ndarray
-    y: np.ndarray
-    foot_x: np.ndarray
-    foot_y: np.ndarray
-    zeta: np.ndarray
-    phase: np.ndarray
     leg_wall: np.ndarray
     jump: np.ndarray
 
@@ -140,13 +135,7 @@ class JumpPlan:
     def of(cls, jump: Jump, robot: PhysicalParams) -> JumpPlan:
         samples, wall = jump.samples, jump.wall
         clip = PathClip(
-            time=samples.time,
-            x=samples.x,
-            y=samples.y,
-            foot_x=samples.foot_x,
-            foot_y=samples.foot_y,
-            zeta=samples.zeta,
-            phase=samples.phase,
+            **{name: getattr(samples, name) for name in Samples.COLUMNS},
             leg_wall=np.where(samples.phase == STANCE, wall, wall.other),
             jump=np.full(samples.time.shape, jump.start.jump),
         )
