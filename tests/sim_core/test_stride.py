@@ -45,7 +45,7 @@ def test_successful_jump_fills_every_slot(paper):
 
 
 def test_flight_is_ballistic_from_the_recorded_liftoff(paper):
-    """What the kernel returns after the stance is the closed-form flight of model.md §2."""
+    """What the kernel returns after the stance is the closed-form flight of docs/model.md §2."""
     right = LegControl.from_degrees(34.0, 0.88)
     record = np.empty((500, STATE_SIZE))
     status, next_xdot, next_ydot, rise, _, flight_time, rows = _jump(paper, START, LEG, right, record)
