@@ -6,6 +6,7 @@ COPY sim_core sim_core
 COPY experiments experiments
 COPY backend backend
 COPY frontend frontend
+COPY cli cli
 RUN pip install --no-cache-dir ".[postgres]"
 ENV PARKOUR_DATA_DIR=/data \
     PARKOUR_CACHE_DIR=/data/cache

@@ -39,7 +39,7 @@ _EXPORTS = {
     "minimal_period": "fixed_points",
     "search_gaits": "fixed_points",
     "gait_of": "fixed_points",
-    "NoGaitFound": "fixed_points",
+    "NoGaitFound": "errors",
     "ModelParams": "params",
     "PhysicalParams": "params",
     "Scales": "params",

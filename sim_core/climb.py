@@ -5,7 +5,7 @@ One sequencer for every real-time climb (docs/model.md §2, §4, §5): jump ``k`
 read at lift-off (the robot positions it during the stance), so a jump runs in two parts —
 :func:`stance`, which does not depend on the next leg, then :func:`jump` with the next leg from
 :func:`read_next_leg` — or is planned whole and planned again at lift-off. Noise, when a
-:class:`sim_core.noise.NoiseSampler` is given, follows :mod:`sim_core.noise`'s rules in its
+:class:`sim_core.noise_rules.NoiseSampler` is given, follows :mod:`sim_core.noise`'s rules in its
 order: at lift-off a pitch step and the next leg's controls, after the jump the section state.
 No threads, clocks or sockets here: callers stream the samples at their own pace.
 
@@ -126,7 +126,7 @@ class Samples:
 
     def take(self, rows) -> Samples:
         """The rows ``rows`` (a slice, mask or index array) of every column."""
-        return Samples(**{name: getattr(self, name)[rows] for name in self.COLUMNS})
+        return type(self)(**{name: getattr(self, name)[rows] for name in self.COLUMNS})
 
 
 @dataclass(frozen=True)
@@ -266,8 +266,13 @@ def touchdown_after(setup: ClimbSetup, done: Jump, sampler: NoiseSampler | None 
 
 
 def replan(setup: ClimbSetup, planned: Jump, next_leg: NextLeg) -> Jump:
-    """``planned`` with another leg in flight (the stance is the same); ``planned`` if unchanged."""
-    if next_leg == planned.next or planned.liftoff >= len(planned.samples):
+    """``planned`` with another leg in flight (the stance is the same); ``planned`` if unchanged.
+
+    A climb that ended in the stance stays ended, except ``no_flight``: that is decided at lift-off
+    and may depend on the next leg (one long enough to reach the other wall already).
+    """
+    ended_in_stance = planned.liftoff >= len(planned.samples) and planned.end is not Failure.NO_FLIGHT
+    if next_leg == planned.next or ended_in_stance:
         return planned
     return jump(setup, planned.start, next_leg)
 

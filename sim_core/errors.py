@@ -6,6 +6,11 @@ API's error mapping — import them from here without loading the kernels.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from sim_core.controls import ControlSchedule
+
 
 class ParameterError(ValueError):
     """A parameter, control or state is outside its allowed range.
@@ -21,3 +26,18 @@ class ParameterError(ValueError):
 
 class FixedPointNotFound(RuntimeError):
     """Levenberg–Marquardt did not converge to a fixed point from the given guess."""
+
+
+class NoGaitFound(FixedPointNotFound):
+    """A grid search found no gait at all (:func:`sim_core.fixed_points.gait_of` without a usable guess).
+
+    Attributes:
+        schedule: the controls searched.
+        period: the period searched for [jumps].
+    """
+
+    def __init__(self, schedule: ControlSchedule, period: int):
+        super().__init__(
+            f"no period-{period} gait found for controls {schedule.describe()}; give a starting state explicitly"
+        )
+        self.schedule, self.period = schedule, period

@@ -19,7 +19,7 @@ import numpy as np
 
 from sim_core import stride
 from sim_core.controls import ControlSchedule
-from sim_core.errors import FixedPointNotFound
+from sim_core.errors import FixedPointNotFound, NoGaitFound
 from sim_core.failures import OK, Failure
 from sim_core.params import ModelParams
 from sim_core.poincare import check_section_state, iterate_map
@@ -31,21 +31,6 @@ JACOBIAN_STEP = 1e-3  # central-difference step, relative to max(1, |q_i|)
 IN_PLACE_TOL = 1e-6  # |climb per jump| [l0] below which a gait jumps in place
 _FAILED_RESIDUAL = 1e3  # residual of a trial point whose orbit fails: LM rejects the step
 DEFAULT_GRID = (6, 6)  # guesses per axis (xdot, ydot) of a gait search
-
-
-class NoGaitFound(FixedPointNotFound):
-    """A grid search found no gait at all (:func:`gait_of` without a usable guess).
-
-    Attributes:
-        schedule: the controls searched.
-        period: the period searched for [jumps].
-    """
-
-    def __init__(self, schedule: ControlSchedule, period: int):
-        super().__init__(
-            f"no period-{period} gait found for controls {schedule.describe()}; give a starting state explicitly"
-        )
-        self.schedule, self.period = schedule, period
 
 
 @dataclass(frozen=True)

@@ -23,3 +23,13 @@ def test_compose_file_declares_the_stack():
 @pytest.mark.skipif(shutil.which("docker-compose") is None, reason="docker-compose (Debian package) not installed")
 def test_compose_file_validates():
     subprocess.run(["docker-compose", "config", "-q"], cwd=ROOT, check=True, timeout=60)
+
+
+def test_the_image_copies_every_package_the_project_installs():
+    """The console script lives in cli/: an image without it has no ``parkour`` (it once lacked it)."""
+    import tomllib
+
+    packages = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"]["find"]
+    wanted = {pattern.rstrip("*") for pattern in packages["include"]}
+    copied = {line.split()[1] for line in (ROOT / "Dockerfile").read_text().splitlines() if line.startswith("COPY ")}
+    assert wanted <= copied, f"the Dockerfile does not COPY {sorted(wanted - copied)}"

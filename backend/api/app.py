@@ -149,7 +149,7 @@ def create_app(
             app.state.view_starter = ViewStarter(view_factory, context).start()
         yield
         if app.state.view_starter is not None:
-            app.state.view_starter.close()
+            await asyncio.to_thread(app.state.view_starter.close)  # may wait for a view still starting
         robot.disconnect()
         runner.stop()
         engine.dispose()

@@ -161,12 +161,18 @@ class JobRunner:
     def run(self, job_id: int) -> None:
         """Run (or resume) one job to its end, committing every chunk."""
         with self.sessions() as session:
-            job = session.get(Job, job_id)
-            if job is None or job.state not in ("queued", "running"):
-                return
-            job.state = "running"
-            job.started_at = job.started_at or utcnow()
+            # Claimed with one conditional UPDATE, as cancel_job changes state: a cancel that lands
+            # between reading the job and writing "running" is not overwritten.
+            claimed = session.execute(
+                update(Job)
+                .where(Job.id == job_id, Job.state.in_(("queued", "running")))
+                .values(state="running", started_at=func.coalesce(Job.started_at, utcnow())),
+                execution_options={"synchronize_session": False},
+            ).rowcount
             session.commit()
+            if not claimed:
+                return
+            job = session.get(Job, job_id)
             kind, spec = job.kind, JOB_KINDS[job.kind](**job.spec)
         if kind != "mjtf":
             self._run_study(job_id, spec)

@@ -97,7 +97,8 @@ def fixed_point(body: FixedPointIn) -> dict:
 def _gait_of(model: ModelParams, schedule: ControlSchedule, period: int | None, guess) -> FixedPoint:
     """:func:`sim_core.fixed_points.gait_of` for a request; a search that finds nothing is a 422
     naming the controls. ``guess`` is the request's state (``xdot``, ``ydot``) or None."""
-    from sim_core.fixed_points import NoGaitFound, gait_of
+    from sim_core.errors import NoGaitFound
+    from sim_core.fixed_points import gait_of
 
     try:
         return gait_of(model, schedule, period, None if guess is None else (guess.xdot, guess.ydot))

@@ -60,6 +60,8 @@ class ViewStarter:
         self._view: SceneView | None = None
         self._error: str | None = None
         self._done = threading.Event()
+        self._lock = threading.Lock()  # orders "built" against "closed": a view built after close() is closed
+        self._closed = False
         self._thread = threading.Thread(target=self._start, name="view-start", daemon=True)
 
     def start(self) -> ViewStarter:
@@ -68,12 +70,19 @@ class ViewStarter:
 
     def _start(self) -> None:
         try:
-            self._view = self._factory(self._context)
+            view = self._factory(self._context)
         except Exception as error:  # the API keeps running without a view, and says why
             log.exception("the 3D view did not start")
             self._error = f"the 3D view did not start: {error}"
-        finally:
             self._done.set()
+            return
+        with self._lock:
+            closed = self._closed
+            if not closed:
+                self._view = view
+        if closed:  # the service shut down while the view was being built
+            view.close()
+        self._done.set()
 
     @property
     def view(self) -> SceneView | None:
@@ -95,5 +104,11 @@ class ViewStarter:
         return self._view
 
     def close(self) -> None:
-        if self.wait(CLOSE_WAIT_S) is not None:
-            self._view.close()
+        """Close the view; one still being built is closed once built (waited for up to
+        :data:`CLOSE_WAIT_S`, then left to close itself)."""
+        self._done.wait(CLOSE_WAIT_S)
+        with self._lock:
+            self._closed = True
+            view, self._view = self._view, None
+        if view is not None:
+            view.close()

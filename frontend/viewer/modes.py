@@ -26,7 +26,8 @@ from frontend.viewer.motion import STANCE, Controls, JumpPlan, PathClip, Simulat
 from frontend.viewer.recordings import Recording, load_recording
 from frontend.viewer.scene import ChuteScene
 from sim_core import ControlSchedule, FixedPoint, LegControl, PhysicalParams
-from sim_core.fixed_points import NoGaitFound, gait_of
+from sim_core.errors import NoGaitFound
+from sim_core.fixed_points import gait_of
 from sim_core.presets import PAPER_GAITS, START_GUESS
 from sim_core.walls import Wall
 

@@ -59,6 +59,8 @@ class PathClip(Samples):
     leg_wall: np.ndarray
     jump: np.ndarray
 
+    COLUMNS = (*Samples.COLUMNS, "leg_wall", "jump")  # so take() keeps them
+
     def __post_init__(self) -> None:
         if self.time.size == 0:
             raise ValueError("a path clip needs at least one sample")

@@ -1,5 +1,6 @@
 """The climb sequencer (sim_core.climb): walls and legs, the next leg at lift-off, noise, the floor."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -15,6 +16,7 @@ from sim_core.climb import (
     jump,
     launch,
     read_next_leg,
+    replan,
     simulate_climb,
     stance,
     start_height,
@@ -127,3 +129,15 @@ def test_a_failing_jump_ends_the_climb_with_its_failure():
     jumps = simulate_climb(SETUP, lambda _wall: steep, START, 5)
     assert len(jumps) == 1 and jumps[0].end is Failure.SLIP and math.isnan(jumps[0].rise)
     assert stance(SETUP, jumps[0].start).end is Failure.SLIP
+
+
+def test_a_next_leg_that_would_reach_the_other_wall_at_liftoff_can_be_replanned():
+    """``no_flight`` is decided at lift-off by the next leg (here: too long for a narrow chute), so
+    reading another leg there gives a jump again; a failure in the stance itself stays."""
+    narrow = ClimbSetup(dataclasses.replace(ROBOT, wall_distance=1.4 * ROBOT.leg_length))
+    start = launch(narrow, LegControl.from_degrees(30, 0.9), (-0.93, -0.2))
+    blocked = jump(narrow, start, NextLeg(LegControl.from_degrees(30, 0.9)))
+    assert blocked.end is Failure.NO_FLIGHT and len(blocked.flight) == 0
+    freed = replan(narrow, blocked, NextLeg(LegControl.from_degrees(60, 0.5)))
+    assert freed.end is None and len(freed.flight) > 0
+    assert_array_equal(freed.stance.y, blocked.stance.y)

@@ -190,3 +190,14 @@ def test_a_failing_job_is_recorded_and_the_runner_goes_on(sessions, session, run
     failed = _wait_until(sessions, failing.id, lambda j: j.state in jobs.FINAL)
     assert failed.state == "failed" and failed.error.startswith("ParameterError: controls")
     assert _wait_until(sessions, after.id, lambda j: j.state in jobs.FINAL).state == "done"
+
+
+def test_the_runner_leaves_a_job_cancelled_before_it_starts_alone(sessions, session):
+    """The runner claims a job with a conditional UPDATE: a cancel that came first wins."""
+    job = jobs.create_job(session, MJTFJobCreate(**(SMALL | {"trials": 1})))
+    cancelled = jobs.cancel_job(session, job.id)
+    assert cancelled.state == "cancelled"
+    jobs.JobRunner(sessions).run(job.id)
+    after = _job(sessions, job.id)
+    assert (after.state, after.started_at, after.finished_at) == ("cancelled", None, cancelled.finished_at)
+    assert _trials(session, job.id) == []

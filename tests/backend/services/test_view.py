@@ -135,3 +135,21 @@ def test_views_implement_scene_view(implementation, method):
     got = inspect.signature(getattr(implementation, method)).parameters
     assert list(got) == list(expected), f"{implementation.__name__}.{method} arguments"
     assert [p.default for p in got.values()] == [p.default for p in expected.values()]
+
+
+def test_a_view_built_after_shutdown_gave_up_waiting_is_closed_too(monkeypatch):
+    import backend.services.view as view_service
+
+    monkeypatch.setattr(view_service, "CLOSE_WAIT_S", 0.01)
+    release, views = threading.Event(), []
+
+    def slow_factory(context: ViewContext) -> SceneView:
+        release.wait(10)
+        views.append(StandInView(context))
+        return views[-1]
+
+    starter = ViewStarter(slow_factory, ViewContext(sessions=lambda: None, robot_service=None)).start()
+    starter.close()  # gives up waiting: the view is not built yet
+    release.set()
+    starter.wait(10)
+    assert views[0].closed and starter.view is None
