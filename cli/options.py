@@ -110,11 +110,7 @@ _MODEL_PARAMETERS = [
 
 def with_model(command: Callable) -> Callable:
     """Add ``--preset --alpha --d-hat --c-zeta --c-psi --mu`` to ``command``; it receives ``setup``."""
-
-    def build(preset: str, **overrides: float | None) -> ModelSetup:
-        return build_setup(preset, **overrides)
-
-    return _with_options(command, "setup", _MODEL_PARAMETERS, build)
+    return _with_options(command, "setup", _MODEL_PARAMETERS, build_setup)
 
 
 _DEFAULT_NOISE = NoiseModel()
