@@ -9,6 +9,9 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, ConfigDict, Discriminator, Field, field_validator, model_validator
 from pydantic import Tag as KindTag
 
+from backend.robot.ports import check_port
+from backend.robot.xbee import ROBOT_ADDRESS
+
 Psi0Deg = Annotated[float, Field(gt=0.0, lt=90.0, description="leg angle at touchdown [degrees], in (0, 90)")]
 Zeta0 = Annotated[float, Field(gt=0.0, lt=1.0, description="leg length at touchdown [l0], in (0, 1)")]
 Label = Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[\w.:/-]+$")]  # a tag
@@ -278,14 +281,19 @@ class FixedPointIn(Strict):
 class RobotConnect(Strict):
     """Open the link: a pyserial URL (``/dev/ttyUSB0``, ``socket://host:port``) and the tracker's UDP port."""
 
-    # Serial devices, the virtual robot's socket, or a loopback: never an arbitrary device file.
+    # Serial devices and ptys (symlinks followed), the virtual robot's socket, RFC 2217, a loopback:
+    # never a regular file or another device (backend.robot.ports).
     url: Annotated[
         str,
-        Field(
-            max_length=200,
-            pattern=r"^(/dev/tty[A-Za-z]+[0-9]*|/dev/serial/by-id/[\w.:-]+|socket://[\w.-]+:[0-9]{1,5}|loop://|COM[0-9]{1,3})$",
-        ),
+        Field(max_length=200, description="a serial device or pty, socket://host:port, rfc2217://host:port, loop://"),
     ]
+    robot_address: Annotated[
+        str,
+        Field(
+            pattern=r"^(0x)?[0-9A-Fa-f]{16}$",
+            description="the robot radio's 64-bit address (its XBee's SH:SL, hex); frames from any other are dropped",
+        ),
+    ] = f"0x{ROBOT_ADDRESS:016X}"
     baud: Annotated[int, Field(ge=1200, le=1_000_000)] = 57_600
     tracker_host: Annotated[str, Field(max_length=100, pattern=r"^[\w.:-]+$")] = "127.0.0.1"
     tracker_port: Annotated[int, Field(ge=0, le=65535)] = 9751
@@ -297,6 +305,11 @@ class RobotConnect(Strict):
     calibration_scale: Annotated[float, Field(gt=0.0, le=1e4, description="metres per camera unit")] = 1.0
     psi0_limits_deg: Annotated[list[Psi0Deg], Field(min_length=2, max_length=2)] = [10.0, 60.0]
     zeta0_limits: Annotated[list[Zeta0], Field(min_length=2, max_length=2)] = [0.75, 0.98]
+
+    @field_validator("url")
+    @classmethod
+    def _openable(cls, url: str) -> str:
+        return check_port(url)
 
 
 class ClosedLoopIn(Strict):

@@ -25,7 +25,10 @@ def main() -> int:
     try:
         for _ in range(options.repeats):
             link.arm()
-            latencies.append(link.estop() * 1000)
+            result = link.estop()
+            if not result.acknowledged:
+                raise SystemExit(f"e-stop not acknowledged: {result.reason}")
+            latencies.append(result.latency * 1000)
             link.reset()
     finally:
         link.close()
@@ -35,6 +38,7 @@ def main() -> int:
         "repeats": options.repeats,
         "p50_ms": statistics.median(latencies),
         "p95_ms": latencies[int(0.95 * (len(latencies) - 1))],
+        "p99_ms": latencies[int(0.99 * (len(latencies) - 1))],
         "max_ms": latencies[-1],
         "frames_rejected": link.parser.stats.bad_checksum + link.rejected_payloads,
     }
@@ -43,7 +47,7 @@ def main() -> int:
     else:
         print(
             f"e-stop to acknowledgement over {options.repeats} runs: p50 {result['p50_ms']:.2f} ms, "
-            f"p95 {result['p95_ms']:.2f} ms, max {result['max_ms']:.2f} ms"
+            f"p95 {result['p95_ms']:.2f} ms, p99 {result['p99_ms']:.2f} ms, max {result['max_ms']:.2f} ms"
         )
     return 0
 

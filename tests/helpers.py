@@ -5,6 +5,7 @@ from __future__ import annotations
 import socket
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -36,3 +37,17 @@ def start_service(data_dir: Path, port: int, *options: str) -> subprocess.Popen:
     process.kill()
     process.wait()
     pytest.fail(f"the service did not start within {SERVICE_START_TIMEOUT:g} s")
+
+
+def answer_within(seconds: float, call, *args):
+    """``call(*args)``'s result, or a test failure if it has not returned after ``seconds`` — so a
+    call that regresses into a hang fails instead of hanging the suite (the thread is left behind)."""
+    box: list = []
+    thread = threading.Thread(target=lambda: box.append(call(*args)), name="answer-within", daemon=True)
+    thread.start()
+    thread.join(seconds)
+    if thread.is_alive():
+        pytest.fail(f"{getattr(call, '__name__', call)} did not answer within {seconds:g} s")
+    if not box:
+        pytest.fail(f"{getattr(call, '__name__', call)} raised (see the thread's traceback)")
+    return box[0]

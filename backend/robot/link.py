@@ -6,11 +6,19 @@ from its telemetry and acknowledgements; a heartbeat thread keeps the robot arme
 the robot for ``heartbeat_timeout`` is a lost link: the state becomes ``disconnected`` and the
 ``on_lost`` callbacks run (a live run aborts, keeping what it recorded). Leg commands are checked
 against the servo limits before they are sent. Every state change is kept in ``transitions``.
+
+Faults a lab meets are bounded and counted, never raised into a caller's lap: no write blocks
+longer than ``WRITE_TIMEOUT`` (pyserial's ``write_timeout``; a timeout is a ``write_timeouts``
+count and a :class:`LinkError`), and only Receive Packets from ``robot_address`` are heard — a
+frame from any other radio is a ``foreign_frames`` count and changes nothing. :meth:`RobotLink.estop`
+takes no lock that a command, a blocked write or a reconnect holds for longer than one bounded
+write, and gives up after its ``timeout`` with an honest :class:`EstopResult`.
 """
 
 from __future__ import annotations
 
 import enum
+import socket
 import threading
 import time
 from collections.abc import Callable
@@ -32,11 +40,14 @@ from backend.robot.messages import (
     decode,
     encode,
 )
+from backend.robot.ports import check_port
 from backend.robot.xbee import ROBOT_ADDRESS, FrameError, FrameParser, encode_frame, parse_rx_packet, tx_request
 
 HEARTBEAT_PERIOD = 0.2  # [s]
 HEARTBEAT_TIMEOUT = 1.0  # [s]
 COMMAND_TIMEOUT = 0.5  # [s] for an acknowledgement
+WRITE_TIMEOUT = 0.1  # [s] the longest any write may block its caller (pyserial's write_timeout)
+ESTOP_TIMEOUT = 0.15  # [s] an e-stop's whole budget, blocked writes included: the API answers within 200 ms
 ESTOP_REPEAT = 0.02  # [s] between e-stop repeats until acknowledged
 READ_TIMEOUT = 0.02  # [s]
 
@@ -59,6 +70,15 @@ _FROM_ROBOT = {
 
 class LinkError(RuntimeError):
     """The robot did not answer, refused a command, or the link is down."""
+
+
+@dataclass(frozen=True)
+class EstopResult:
+    """What an e-stop achieved: acknowledged by the robot after ``latency`` [s], or not, and why."""
+
+    acknowledged: bool
+    latency: float  # [s] from the call to the acknowledgement, or to giving up
+    reason: str | None = None  # why it was not acknowledged
 
 
 @dataclass(frozen=True)
@@ -89,6 +109,9 @@ class RobotLink:
         self.telemetry: Telemetry | None = None
         self.parser = FrameParser()
         self.rejected_payloads = 0
+        self.foreign_frames = 0  # Receive Packets from a radio that is not robot_address
+        self.write_timeouts = 0
+        self.estops_unacknowledged = 0
         self.on_lost: list[Callable[[str], None]] = []
         self._port = None
         self._seq = 0
@@ -99,16 +122,24 @@ class RobotLink:
         self._stop = threading.Event()
         self._threads: list[threading.Thread] = []
         self.send_heartbeats = True  # tests turn this off to starve the robot
+        # An unacknowledged e-stop stops the heartbeats, so the robot's own watchdog disarms it
+        # even if the line is only lossy; a reset or a new connection resumes them.
+        self._starved = False
 
     # Connection -----------------------------------------------------------------------------
     def connect(self, timeout: float = 3.0) -> LinkState:
         """Open the port and wait for the robot's first telemetry."""
         self.telemetry = None
         self.parser = FrameParser()
+        self._starved = False
         try:
-            self._port = serial.serial_for_url(self.url, baudrate=self.baud, timeout=READ_TIMEOUT)
+            check_port(self.url)
+            self._port = serial.serial_for_url(
+                self.url, baudrate=self.baud, timeout=READ_TIMEOUT, write_timeout=WRITE_TIMEOUT
+            )
         except (serial.SerialException, ValueError, OSError) as error:
             raise LinkError(f"cannot open {self.url}: {error}") from None
+        _no_delay(self._port)
         self._stop.clear()
         self._last_heard = time.monotonic()
         self._threads = [
@@ -136,17 +167,20 @@ class RobotLink:
         for thread in self._threads:
             if thread is not threading.current_thread():
                 thread.join(2)
-        if self._port is not None:
-            self._port.close()
-            self._port = None
+        with self._write_lock:  # no write is under way on the port being closed (each is bounded)
+            port, self._port = self._port, None
+        if port is not None:
+            port.close()
         self._move(LinkState.DISCONNECTED, "closed")
 
     # Commands -------------------------------------------------------------------------------
     def arm(self) -> None:
+        self._refuse_if_starved("arm")
         self._command(Command(self._next_seq(), Kind.ARM), expect=LinkState.ARMED)
 
     def start(self) -> None:
         """Armed robot: launch and keep jumping with the legs' current controls."""
+        self._refuse_if_starved("start")
         self._command(Command(self._next_seq(), Kind.START), expect=LinkState.RUNNING)
 
     def disarm(self) -> None:
@@ -154,29 +188,68 @@ class RobotLink:
 
     def reset(self) -> None:
         self._command(Command(self._next_seq(), Kind.RESET), expect=LinkState.DISARMED)
+        self._starved = False
 
     def set_leg(self, leg: Leg, psi0_deg: float, zeta0: float) -> None:
         """Send a leg's controls for its next touchdown; outside the servo limits, refuse to send."""
         self.limits.check(psi0_deg, zeta0)
         self._command(SetLeg(self._next_seq(), leg, psi0_deg, zeta0))
 
-    def estop(self, timeout: float = 2.0) -> float:
-        """Emergency stop: repeat ESTOP until acknowledged; returns the latency to the ack [s]."""
+    def estop(self, timeout: float = ESTOP_TIMEOUT) -> EstopResult:
+        """Emergency stop: repeat ESTOP every ESTOP_REPEAT until acknowledged or ``timeout`` [s].
+
+        Tried whatever the link believes (a link seen as lost may still reach the robot), and never
+        raises: a blocked or closed port only ends the attempt sooner. Not acknowledged, the
+        heartbeats stop, so the robot's own watchdog disarms it within its heartbeat timeout."""
         started = time.monotonic()
+        deadline = started + timeout
+        write_by = deadline - WRITE_TIMEOUT  # a write started by then ends, even blocked, by the deadline
         message = Command(self._next_seq(), Kind.ESTOP)
         event, _box = self._expect(message.seq)
+        reason = None
+        self._starved = True  # the line is the e-stop's; heartbeats resume only if acknowledged
         try:
-            while not event.is_set():
-                if time.monotonic() - started > timeout:
-                    raise LinkError(f"e-stop not acknowledged within {timeout:g} s")
-                self._write(message)
-                event.wait(ESTOP_REPEAT)
+            while not event.is_set() and time.monotonic() < deadline:
+                if time.monotonic() < write_by:
+                    try:
+                        self._write(message, deadline=write_by)
+                    except LinkError as error:
+                        reason = str(error)
+                        if self._port is None:
+                            break  # closed: nothing to retry on
+                event.wait(min(ESTOP_REPEAT, max(0.0, deadline - time.monotonic())))
         finally:
             self._acks.pop(message.seq, None)
-        self._move(LinkState.ESTOPPED, "e-stop acknowledged")
-        return time.monotonic() - started
+        latency = time.monotonic() - started
+        if event.is_set():
+            self._starved = False
+            self._move(LinkState.ESTOPPED, "e-stop acknowledged")
+            return EstopResult(True, latency)
+        self.estops_unacknowledged += 1
+        why = f"no acknowledgement within {timeout * 1000:.0f} ms" + (f" ({reason})" if reason else "")
+        return EstopResult(False, latency, why)
+
+    def counters(self) -> dict[str, int]:
+        """Frames and faults since the last connect (the parser's) and since this link was made."""
+        stats = self.parser.stats
+        return {
+            "frames_in": stats.frames,
+            "bad_checksum": stats.bad_checksum,
+            "truncated": stats.truncated,
+            "bad_length": stats.bad_length,
+            "garbage_bytes": stats.garbage_bytes,
+            "rejected_payloads": self.rejected_payloads,
+            "foreign_frames": self.foreign_frames,
+            "write_timeouts": self.write_timeouts,
+            "estops_unacknowledged": self.estops_unacknowledged,
+        }
 
     # Internals ------------------------------------------------------------------------------
+    def _refuse_if_starved(self, name: str) -> None:
+        # As the firmware latches an e-stop, the link latches one it could not confirm.
+        if self._starved:
+            raise LinkError(f"an e-stop was not acknowledged; reset before you {name}")
+
     def _command(self, message, expect: LinkState | None = None) -> Ack:
         """Send, wait for the acknowledgement, and (``expect``) for the telemetry showing its effect."""
         if self.state == LinkState.DISCONNECTED:
@@ -204,15 +277,26 @@ class RobotLink:
         self._acks[seq] = entry
         return entry
 
-    def _write(self, message) -> None:
+    def _write(self, message, deadline: float | None = None) -> None:
+        """Send one frame, blocking at most WRITE_TIMEOUT once the port is ours; waits for the write
+        lock until ``deadline`` (monotonic), or without one as long as another writer's bounded write."""
         frame = encode_frame(tx_request(encode(message), frame_id=0, destination64=self.robot_address))
-        with self._write_lock:
-            if self._port is None:
+        wait = -1 if deadline is None else max(0.0, deadline - time.monotonic())
+        if not self._write_lock.acquire(timeout=wait):
+            raise LinkError("another write is blocked on the port")
+        try:
+            port = self._port
+            if port is None:
                 raise LinkError("the link is down")
-            try:
-                self._port.write(frame)
-            except (serial.SerialException, OSError) as error:
-                raise LinkError(f"write failed: {error}") from None
+            port.write(frame)
+        except serial.SerialTimeoutException:
+            # A partial frame may be on the wire: the robot's parser resynchronises on the next start byte.
+            self.write_timeouts += 1
+            raise LinkError(f"write blocked for {WRITE_TIMEOUT * 1000:.0f} ms: the line is jammed") from None
+        except (serial.SerialException, OSError) as error:
+            raise LinkError(f"write failed: {error}") from None
+        finally:
+            self._write_lock.release()
 
     def _next_seq(self) -> int:
         with self._lock:
@@ -232,7 +316,11 @@ class RobotLink:
                 return
             for data in self.parser.feed(chunk):
                 try:
-                    message = decode(parse_rx_packet(data).payload)
+                    packet = parse_rx_packet(data)
+                    if packet.source64 != self.robot_address:
+                        self.foreign_frames += 1  # another radio: never our robot's state or heartbeat
+                        continue
+                    message = decode(packet.payload)
                 except (FrameError, ProtocolError):
                     self.rejected_payloads += 1
                     continue
@@ -254,11 +342,13 @@ class RobotLink:
 
     def _heartbeat_loop(self) -> None:
         while not self._stop.wait(HEARTBEAT_PERIOD):
-            if self.send_heartbeats:
+            if self.send_heartbeats and not self._starved:
                 try:
                     self._write(Command(self._next_seq(), Kind.HEARTBEAT))
                 except LinkError:
-                    return
+                    if self._port is None:
+                        return
+                    # Blocked (counted): the next one may pass; if none does, the robot disarms itself.
 
     def _lost(self, reason: str) -> None:
         self._stop.set()
@@ -272,3 +362,11 @@ class RobotLink:
                 return
             self.transitions.append(Transition(time.time(), self.state, state, reason))
             self.state = state
+
+
+def _no_delay(port) -> None:
+    """TCP_NODELAY on a socket:// or rfc2217:// transport: an e-stop must not wait behind Nagle's
+    algorithm for the previous segment's ACK. pyserial keeps the socket in ``_socket``."""
+    sock = getattr(port, "_socket", None)
+    if isinstance(sock, socket.socket) and sock.family in (socket.AF_INET, socket.AF_INET6):
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)

@@ -40,6 +40,7 @@ class VirtualRobot:
         self.server = socket.create_server((host, port))
         self.address = self.server.getsockname()
         self.lock = threading.Lock()  # the firmware is shared by the reader and the ticker
+        self._send_lock = threading.Lock()  # whole frames on the connection, whoever sends
         self.parser = FrameParser()
         self.rejected_payloads = 0
         self._connection: socket.socket | None = None
@@ -67,6 +68,13 @@ class VirtualRobot:
         self._close_connection()
         self.server.close()
 
+    def inject(self, data: bytes) -> None:
+        """Bytes the PC's radio delivers besides the robot's (another radio's frames, line noise):
+        the fault tests' way to put them on the line."""
+        with self._send_lock:
+            if self._connection is not None:
+                self._connection.sendall(data)
+
     def _legs(self) -> dict:
         with self.lock:
             return dict(self.firmware.legs)
@@ -87,6 +95,8 @@ class VirtualRobot:
             ready, _, _ = select.select(sockets, [], [], max(0.0, next_tick - time.monotonic()))
             if self.server in ready:
                 connection, _ = self.server.accept()
+                # No Nagle: an acknowledgement must not wait for the ACK of the telemetry before it.
+                connection.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
                 self._close_connection()
                 self._connection = connection
                 self.parser = FrameParser()
@@ -125,7 +135,8 @@ class VirtualRobot:
             return
         data = b"".join(encode_frame(rx_packet(encode(message), source64=ROBOT_ADDRESS)) for message in messages)
         try:
-            self._connection.sendall(data)
+            with self._send_lock:
+                self._connection.sendall(data)
         except OSError:
             self._close_connection()
 

@@ -7,10 +7,15 @@ Closed loop, each detected touchdown's height goes through the simulator's PID
 robot positions during the coming stance. The run ends when its jumps or time are used up,
 when stopped, or when anything goes wrong (e-stop, fall, lost link); it is then stored as a run
 of kind ``robot``, with the model's prediction for the same controls beside it, whatever ended it.
+
+The e-stop does not wait for any of this: :meth:`RobotService.estop_now` runs it on the service's
+own e-stop thread, under no lock, bounded, and answers whether the robot acknowledged it.
 """
 
 from __future__ import annotations
 
+import asyncio
+import concurrent.futures
 import math
 import threading
 import time
@@ -19,7 +24,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from backend.robot.limits import ServoLimits
-from backend.robot.link import LinkError, LinkState, RobotLink
+from backend.robot.link import EstopResult, LinkError, LinkState, RobotLink
 from backend.robot.messages import Leg
 from backend.robot.touchdown import Touchdown, detect_touchdowns, height_gains
 from backend.robot.tracker import Calibration, UdpPoseSource
@@ -35,6 +40,7 @@ from sim_core.walls import wall_of
 
 POLL = 0.005  # [s] how often a live run looks at new poses
 RECONNECT_PERIOD = 1.0  # [s] between attempts on a dropped link
+ESTOP_ANSWER = 0.17  # [s] the longest an e-stop request waits for its answer (the link gives up at 0.15 s)
 
 
 class RobotUnavailable(RuntimeError):
@@ -67,6 +73,11 @@ class RobotService:
         self.run: LiveRun | None = None
         self._wanted = False  # reconnect after a dropped link until disconnected by hand
         self._lock = threading.Lock()
+        # The e-stop's own thread: not the request pool that compute can fill, and no lock that a
+        # connect, a reconnect or a run holds. Presses while one is under way join it.
+        self._estop_executor = concurrent.futures.ThreadPoolExecutor(1, thread_name_prefix="robot-estop")
+        self._estop_guard = threading.Lock()  # held only to read or replace _estop_pending
+        self._estop_pending: concurrent.futures.Future | None = None
 
     # Connection -------------------------------------------------------------------------------
     def connect(self, body: RobotConnect) -> dict:
@@ -75,7 +86,7 @@ class RobotService:
             limits = ServoLimits(tuple(body.psi0_limits_deg), tuple(body.zeta0_limits))
             calibration = Calibration(tuple(body.calibration_origin), body.calibration_angle, body.calibration_scale)
             self.tracker = UdpPoseSource(body.tracker_host, body.tracker_port, calibration=calibration)
-            link = RobotLink(body.url, baud=body.baud, limits=limits)
+            link = RobotLink(body.url, baud=body.baud, limits=limits, robot_address=int(body.robot_address, 16))
             try:
                 link.connect()
             except LinkError:
@@ -92,6 +103,11 @@ class RobotService:
             self._wanted = False
             self._disconnect()
         return self.status()
+
+    def close(self) -> None:
+        """Service shutdown: disconnect, and let the e-stop thread go."""
+        self.disconnect()
+        self._estop_executor.shutdown(wait=False)
 
     def _on_lost(self, reason: str) -> None:
         """A dropped link is retried every RECONNECT_PERIOD until it answers or is disconnected by hand.
@@ -125,6 +141,8 @@ class RobotService:
             {
                 "state": LinkState.DISCONNECTED.value if link is None else link.state.value,
                 "url": None if link is None else link.url,
+                "robot_address": None if link is None else f"0x{link.robot_address:016X}",
+                "counters": None if link is None else link.counters(),
                 "telemetry": None if link is None or link.telemetry is None else _telemetry(link.telemetry),
                 "tracker": None
                 if tracker is None
@@ -177,13 +195,36 @@ class RobotService:
         return self.status()
 
     def estop(self) -> dict:
-        """Emergency stop at any moment; ends a live run (which is still stored)."""
-        link = self._connected()
-        latency = link.estop()
-        if self.run is not None and not self.run.done.is_set():
-            self.run.end_reason = self.run.end_reason or "e-stop"
-            self.run.stop_requested.set()
-        return {"latency_ms": latency * 1000.0, **self.status()}
+        """Emergency stop at any moment, bounded (the link gives up after ESTOP_TIMEOUT): ends a live
+        run (still stored) whether or not the robot acknowledges. Answers ``acknowledged`` and
+        ``latency_ms``; not acknowledged, a ``reason`` — the robot's watchdog then disarms it, as
+        the link has stopped its heartbeats. Takes no lock: it must not wait for anything that moves."""
+        link, run = self.link, self.run
+        if run is not None and not run.done.is_set():
+            run.end_reason = run.end_reason or "e-stop"
+            run.stop_requested.set()  # before the e-stop: the control loop sends nothing more
+        result = EstopResult(False, 0.0, "the robot is not connected") if link is None else link.estop()
+        answer = {"acknowledged": result.acknowledged, "latency_ms": result.latency * 1000.0}
+        if not result.acknowledged:
+            answer["reason"] = result.reason
+        return {**answer, **self.status()}
+
+    async def estop_now(self) -> dict:
+        """:meth:`estop` on the service's e-stop thread, for an ``async`` route: answers within
+        ESTOP_ANSWER whatever the link, the request pool or the locks are doing."""
+        with self._estop_guard:
+            if self._estop_pending is None or self._estop_pending.done():
+                self._estop_pending = self._estop_executor.submit(self.estop)
+            pending = self._estop_pending
+        waiting = asyncio.wrap_future(pending)
+        done, _ = await asyncio.wait({waiting}, timeout=ESTOP_ANSWER)  # wait() never cancels it
+        if done and waiting.exception() is None:
+            return waiting.result()
+        if done:  # a bug, not a fault of the line: still an answer, never a 500 for an e-stop
+            reason = f"the e-stop failed: {waiting.exception()!r}"
+        else:
+            reason = f"the e-stop did not finish within {ESTOP_ANSWER * 1000:.0f} ms (still trying)"
+        return {"acknowledged": False, "latency_ms": ESTOP_ANSWER * 1000.0, "reason": reason, **self.status()}
 
     # Live runs -------------------------------------------------------------------------------
     def start_run(self, body: RobotRunCreate) -> LiveRun:

@@ -439,6 +439,7 @@ function showStatus(status) {
     state: status.state, link: status.url || "—", battery: telemetry.battery_mv ? `${telemetry.battery_mv} mV` : "—",
     faults: telemetry.faults ?? "—", "tracker frames": tracker.received ?? "—", "tracker loss": tracker.loss !== undefined ? `${(100 * tracker.loss).toFixed(1)} %` : "—",
     run: status.run ? `${status.run.active ? "running" : status.run.end_reason}, ${status.run.touchdowns} touchdowns` : "—",
+    "link faults": status.counters ? `${status.counters.foreign_frames} foreign frames, ${status.counters.bad_checksum} bad checksums, ${status.counters.write_timeouts} write timeouts` : "—",
   };
   $("#robot-status").innerHTML = Object.entries(fields).map(([k, v]) => `<dt>${k}</dt><dd>${v}</dd>`).join("");
 }
@@ -494,10 +495,16 @@ on("#robot-run-form", "submit", async (event) => {
   say(`Run started: ${body.jumps} jumps at most, ${body.max_seconds} s at most${heldHeight === null ? "" : `, holding ${heldHeight} m`}.`);
 });
 on("#stop-run", "click", async () => showStatus(await call("POST", "/robot/runs/stop")));
+// The e-stop needs no token (the service allows stopping to anyone) and always answers within
+// 200 ms; it says whether the robot confirmed the stop.
 on("#estop", "click", async () => {
   const result = await call("POST", "/robot/estop");
   showStatus(result);
-  say(`Emergency stop acknowledged by the robot in ${result.latency_ms.toFixed(1)} ms.`);
+  if (result.acknowledged === false) {
+    say(`Emergency stop NOT acknowledged by the robot: ${result.reason}. Its heartbeats are stopped, so its watchdog disarms it within 1 s — check the robot.`, "error");
+  } else {
+    say(`Emergency stop acknowledged by the robot in ${result.latency_ms.toFixed(1)} ms.`);
+  }
 });
 
 // 3D view ------------------------------------------------------------------------------------

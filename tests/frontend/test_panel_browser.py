@@ -282,6 +282,7 @@ def test_closed_loop_run_then_emergency_stop(page, service):
             "document.querySelector('#robot-status').textContent.includes('running')", timeout=10_000
         )
         time.sleep(1.0)
+        page.fill("#token", "")  # a colleague's browser: stopping needs no token
         page.click("#estop")
         page.wait_for_function(
             "document.querySelector('.message')?.textContent.includes('Emergency stop acknowledged')"

@@ -1,10 +1,18 @@
 """Live runs through the API against the virtual robot: recorded like simulated runs, safe to stop."""
 
+import socket
+import threading
 import time
 
 import pytest
 
+from backend.robot.messages import RobotState
 from backend.robot.virtual import VirtualRobot
+from tests.helpers import answer_within, free_port
+from tests.robot_rig import PtyRobot
+
+POOL_FILLERS = 45  # more than the request thread pool's 40 threads
+ANSWER_BOUND_S = 2.0  # [s] "answers instead of hanging": generous, not a latency claim
 
 CONTROLS = [{"psi0_deg": 30, "zeta0": 0.87}, {"psi0_deg": 30, "zeta0": 0.9}]
 
@@ -38,8 +46,85 @@ def _finish(client, timeout=30.0):
 def test_robot_calls_need_the_token(client, virtual):
     robot, port = virtual
     assert client.post("/api/v1/robot/connect", json={"url": robot.url, "tracker_port": port}).status_code == 401
-    assert client.post("/api/v1/robot/estop").status_code == 401
+    for call in ("arm", "disarm", "reset", "disconnect", "runs/stop"):
+        assert client.post(f"/api/v1/robot/{call}").status_code == 401, call
+    assert client.post("/api/v1/robot/runs", json={"controls": CONTROLS}).status_code == 401
     assert client.get("/api/v1/robot").json()["state"] == "disconnected"
+
+
+def test_estop_needs_no_token_and_reaches_the_robot(client, auth, connected):
+    client.post("/api/v1/robot/arm", headers=auth)
+    response = client.post("/api/v1/robot/estop")  # no token: stopping is always allowed
+    assert response.status_code == 200, response.text
+    stopped = response.json()
+    assert stopped["acknowledged"] is True and "reason" not in stopped and stopped["latency_ms"] >= 0
+    assert stopped["state"] == "estopped" and connected.firmware.state.name == "ESTOPPED"
+    assert client.post("/api/v1/robot/reset").status_code == 401, "releasing it needs the token"
+
+
+def test_estop_answers_while_compute_fills_the_request_pool(client, connected):
+    from backend.services.simulation import KERNEL_LOCK
+
+    body = {"controls": CONTROLS[:1], "start": {"xdot": -0.9, "ydot": -0.2}, "jumps": 3}
+    answers = []
+
+    def compute():
+        answers.append(client.post("/api/v1/sim/map", json=body).status_code)
+
+    callers = [threading.Thread(target=compute, daemon=True) for _ in range(POOL_FILLERS)]
+    with KERNEL_LOCK:  # a long computation: every /sim/map call waits in the request pool's threads
+        for caller in callers:
+            caller.start()
+        time.sleep(0.5)  # they reach the lock (not a timing assertion: later ones only queue)
+        stopped = answer_within(ANSWER_BOUND_S, client.post, "/api/v1/robot/estop").json()
+    assert stopped["acknowledged"] is True and stopped["state"] == "estopped"
+    for caller in callers:
+        caller.join(60)
+    assert answers == [200] * POOL_FILLERS, "the computations were real, and held the pool"
+
+
+def test_estop_without_a_robot_says_so(client):
+    stopped = client.post("/api/v1/robot/estop").json()
+    assert (stopped["acknowledged"], stopped["reason"]) == (False, "the robot is not connected")
+
+
+def test_estop_on_a_jammed_line_answers_without_hanging(client, auth):
+    rig = PtyRobot(RobotState.ARMED).start()
+    try:
+        body = {"url": rig.path, "tracker_port": free_port(socket.SOCK_DGRAM)}  # a pty, as socat gives one
+        response = client.post("/api/v1/robot/connect", json=body, headers=auth)
+        assert response.status_code == 200 and response.json()["state"] == "armed", response.text
+        rig.jam()
+        response = answer_within(ANSWER_BOUND_S, client.post, "/api/v1/robot/estop")
+        stopped = response.json()
+        assert response.status_code == 200 and stopped["acknowledged"] is False, stopped
+        assert "no acknowledgement" in stopped["reason"] and stopped["state"] == "armed"
+        counters = client.get("/api/v1/robot").json()["counters"]
+        assert counters["write_timeouts"] >= 1 and counters["estops_unacknowledged"] == 1
+        arm = client.post("/api/v1/robot/arm", headers=auth)
+        assert arm.status_code == 503 and "reset" in arm.text, "a blocked line is a 503, not a 500"
+    finally:
+        client.post("/api/v1/robot/disconnect", headers=auth)
+        rig.stop()
+
+
+def test_status_shows_the_robot_address_and_the_links_counters(client, connected):
+    status = client.get("/api/v1/robot").json()
+    assert status["robot_address"] == "0x0013A20040B0B0B0"
+    counters = status["counters"]
+    assert counters["frames_in"] > 0
+    for name in ("bad_checksum", "garbage_bytes", "rejected_payloads", "foreign_frames", "write_timeouts"):
+        assert counters[name] == 0, name
+
+
+def test_a_link_to_another_robot_address_hears_nothing(client, auth, virtual):
+    robot, port = virtual
+    body = {"url": robot.url, "tracker_port": port, "robot_address": "0013A200DEADBEEF"}
+    response = client.post("/api/v1/robot/connect", json=body, headers=auth)
+    assert response.status_code == 503 and "no telemetry" in response.text
+    body["robot_address"] = "0x12"
+    response = client.post("/api/v1/robot/connect", json=body, headers=auth)
+    assert response.status_code == 422 and response.json()["detail"][0]["loc"] == ["body", "robot_address"]
 
 
 def test_open_loop_live_run_is_stored_with_the_model_beside_it(client, auth, connected):
@@ -67,8 +152,8 @@ def test_open_loop_live_run_is_stored_with_the_model_beside_it(client, auth, con
 def test_estop_during_a_run_ends_it_and_keeps_the_data(client, auth, connected):
     client.post("/api/v1/robot/runs", json={"controls": CONTROLS, "jumps": 1000}, headers=auth)
     _wait_for_touchdowns(client, 3)
-    stopped = client.post("/api/v1/robot/estop", headers=auth).json()
-    assert stopped["state"] == "estopped" and stopped["latency_ms"] < 100
+    stopped = client.post("/api/v1/robot/estop").json()
+    assert stopped["acknowledged"] is True and stopped["state"] == "estopped"
     status = _finish(client)
     assert status["run"]["end_reason"] == "e-stop"
     run = client.get(f"/api/v1/runs/{status['run']['stored_run_id']}").json()
@@ -106,10 +191,20 @@ def test_closed_loop_live_run_holds_a_height(client, auth, connected):
     assert sum(c["why"].startswith("pid") for c in results["commands"]) >= 40
 
 
-@pytest.mark.parametrize("url", ["/dev/sda", "/dev/watchdog", "http://robot", "socket://a b:1"])
+@pytest.mark.parametrize("url", ["/dev/sda", "/dev/watchdog", "/dev/null", "http://robot", "socket://a b:1"])
 def test_only_serial_ports_and_robot_sockets_can_be_opened(client, auth, url):
     response = client.post("/api/v1/robot/connect", json={"url": url}, headers=auth)
-    assert response.status_code == 422 and "url" in response.text
+    assert response.status_code == 422 and response.json()["detail"][0]["loc"] == ["body", "url"]
+
+
+@pytest.mark.parametrize(("name", "why"), [("ttyUSB0", "is not a character device"), ("ttyUSB97", "does not exist")])
+def test_a_device_path_that_is_not_a_device_is_a_422_naming_it(client, auth, tmp_path, name, why):
+    (tmp_path / "ttyUSB0").write_bytes(b"")  # a regular file: never opened
+    path = str(tmp_path / name)
+    response = client.post("/api/v1/robot/connect", json={"url": path}, headers=auth)
+    assert response.status_code == 422
+    detail = response.json()["detail"][0]
+    assert detail["loc"] == ["body", "url"] and f"{path} {why}" in detail["msg"]
 
 
 def test_live_state_streams_over_websocket(client, auth, connected):

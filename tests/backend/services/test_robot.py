@@ -3,17 +3,28 @@
 Through the API, tests/backend/api/test_robot_api.py covers e-stop, a lost link and reconnects.
 """
 
+import asyncio
+import socket
+import threading
+import time
+
 import pytest
 
+from backend.robot.link import LinkError
+from backend.robot.messages import RobotState
 from backend.schemas import LegIn, RobotConnect, RobotRunCreate
 from backend.services import records
-from backend.services.robot import RobotService, RobotUnavailable, replay_run, touchdown_results
+from backend.services.robot import ESTOP_ANSWER, LiveRun, RobotService, RobotUnavailable, replay_run, touchdown_results
 from backend.services.simulation import unpack_trajectory
 from sim_core import ParameterError, get_preset
+from tests.helpers import answer_within, free_port
+from tests.robot_rig import PtyRobot, received_frame, telemetry
 
 LEGS = [LegIn(psi0_deg=30.0, zeta0=0.87), LegIn(psi0_deg=30.0, zeta0=0.9)]  # [left, right]
 JUMPS = 4
 RUN_WAIT_S = 30.0  # [s] an upper bound for a 4-jump run at 4x speed, not a timing assertion
+ANSWER_BOUND_S = 2.0  # [s] "answers instead of hanging": generous, not a latency claim
+FOREIGN = 0x0013A200DEADBEEF  # another XBee in range
 
 
 @pytest.fixture
@@ -42,9 +53,11 @@ def test_without_a_robot_nothing_moves(service):
     status = service.status()
     assert (status["state"], status["url"], status["tracker"], status["run"]) == ("disconnected", None, None, None)
     assert status["transitions"] == [] and service.live()["recent_touchdowns"] == []
-    for command in (service.arm, service.disarm, service.reset, service.estop):
+    for command in (service.arm, service.disarm, service.reset):
         with pytest.raises(RobotUnavailable, match="not connected"):
             command()
+    stopped = service.estop()  # always answers: stopping is always allowed
+    assert (stopped["acknowledged"], stopped["reason"]) == (False, "the robot is not connected")
     with pytest.raises(RobotUnavailable):
         service.start_run(RobotRunCreate(controls=LEGS))
     with pytest.raises(records.NotFound):
@@ -99,3 +112,71 @@ def test_disconnect_closes_the_link_and_the_tracker(connected):
 def test_touchdown_results_need_two_touchdowns_for_a_prediction():
     robot = get_preset("paper")
     assert touchdown_results([], [], robot) == {"touchdowns": [], "states": [], "rises": [], "prediction": None}
+
+
+def _wait_for(predicate, what: str, timeout=RUN_WAIT_S) -> None:
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        assert time.monotonic() < deadline, f"{what} within {timeout:g} s"
+        time.sleep(0.01)
+
+
+def test_a_foreign_radio_cannot_end_a_live_run(connected, virtual, session):
+    robot, _ = virtual
+    run = connected.start_run(RobotRunCreate(controls=LEGS, jumps=1000))
+    _wait_for(lambda: len(run.touchdowns) >= 2, "two touchdowns")
+    robot.inject(received_frame(telemetry(1, RobotState.DISARMED), source64=FOREIGN) * 3)
+    _wait_for(lambda: connected.status()["counters"]["foreign_frames"] == 3, "three foreign frames counted")
+    seen = len(run.touchdowns)
+    _wait_for(lambda: len(run.touchdowns) >= seen + 2, "two more touchdowns")
+    assert not run.done.is_set() and connected.status()["state"] == "running"
+    assert robot.firmware.state == RobotState.RUNNING
+    status = connected.stop_run()
+    assert status["run"]["end_reason"] == "stopped" and status["state"] == "disarmed"
+    assert records.get_run(session, status["run"]["stored_run_id"]).status == "done"
+
+
+def test_estop_ends_a_live_run_even_unacknowledged(service):
+    run = LiveRun(RobotRunCreate(controls=LEGS))
+    service.run = run  # a run whose link is gone
+    stopped = service.estop()
+    assert stopped["acknowledged"] is False and run.stop_requested.is_set() and run.end_reason == "e-stop"
+    run.done.set()
+
+
+def test_estop_on_a_jammed_line_answers_in_bound_and_honestly(service):
+    rig = PtyRobot(RobotState.ARMED).start()
+    try:
+        status = service.connect(RobotConnect(url=rig.path, tracker_port=free_port(socket.SOCK_DGRAM)))
+        assert status["state"] == "armed"
+        rig.jam()
+        stopped = answer_within(ANSWER_BOUND_S, asyncio.run, service.estop_now())
+        assert stopped["acknowledged"] is False and "no acknowledgement" in stopped["reason"]
+        assert stopped["state"] == "armed" and stopped["counters"]["estops_unacknowledged"] == 1
+        with pytest.raises(LinkError, match="reset before you arm"):
+            service.arm()
+    finally:
+        service.disconnect()
+        rig.stop()
+
+
+def test_estop_now_answers_even_when_the_estop_thread_is_stuck(service, monkeypatch):
+    release = threading.Event()
+    calls = []
+
+    def stuck():
+        calls.append(1)
+        release.wait(5)
+        return {"acknowledged": True}
+
+    monkeypatch.setattr(service, "estop", stuck)
+
+    async def press_twice():
+        return await asyncio.gather(service.estop_now(), service.estop_now())
+
+    answers = answer_within(ANSWER_BOUND_S, asyncio.run, press_twice())
+    release.set()
+    for answer in answers:
+        assert answer["acknowledged"] is False and "did not finish" in answer["reason"]
+        assert answer["latency_ms"] == pytest.approx(ESTOP_ANSWER * 1000)
+    assert len(calls) == 1, "a press during an e-stop joins it"

@@ -1,0 +1,40 @@
+"""Which ports a robot link may open: serial devices as labs name them, and pyserial's network URLs.
+
+A USB radio appears as ``/dev/ttyUSB0`` or ``/dev/ttyACM0`` (Linux), ``/dev/cu.usbserial-…``
+(macOS), or through the stable symlinks ``/dev/serial/by-id/…`` and ``/dev/serial/by-path/…``;
+a test rig or ``socat`` gives a pty (``/dev/pts/N``); a serial server gives ``rfc2217://``; the
+virtual robot ``socket://``. The check follows symlinks and looks at what the path is, so a
+regular file is never opened, and neither is a character device that is not a serial line —
+opening ``/dev/watchdog`` arms a hardware watchdog.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import stat
+
+# pyserial's URLs a link may open (no options), and Windows' COM ports.
+SERIAL_URL = re.compile(r"^((socket|rfc2217)://[\w.-]+:[0-9]{1,5}|loop://|COM[0-9]{1,3})$")
+SERIAL_DEVICE = re.compile(r"^/dev/(tty[\w.-]*|cu\.[\w.-]+|pts/[0-9]+|rfcomm[0-9]+)$")
+
+
+def check_port(url: str) -> str:
+    """``url`` if a link may open it, else ValueError naming it: a pyserial socket, RFC 2217 or loop
+    URL, a Windows ``COMn``, or an existing character device (or a symlink to one, as
+    ``/dev/serial/by-id/…``) that is a serial port or a pty. A regular file, a block device or
+    another kind of character device (``/dev/watchdog``, ``/dev/mem``) is never opened."""
+    if SERIAL_URL.match(url):
+        return url
+    if not url.startswith("/"):
+        raise ValueError(f"{url!r} is not a device path, socket://host:port, rfc2217://host:port or loop://")
+    try:
+        mode = os.stat(url).st_mode  # follows symlinks
+    except (OSError, ValueError):  # ValueError: a NUL in the path
+        raise ValueError(f"{url} does not exist") from None
+    if not stat.S_ISCHR(mode):
+        raise ValueError(f"{url} is not a character device")
+    target = os.path.realpath(url)
+    if not SERIAL_DEVICE.match(target):
+        raise ValueError(f"{url} ({target}) is not a serial port or a pty")
+    return url
