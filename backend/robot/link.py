@@ -158,7 +158,8 @@ class RobotLink:
 
     def reconnect(self, timeout: float = 1.0) -> LinkState:
         """Close what is left of a dropped link and connect again (the robot stays as it decided:
-        after silence it has disarmed itself)."""
+        after silence it has disarmed itself). In the service only the link's supervisor calls
+        this, ``connect`` and ``close``: one thread at a time."""
         self.close()
         return self.connect(timeout)
 

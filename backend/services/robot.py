@@ -8,6 +8,8 @@ robot positions during the coming stance. The run ends when its jumps or time ar
 when stopped, or when anything goes wrong (e-stop, fall, lost link); it is then stored as a run
 of kind ``robot``, with the model's prediction for the same controls beside it, whatever ended it.
 
+The link itself belongs to :class:`backend.robot.supervisor.LinkSupervisor`: connecting,
+disconnecting and shutting down are requests to it, and it alone reconnects a dropped link.
 The e-stop does not wait for any of this: :meth:`RobotService.estop_now` runs it on the service's
 own e-stop thread, under no lock, bounded, and answers whether the robot acknowledged it.
 """
@@ -26,6 +28,7 @@ import numpy as np
 from backend.robot.limits import ServoLimits
 from backend.robot.link import EstopResult, LinkError, LinkState, RobotLink
 from backend.robot.messages import Leg
+from backend.robot.supervisor import LinkSupervisor
 from backend.robot.touchdown import Touchdown, detect_touchdowns, height_gains
 from backend.robot.tracker import Calibration, UdpPoseSource
 from backend.schemas import RobotConnect, RobotRunCreate
@@ -39,7 +42,6 @@ from sim_core.presets import get_preset
 from sim_core.walls import wall_of
 
 POLL = 0.005  # [s] how often a live run looks at new poses
-RECONNECT_PERIOD = 1.0  # [s] between attempts on a dropped link
 ESTOP_ANSWER = 0.17  # [s] the longest an e-stop request waits for its answer (the link gives up at 0.15 s)
 
 
@@ -68,10 +70,9 @@ class RobotService:
     def __init__(self, sessions, robot=None):
         self.sessions = sessions
         self.robot = robot or get_preset("paper")  # the robot's physical parameters
-        self.link: RobotLink | None = None
+        self.supervisor = LinkSupervisor()  # the link's one owner (backend/robot/supervisor.py)
         self.tracker: UdpPoseSource | None = None
         self.run: LiveRun | None = None
-        self._wanted = False  # reconnect after a dropped link until disconnected by hand
         self._lock = threading.Lock()
         # The e-stop's own thread: not the request pool that compute can fill, and no lock that a
         # connect, a reconnect or a run holds. Presses while one is under way join it.
@@ -79,7 +80,11 @@ class RobotService:
         self._estop_guard = threading.Lock()  # held only to read or replace _estop_pending
         self._estop_pending: concurrent.futures.Future | None = None
 
-    # Connection -------------------------------------------------------------------------------
+    # Connection: the supervisor alone opens, reconnects and closes the link ------------------
+    @property
+    def link(self) -> RobotLink | None:
+        return self.supervisor.link
+
     def connect(self, body: RobotConnect) -> dict:
         with self._lock:
             self._disconnect()
@@ -88,48 +93,30 @@ class RobotService:
             self.tracker = UdpPoseSource(body.tracker_host, body.tracker_port, calibration=calibration)
             link = RobotLink(body.url, baud=body.baud, limits=limits, robot_address=int(body.robot_address, 16))
             try:
-                link.connect()
+                self.supervisor.connect(link)
             except LinkError:
                 self.tracker.close()
                 self.tracker = None
                 raise
-            self.link = link
-            self._wanted = True
-            link.on_lost.append(self._on_lost)
         return self.status()
 
     def disconnect(self) -> dict:
         with self._lock:
-            self._wanted = False
             self._disconnect()
         return self.status()
 
     def close(self) -> None:
-        """Service shutdown: disconnect, and let the e-stop thread go."""
+        """Service shutdown: disconnect, end the link's supervisor, and let the e-stop thread go."""
         self.disconnect()
+        self.supervisor.close()
         self._estop_executor.shutdown(wait=False)
 
-    def _on_lost(self, reason: str) -> None:
-        """A dropped link is retried every RECONNECT_PERIOD until it answers or is disconnected by hand.
-        A live run does not resume: it has ended, and the robot has disarmed itself."""
-        threading.Thread(target=self._reconnect, args=(self.link,), name="robot-reconnect", daemon=True).start()
-
-    def _reconnect(self, link: RobotLink) -> None:
-        while self._wanted and self.link is link:
-            try:
-                link.reconnect(timeout=RECONNECT_PERIOD)
-                link.on_lost[:] = [self._on_lost]
-                return
-            except LinkError:
-                time.sleep(RECONNECT_PERIOD)
-
     def _disconnect(self) -> None:
+        """End a live run, close the link (no more reconnects) and the tracker."""
         if self.run is not None and not self.run.done.is_set():
             self.run.stop_requested.set()
             self.run.done.wait(5)
-        if self.link is not None:
-            self.link.close()
-            self.link = None
+        self.supervisor.disconnect()
         if self.tracker is not None:
             self.tracker.close()
             self.tracker = None

@@ -4,6 +4,7 @@ Through the API, tests/backend/api/test_robot_api.py covers e-stop, a lost link 
 """
 
 import asyncio
+import logging
 import socket
 import threading
 import time
@@ -12,26 +13,29 @@ import pytest
 
 from backend.robot.link import LinkError
 from backend.robot.messages import RobotState
+from backend.robot.virtual import VirtualRobot
 from backend.schemas import LegIn, RobotConnect, RobotRunCreate
 from backend.services import records
 from backend.services.robot import ESTOP_ANSWER, LiveRun, RobotService, RobotUnavailable, replay_run, touchdown_results
 from backend.services.simulation import unpack_trajectory
 from sim_core import ParameterError, get_preset
 from tests.helpers import answer_within, free_port
-from tests.robot_rig import PtyRobot, received_frame, telemetry
+from tests.robot_rig import LinkCalls, PtyRobot, Radio, received_frame, telemetry
 
 LEGS = [LegIn(psi0_deg=30.0, zeta0=0.87), LegIn(psi0_deg=30.0, zeta0=0.9)]  # [left, right]
 JUMPS = 4
 RUN_WAIT_S = 30.0  # [s] an upper bound for a 4-jump run at 4x speed, not a timing assertion
 ANSWER_BOUND_S = 2.0  # [s] "answers instead of hanging": generous, not a latency claim
 FOREIGN = 0x0013A200DEADBEEF  # another XBee in range
+FLAP_S = 4.0  # [s] the radio flaps in the service's test (tests/backend/robot/test_supervisor.py flaps longer)
+FLAP_ANSWER_S = 20.0  # [s] a connect, a close or the threads' end, instead of a hang: generous
 
 
 @pytest.fixture
 def service(sessions):
     service = RobotService(sessions)
     yield service
-    service.disconnect()
+    service.close()
 
 
 @pytest.fixture
@@ -180,3 +184,29 @@ def test_estop_now_answers_even_when_the_estop_thread_is_stuck(service, monkeypa
         assert answer["acknowledged"] is False and "did not finish" in answer["reason"]
         assert answer["latency_ms"] == pytest.approx(ESTOP_ANSWER * 1000)
     assert len(calls) == 1, "a press during an e-stop joins it"
+
+
+def test_the_services_link_has_one_owner_while_it_flaps(service, monkeypatch, caplog):
+    """The service's connect, the lost link's reconnects and its close all go through the supervisor."""
+    caplog.set_level(logging.DEBUG, logger="parkourlab.robot")
+    thread_errors = []
+    monkeypatch.setattr(threading, "excepthook", thread_errors.append)
+    calls = LinkCalls(monkeypatch)
+    baseline = threading.active_count()
+    radio = Radio(seed=3)
+    robot = VirtualRobot("127.0.0.1", radio.port).start()
+    body = RobotConnect(url=radio.url, tracker_port=free_port(socket.SOCK_DGRAM))
+    assert answer_within(FLAP_ANSWER_S, service.connect, body)["state"] == "disarmed"
+    robot.stop()
+    radio.flap(FLAP_S)
+    radio.join()
+    robot = VirtualRobot("127.0.0.1", radio.port).start()
+    try:
+        _wait_for(lambda: service.status()["state"] == "disarmed", "the link back once the robot is")
+        answer_within(FLAP_ANSWER_S, service.close)
+    finally:
+        robot.stop()
+    _wait_for(lambda: threading.active_count() <= baseline + 1, "the threads back to the baseline", FLAP_ANSWER_S)
+    errors = [r for r in caplog.records if r.levelno >= logging.WARNING or r.exc_info]
+    assert errors == [] and thread_errors == [], (errors, thread_errors)
+    assert calls.most_connecting == 1 and calls.callers == {"robot-link-supervisor"}, calls.callers
