@@ -67,6 +67,8 @@ _FROM_ROBOT = {
     RobotState.ESTOPPED: LinkState.ESTOPPED,
 }
 
+_SAFE = (RobotState.DISARMED, RobotState.ESTOPPED)  # what every ending must leave the robot in
+
 
 class LinkError(RuntimeError):
     """The robot did not answer, refused a command, or the link is down."""
@@ -107,6 +109,7 @@ class RobotLink:
         self.state = LinkState.DISCONNECTED
         self.transitions: list[Transition] = []
         self.telemetry: Telemetry | None = None
+        self._telemetry_heard = 0  # TELEMETRY frames from the robot (written by the reader only)
         self.parser = FrameParser()
         self.rejected_payloads = 0
         self.foreign_frames = 0  # Receive Packets from a radio that is not robot_address
@@ -186,6 +189,29 @@ class RobotLink:
 
     def disarm(self) -> None:
         self._command(Command(self._next_seq(), Kind.DISARM), expect=LinkState.DISARMED)
+
+    def make_safe(self) -> LinkState:
+        """Every ending's DISARM: sent whatever the link believes (a stale or forged TELEMETRY may
+        say disarmed while the robot runs), then confirmed by telemetry received after the robot's
+        acknowledgement. Returns the confirmed state: disarmed, or e-stopped (an e-stopped robot
+        refuses DISARM and is as safe); raises LinkError if neither is confirmed in time."""
+        if self.state == LinkState.DISCONNECTED:
+            raise LinkError("the link is down: the robot's watchdog disarms it")
+        message = Command(self._next_seq(), Kind.DISARM)
+        event, box = self._expect(message.seq)
+        try:
+            self._write(message)
+            if not event.wait(COMMAND_TIMEOUT):
+                raise LinkError(f"no acknowledgement for DISARM within {COMMAND_TIMEOUT:g} s")
+        finally:
+            self._acks.pop(message.seq, None)
+        heard = self._telemetry_heard  # telemetry counted from here on was sent after the DISARM's ack
+        deadline = time.monotonic() + COMMAND_TIMEOUT
+        while self._telemetry_heard == heard or self.telemetry.state not in _SAFE:
+            if time.monotonic() > deadline:
+                raise LinkError(f"DISARM answered {box[0].result.name.lower()} but no telemetry confirms it")
+            time.sleep(0.001)
+        return _FROM_ROBOT[self.telemetry.state]
 
     def reset(self) -> None:
         self._command(Command(self._next_seq(), Kind.RESET), expect=LinkState.DISARMED)
@@ -339,6 +365,7 @@ class RobotLink:
                 entry[0].set()
         elif isinstance(message, Telemetry):
             self.telemetry = message
+            self._telemetry_heard += 1
             self._move(_FROM_ROBOT[message.state], "telemetry")
 
     def _heartbeat_loop(self) -> None:

@@ -11,6 +11,10 @@ answers again, a disconnect by hand, or shutdown. An attempt is bounded (``retry
 robot's first telemetry, plus closing what is left), and requests that arrive during it wait for it
 to end. Nobody else may call the link's ``connect``, ``reconnect`` or ``close``; reading the link and
 sending it commands (arm, set_leg, the e-stop) needs no request: those are the link's own, bounded.
+
+Every ending the supervisor sees disarms: before it closes a live link (a disconnect, a connect to
+another, shutdown), and when a lost link comes back, it sends DISARM and waits for telemetry to
+confirm it (:meth:`RobotLink.make_safe`), whatever the link believed the robot's state to be.
 """
 
 from __future__ import annotations
@@ -131,11 +135,14 @@ class LinkSupervisor:
                 request = self._requests.get(timeout=self._until_retry())
             except queue.Empty:
                 request = None
-            try:
-                if isinstance(request, Shutdown):
+            if isinstance(request, Shutdown):
+                try:
                     self._close_link()
-                    request.answer.set_result(None)
-                    return
+                except Exception:  # a bug: say so, and end all the same
+                    log.exception("the robot link's supervisor failed to close the link at shutdown")
+                request.answer.set_result(None)
+                return
+            try:
                 self._handle(request)
             except Exception as error:  # a bug: say so, answer the caller, and keep owning the link
                 log.exception("the robot link's supervisor failed on %r", request)
@@ -181,9 +188,21 @@ class LinkSupervisor:
             return
         self.reconnects += 1
         log.info("robot link to %s is back (%s)", link.url, link.state.value)
+        _make_safe(link, "the link came back")  # a run the loss ended: nothing may still move
 
     def _close_link(self) -> None:
         link, self._wanted = self.link, False
         if link is not None:
+            if link.state != LinkState.DISCONNECTED:
+                _make_safe(link, "closing the link")  # disconnect, another connect, shutdown
             link.close()
             self.link = None
+
+
+def _make_safe(link: RobotLink, why: str) -> None:
+    """DISARM, confirmed by telemetry (:meth:`RobotLink.make_safe`). Unconfirmed, the link's
+    heartbeats end with it, and the robot's own watchdog disarms it within its timeout."""
+    try:
+        log.info("%s: robot confirmed %s", why, link.make_safe().value)
+    except LinkError as error:
+        log.info("%s: DISARM not confirmed (%s); the robot's watchdog disarms it", why, error)

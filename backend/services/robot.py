@@ -5,8 +5,9 @@ frames, the touchdowns detected in them, every command sent, telemetry and link 
 Closed loop, each detected touchdown's height goes through the simulator's PID
 (:func:`sim_core.closed_loop.pid_step`) to the leg of the touchdown after next — the one the
 robot positions during the coming stance. The run ends when its jumps or time are used up,
-when stopped, or when anything goes wrong (e-stop, fall, lost link); it is then stored as a run
-of kind ``robot``, with the model's prediction for the same controls beside it, whatever ended it.
+when stopped, or when anything goes wrong (e-stop, fall, lost link); whatever ended it, it then
+disarms the robot, confirmed by telemetry (:meth:`RobotLink.make_safe`), and is stored as a run
+of kind ``robot``, with the model's prediction for the same controls beside it.
 
 The link itself belongs to :class:`backend.robot.supervisor.LinkSupervisor`: connecting,
 disconnecting and shutting down are requests to it, and it alone reconnects a dropped link.
@@ -61,6 +62,7 @@ class LiveRun:
     touchdown_controls: list[LegControl] = field(default_factory=list)
     commanded: dict[Leg, LegControl] = field(default_factory=dict)
     end_reason: str | None = None
+    disarm: str | None = None  # how the run's ending left the robot: "disarmed", "estopped" or why unconfirmed
     stored_run_id: int | None = None
     stop_requested: threading.Event = field(default_factory=threading.Event)
     done: threading.Event = field(default_factory=threading.Event)
@@ -147,6 +149,7 @@ class RobotService:
                     "active": not run.done.is_set(),
                     "touchdowns": len(run.touchdowns),
                     "end_reason": run.end_reason,
+                    "disarm": run.disarm,
                     "stored_run_id": run.stored_run_id,
                 },
                 "transitions": [] if link is None else _transitions(link.transitions[-20:]),
@@ -305,11 +308,10 @@ class RobotService:
                         run.end_reason = "jumps done"
                         break
                 time.sleep(POLL)
-            if link.state in (LinkState.RUNNING, LinkState.ARMED):
-                link.disarm()
         except (LinkError, ParameterError) as error:
             run.end_reason = run.end_reason or f"error: {error}"
         finally:
+            run.disarm = _end_safely(link)  # whatever ended it, and whatever the link believes
             self._store(run, tracker, first_pose, run_controls, link)
             run.done.set()
 
@@ -330,6 +332,7 @@ class RobotService:
         analysis = touchdown_results(touchdowns, controls, self.robot)
         results = {
             "end_reason": run.end_reason,
+            "disarm": run.disarm,
             **analysis,
             "touchdown_controls": [[leg.psi0_deg, leg.zeta0] for leg in controls[: len(touchdowns)]],
             "commands": run.commands,
@@ -446,3 +449,12 @@ def _telemetry(telemetry) -> dict:
         "battery_mv": telemetry.battery_mv,
         "faults": telemetry.faults,
     }
+
+
+def _end_safely(link: RobotLink) -> str:
+    """A run's ending: DISARM confirmed by telemetry (:meth:`RobotLink.make_safe`), or why not — a
+    lost link's robot disarms itself by its watchdog, and the supervisor disarms it when it is back."""
+    try:
+        return link.make_safe().value
+    except LinkError as error:
+        return f"not confirmed: {error}"

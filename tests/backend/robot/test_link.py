@@ -173,3 +173,32 @@ def test_both_ends_of_the_virtual_radio_disable_nagle(robot, link):
     _wait_for(lambda: robot._connection is not None)
     for sock in (link._port._socket, robot._connection):
         assert sock.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY)
+
+
+def test_make_safe_disarms_whatever_the_link_believes(robot, link):
+    link.arm()
+    robot.inject(received_frame(telemetry(9, RobotState.DISARMED)))  # stale: the robot is armed
+    _wait_for(lambda: link.state == LinkState.DISARMED)
+    assert robot.firmware.state == RobotState.ARMED
+    assert link.make_safe() == LinkState.DISARMED and robot.firmware.state == RobotState.DISARMED
+
+
+def test_make_safe_accepts_an_estopped_robot(robot, link):
+    assert link.estop().acknowledged
+    assert link.make_safe() == LinkState.ESTOPPED and robot.firmware.state == RobotState.ESTOPPED
+
+
+def test_make_safe_says_when_it_cannot_confirm(jammed):
+    error = answer_within(JAMMED_ANSWER_S, _raises_link_error, jammed.make_safe)
+    assert "jammed" in str(error) or "no acknowledgement" in str(error), error
+    jammed.close()
+    with pytest.raises(LinkError, match="down"):
+        jammed.make_safe()
+
+
+def _raises_link_error(call):
+    try:
+        call()
+    except LinkError as error:
+        return error
+    pytest.fail(f"{call.__name__} did not raise LinkError")

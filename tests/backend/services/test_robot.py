@@ -12,7 +12,7 @@ import time
 import pytest
 
 from backend.robot.link import LinkError
-from backend.robot.messages import RobotState
+from backend.robot.messages import Fault, RobotState
 from backend.robot.virtual import VirtualRobot
 from backend.schemas import LegIn, RobotConnect, RobotRunCreate
 from backend.services import records
@@ -210,3 +210,61 @@ def test_the_services_link_has_one_owner_while_it_flaps(service, monkeypatch, ca
     errors = [r for r in caplog.records if r.levelno >= logging.WARNING or r.exc_info]
     assert errors == [] and thread_errors == [], (errors, thread_errors)
     assert calls.most_connecting == 1 and calls.callers == {"robot-link-supervisor"}, calls.callers
+
+
+def _running(service, run) -> LiveRun:
+    _wait_for(lambda: len(run.touchdowns) >= 2, "two touchdowns")
+    return run
+
+
+def _end_by_jumps(service, robot) -> LiveRun:
+    run = service.start_run(RobotRunCreate(controls=LEGS, jumps=JUMPS))
+    assert run.done.wait(RUN_WAIT_S), "the live run did not end"
+    return run
+
+
+def _end_by_stop(service, robot) -> LiveRun:
+    run = _running(service, service.start_run(RobotRunCreate(controls=LEGS, jumps=1000)))
+    service.stop_run()
+    return run
+
+
+def _end_by_a_stale_disarmed_telemetry(service, robot) -> LiveRun:
+    # The link believes the robot disarmed while it runs on: the ending must disarm it all the same.
+    run = _running(service, service.start_run(RobotRunCreate(controls=LEGS, jumps=1000)))
+    robot.inject(received_frame(telemetry(1, RobotState.DISARMED)))
+    assert run.done.wait(RUN_WAIT_S), "the live run did not end"
+    assert run.end_reason.startswith("robot disarmed")
+    return run
+
+
+def _end_by_shutdown(service, robot) -> LiveRun:
+    run = _running(service, service.start_run(RobotRunCreate(controls=LEGS, jumps=1000)))
+    answer_within(FLAP_ANSWER_S, service.close)
+    return run
+
+
+@pytest.mark.parametrize("end", [_end_by_jumps, _end_by_stop, _end_by_a_stale_disarmed_telemetry, _end_by_shutdown])
+def test_every_ending_disarms_the_robot(connected, virtual, session, end):
+    robot, _ = virtual
+    run = end(connected, robot)
+    assert run.done.is_set() and run.disarm == "disarmed", (run.end_reason, run.disarm)
+    assert robot.firmware.state == RobotState.DISARMED, run.end_reason
+    assert not robot.firmware.faults & Fault.HEARTBEAT_LOST, "disarmed by a DISARM, not by its watchdog"
+    assert records.get_run(session, run.stored_run_id).results["disarm"] == "disarmed"
+
+
+def test_an_estop_ending_leaves_the_robot_estopped(connected, virtual):
+    robot, _ = virtual
+    run = _running(connected, connected.start_run(RobotRunCreate(controls=LEGS, jumps=1000)))
+    assert connected.estop()["acknowledged"] is True
+    assert run.done.wait(RUN_WAIT_S) and run.disarm == "estopped" and robot.firmware.state == RobotState.ESTOPPED
+
+
+@pytest.mark.parametrize("ending", ["disconnect", "close"])
+def test_disconnecting_an_armed_robot_disarms_it(connected, virtual, ending):
+    robot, _ = virtual
+    connected.arm()
+    assert robot.firmware.state == RobotState.ARMED
+    answer_within(FLAP_ANSWER_S, getattr(connected, ending))
+    assert robot.firmware.state == RobotState.DISARMED and not robot.firmware.faults & Fault.HEARTBEAT_LOST
