@@ -229,6 +229,12 @@ def _end_by_stop(service, robot) -> LiveRun:
     return run
 
 
+def _end_by_the_time_limit(service, robot) -> LiveRun:
+    run = service.start_run(RobotRunCreate(controls=LEGS, jumps=1000, max_seconds=1.0))
+    assert run.done.wait(RUN_WAIT_S) and run.end_reason == "time limit", run.end_reason
+    return run
+
+
 def _end_by_a_stale_disarmed_telemetry(service, robot) -> LiveRun:
     # The link believes the robot disarmed while it runs on: the ending must disarm it all the same.
     run = _running(service, service.start_run(RobotRunCreate(controls=LEGS, jumps=1000)))
@@ -244,7 +250,9 @@ def _end_by_shutdown(service, robot) -> LiveRun:
     return run
 
 
-@pytest.mark.parametrize("end", [_end_by_jumps, _end_by_stop, _end_by_a_stale_disarmed_telemetry, _end_by_shutdown])
+@pytest.mark.parametrize(
+    "end", [_end_by_jumps, _end_by_stop, _end_by_the_time_limit, _end_by_a_stale_disarmed_telemetry, _end_by_shutdown]
+)
 def test_every_ending_disarms_the_robot(connected, virtual, session, end):
     robot, _ = virtual
     run = end(connected, robot)
