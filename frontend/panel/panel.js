@@ -421,10 +421,16 @@ on("#compare", "click", async () => {
   const ids = [...document.querySelectorAll("#run-table input:checked")].map((box) => box.value);
   if (ids.length < 2) return say("Select two or more runs to compare.", "error");
   const result = await call("GET", `/runs/compare?${ids.map((id) => `ids=${id}`).join("&")}`);
-  const header = `<tr><th>field</th>${result.runs.map((r) => `<th>run ${r.id}</th>`).join("")}</tr>`;
-  const rows = result.fields.filter((f) => f !== "id").map((field) =>
-    `<tr class="differs"><td>${field}</td>${result.runs.map((r) => `<td>${r[field] ?? ""}</td>`).join("")}</tr>`).join("");
-  $("#compare-out").innerHTML = `<table id="compare-table"><caption>What differs</caption>${header}${rows}</table>`;
+  // Every value (notes included) goes in as text, never as markup.
+  const table = element("table", null, element("caption", "What differs"));
+  table.id = "compare-table";
+  table.append(element("tr", null, element("th", "field"), ...result.runs.map((r) => element("th", `run ${r.id}`))));
+  for (const field of result.fields.filter((f) => f !== "id")) {
+    const row = element("tr", null, element("td", field), ...result.runs.map((r) => element("td", String(r[field] ?? ""))));
+    row.className = "differs";
+    table.append(row);
+  }
+  $("#compare-out").replaceChildren(table);
 });
 
 // Robot --------------------------------------------------------------------------------------
@@ -441,7 +447,15 @@ function showStatus(status) {
     run: status.run ? `${status.run.active ? "running" : status.run.end_reason}, ${status.run.touchdowns} touchdowns` : "—",
     "link faults": status.counters ? `${status.counters.foreign_frames} foreign frames, ${status.counters.bad_checksum} bad checksums, ${status.counters.write_timeouts} write timeouts` : "—",
   };
-  $("#robot-status").innerHTML = Object.entries(fields).map(([k, v]) => `<dt>${k}</dt><dd>${v}</dd>`).join("");
+  $("#robot-status").replaceChildren(...Object.entries(fields).flatMap(([k, v]) => [element("dt", k), element("dd", String(v))]));
+}
+
+// An element with ``text`` as its text (never parsed as markup) and ``children`` after it.
+function element(tag, text, ...children) {
+  const node = document.createElement(tag);
+  if (text !== null) node.textContent = text;
+  node.append(...children);
+  return node;
 }
 
 async function refreshRobot() { showStatus(await call("GET", "/robot")); }

@@ -146,15 +146,21 @@ def test_sweep_and_basin_grid_jobs_from_the_jobs_tab(page):
     page.select_option("#job-kind", "mjtf")
 
 
+MARKUP_NOTE = "<img src=x onerror=window.__xss=1>"
+
+
 def test_history_compares_and_exports(page, service):
     base, token = service
-    for zeta0 in (0.88, 0.92):
+    auth = {"Authorization": f"Bearer {token}"}
+    for zeta0, notes in ((0.88, "plain"), (0.92, MARKUP_NOTE)):
         body = {
             "controls": [{"psi0_deg": 30, "zeta0": zeta0}],
             "start": {"xdot": -0.93, "ydot": -0.2},
             "tags": ["panel"],
         }
-        httpx.post(f"{base}/api/v1/runs", json=body, headers={"Authorization": f"Bearer {token}"}).raise_for_status()
+        run = httpx.post(f"{base}/api/v1/runs", json=body, headers=auth)
+        run.raise_for_status()
+        httpx.patch(f"{base}/api/v1/runs/{run.json()['id']}", json={"notes": notes}, headers=auth).raise_for_status()
     page.click("nav [data-tab=history]")
     # The table may still show an earlier visit's rows: wait for the reload with the saved run and these two.
     page.wait_for_function("document.querySelectorAll('#run-table tbody tr').length >= 3")
@@ -164,6 +170,9 @@ def test_history_compares_and_exports(page, service):
     page.click("#compare")
     page.wait_for_selector("#compare-table")
     assert "leg0.zeta0" in page.inner_text("#compare-table")
+    # A note is shown as the text it is: no element made of it, no script run.
+    assert MARKUP_NOTE in page.inner_text("#compare-table")
+    assert page.query_selector("#compare-table img") is None and page.evaluate("window.__xss") is None
     exported = page.request.get(base + page.get_attribute("#export-csv", "href"))
     assert exported.ok and exported.text().startswith("id,")
     _shot(page, "history")
