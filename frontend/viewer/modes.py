@@ -29,7 +29,6 @@ from sim_core import ControlSchedule, FixedPoint, LegControl, PhysicalParams
 from sim_core.errors import NoGaitFound
 from sim_core.fixed_points import gait_of
 from sim_core.presets import PAPER_GAITS, START_GUESS
-from sim_core.walls import Wall
 
 
 def _preset_label(name: str, pairs: tuple[tuple[float, float], ...]) -> str:
@@ -298,7 +297,7 @@ class LiveMode(_Mode):
             return None
         touchdown = touchdowns[k]
         # The leg in flight after touchdown k reaches for the other wall: the one commanded now.
-        next_leg = run.commanded.get(Leg.of(Wall(touchdown.wall).other), controls[k])
+        next_leg = run.commanded.get(Leg.of(touchdown.wall.other), controls[k])
         try:
             plan = model_jump(robot, touchdown.state, controls[k], next_leg, wall=touchdown.wall,
                               start_time=touchdown.time, start_height=touchdown.body_height)  # fmt: skip
