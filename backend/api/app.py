@@ -35,7 +35,8 @@ from sqlalchemy.orm import Session
 from backend import schemas
 from backend.robot.link import LinkError
 from backend.services import jobs, records, simulation
-from backend.services.robot import RobotService, RobotUnavailable, replay_run
+from backend.services.robot import RobotService, RobotUnavailable
+from backend.services.robot_records import replay_run
 from backend.services.view import ViewContext, ViewFactory, ViewStarter
 from backend.settings import Settings
 from backend.store.database import make_engine, migrate, session_factory
@@ -140,6 +141,7 @@ def create_app(
     @contextlib.asynccontextmanager
     async def lifespan(app: FastAPI):
         migrate(engine)
+        robot.recover()  # live runs the previous process died during: stored as interrupted, nothing re-armed
         if warm_kernels:
             threading.Thread(target=simulation.warm_up, name="warm-kernels", daemon=True).start()
         if run_jobs:
@@ -457,7 +459,9 @@ def create_app(
         await websocket.accept()
         try:
             while True:
-                await websocket.send_json(await asyncio.to_thread(robot.live))
+                # Built from immutable snapshots under no lock that waits: on the event loop itself,
+                # so a request pool full of compute cannot stall the live view.
+                await websocket.send_json(robot.live())
                 await asyncio.sleep(1.0 / rate)
         except (WebSocketDisconnect, RuntimeError):
             return

@@ -90,6 +90,9 @@ class Transition:
     after: LinkState
     reason: str
 
+    def to_dict(self) -> dict:
+        return {"time": self.time, "from": self.before.value, "to": self.after.value, "reason": self.reason}
+
 
 class RobotLink:
     def __init__(
@@ -216,6 +219,11 @@ class RobotLink:
     def reset(self) -> None:
         self._command(Command(self._next_seq(), Kind.RESET), expect=LinkState.DISARMED)
         self._starved = False
+
+    @property
+    def estop_latched(self) -> bool:
+        """An e-stop was not acknowledged: heartbeats are stopped and arm/start refused until a reset."""
+        return self._starved
 
     def set_leg(self, leg: Leg, psi0_deg: float, zeta0: float) -> None:
         """Send a leg's controls for its next touchdown; outside the servo limits, refuse to send."""

@@ -36,6 +36,14 @@ class Touchdown:
     foot_height: float  # [m]
     poses_fitted: int
 
+    def to_dict(self) -> dict:
+        """As JSON stores it (the wall as its sign, the state as a list)."""
+        return {**vars(self), "wall": int(self.wall), "state": list(self.state)}
+
+    @classmethod
+    def from_dict(cls, stored: dict) -> Touchdown:
+        return cls(**{**stored, "wall": Wall(stored["wall"]), "state": tuple(stored["state"])})
+
 
 def detect_touchdowns(
     time: np.ndarray,

@@ -93,7 +93,9 @@ class TrackerStats:
 
 
 class PoseHistory:
-    """Poses in time order with thread-safe appends and reads."""
+    """Poses in time order with thread-safe appends and reads. The newest HISTORY are kept; an
+    index (:meth:`count`, :meth:`poses_from`) counts every pose received, so it stays valid when
+    older ones are let go (a live run holds its own copy of the frames it journals)."""
 
     def __init__(self, calibration: Calibration, stale_after: float = STALE_AFTER):
         self.calibration = calibration
@@ -101,6 +103,7 @@ class PoseHistory:
         self._poses: list[Pose] = []
         self._times: list[float] = []
         self._arrived = -math.inf  # time.monotonic() of the newest pose's arrival
+        self._released = 0  # poses let go from the front: _poses[0] is the pose with this index
         self._lock = threading.Lock()
 
     def add(self, pose: Pose) -> None:
@@ -110,8 +113,10 @@ class PoseHistory:
             self._times.append(pose.time)
             self._arrived = time.monotonic()
             if len(self._poses) > HISTORY:
-                del self._poses[: len(self._poses) - HISTORY]
-                del self._times[: len(self._times) - HISTORY]
+                excess = len(self._poses) - HISTORY
+                del self._poses[:excess]
+                del self._times[:excess]
+                self._released += excess
 
     def latest(self, now: float | None = None) -> Pose | None:
         """The newest pose, or None if there is none or it is stale: it arrived more than
@@ -124,14 +129,15 @@ class PoseHistory:
         return pose
 
     def count(self) -> int:
-        """Poses received so far (an index for :meth:`poses_from`)."""
+        """Poses received so far, all of them (an index for :meth:`poses_from`)."""
         with self._lock:
-            return len(self._poses)
+            return self._released + len(self._poses)
 
     def poses_from(self, index: int) -> list[Pose]:
-        """Poses from the ``index``-th received on (no copy of the older ones)."""
+        """Poses from the ``index``-th received on, or from the oldest still kept (no copy of the
+        older ones)."""
         with self._lock:
-            return self._poses[index:]
+            return self._poses[max(0, index - self._released) :]
 
     def poses_since(self, since: float) -> list[Pose]:
         with self._lock:

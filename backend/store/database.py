@@ -21,7 +21,7 @@ if TYPE_CHECKING:
 MIGRATIONS = Path(__file__).resolve().parent / "migrations"
 # The newest migration's revision. tests/backend/store/test_database.py fails when a migration is
 # added without moving this: a stale value would let a database one revision behind start unmigrated.
-SCHEMA_HEAD = "0004"
+SCHEMA_HEAD = "0005"
 
 
 def sqlite_url(data_dir: Path) -> str:

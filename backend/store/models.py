@@ -66,7 +66,9 @@ class Run(Base):
     id: Mapped[int] = mapped_column(primary_key=True)
     experiment_id: Mapped[int | None] = mapped_column(ForeignKey("experiments.id", ondelete="RESTRICT"), index=True)
     kind: Mapped[str] = mapped_column(String(16), index=True)  # sim | robot | replay
-    status: Mapped[str] = mapped_column(String(16), index=True)  # done | failed (a physical failure is "done")
+    # done | failed (a physical failure is "done"); a live robot run is "running" from its start,
+    # and "interrupted" if the service died during it (its journal is then folded into it).
+    status: Mapped[str] = mapped_column(String(16), index=True)
     created_at: Mapped[datetime.datetime] = mapped_column(default=utcnow, index=True)
     duration_s: Mapped[float] = mapped_column(default=0.0)
     code_version: Mapped[str] = mapped_column(String(64))
@@ -91,6 +93,19 @@ class Run(Base):
     @property
     def tags(self) -> list[str]:
         return sorted(tag.tag for tag in self.run_tags)
+
+
+class RunJournal(Base):
+    """A live robot run's data, appended while it runs (frames, touchdowns, commands, telemetry
+    and link transitions since the previous entry): what a crash cannot take away. Folded into
+    the run and deleted when the run ends, or at the next start if the service died first."""
+
+    __tablename__ = "run_journal"
+
+    id: Mapped[int] = mapped_column(primary_key=True)
+    run_id: Mapped[int] = mapped_column(ForeignKey("runs.id", ondelete="CASCADE"), index=True)
+    written_at: Mapped[datetime.datetime] = mapped_column(default=utcnow)
+    data: Mapped[dict]
 
 
 class RunTag(Base):

@@ -282,22 +282,23 @@ class LiveMode(_Mode):
         self.last_error: float | None = None
 
     def _touchdowns(self):
-        run = self.robot_service.run if self.robot_service is not None else None
-        if run is not self._run:
-            self._run, self._ghosts, self._marked, self.last_error = run, {}, 0, None
+        run = self.robot_service.run_snapshot() if self.robot_service is not None else None
+        if (run is None) != (self._run is None) or (run is not None and run.started != self._run.started):
+            self._ghosts, self._marked, self.last_error = {}, 0, None  # a new run
             self.scene.clear_history()
+        self._run = run
         return [] if run is None else list(run.touchdowns)
 
     def _ghost(self, touchdowns, k: int) -> JumpPlan | None:
         if k in self._ghosts:
             return self._ghosts[k]
         run, robot = self._run, self.robot_service.robot
-        controls = list(run.touchdown_controls)
+        controls = run.touchdown_controls
         if k >= len(controls):
             return None
         touchdown = touchdowns[k]
         # The leg in flight after touchdown k reaches for the other wall: the one commanded now.
-        next_leg = run.commanded.get(Leg.of(touchdown.wall.other), controls[k])
+        next_leg = run.command_for(Leg.of(touchdown.wall.other)) or controls[k]
         try:
             plan = model_jump(robot, touchdown.state, controls[k], next_leg, wall=touchdown.wall,
                               start_time=touchdown.time, start_height=touchdown.body_height)  # fmt: skip

@@ -64,3 +64,57 @@ def test_kill_nine_mid_job_resumes_exactly(tmp_path):
     jumps = np.array([row.jumps for row in rows]).reshape(2, SPEC["trials"])
     for level, expected in enumerate(study.levels):
         np.testing.assert_array_equal(jumps[level], expected.jumps)
+
+
+def test_kill_nine_during_a_live_run_keeps_it_interrupted_to_the_last_second(tmp_path, virtual):
+    """The run is stored as it starts and journaled while it runs: after kill -9 and a restart it
+    is there, interrupted, with its touchdowns and frames to within a second of the kill; the
+    robot, its heartbeats gone, disarms itself, and the restarted service arms nothing."""
+    from backend.robot.messages import Fault, RobotState  # only the robot tests load the robot side
+
+    robot, tracker_port = virtual
+    data_dir, port = tmp_path / "data", free_port()
+    base = f"http://127.0.0.1:{port}/api/v1"
+    first = start_service(data_dir, port, "--no-view")
+    try:
+        auth = {"Authorization": f"Bearer {(data_dir / 'api_token').read_text().strip()}"}
+        connect = {"url": robot.url, "tracker_port": tracker_port}
+        httpx.post(f"{base}/robot/connect", json=connect, headers=auth, timeout=10).raise_for_status()
+        run = {"controls": [{"psi0_deg": 30.0, "zeta0": 0.87}, {"psi0_deg": 30.0, "zeta0": 0.9}], "jumps": 1000}
+        httpx.post(f"{base}/robot/runs", json=run, headers=auth, timeout=10).raise_for_status()
+        deadline = time.monotonic() + 60
+        while (live := httpx.get(f"{base}/robot").json()["run"])["touchdowns"] < 6:
+            assert time.monotonic() < deadline and live["active"], live
+            time.sleep(0.05)
+        seen = httpx.get(f"{base}/robot").json()["run"]
+        time.sleep(1.0)  # what was seen a second before the kill must be stored
+    finally:
+        os.kill(first.pid, signal.SIGKILL)
+        first.wait()
+    killed_at = time.time()
+    print(f"SIGKILL during live run {seen['id']} with {seen['touchdowns']} touchdowns seen")
+
+    deadline = time.monotonic() + 10
+    while robot.firmware.state != RobotState.DISARMED:  # its watchdog, not a DISARM: nobody is left to send one
+        assert time.monotonic() < deadline, robot.firmware.state
+        time.sleep(0.05)
+    assert robot.firmware.faults & Fault.HEARTBEAT_LOST
+
+    second = start_service(data_dir, port, "--no-view")
+    try:
+        stored = httpx.get(f"{base}/runs/{seen['id']}").json()
+        status = httpx.get(f"{base}/robot").json()
+    finally:
+        second.terminate()
+        second.wait(30)
+    assert stored["kind"] == "robot" and stored["status"] == "interrupted", stored["status"]
+    results = stored["results"]
+    assert results["end_reason"].startswith("interrupted") and results["disarm"].startswith("not confirmed")
+    assert len(results["touchdowns"]) >= seen["touchdowns"], "every touchdown seen a second before the kill is kept"
+    assert stored["jumps_completed"] == len(results["touchdowns"]) - 1 and stored["has_trajectory"]
+    lived = killed_at - seen["started"]  # [s] from the run's start to the kill
+    assert lived - stored["duration_s"] < 1.5, "data to within a second of the kill (plus one journal period)"
+    frames = results["tracker"]["frames"]
+    print(f"after restart: {stored['status']}, {len(results['touchdowns'])} touchdowns, {frames} frames, "
+          f"{stored['duration_s']:.2f} s of {lived:.2f} s")  # fmt: skip
+    assert status["state"] == "disconnected" and robot.firmware.state == RobotState.DISARMED, "nothing re-armed"

@@ -87,3 +87,15 @@ def test_recorded_poses_replay(climb):
     history = recorded_poses({"time": si.time, "x": si.x, "y": si.y})
     assert len(history.poses_since(si.time[-10])) == 10
     assert history.as_arrays()["y"][-1] == si.y[-1]
+
+
+def test_indices_count_every_pose_received_when_old_ones_are_let_go(monkeypatch):
+    from backend.robot import tracker
+
+    monkeypatch.setattr(tracker, "HISTORY", 5)
+    history = tracker.PoseHistory(Calibration())
+    for k in range(12):
+        history.add(Pose(float(k), 0.0, 0.0, 0.0))
+    assert history.count() == 12, "a live run's index keeps counting past the history kept"
+    assert [pose.time for pose in history.poses_from(9)] == [9.0, 10.0, 11.0]
+    assert [pose.time for pose in history.poses_from(0)] == [7.0, 8.0, 9.0, 10.0, 11.0], "from the oldest kept"

@@ -31,3 +31,24 @@ def make_run(session):
         return records.create_run(session, run_body(zeta0, psi0_deg, **fields))
 
     return make
+
+
+@pytest.fixture
+def service(sessions):
+    """The robot service, closed afterwards."""
+    from backend.services.robot import RobotService  # only the robot tests load the robot side
+
+    service = RobotService(sessions)
+    yield service
+    service.close()
+
+
+@pytest.fixture
+def connected(service, virtual):
+    """The robot service connected to the virtual robot (disarmed)."""
+    from backend.schemas import RobotConnect
+
+    robot, tracker_port = virtual
+    status = service.connect(RobotConnect(url=robot.url, tracker_port=tracker_port))
+    assert status["state"] == "disarmed", status
+    return service

@@ -12,11 +12,13 @@ import time
 import pytest
 
 from backend.robot.link import LinkError
+from backend.robot.live_run import LiveRun, RunSnapshot
 from backend.robot.messages import Fault, RobotState
 from backend.robot.virtual import VirtualRobot
 from backend.schemas import LegIn, RobotConnect, RobotRunCreate
 from backend.services import records
-from backend.services.robot import ESTOP_ANSWER, LiveRun, RobotService, RobotUnavailable, replay_run, touchdown_results
+from backend.services.robot import ESTOP_ANSWER, RobotUnavailable
+from backend.services.robot_records import replay_run, touchdown_results
 from backend.services.simulation import unpack_trajectory
 from sim_core import ParameterError, get_preset
 from tests.helpers import answer_within, free_port
@@ -31,25 +33,10 @@ FLAP_S = 4.0  # [s] the radio flaps in the service's test (tests/backend/robot/t
 FLAP_ANSWER_S = 20.0  # [s] a connect, a close or the threads' end, instead of a hang: generous
 
 
-@pytest.fixture
-def service(sessions):
-    service = RobotService(sessions)
-    yield service
-    service.close()
-
-
-@pytest.fixture
-def connected(service, virtual):
-    robot, tracker_port = virtual
-    status = service.connect(RobotConnect(url=robot.url, tracker_port=tracker_port))
-    assert status["state"] == "disarmed", status
-    return service
-
-
 def _live_run(service, **fields) -> dict:
     """Start a live run, wait for its end, and return the service's status then."""
-    run = service.start_run(RobotRunCreate(controls=LEGS, jumps=JUMPS, **fields))
-    assert run.done.wait(RUN_WAIT_S), "the live run did not end"
+    service.start_run(RobotRunCreate(controls=LEGS, jumps=JUMPS, **fields))
+    assert not service.wait_run(RUN_WAIT_S).active, "the live run did not end"
     return service.status()
 
 
@@ -127,13 +114,11 @@ def _wait_for(predicate, what: str, timeout=RUN_WAIT_S) -> None:
 
 def test_a_foreign_radio_cannot_end_a_live_run(connected, virtual, session):
     robot, _ = virtual
-    run = connected.start_run(RobotRunCreate(controls=LEGS, jumps=1000))
-    _wait_for(lambda: len(run.touchdowns) >= 2, "two touchdowns")
+    seen = len(_running(connected, connected.start_run(RobotRunCreate(controls=LEGS, jumps=1000))).touchdowns)
     robot.inject(received_frame(telemetry(1, RobotState.DISARMED), source64=FOREIGN) * 3)
     _wait_for(lambda: connected.status()["counters"]["foreign_frames"] == 3, "three foreign frames counted")
-    seen = len(run.touchdowns)
-    _wait_for(lambda: len(run.touchdowns) >= seen + 2, "two more touchdowns")
-    assert not run.done.is_set() and connected.status()["state"] == "running"
+    _wait_for(lambda: len(connected.run_snapshot().touchdowns) >= seen + 2, "two more touchdowns")
+    assert connected.run_snapshot().active and connected.status()["state"] == "running"
     assert robot.firmware.state == RobotState.RUNNING
     status = connected.stop_run()
     assert status["run"]["end_reason"] == "stopped" and status["state"] == "disarmed"
@@ -141,10 +126,10 @@ def test_a_foreign_radio_cannot_end_a_live_run(connected, virtual, session):
 
 
 def test_estop_ends_a_live_run_even_unacknowledged(service):
-    run = LiveRun(RobotRunCreate(controls=LEGS))
-    service.run = run  # a run whose link is gone
+    run = LiveRun(jumps=4, max_seconds=60.0)
+    service._run = run  # a run whose link is gone
     stopped = service.estop()
-    assert stopped["acknowledged"] is False and run.stop_requested.is_set() and run.end_reason == "e-stop"
+    assert stopped["acknowledged"] is False and run.stop_reason() == "e-stop"
     run.done.set()
 
 
@@ -212,42 +197,49 @@ def test_the_services_link_has_one_owner_while_it_flaps(service, monkeypatch, ca
     assert calls.most_connecting == 1 and calls.callers == {"robot-link-supervisor"}, calls.callers
 
 
-def _running(service, run) -> LiveRun:
-    _wait_for(lambda: len(run.touchdowns) >= 2, "two touchdowns")
+def _running(service, _started: RunSnapshot) -> RunSnapshot:
+    """The live run just started, once it has two touchdowns."""
+    _wait_for(lambda: len(service.run_snapshot().touchdowns) >= 2, "two touchdowns")
+    return service.run_snapshot()
+
+
+def _ended(service) -> RunSnapshot:
+    run = service.wait_run(RUN_WAIT_S)
+    assert not run.active, "the live run did not end"
     return run
 
 
-def _end_by_jumps(service, robot) -> LiveRun:
-    run = service.start_run(RobotRunCreate(controls=LEGS, jumps=JUMPS))
-    assert run.done.wait(RUN_WAIT_S), "the live run did not end"
-    return run
+def _end_by_jumps(service, robot) -> RunSnapshot:
+    service.start_run(RobotRunCreate(controls=LEGS, jumps=JUMPS))
+    return _ended(service)
 
 
-def _end_by_stop(service, robot) -> LiveRun:
-    run = _running(service, service.start_run(RobotRunCreate(controls=LEGS, jumps=1000)))
+def _end_by_stop(service, robot) -> RunSnapshot:
+    _running(service, service.start_run(RobotRunCreate(controls=LEGS, jumps=1000)))
     service.stop_run()
+    return _ended(service)
+
+
+def _end_by_the_time_limit(service, robot) -> RunSnapshot:
+    service.start_run(RobotRunCreate(controls=LEGS, jumps=1000, max_seconds=1.0))
+    run = _ended(service)
+    assert run.end_reason == "time limit", run.end_reason
     return run
 
 
-def _end_by_the_time_limit(service, robot) -> LiveRun:
-    run = service.start_run(RobotRunCreate(controls=LEGS, jumps=1000, max_seconds=1.0))
-    assert run.done.wait(RUN_WAIT_S) and run.end_reason == "time limit", run.end_reason
-    return run
-
-
-def _end_by_a_stale_disarmed_telemetry(service, robot) -> LiveRun:
+def _end_by_a_stale_disarmed_telemetry(service, robot) -> RunSnapshot:
     # The link believes the robot disarmed while it runs on: the ending must disarm it all the same.
-    run = _running(service, service.start_run(RobotRunCreate(controls=LEGS, jumps=1000)))
+    _running(service, service.start_run(RobotRunCreate(controls=LEGS, jumps=1000)))
     robot.inject(received_frame(telemetry(1, RobotState.DISARMED)))
-    assert run.done.wait(RUN_WAIT_S), "the live run did not end"
+    run = _ended(service)
     assert run.end_reason.startswith("robot disarmed")
     return run
 
 
-def _end_by_shutdown(service, robot) -> LiveRun:
-    run = _running(service, service.start_run(RobotRunCreate(controls=LEGS, jumps=1000)))
+def _end_by_shutdown(service, robot) -> RunSnapshot:
+    _running(service, service.start_run(RobotRunCreate(controls=LEGS, jumps=1000)))
     answer_within(FLAP_ANSWER_S, service.close)
-    return run
+    return service.run_snapshot()
 
 
 @pytest.mark.parametrize(
@@ -256,17 +248,17 @@ def _end_by_shutdown(service, robot) -> LiveRun:
 def test_every_ending_disarms_the_robot(connected, virtual, session, end):
     robot, _ = virtual
     run = end(connected, robot)
-    assert run.done.is_set() and run.disarm == "disarmed", (run.end_reason, run.disarm)
+    assert not run.active and run.disarm == "disarmed", (run.end_reason, run.disarm)
     assert robot.firmware.state == RobotState.DISARMED, run.end_reason
     assert not robot.firmware.faults & Fault.HEARTBEAT_LOST, "disarmed by a DISARM, not by its watchdog"
-    assert records.get_run(session, run.stored_run_id).results["disarm"] == "disarmed"
+    assert records.get_run(session, run.run_id).results["disarm"] == "disarmed"
 
 
 def test_an_estop_ending_leaves_the_robot_estopped(connected, virtual):
     robot, _ = virtual
-    run = _running(connected, connected.start_run(RobotRunCreate(controls=LEGS, jumps=1000)))
+    _running(connected, connected.start_run(RobotRunCreate(controls=LEGS, jumps=1000)))
     assert connected.estop()["acknowledged"] is True
-    assert run.done.wait(RUN_WAIT_S) and run.disarm == "estopped" and robot.firmware.state == RobotState.ESTOPPED
+    assert _ended(connected).disarm == "estopped" and robot.firmware.state == RobotState.ESTOPPED
 
 
 @pytest.mark.parametrize("ending", ["disconnect", "close"])

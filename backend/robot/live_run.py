@@ -1,0 +1,258 @@
+"""A live run on the robot: its control loop, the one thread that owns the run's data.
+
+The loop sets the legs, arms and starts the robot, then watches the tracker: each touchdown it
+detects is recorded and, closed loop, its height goes through the simulator's PID
+(:func:`sim_core.closed_loop.pid_step`) to the leg of the touchdown after next — the one the
+robot positions during the coming stance. It ends when its jumps or time are used up, when
+stopped, or when anything goes wrong (e-stop, fall, lost link); whatever ended it, it then
+disarms the robot, confirmed by telemetry (:meth:`RobotLink.make_safe`).
+
+Only the loop's thread writes the run's records. Everyone else sees them two ways, neither of
+which shares anything mutable: :attr:`LiveRun.snapshot`, an immutable :class:`RunSnapshot`
+replaced whole after every change (the panel, the live 3D view), and :attr:`LiveRun.journal`, a
+queue of :class:`Record` s — each appended record, once, in order — that the run's journal writer
+drains to the store (:mod:`backend.services.robot_journal`).
+"""
+
+from __future__ import annotations
+
+import math
+import queue
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from backend.robot.link import LinkError, LinkState, RobotLink
+from backend.robot.messages import Leg
+from backend.robot.touchdown import Touchdown, detect_touchdowns
+from backend.robot.tracker import PoseHistory
+from sim_core.controls import LegControl
+from sim_core.errors import ParameterError
+from sim_core.walls import wall_of
+
+POLL = 0.005  # [s] how often the loop looks at new poses
+CLEAN_ENDINGS = ("jumps done", "stopped", "time limit")  # a run that ended so is "done", else "failed"
+
+
+@dataclass(frozen=True)
+class Record:
+    """One thing the run recorded, for its journal: ``kind`` is ``touchdown`` (``value`` is the
+    :class:`Touchdown` and the :class:`LegControl` it was made with), ``command`` or ``telemetry``
+    (a dict); ``value`` is never changed after it is made."""
+
+    kind: str
+    value: object
+
+
+@dataclass(frozen=True)
+class RunSnapshot:
+    """What a live run is now, immutable: read it from any thread, as often as you like."""
+
+    run_id: int | None  # the stored run's id (it is stored when it starts)
+    started: float  # time.time()
+    jumps: int  # asked for
+    max_seconds: float
+    active: bool = True
+    touchdowns: tuple[Touchdown, ...] = ()
+    touchdown_controls: tuple[LegControl, ...] = ()  # the controls each detected touchdown was made with
+    commanded: tuple[tuple[Leg, LegControl], ...] = ()  # what each leg is commanded now
+    commands: int = 0  # sent so far
+    end_reason: str | None = None
+    disarm: str | None = None  # how the ending left the robot: "disarmed", "estopped" or why unconfirmed
+
+    def command_for(self, leg: Leg) -> LegControl | None:
+        return dict(self.commanded).get(leg)
+
+    def to_status(self) -> dict:
+        return {
+            "id": self.run_id,
+            "active": self.active,
+            "started": self.started,
+            "touchdowns": len(self.touchdowns),
+            "jumps": self.jumps,
+            "max_seconds": self.max_seconds,
+            "commands": self.commands,
+            "end_reason": self.end_reason,
+            "disarm": self.disarm,
+            "stored_run_id": self.run_id,
+        }
+
+
+@dataclass
+class LiveRun:
+    """A run's records, written by its control loop's thread only (:func:`execute`); other
+    threads read :attr:`snapshot`, drain :attr:`journal`, or ask it to :meth:`stop`."""
+
+    jumps: int  # touchdowns to record before it ends
+    max_seconds: float  # [s] from the start, at most
+    run_id: int | None = None
+    started: float = field(default_factory=time.time)
+    first_pose: int = 0  # the tracker's index of the run's first frame
+    touchdowns: list[Touchdown] = field(default_factory=list)
+    touchdown_controls: list[LegControl] = field(default_factory=list)
+    commanded: dict[Leg, LegControl] = field(default_factory=dict)
+    commands: list[dict] = field(default_factory=list)
+    telemetry: list[dict] = field(default_factory=list)
+    end_reason: str | None = None
+    disarm: str | None = None
+    journal: queue.SimpleQueue[Record] = field(default_factory=queue.SimpleQueue)
+    done: threading.Event = field(default_factory=threading.Event)
+    snapshot: RunSnapshot = field(init=False)
+    _stop_requests: queue.SimpleQueue[str] = field(default_factory=queue.SimpleQueue)
+
+    def __post_init__(self) -> None:
+        self.snapshot = RunSnapshot(self.run_id, self.started, self.jumps, self.max_seconds)
+
+    def stop(self, reason: str = "stopped") -> None:
+        """Any thread: ask the loop to end; it sends nothing more once it has seen this (the first
+        reason asked is the run's end reason)."""
+        self._stop_requests.put(reason)
+
+    # The loop's thread only -------------------------------------------------------------------
+    def stop_reason(self) -> str | None:
+        try:
+            return self._stop_requests.get_nowait()
+        except queue.Empty:
+            return None
+
+    def record(self, kind: str, value, into: list) -> None:
+        into.append(value[0] if kind == "touchdown" else value)
+        self.journal.put(Record(kind, value))
+
+    def publish(self, **changes) -> None:
+        """A new snapshot of the run (the loop's thread only): readers never see a half-made one."""
+        self.snapshot = replace(
+            self.snapshot,
+            touchdowns=tuple(self.touchdowns),
+            touchdown_controls=tuple(self.touchdown_controls),
+            commanded=tuple(self.commanded.items()),
+            commands=len(self.commands),
+            end_reason=self.end_reason,
+            disarm=self.disarm,
+            **changes,
+        )
+
+
+PidLaw = tuple[float, float, float, float, float, float]  # hover zeta0, kp, ki, kd, zeta0 min, max
+
+
+def execute(
+    run: LiveRun,
+    link: RobotLink,
+    tracker: PoseHistory,
+    robot,
+    legs: list[LegControl],
+    controller: tuple[float, PidLaw] | None,
+    on_end: Callable[[LiveRun], None],
+) -> None:
+    """The run's control loop, on its own thread, to the end. Then the robot is made safe,
+    ``on_end(run)`` stores the run, and only then the snapshot turns inactive and ``run.done`` is
+    set, whatever happened. ``controller`` is (target height [m], PID law), or None for open
+    loop; ``robot`` the physical parameters (touchdown detection, units)."""
+    from sim_core.closed_loop import pid_step  # loaded before the first touchdown, not with the service
+
+    commanded = run.commanded
+    commanded.update({Leg.LEFT: legs[0], Leg.RIGHT: legs[1]})
+    integral, previous_error = 0.0, math.nan
+    seen_poses = run.first_pose
+
+    def send(leg: Leg, control: LegControl, why: str) -> None:
+        link.set_leg(leg, control.psi0_deg, control.zeta0)
+        commanded[leg] = control
+        run.record("command", {"time": time.time(), "leg": leg.name.lower(), "psi0_deg": control.psi0_deg,
+                               "zeta0": control.zeta0, "why": why}, run.commands)  # fmt: skip
+        run.publish()
+
+    def leg_for(k: int) -> LegControl:
+        # Detected touchdown k is the climb's touchdown k + 1: even climb touchdowns are the left leg's.
+        controls = run.touchdown_controls
+        return controls[k] if k < len(controls) else commanded[Leg.of(wall_of(k + 1))]
+
+    try:
+        send(Leg.LEFT, legs[0], "start")
+        send(Leg.RIGHT, legs[1], "start")
+        if link.state == LinkState.DISARMED:
+            link.arm()
+        link.start()
+        deadline = time.monotonic() + run.max_seconds
+        while run.end_reason is None:
+            run.end_reason = _ending(run, link, deadline)
+            if run.end_reason is not None:
+                break
+            telemetry = link.telemetry
+            if telemetry is not None and (not run.telemetry or run.telemetry[-1]["seq"] != telemetry.seq):
+                run.record("telemetry", {"time": time.time(), **telemetry_dict(telemetry)}, run.telemetry)
+            if tracker.count() == seen_poses:
+                time.sleep(POLL)  # nothing new to analyse
+                continue
+            seen_poses = tracker.count()
+            poses = tracker.poses_from(run.first_pose)
+            if len(poses) > 1:
+                times = np.array([p.time for p in poses])
+                found = detect_touchdowns(times, np.array([p.x for p in poses]), np.array([p.y for p in poses]),
+                                          robot, leg_for)  # fmt: skip
+                while len(run.touchdown_controls) < len(found):
+                    run.touchdown_controls.append(leg_for(len(run.touchdown_controls)))
+                for touchdown in found[len(run.touchdowns) :]:
+                    run.record("touchdown", (touchdown, run.touchdown_controls[touchdown.index]), run.touchdowns)
+                    run.publish()
+                    if controller is not None:
+                        target_m, law = controller
+                        error = (target_m - touchdown.body_height) / robot.leg_length
+                        command, integral = pid_step(error, previous_error, integral, *law)
+                        previous_error = error
+                        leg = Leg.of(wall_of(touchdown.index + 2))  # the next touchdown's (climb numbering)
+                        send(leg, LegControl(commanded[leg].psi0, command), f"pid after touchdown {touchdown.index}")
+                if len(run.touchdowns) >= run.jumps:
+                    run.end_reason = "jumps done"
+            time.sleep(POLL)
+    except (LinkError, ParameterError) as error:
+        run.end_reason = run.end_reason or f"error: {error}"
+    finally:
+        run.end_reason = run.end_reason or "error: the control loop failed"
+        run.disarm = end_safely(link)  # whatever ended it, and whatever the link believes
+        run.publish()
+        try:
+            on_end(run)
+        finally:
+            run.publish(active=False)  # inactive once stored: a reader that saw it end finds it stored
+            run.done.set()
+
+
+def _ending(run: LiveRun, link: RobotLink, deadline: float) -> str | None:
+    """Why the run must end now, or None."""
+    asked = run.stop_reason()
+    if asked is not None:
+        return asked
+    if link.state != LinkState.RUNNING:
+        return {
+            LinkState.DISCONNECTED: "link lost",
+            LinkState.ESTOPPED: "e-stop",
+        }.get(link.state, "robot disarmed (fell or timed out)")
+    if time.monotonic() > deadline:
+        return "time limit"
+    return None
+
+
+def end_safely(link: RobotLink) -> str:
+    """A run's ending: DISARM confirmed by telemetry (:meth:`RobotLink.make_safe`), or why not — a
+    lost link's robot disarms itself by its watchdog, and the supervisor disarms it when it is back."""
+    try:
+        return link.make_safe().value
+    except LinkError as error:
+        return f"not confirmed: {error}"
+
+
+def telemetry_dict(telemetry) -> dict:
+    """A TELEMETRY message as the API and the stored run show it."""
+    return {
+        "seq": telemetry.seq,
+        "state": telemetry.state.name.lower(),
+        "psi_servo_deg": list(telemetry.psi_servo_deg),
+        "zeta_servo": list(telemetry.zeta_servo),
+        "battery_mv": telemetry.battery_mv,
+        "faults": telemetry.faults,
+    }

@@ -1,0 +1,200 @@
+"""Robot runs in the store: opened when they start, journaled while they run, folded when they end.
+
+A live run is a row of kind ``robot`` from its first moment (status ``running``,
+:func:`open_robot_run`). While it runs, its journal writer appends what it recorded
+(:class:`~backend.store.models.RunJournal` entries, :mod:`backend.services.robot_journal`). When
+it ends, :func:`fold_journal` turns the entries into the run's results and tracker frames —
+touchdowns and the model's prediction beside them — and deletes them. A run the service did not
+live to end is folded the same way at the next start (:func:`recover_interrupted`), as
+``interrupted``: everything to its last journal entry is kept, and nothing is re-armed.
+
+A stored run's frames can be analysed again with today's detector (:func:`replay_run`).
+"""
+
+from __future__ import annotations
+
+import datetime
+import math
+from dataclasses import asdict
+
+import numpy as np
+from sqlalchemy import delete, select
+
+from backend.robot.touchdown import Touchdown, detect_touchdowns, height_gains
+from backend.services.records import Conflict, NotFound
+from backend.services.simulation import current_code_version, pack_trajectory, unpack_trajectory
+from backend.store.models import Run, RunJournal, RunTag
+from experiments.manifest import json_safe
+from sim_core.controls import ControlSchedule, LegControl
+from sim_core.presets import get_preset
+
+FRAME_COLUMNS = ("time", "x", "y", "pitch")
+INTERRUPTED = "interrupted: the service stopped during the run; kept to its last journal entry"
+
+
+def open_robot_run(session, request, robot, calibration) -> int:
+    """Store a live run as it starts (status ``running``); returns its id. ``request`` is the
+    :class:`~backend.schemas.RobotRunCreate`, ``robot`` the physical parameters."""
+    model = robot.to_model()
+    first = request.controls[0]
+    run = Run(
+        experiment_id=request.experiment_id,
+        kind="robot",
+        status="running",
+        duration_s=0.0,
+        code_version=current_code_version(),
+        model=json_safe(asdict(model)),
+        controls=[[leg.psi0_deg, leg.zeta0] for leg in request.controls],
+        jumps=request.jumps,
+        alpha=model.alpha,
+        psi0_deg=first.psi0_deg,
+        zeta0=first.zeta0,
+        **touchdown_columns([], {"rises": []}),
+        results=json_safe(
+            {
+                "end_reason": None,
+                "calibration": asdict(calibration),
+                "closed_loop": None if request.closed_loop is None else request.closed_loop.model_dump(),
+            }
+        ),
+        trajectory=None,
+    )
+    run.run_tags = [RunTag(tag=tag) for tag in sorted(set(request.tags))]
+    session.add(run)
+    session.commit()
+    return run.id
+
+
+def fold_journal(session, run_id: int, *, status: str, end_reason: str, disarm: str | None, robot=None) -> Run:
+    """The run's journal entries folded into the run (results, tracker frames, the touchdown
+    columns) and deleted, in one transaction; ``status`` and ``end_reason`` say how it ended."""
+    robot = robot or get_preset("paper")
+    run = session.get(Run, run_id)
+    entries = session.scalars(select(RunJournal).where(RunJournal.run_id == run_id).order_by(RunJournal.id)).all()
+    frames = {name: [] for name in FRAME_COLUMNS}
+    touchdowns, controls, commands, telemetry, transitions, tracker = [], [], [], [], [], None
+    for entry in entries:
+        data = entry.data
+        for name in FRAME_COLUMNS:
+            frames[name].extend(data["frames"][name])
+        for stored in data["touchdowns"]:
+            touchdowns.append(Touchdown.from_dict(stored["touchdown"]))
+            controls.append(LegControl.from_degrees(*stored["control"]))
+        commands.extend(data["commands"])
+        telemetry.extend(data["telemetry"])
+        transitions.extend(data["transitions"])
+        tracker = data["tracker"] or tracker
+    analysis = touchdown_results(touchdowns, controls, robot)
+    run.status = status
+    if entries:
+        run.duration_s = max(run.duration_s, _seconds_between(run.created_at, entries[-1].written_at))
+    run.results = json_safe(
+        {
+            **run.results,
+            "end_reason": end_reason,
+            "disarm": disarm,
+            **analysis,
+            "touchdown_controls": [[leg.psi0_deg, leg.zeta0] for leg in controls],
+            "commands": commands,
+            "telemetry": telemetry,
+            "transitions": transitions,
+            "tracker": {"frames": len(frames["time"]), **(tracker or {"dropped": 0, "loss": 0.0})},
+        }
+    )
+    for name, value in touchdown_columns(touchdowns, analysis).items():
+        setattr(run, name, value)
+    columns = {name: np.asarray(values, dtype=float) for name, values in frames.items()}
+    run.trajectory = pack_trajectory(columns) if frames["time"] else None
+    session.execute(delete(RunJournal).where(RunJournal.run_id == run_id))
+    session.commit()
+    return run
+
+
+def recover_interrupted(sessions, robot=None) -> list[int]:
+    """At start-up: every robot run still ``running`` was cut short by the service's death; fold
+    its journal as ``interrupted`` (the disarm unconfirmed: the robot's watchdog saw to it).
+    Returns their ids. Nothing is sent to any robot."""
+    with sessions() as session:
+        ids = session.scalars(select(Run.id).where(Run.kind == "robot", Run.status == "running")).all()
+        for run_id in ids:
+            fold_journal(session, run_id, status="interrupted", end_reason=INTERRUPTED,
+                         disarm="not confirmed: the service stopped", robot=robot)  # fmt: skip
+    return list(ids)
+
+
+def touchdown_columns(touchdowns: list[Touchdown], analysis: dict) -> dict:
+    """The stored run's columns its touchdowns decide (a robot run or its replay): the first
+    section state, the jumps between touchdowns and their climb; a tracked run has no failure code."""
+    return {
+        "start_state": json_safe(list(touchdowns[0].state) if touchdowns else [math.nan, math.nan]),
+        "failure_code": None,
+        "jumps_completed": max(len(touchdowns) - 1, 0),
+        "climb": float(np.sum(analysis["rises"])),
+    }
+
+
+def touchdown_results(touchdowns: list[Touchdown], controls: list[LegControl], robot) -> dict:
+    """What a robot or replay run stores about its touchdowns: each touchdown, its section state,
+    the height gains, and the model's prediction from the first touchdown with the same controls."""
+    from sim_core.poincare import iterate_map
+
+    gains = height_gains(touchdowns, robot) if len(touchdowns) > 1 else np.empty(0)
+    prediction = None
+    if len(touchdowns) > 1:
+        schedule = ControlSchedule.of(*controls[: len(touchdowns)])
+        prediction = iterate_map(robot.to_model(), schedule, touchdowns[0].state, len(touchdowns) - 1).to_dict()
+    return {
+        "touchdowns": [td.to_dict() for td in touchdowns],
+        "states": [list(td.state) for td in touchdowns],
+        "rises": gains.tolist(),
+        "prediction": prediction,
+    }
+
+
+def replay_run(session, run_id: int, robot=None) -> Run:
+    """A stored robot run's tracker frames analysed again (kind ``replay``): touchdowns, gains and
+    the model's prediction, with today's detection — e.g. after a calibration or detector change."""
+    robot = robot or get_preset("paper")
+    source = session.get(Run, run_id)
+    if source is None:
+        raise NotFound("run", run_id)
+    if source.kind == "robot" and source.status == "running":
+        raise Conflict(f"run {run_id} is still running; replay it once it has ended")
+    if source.kind != "robot" or source.trajectory is None:
+        raise Conflict(f"run {run_id} is a {source.kind} run without tracker frames; only robot runs can be replayed")
+    frames = unpack_trajectory(source.trajectory)
+    recorded = [LegControl.from_degrees(*pair) for pair in source.results.get("touchdown_controls", [])]
+    alternating = [LegControl.from_degrees(*pair) for pair in source.controls]
+
+    def leg_for(k: int) -> LegControl:
+        return recorded[k] if k < len(recorded) else alternating[(k + 1) % 2]
+
+    touchdowns = detect_touchdowns(frames["time"], frames["x"], frames["y"], robot, leg_for)
+    analysis = touchdown_results(touchdowns, [leg_for(k) for k in range(len(touchdowns))], robot)
+    replay = Run(
+        experiment_id=source.experiment_id,
+        kind="replay",
+        status="done",
+        duration_s=0.0,
+        code_version=current_code_version(),
+        model=source.model,
+        controls=source.controls,
+        jumps=source.jumps,
+        alpha=source.alpha,
+        psi0_deg=source.psi0_deg,
+        zeta0=source.zeta0,
+        **touchdown_columns(touchdowns, analysis),
+        results=json_safe({"source_run_id": run_id, **analysis}),
+        trajectory=None,
+    )
+    replay.run_tags = [RunTag(tag=tag) for tag in sorted({*source.tags, "replay"})]
+    session.add(replay)
+    session.commit()
+    return replay
+
+
+def _seconds_between(start: datetime.datetime, end: datetime.datetime) -> float:
+    def aware(moment: datetime.datetime) -> datetime.datetime:
+        return moment if moment.tzinfo is not None else moment.replace(tzinfo=datetime.UTC)
+
+    return max(0.0, (aware(end) - aware(start)).total_seconds())

@@ -1,0 +1,53 @@
+"""A live run's records: one writer, immutable snapshots for everyone else, a journal queue."""
+
+import dataclasses
+
+import pytest
+
+from backend.robot.live_run import LiveRun, Record, RunSnapshot
+from backend.robot.messages import Leg
+from backend.robot.touchdown import Touchdown
+from sim_core.controls import LegControl
+from sim_core.walls import Wall
+
+TOUCHDOWN = Touchdown(0, 1.5, Wall.RIGHT, (-0.9, 0.1), 0.4, 0.35, 8)
+CONTROL = LegControl.from_degrees(30.0, 0.87)
+
+
+def test_a_snapshot_is_immutable_and_replaced_whole():
+    run = LiveRun(jumps=4, max_seconds=60.0, run_id=7)
+    before = run.snapshot
+    run.record("touchdown", (TOUCHDOWN, CONTROL), run.touchdowns)
+    run.commanded[Leg.LEFT] = CONTROL
+    assert before.touchdowns == () and run.snapshot is before, "nothing shows until published"
+    run.publish()
+    after = run.snapshot
+    assert after is not before and after.touchdowns == (TOUCHDOWN,) and after.command_for(Leg.LEFT) == CONTROL
+    assert isinstance(after.touchdowns, tuple) and isinstance(after.commanded, tuple)
+    run.touchdowns.append(TOUCHDOWN)  # the loop goes on writing: a reader's snapshot does not move
+    assert len(after.touchdowns) == 1
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        after.active = False  # type: ignore[misc]
+
+
+def test_records_reach_the_journal_once_in_order():
+    run = LiveRun(jumps=4, max_seconds=60.0)
+    run.record("command", {"leg": "left", "why": "start"}, run.commands)
+    run.record("touchdown", (TOUCHDOWN, CONTROL), run.touchdowns)
+    drained = [run.journal.get_nowait() for _ in range(2)]
+    assert drained == [Record("command", {"leg": "left", "why": "start"}), Record("touchdown", (TOUCHDOWN, CONTROL))]
+    assert run.journal.empty() and run.touchdowns == [TOUCHDOWN]
+
+
+def test_the_first_stop_asked_is_the_runs_reason():
+    run = LiveRun(jumps=4, max_seconds=60.0)
+    assert run.stop_reason() is None
+    run.stop("e-stop")
+    run.stop("stopped")
+    assert run.stop_reason() == "e-stop"
+
+
+def test_status_names_the_stored_run():
+    status = RunSnapshot(run_id=3, started=10.0, jumps=4, max_seconds=60.0).to_status()
+    assert (status["id"], status["stored_run_id"], status["active"], status["touchdowns"]) == (3, 3, True, 0)
+    assert set(status) >= {"started", "jumps", "max_seconds", "commands", "end_reason", "disarm"}
