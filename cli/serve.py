@@ -47,7 +47,8 @@ def serve_command(
     """Start the service (SQLite in the data directory unless DATABASE_URL says otherwise)."""
     import uvicorn
 
-    from backend.api.app import api_token, create_app
+    from backend.api.app import create_app
+    from backend.api.security import api_token
 
     settings = Settings.from_environment(data_dir)
     token, created = api_token(settings.data_dir)

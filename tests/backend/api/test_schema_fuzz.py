@@ -8,7 +8,8 @@ import pytest
 import schemathesis
 from hypothesis import HealthCheck, settings
 
-from backend.api.app import api_token, create_app
+from backend.api.app import create_app
+from backend.api.security import api_token
 from backend.settings import Settings
 from backend.store.database import make_engine, migrate
 

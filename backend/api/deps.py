@@ -1,0 +1,90 @@
+"""What routes ask FastAPI for: a database session, the token check, the service's parts, and the
+shared path and query parameters (ids, pages, the run filters)."""
+
+from __future__ import annotations
+
+import datetime
+from collections.abc import Iterator
+from typing import Annotated
+
+from fastapi import Depends, HTTPException, Query, Request, status
+from fastapi import Path as FastAPIPath
+from sqlalchemy.orm import Session
+
+from backend import schemas
+from backend.api.security import require_token
+from backend.services import jobs, records
+from backend.services.robot import RobotService
+
+VIEW_NOT_STARTED = "the 3D view is not running (it starts with `parkour serve`)"
+
+
+def get_session(request: Request) -> Iterator[Session]:
+    with request.app.state.sessions() as session:
+        yield session
+
+
+def run_filter(
+    experiment_id: Annotated[int | None, Query(ge=1, le=schemas.MAX_ID)] = None,
+    kind: Annotated[str | None, Query(pattern="^(sim|robot|replay)$")] = None,
+    status_: Annotated[str | None, Query(alias="status", pattern="^(done|failed|running|interrupted)$")] = None,
+    tag: Annotated[str | None, Query(max_length=64)] = None,
+    failure_code: Annotated[str | None, Query(max_length=32)] = None,
+    zeta0_min: Annotated[float | None, Query(ge=0.0, le=1.0)] = None,
+    zeta0_max: Annotated[float | None, Query(ge=0.0, le=1.0)] = None,
+    psi0_min: Annotated[float | None, Query(ge=0.0, le=90.0)] = None,
+    psi0_max: Annotated[float | None, Query(ge=0.0, le=90.0)] = None,
+    created_after: datetime.datetime | None = None,
+    created_before: datetime.datetime | None = None,
+) -> records.RunFilter:
+    """The run filters shared by list, export and aggregate."""
+    return records.RunFilter(
+        experiment_id=experiment_id,
+        kind=kind,
+        status=status_,
+        tag=tag,
+        failure_code=failure_code,
+        zeta0_min=zeta0_min,
+        zeta0_max=zeta0_max,
+        psi0_min=psi0_min,
+        psi0_max=psi0_max,
+        created_after=created_after,
+        created_before=created_before,
+    )
+
+
+async def robot_service(request: Request) -> RobotService:
+    # async: FastAPI runs a plain def dependency in the request thread pool, which compute can fill
+    # — and the e-stop asks for this one.
+    return request.app.state.robot
+
+
+def job_runner(request: Request) -> jobs.JobRunner | None:
+    """The service's job runner, or None when it runs no jobs (``create_app(run_jobs=False)``)."""
+    return request.app.state.runner
+
+
+def view_unavailable_reason(request: Request) -> str:
+    starter = request.app.state.view_starter
+    return VIEW_NOT_STARTED if starter is None else starter.unavailable_reason
+
+
+def scene_view(request: Request):
+    """The 3D view, or a 503 saying why there is none (not started, still starting, failed)."""
+    starter = request.app.state.view_starter
+    view = None if starter is None else starter.view
+    if view is None:
+        raise HTTPException(status.HTTP_503_SERVICE_UNAVAILABLE, view_unavailable_reason(request))
+    return view
+
+
+Db = Annotated[Session, Depends(get_session)]
+RunQuery = Annotated[records.RunFilter, Depends(run_filter)]
+Robot = Annotated[RobotService, Depends(robot_service)]
+Runner = Annotated[jobs.JobRunner | None, Depends(job_runner)]
+SceneView = Annotated[object, Depends(scene_view)]  # frontend.viewer's view (the backend does not import it)
+AUTHORIZED = [Depends(require_token)]  # every mutating route's dependencies
+PageLimit = Annotated[int, Query(ge=1, le=records.MAX_PAGE, description="items per page")]
+Cursor = Annotated[int | None, Query(ge=1, le=schemas.MAX_ID, description="next_cursor of the previous page")]
+RecordId = Annotated[int, FastAPIPath(ge=1, le=schemas.MAX_ID)]
+OptionalRecordId = Annotated[int | None, Query(ge=1, le=schemas.MAX_ID)]

@@ -1,0 +1,111 @@
+"""Batch jobs: MJTF trials, sweeps, basins and gait searches, queued and resumed across restarts."""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import time
+from typing import Annotated
+
+from fastapi import APIRouter, Query, Request
+from fastapi.encoders import jsonable_encoder
+from fastapi.responses import StreamingResponse
+
+from backend import schemas
+from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, RecordId, Runner
+from backend.services import jobs
+
+EVENT_POLL_S = 0.25  # progress comes from committed chunks; a quarter second is live enough
+
+router = APIRouter(prefix="/api/v1/jobs", tags=["jobs"])
+
+
+@router.post("", status_code=202, dependencies=AUTHORIZED, response_model=schemas.JobOut)
+def create_job(body: schemas.JobCreate, db: Db, runner: Runner):
+    job = jobs.create_job(db, body)
+    if runner is not None:
+        runner.submit(job.id)
+    return job_out(job)
+
+
+@router.get("", response_model=schemas.Page)
+def list_jobs(
+    db: Db,
+    limit: PageLimit = 50,
+    cursor: Cursor = None,
+    state: Annotated[str | None, Query(pattern="^(queued|running|cancelling|cancelled|done|failed)$")] = None,
+):
+    rows, next_cursor = jobs.list_jobs(db, state=state, limit=limit, cursor=cursor)
+    return {"items": [job_out(row) for row in rows], "next_cursor": next_cursor}
+
+
+@router.get("/{job_id}", response_model=schemas.JobOut)
+def get_job(job_id: RecordId, db: Db):
+    return job_out(jobs.get_job(db, job_id))
+
+
+@router.get("/{job_id}/results", response_model=schemas.JobResults)
+def job_results(job_id: RecordId, db: Db):
+    job = jobs.get_job(db, job_id)
+    if job.kind != "mjtf":
+        return {"job": job_out(job), "result": job.result}
+    return {"job": job_out(job), "levels": [_finite(level) for level in jobs.level_summaries(db, job)]}
+
+
+@router.get("/{job_id}/events", response_class=StreamingResponse)
+async def job_events(
+    job_id: RecordId,
+    request: Request,
+    timeout: Annotated[float, Query(gt=0, le=86_400, description="close the stream after this many seconds")] = 3600,
+):
+    """Server-sent events: a ``progress`` event whenever the job's state or count changes; the
+    stream ends after the job's final state (done, cancelled, failed) or ``timeout``."""
+    sessions = request.app.state.sessions
+
+    def snapshot() -> dict:
+        with sessions() as db:
+            return job_out(jobs.get_job(db, job_id))
+
+    first = await asyncio.to_thread(snapshot)  # a missing job is a 404 before the stream opens
+
+    async def stream():
+        job, last, deadline = first, None, time.monotonic() + timeout
+        while True:
+            key = (job["state"], job["completed"])
+            if key != last:
+                last = key
+                yield f"event: progress\ndata: {json.dumps(jsonable_encoder(job))}\n\n"
+            if job["state"] in jobs.FINAL or time.monotonic() > deadline or await request.is_disconnected():
+                return
+            await asyncio.sleep(EVENT_POLL_S)
+            job = await asyncio.to_thread(snapshot)
+
+    return StreamingResponse(stream(), media_type="text/event-stream", headers={"Cache-Control": "no-cache"})
+
+
+@router.post("/{job_id}/cancel", dependencies=AUTHORIZED, response_model=schemas.JobOut)
+def cancel_job(job_id: RecordId, db: Db):
+    return job_out(jobs.cancel_job(db, job_id))
+
+
+def job_out(job) -> dict:
+    return {
+        "id": job.id,
+        "experiment_id": job.experiment_id,
+        "kind": job.kind,
+        "state": job.state,
+        "total": job.total,
+        "completed": job.completed,
+        "progress": job.completed / job.total if job.total else 1.0,
+        "error": job.error,
+        "spec": job.spec,
+        "created_at": job.created_at,
+        "started_at": job.started_at,
+        "finished_at": job.finished_at,
+    }
+
+
+def _finite(level: dict) -> dict:
+    """JSON has no NaN: a level without trials yet reports mean 0 with trials 0."""
+    mean = level["mean"]
+    return level | {"mean": mean if mean == mean else 0.0}

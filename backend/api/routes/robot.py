@@ -1,0 +1,85 @@
+"""The robot: one link per service; every call that moves or commands it needs the token, except
+the e-stop — stopping is always allowed (docs/service.md)."""
+
+from __future__ import annotations
+
+import asyncio
+from typing import Annotated
+
+from fastapi import APIRouter, Query, WebSocket, WebSocketDisconnect
+
+from backend import schemas
+from backend.api.deps import AUTHORIZED, Robot
+
+router = APIRouter(prefix="/api/v1/robot", tags=["robot"])
+
+
+@router.get("")
+def robot_status(robot: Robot) -> dict:
+    return robot.status()
+
+
+@router.websocket("/live")
+async def robot_live(
+    websocket: WebSocket, rate: Annotated[float, Query(gt=0, le=50, description="messages per second")] = 20
+):
+    """Live state for the panel: link state, telemetry, the latest tracked pose, the run's
+    newest touchdowns — ``rate`` messages per second until the client goes away."""
+    robot = websocket.app.state.robot
+    await websocket.accept()
+    try:
+        while True:
+            # Built from immutable snapshots under no lock that waits: on the event loop itself,
+            # so a request pool full of compute cannot stall the live view.
+            await websocket.send_json(robot.live())
+            await asyncio.sleep(1.0 / rate)
+    except (WebSocketDisconnect, RuntimeError):
+        return
+
+
+@router.post("/connect", dependencies=AUTHORIZED)
+def robot_connect(body: schemas.RobotConnect, robot: Robot) -> dict:
+    return robot.connect(body)
+
+
+@router.post("/disconnect", dependencies=AUTHORIZED)
+def robot_disconnect(robot: Robot) -> dict:
+    return robot.disconnect()
+
+
+@router.post("/arm", dependencies=AUTHORIZED)
+def robot_arm(robot: Robot) -> dict:
+    return robot.arm()
+
+
+@router.post("/disarm", dependencies=AUTHORIZED)
+def robot_disarm(robot: Robot) -> dict:
+    return robot.disarm()
+
+
+@router.post("/reset", dependencies=AUTHORIZED)
+def robot_reset(robot: Robot) -> dict:
+    return robot.reset()
+
+
+# No token, async, and on the robot service's own e-stop thread: a request pool filled by compute
+# cannot hold it back.
+@router.post("/estop")
+async def robot_estop(robot: Robot) -> dict:
+    """Emergency stop, at any moment and without the token; answers within 200 ms. A live run
+    ends (and is stored). ``acknowledged`` says whether the robot confirmed it (``latency_ms``);
+    if not (``reason``: link blocked or lost), the robot's 1 s watchdog disarms it."""
+    return await robot.estop_now()
+
+
+@router.post("/runs", status_code=202, dependencies=AUTHORIZED)
+def robot_run(body: schemas.RobotRunCreate, robot: Robot) -> dict:
+    """Start a live run: stored at once (status running, ``run.id``), journaled while it runs,
+    complete when it ends (see GET /api/v1/robot)."""
+    robot.start_run(body)
+    return robot.status()
+
+
+@router.post("/runs/stop", dependencies=AUTHORIZED)
+def robot_run_stop(robot: Robot) -> dict:
+    return robot.stop_run()

@@ -1,0 +1,126 @@
+"""Runs: stored, listed with filters and pages, exported, compared, aggregated, replayed."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+from fastapi import APIRouter, Query, Request
+from fastapi.responses import StreamingResponse
+from pydantic import Field
+
+from backend import schemas
+from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, RecordId, RunQuery
+from backend.services import records, simulation
+from backend.services.robot_records import replay_run
+
+router = APIRouter(prefix="/api/v1/runs", tags=["runs"])
+
+
+@router.post("", status_code=201, dependencies=AUTHORIZED, response_model=schemas.RunDetail)
+def create_run(body: schemas.RunCreate, db: Db):
+    return run_out(records.create_run(db, body), detail=True)
+
+
+@router.get("", response_model=schemas.Page)
+def list_runs(
+    db: Db,
+    where: RunQuery,
+    limit: PageLimit = 50,
+    cursor: Cursor = None,
+    sort: Annotated[str, Query(pattern=f"^({'|'.join(records.SORTS)})$", description="-climb: best first")] = "-id",
+    offset: Annotated[int, Query(ge=0, le=10_000_000, description="for sorts other than id")] = 0,
+):
+    """Runs matching the filters. Sorted by id, ``next_cursor`` pages by keyset; sorted by another
+    field, pass ``next_cursor`` back as ``offset``."""
+    rows, next_cursor = records.list_runs(db, where, limit=limit, cursor=cursor, sort=sort, offset=offset)
+    return {"items": [run_out(row) for row in rows], "next_cursor": next_cursor}
+
+
+@router.get("/export", response_class=StreamingResponse)
+def export_runs(
+    request: Request, where: RunQuery, format_: Annotated[str, Query(alias="format", pattern="^(csv|json)$")] = "csv"
+):
+    """Every run matching the filters, streamed, with tags, timings and parameters (not the path)."""
+    rows = records.export_rows(request.app.state.sessions, where)
+    media = "text/csv" if format_ == "csv" else "application/json"
+    body = records.rows_as_csv(rows) if format_ == "csv" else records.rows_as_json(rows)
+    disposition = {"Content-Disposition": f'attachment; filename="runs.{format_}"'}
+    return StreamingResponse(body, media_type=media, headers=disposition)
+
+
+@router.get("/compare")
+def compare_runs(
+    db: Db,
+    ids: Annotated[
+        list[Annotated[int, Field(ge=1, le=schemas.MAX_ID)]],
+        Query(min_length=2, max_length=records.MAX_COMPARE, description="run ids"),
+    ],
+    only_differences: bool = True,
+) -> dict:
+    """Runs side by side as flat fields; by default only the fields whose values differ."""
+    return records.compare_runs(db, ids, only_differences=only_differences)
+
+
+@router.get("/aggregate")
+def aggregate_runs(
+    db: Db,
+    where: RunQuery,
+    by: Annotated[str, Query(pattern=f"^({'|'.join(records.GROUP_BY)})$")] = "zeta0",
+) -> dict:
+    """Runs grouped by a parameter or tag: count, mean, std, min and max of climb and jumps completed."""
+    return {"by": by, "groups": records.aggregate_runs(db, where, by)}
+
+
+@router.get("/{run_id}", response_model=schemas.RunDetail)
+def get_run(run_id: RecordId, db: Db):
+    return run_out(records.get_run(db, run_id), detail=True)
+
+
+@router.get("/{run_id}/trajectory")
+def get_trajectory(run_id: RecordId, db: Db) -> dict:
+    run = records.get_run(db, run_id)
+    if run.trajectory is None:
+        raise records.NotFound("trajectory of run", run_id)
+    columns = simulation.unpack_trajectory(run.trajectory)
+    return {"units": "nondimensional", "columns": {name: values.tolist() for name, values in columns.items()}}
+
+
+@router.post("/{run_id}/replay", status_code=201, dependencies=AUTHORIZED, response_model=schemas.RunDetail)
+def replay(run_id: RecordId, db: Db):
+    """Analyse a robot run's recorded tracker frames again, stored as a run of kind replay."""
+    return run_out(replay_run(db, run_id), detail=True)
+
+
+@router.patch("/{run_id}", dependencies=AUTHORIZED, response_model=schemas.RunOut)
+def update_run(run_id: RecordId, body: schemas.RunUpdate, db: Db):
+    return run_out(records.update_run(db, run_id, tags=body.tags, notes=body.notes))
+
+
+@router.delete("/{run_id}", status_code=204, dependencies=AUTHORIZED)
+def delete_run(run_id: RecordId, db: Db) -> None:
+    records.delete_run(db, run_id)
+
+
+def run_out(run, *, detail: bool = False) -> dict:
+    out = {
+        "id": run.id,
+        "experiment_id": run.experiment_id,
+        "kind": run.kind,
+        "status": run.status,
+        "created_at": run.created_at,
+        "duration_s": run.duration_s,
+        "code_version": run.code_version,
+        "model": run.model,
+        "controls": run.controls,
+        "start_state": run.start_state,
+        "jumps": run.jumps,
+        "jumps_completed": run.jumps_completed,
+        "failure_code": run.failure_code,
+        "climb": run.climb,
+        "tags": run.tags,
+        "notes": run.notes,
+        "has_trajectory": run.trajectory is not None,
+    }
+    if detail:
+        out["results"] = run.results
+    return out

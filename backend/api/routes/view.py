@@ -1,0 +1,36 @@
+"""The 3D view: where it is, a stored run on its timeline, and a run's replay as one HTML file."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter, HTTPException, Request
+from fastapi.responses import HTMLResponse
+
+from backend import schemas
+from backend.api.deps import AUTHORIZED, OptionalRecordId, RecordId, SceneView, scene_view, view_unavailable_reason
+
+router = APIRouter(tags=["view"])
+
+
+@router.get("/api/v1/view", response_model=schemas.ViewOut)
+def view_info(request: Request):
+    """Where the 3D view is (its own port on this host) and what it shows."""
+    try:
+        return scene_view(request).info()
+    except HTTPException:
+        starter = request.app.state.view_starter
+        starting = starter is not None and starter.starting
+        return {"available": False, "reason": view_unavailable_reason(request), "starting": starting}
+
+
+@router.post("/api/v1/view/replay", dependencies=AUTHORIZED, response_model=schemas.ViewOut)
+def view_replay(body: schemas.ViewReplay, view: SceneView):
+    """Show a stored run in the 3D view (replay mode), optionally with another as a ghost."""
+    return view.open_run(body.run_id, body.overlay_run_id)
+
+
+@router.get("/api/v1/runs/{run_id}/share.html", response_class=HTMLResponse)
+def share_run(run_id: RecordId, view: SceneView, overlay_run_id: OptionalRecordId = None) -> HTMLResponse:
+    """The run's 3D replay as one standalone HTML file: it plays offline, from disk, in any browser."""
+    html = view.share_html(run_id, overlay_run_id)
+    disposition = f'attachment; filename="parkourlab-run-{run_id}.html"'
+    return HTMLResponse(html, headers={"Content-Disposition": disposition})

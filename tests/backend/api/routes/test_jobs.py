@@ -1,0 +1,110 @@
+"""Batch jobs through the API: the library's numbers, progress events, cancel (backend/api/routes/jobs.py)."""
+
+import json
+import math
+import time
+
+import numpy as np
+import pytest
+
+from sim_core import get_preset
+from sim_core.mjtf import mjtf_study
+from sim_core.noise import NoiseModel
+
+
+def _wait(client, job_id, states=("done", "failed", "cancelled"), timeout=60.0):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        job = client.get(f"/api/v1/jobs/{job_id}").json()
+        if job["state"] in states:
+            return job
+        time.sleep(0.05)
+    pytest.fail(f"job {job_id} still {job['state']} after {timeout} s")
+
+
+def test_mjtf_job_gives_the_library_numbers(client, auth):
+    spec = {"zeta0s": [0.88, 0.94], "trials": 40, "cap": 200, "seed": 5, "guess": {"xdot": -0.93, "ydot": -0.2}}
+    job = client.post("/api/v1/jobs", json=spec, headers=auth)
+    assert job.status_code == 202 and job.json()["total"] == 80
+    assert _wait(client, job.json()["id"])["state"] == "done"
+    levels = client.get(f"/api/v1/jobs/{job.json()['id']}/results").json()["levels"]
+    study = mjtf_study(
+        get_preset("paper").to_model(), math.radians(30), [0.88, 0.94], noise=NoiseModel(), trials=40, cap=200, seed=5,
+        guess=(-0.93, -0.2),
+    )  # fmt: skip
+    for got, expected in zip(levels, study.levels, strict=True):
+        assert got["trials"] == 40
+        assert got["mean"] == pytest.approx(float(np.mean(expected.jumps)))
+        assert got["outcomes"] == expected.histogram()
+
+
+def test_job_progress_streams_as_server_sent_events(client, auth):
+    spec = {"zeta0s": [0.88, 0.9], "trials": 96, "cap": 300, "guess": {"xdot": -0.93, "ydot": -0.2}}
+    job_id = client.post("/api/v1/jobs", json=spec, headers=auth).json()["id"]
+    events = []
+    with client.stream("GET", f"/api/v1/jobs/{job_id}/events") as stream:
+        assert stream.headers["content-type"].startswith("text/event-stream")
+        for line in stream.iter_lines():
+            if line.startswith("data: "):
+                events.append(json.loads(line.removeprefix("data: ")))
+    counts = [event["completed"] for event in events]
+    assert events[-1]["state"] == "done" and counts[-1] == 192
+    assert counts == sorted(counts), "progress only grows"
+    assert client.get("/api/v1/jobs/999/events").status_code == 404
+
+
+def test_cancel_stops_a_job(client, auth):
+    spec = {"zeta0s": [0.84, 0.86, 0.88], "trials": 3000, "cap": 2000, "guess": {"xdot": -0.93, "ydot": 0.2}}
+    job_id = client.post("/api/v1/jobs", json=spec, headers=auth).json()["id"]
+    assert client.post(f"/api/v1/jobs/{job_id}/cancel").status_code == 401
+    client.post(f"/api/v1/jobs/{job_id}/cancel", headers=auth)
+    job = _wait(client, job_id)
+    assert job["state"] == "cancelled" and job["completed"] < job["total"]
+
+
+@pytest.mark.parametrize(
+    ("spec", "field"),
+    [
+        ({"zeta0s": [], "trials": 8}, "zeta0s"),
+        ({"zeta0s": [0.9], "trials": -1}, "trials"),
+        ({"zeta0s": [0.9], "trials": 10**9}, "trials"),
+        ({"zeta0s": [0.9, 0.9]}, "zeta0s"),
+    ],
+)
+def test_bad_job_specs_are_refused_before_any_work(client, auth, spec, field):
+    response = client.post("/api/v1/jobs", json=spec, headers=auth)
+    assert response.status_code == 422 and any(field in e["loc"] for e in response.json()["detail"])
+    assert client.get("/api/v1/jobs").json()["items"] == []
+
+
+def test_sweep_basin_and_gait_search_jobs(client, auth):
+    specs = {
+        "sweep": {"kind": "sweep", "zeta0_low": 0.9, "zeta0_high": 0.97, "steps": 4, "basin_grid": 8,
+                  "guess": {"xdot": -0.93, "ydot": -0.2}},
+        "basin": {"kind": "basin", "controls": [{"psi0_deg": 30, "zeta0": 0.9}], "grid": 12, "jumps": 30,
+                  "guess": {"xdot": -0.9, "ydot": -0.2}},
+        "gaits": {"kind": "gaits", "controls": [{"psi0_deg": 30, "zeta0": 0.9}], "grid": 2},
+    }  # fmt: skip
+    ids = {kind: client.post("/api/v1/jobs", json=spec, headers=auth).json()["id"] for kind, spec in specs.items()}
+    results = {}
+    for kind, job_id in ids.items():
+        job = _wait(client, job_id)
+        assert job["state"] == "done" and job["completed"] == job["total"], job
+        results[kind] = client.get(f"/api/v1/jobs/{job_id}/results").json()["result"]
+    assert len(results["sweep"]["points"]) == 4 and len(results["sweep"]["in_place_zeta0"]) == 1
+    assert sum(results["basin"]["counts"].values()) == 144 and results["basin"]["counts"]["converged"] > 0
+    assert results["gaits"]["gaits"][0]["period"] == 1
+
+
+@pytest.mark.parametrize(
+    ("spec", "field"),
+    [
+        ({"kind": "sweep", "zeta0_low": 0.95, "zeta0_high": 0.9}, "sweep"),
+        ({"kind": "basin", "controls": [{"psi0_deg": 30, "zeta0": 0.9}], "grid": 10**6}, "grid"),
+        ({"kind": "atlas"}, "kind"),
+    ],
+)
+def test_bad_study_specs_are_a_422(client, auth, spec, field):
+    response = client.post("/api/v1/jobs", json=spec, headers=auth)
+    assert response.status_code == 422, response.text
+    assert field in str(response.json()["detail"])

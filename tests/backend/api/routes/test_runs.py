@@ -1,0 +1,146 @@
+"""Runs through the API: stored, listed, exported, compared, aggregated (backend/api/routes/runs.py)."""
+
+import csv
+import io
+
+import pytest
+
+from tests.backend.api.bodies import RUN
+
+
+def test_run_matches_the_simulator_and_stores_its_path(client, auth):
+    body = RUN | {"trajectory_rate": 40.0, "tags": ["a", "b"]}
+    run = client.post("/api/v1/runs", json=body, headers=auth).json()
+    direct = client.post("/api/v1/sim/map", json={k: RUN[k] for k in ("controls", "start", "jumps")}).json()
+    assert run["results"]["states"] == direct["states"] and run["jumps_completed"] == 4
+    assert run["climb"] == pytest.approx(sum(direct["rises"])) and run["tags"] == ["a", "b"]
+    path = client.get(f"/api/v1/runs/{run['id']}/trajectory").json()["columns"]
+    assert len(path["time"]) == len(path["y"]) > 100
+    assert (
+        run["created_at"].endswith("Z")
+        and client.get(f"/api/v1/runs/{run['id']}").json()["created_at"] == run["created_at"]
+    )
+
+
+def test_run_lists_filter_and_page(client, auth):
+    for zeta0, tag in [(0.86, "low"), (0.88, "low"), (0.9, "mid"), (0.92, "high"), (0.94, "high")]:
+        body = RUN | {"controls": [{"psi0_deg": 30, "zeta0": zeta0}], "tags": [tag]}
+        assert client.post("/api/v1/runs", json=body, headers=auth).status_code == 201
+    in_range = client.get("/api/v1/runs", params={"zeta0_min": 0.87, "zeta0_max": 0.93}).json()["items"]
+    assert sorted(run["controls"][0][1] for run in in_range) == [0.88, 0.9, 0.92]
+    assert [run["tags"] for run in client.get("/api/v1/runs", params={"tag": "high"}).json()["items"]] == [["high"]] * 2
+    seen, cursor = [], None
+    while True:
+        page = client.get("/api/v1/runs", params={"limit": 2} | ({"cursor": cursor} if cursor else {})).json()
+        seen += [run["id"] for run in page["items"]]
+        if (cursor := page["next_cursor"]) is None:
+            break
+    assert seen == sorted(seen, reverse=True) and len(seen) == len(set(seen)) == 5
+
+
+def _seed_runs(client, auth):
+    ids = []
+    for zeta0, tag in [(0.88, "low"), (0.88, "low"), (0.92, "high")]:
+        body = RUN | {"controls": [{"psi0_deg": 30, "zeta0": zeta0}], "tags": [tag, "all"]}
+        ids.append(client.post("/api/v1/runs", json=body, headers=auth).json()["id"])
+    return ids
+
+
+def test_export_csv_and_json(client, auth):
+    ids = _seed_runs(client, auth)
+    exported = client.get("/api/v1/runs/export", params={"format": "csv", "tag": "low"})
+    assert exported.status_code == 200 and exported.headers["content-type"].startswith("text/csv")
+    rows = list(csv.DictReader(io.StringIO(exported.text)))
+    assert [int(row["id"]) for row in rows] == ids[:2]
+    assert {"tags", "duration_s", "created_at", "climb", "leg0.zeta0", "model.alpha"} <= set(rows[0])
+    assert rows[0]["tags"] == "all low"
+    as_json = client.get("/api/v1/runs/export", params={"format": "json"}).json()
+    assert [row["id"] for row in as_json] == ids and as_json[2]["leg0.zeta0"] == 0.92
+    assert client.get("/api/v1/runs/export", params={"format": "xml"}).status_code == 422
+
+
+def test_compare_shows_only_what_differs(client, auth):
+    first, second, third = _seed_runs(client, auth)
+    same = client.get("/api/v1/runs/compare", params={"ids": [first, second]}).json()
+    assert set(same["differing"]) <= {"id", "created_at", "duration_s"}
+    differ = client.get("/api/v1/runs/compare", params={"ids": [first, third]}).json()
+    assert {"leg0.zeta0", "climb", "tags"} <= set(differ["differing"]) and "model.alpha" not in differ["fields"]
+    assert [run["leg0.zeta0"] for run in differ["runs"]] == [0.88, 0.92]
+    assert client.get("/api/v1/runs/compare", params={"ids": [first]}).status_code == 422
+    assert client.get("/api/v1/runs/compare", params={"ids": [first, 999]}).status_code == 404
+
+
+def test_aggregate_groups_runs(client, auth):
+    _seed_runs(client, auth)
+    by_zeta0 = client.get("/api/v1/runs/aggregate", params={"by": "zeta0"}).json()["groups"]
+    assert [(group["key"], group["runs"]) for group in by_zeta0] == [(0.88, 2), (0.92, 1)]
+    low = by_zeta0[0]["climb"]
+    assert low["std"] == pytest.approx(0.0, abs=1e-9) and low["min"] == low["max"] == pytest.approx(low["mean"])
+    by_tag = client.get("/api/v1/runs/aggregate", params={"by": "tag"}).json()["groups"]
+    assert [(group["key"], group["runs"]) for group in by_tag] == [("all", 3), ("high", 1), ("low", 2)]
+    assert client.get("/api/v1/runs/aggregate", params={"by": "secret"}).status_code == 422
+
+
+@pytest.mark.parametrize(
+    ("body", "field"),
+    [
+        (RUN | {"controls": [{"psi0_deg": 30, "zeta0": 1.2}]}, "zeta0"),
+        (RUN | {"controls": [{"psi0_deg": 95, "zeta0": 0.9}]}, "psi0_deg"),
+        (RUN | {"start": {"xdot": 0.5, "ydot": 0}}, "xdot"),
+        (RUN | {"jumps": 10**7}, "jumps"),
+        (RUN | {"model": {"alpha": -1}}, "alpha"),
+        (RUN | {"unknown": 1}, "unknown"),
+    ],
+)
+def test_bad_input_is_a_422_naming_the_field(client, auth, body, field):
+    response = client.post("/api/v1/runs", json=body, headers=auth)
+    assert response.status_code == 422
+    assert any(field in error["loc"] for error in response.json()["detail"]), response.json()
+
+
+def test_concurrent_clients_do_not_corrupt_state(client, auth):
+    from concurrent.futures import ThreadPoolExecutor
+
+    experiment = client.post("/api/v1/experiments", json={"name": "busy"}, headers=auth).json()["id"]
+
+    def create(i):
+        body = RUN | {"experiment_id": experiment, "jumps": 2, "tags": [f"t{i % 3}"]}
+        return client.post("/api/v1/runs", json=body, headers=auth).status_code
+
+    with ThreadPoolExecutor(8) as pool:
+        codes = list(pool.map(create, range(40)))
+    assert codes == [201] * 40
+    assert client.get(f"/api/v1/experiments/{experiment}").json()["runs"] == 40
+    counts = {g["key"]: g["runs"] for g in client.get("/api/v1/runs/aggregate", params={"by": "tag"}).json()["groups"]}
+    assert counts == {"t0": 14, "t1": 13, "t2": 13}
+
+
+def test_sorting_best_first_pages_by_offset(client, auth):
+    for zeta0 in (0.9, 0.84, 0.94, 0.88):
+        body = RUN | {"controls": [{"psi0_deg": 30, "zeta0": zeta0}]}
+        client.post("/api/v1/runs", json=body, headers=auth)
+    first = client.get("/api/v1/runs", params={"sort": "-climb", "limit": 3}).json()
+    climbs = [run["climb"] for run in first["items"]]
+    assert climbs == sorted(climbs, reverse=True) and first["next_cursor"] == 3
+    rest = client.get("/api/v1/runs", params={"sort": "-climb", "limit": 3, "offset": 3}).json()
+    assert len(rest["items"]) == 1 and rest["next_cursor"] is None and rest["items"][0]["climb"] < climbs[-1]
+    assert client.get("/api/v1/runs", params={"sort": "password"}).status_code == 422
+
+
+def test_run_with_fixed_point_and_retagging(client, auth):
+    run = client.post("/api/v1/runs", json=RUN | {"fixed_point": True}, headers=auth).json()
+    gait = run["results"]["fixed_point"]
+    assert gait["found"] and gait["period"] == 1 and gait["max_abs_eigenvalue"] == pytest.approx(0.8486, abs=1e-4)
+    lost = client.post(
+        "/api/v1/runs", json=RUN | {"fixed_point": True, "start": {"xdot": -0.3, "ydot": 5.0}}, headers=auth
+    ).json()
+    assert lost["results"]["fixed_point"]["found"] is False and lost["failure_code"] == "no_flight"
+    retagged = client.patch(f"/api/v1/runs/{run['id']}", json={"tags": ["keep", "keep", "best"]}, headers=auth)
+    assert retagged.json()["tags"] == ["best", "keep"]
+    assert client.patch(f"/api/v1/runs/{run['id']}", json={"climb": 9}, headers=auth).status_code == 422
+    assert run["notes"] == ""
+    noted = client.patch(f"/api/v1/runs/{run['id']}", json={"notes": "left foot slipped once"}, headers=auth).json()
+    assert noted["notes"] == "left foot slipped once" and noted["tags"] == ["best", "keep"], "tags left out stay"
+    assert client.get(f"/api/v1/runs/{run['id']}").json()["notes"] == "left foot slipped once"
+    too_long = client.patch(f"/api/v1/runs/{run['id']}", json={"notes": "x" * 100_001}, headers=auth)
+    assert too_long.status_code == 422 and "notes" in too_long.text
