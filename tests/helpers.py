@@ -1,18 +1,28 @@
-"""Helpers that test modules share: free ports, and the real service started as ``parkour serve``."""
+"""Helpers that test modules share: free ports, the real service started as ``parkour serve``, and
+clients that keep its request thread pool full."""
 
 from __future__ import annotations
 
+import json
 import socket
 import subprocess
 import sys
 import threading
 import time
+from collections import Counter
 from pathlib import Path
 
 import httpx
 import pytest
 
+ROOT = Path(__file__).resolve().parents[1]  # the checkout
 SERVICE_START_TIMEOUT = 60.0  # [s] a cold start compiles nothing, but CI machines are slow
+POOL_FILLERS = 45  # more than the request thread pool's 40 threads (anyio's default)
+# A /sim/map call of 1000 jumps: a few ms of kernel under the service's kernel lock, back to back.
+MAP_BODY = {"controls": [{"psi0_deg": 30, "zeta0": 0.87}], "start": {"xdot": -0.9, "ydot": -0.2}, "jumps": 1000}
+# A heavy MJTF job: 11 energy levels x 4096 trials of up to 1000 jumps, 1408 chunks of 32 trials
+# (tens of ms each, under the kernel lock, on every core numba has): a minute or more; cancel it.
+HEAVY_JOB = {"kind": "mjtf", "zeta0s": [round(0.85 + 0.01 * i, 2) for i in range(11)], "trials": 4096, "cap": 1000}
 
 
 def free_port(kind: socket.SocketKind = socket.SOCK_STREAM) -> int:
@@ -51,3 +61,78 @@ def answer_within(seconds: float, call, *args):
     if not box:
         pytest.fail(f"{getattr(call, '__name__', call)} raised (see the thread's traceback)")
     return box[0]
+
+
+class MapLoad:
+    """``clients`` threads, each POSTing ``/api/v1/sim/map`` to ``base`` back to back until :meth:`stop`.
+
+    With more clients than the request thread pool has threads, the pool stays full: every sync
+    route waits for a thread. :attr:`in_flight` is how many requests are out now; :meth:`stop`
+    returns how each was answered (status codes, or the httpx error's name)."""
+
+    def __init__(self, base: str, clients: int = POOL_FILLERS, body: dict = MAP_BODY):
+        self.base, self.body, self.clients = base, body, clients
+        self.in_flight = 0
+        self.answered: Counter = Counter()
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._threads = [
+            threading.Thread(target=self._client, name=f"map-load-{i}", daemon=True) for i in range(clients)
+        ]
+
+    def start(self) -> MapLoad:
+        for thread in self._threads:
+            thread.start()
+        return self
+
+    def stop(self, timeout: float = 60.0) -> Counter:
+        self._stop.set()
+        deadline = time.monotonic() + timeout
+        for thread in self._threads:
+            thread.join(max(0.0, deadline - time.monotonic()))
+        return self.answered
+
+    def _client(self) -> None:
+        with httpx.Client(base_url=self.base, timeout=60) as client:
+            while not self._stop.is_set():
+                with self._lock:
+                    self.in_flight += 1
+                try:
+                    answer = client.post("/api/v1/sim/map", json=self.body).status_code
+                except httpx.HTTPError as error:
+                    answer = type(error).__name__
+                with self._lock:
+                    self.in_flight -= 1
+                    self.answered[answer] += 1
+
+
+LOAD_SCRIPT = """
+import json, sys, time
+from tests.helpers import MapLoad
+load = MapLoad(sys.argv[1], int(sys.argv[2])).start()
+deadline = time.monotonic() + 60
+while load.in_flight < load.clients or sum(load.answered.values()) < load.clients:
+    if time.monotonic() > deadline:
+        sys.exit("the load's clients did not all get going")
+    time.sleep(0.01)
+print("ready", flush=True)
+sys.stdin.read()
+print(json.dumps({str(key): count for key, count in load.stop().items()}))
+"""
+
+
+def start_map_load(base: str, clients: int = POOL_FILLERS) -> subprocess.Popen:
+    """:class:`MapLoad` in a process of its own (its threads do not compete for this process's GIL),
+    returned once every client has a request out and all have been answered at least once."""
+    command = [sys.executable, "-c", LOAD_SCRIPT, base, str(clients)]
+    process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, cwd=ROOT)
+    if process.stdout.readline().strip() != "ready":
+        process.kill()
+        raise RuntimeError("the /sim/map load did not get going")
+    return process
+
+
+def stop_map_load(process: subprocess.Popen) -> dict:
+    """End a :func:`start_map_load` process; returns how its requests were answered (status: count)."""
+    answered, _ = process.communicate("", timeout=120)
+    return json.loads(answered)

@@ -11,9 +11,8 @@ from backend.robot.messages import Fault, Leg, RobotState
 from backend.robot.virtual import VirtualRobot
 from sim_core import ParameterError
 from tests.helpers import answer_within
-from tests.robot_rig import PtyRobot, received_frame, telemetry
+from tests.robot_rig import FOREIGN, PtyRobot, received_frame, telemetry
 
-FOREIGN = 0x0013A200DEADBEEF  # another XBee in range
 JAMMED_ANSWER_S = 2.0  # [s] "answers instead of hanging": a generous bound, not a latency claim
 
 

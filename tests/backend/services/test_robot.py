@@ -22,13 +22,12 @@ from backend.services.robot_records import replay_run, touchdown_results
 from backend.services.simulation import unpack_trajectory
 from sim_core import ParameterError, get_preset
 from tests.helpers import answer_within, free_port
-from tests.robot_rig import LinkCalls, PtyRobot, Radio, received_frame, telemetry
+from tests.robot_rig import FOREIGN, LinkCalls, PtyRobot, Radio, received_frame, telemetry
 
 LEGS = [LegIn(psi0_deg=30.0, zeta0=0.87), LegIn(psi0_deg=30.0, zeta0=0.9)]  # [left, right]
 JUMPS = 4
 RUN_WAIT_S = 30.0  # [s] an upper bound for a 4-jump run at 4x speed, not a timing assertion
 ANSWER_BOUND_S = 2.0  # [s] "answers instead of hanging": generous, not a latency claim
-FOREIGN = 0x0013A200DEADBEEF  # another XBee in range
 FLAP_S = 4.0  # [s] the radio flaps in the service's test (tests/backend/robot/test_supervisor.py flaps longer)
 FLAP_ANSWER_S = 20.0  # [s] a connect, a close or the threads' end, instead of a hang: generous
 
