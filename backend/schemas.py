@@ -20,6 +20,10 @@ MAX_JUMPS = 10_000
 MAX_TRIALS = 100_000
 MAX_LEVELS = 100
 MAX_PATH_SAMPLES = 100_000
+# A job's work, in jumps at its worst (every trial to its cap, every basin point to its jump limit):
+# about an hour of the job worker on the lab's machine (1.35e5-1.6e5 jumps/s measured by
+# scripts/bench_job_rate.py on 2 cores). Larger jobs are refused with a 422 naming the limit.
+WORK_BUDGET_JUMPS = 500_000_000
 MAX_ID = 2**31 - 1  # integer keys: the smallest range among the supported databases (PostgreSQL)
 RecordRef = Annotated[int, Field(ge=1, le=MAX_ID)]
 
@@ -161,6 +165,10 @@ class MJTFJobCreate(Strict):
             raise ValueError("zeta0 values must be distinct")
         return values
 
+    @model_validator(mode="after")
+    def _within_budget(self) -> MJTFJobCreate:
+        return _within_budget(self, len(self.zeta0s) * self.trials * self.cap, "levels x trials x cap")
+
 
 class SweepJobCreate(Strict):
     """An energy sweep: the gait followed over zeta0, with basin areas (``basin_grid`` 0: none)."""
@@ -182,7 +190,9 @@ class SweepJobCreate(Strict):
             raise ValueError(f"zeta0_low must be below zeta0_high, got {self.zeta0_low:g} >= {self.zeta0_high:g}")
         if self.basin_grid == 1:
             raise ValueError("basin_grid must be 0 (no basins) or at least 2")
-        return self
+        return _within_budget(
+            self, self.steps * self.basin_grid**2 * self.basin_jumps, "steps x basin_grid² x basin_jumps"
+        )
 
 
 class BasinJobCreate(Strict):
@@ -198,6 +208,10 @@ class BasinJobCreate(Strict):
     jumps: Annotated[int, Field(ge=1, le=1000)] = 60
     tolerance: Annotated[float, Field(gt=0.0, lt=10.0)] = 0.02
 
+    @model_validator(mode="after")
+    def _within_budget(self) -> BasinJobCreate:
+        return _within_budget(self, self.grid**2 * self.jumps, "grid² x jumps")
+
 
 class GaitSearchJobCreate(Strict):
     """Distinct gaits of one control schedule, from a grid of guesses."""
@@ -208,6 +222,16 @@ class GaitSearchJobCreate(Strict):
     controls: Annotated[list[LegIn], Field(min_length=1, max_length=16)]
     period: Annotated[int, Field(ge=1, le=16)] | None = None
     grid: Annotated[int, Field(ge=1, le=20)] = 6
+
+
+def _within_budget(job, jumps: int, formula: str):
+    """``job`` if its worst-case work (``jumps``, counted as ``formula``) fits the budget."""
+    if jumps > WORK_BUDGET_JUMPS:
+        raise ValueError(
+            f"the job would take up to {jumps:.3g} jumps ({formula}), over the limit of {WORK_BUDGET_JUMPS:.3g} "
+            "(about an hour of the job worker); ask for less, or split it into several jobs"
+        )
+    return job
 
 
 def _job_kind(value) -> str:

@@ -22,6 +22,10 @@ class ParameterError(ValueError):
     def __init__(self, field: str, message: str):
         super().__init__(f"{field}: {message}")
         self.field = field
+        self.message = message
+
+    def __reduce__(self):  # picklable as made (the service computes in worker processes)
+        return type(self), (self.field, self.message)
 
 
 class FixedPointNotFound(RuntimeError):
@@ -41,3 +45,6 @@ class NoGaitFound(FixedPointNotFound):
             f"no period-{period} gait found for controls {schedule.describe()}; give a starting state explicitly"
         )
         self.schedule, self.period = schedule, period
+
+    def __reduce__(self):
+        return type(self), (self.schedule, self.period)

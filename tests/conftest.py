@@ -26,6 +26,17 @@ def alternating() -> ControlSchedule:
     return ControlSchedule.from_degrees([(30.0, 0.87), (30.0, 0.9)])
 
 
+@pytest.fixture(scope="session")
+def compute():
+    """The service's compute worker pools, shared by every test's app (a worker's start, about a
+    second, is paid once per session); stopped at the end."""
+    from backend.services.compute import Compute  # only the tests that use the service load it
+
+    pools = Compute()
+    yield pools
+    pools.close()
+
+
 @pytest.fixture
 def virtual():
     """``(robot, tracker_port)``: a noiseless virtual robot at 4x speed streaming its tracker poses

@@ -11,7 +11,6 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import logging
-import threading
 from pathlib import Path
 
 from fastapi import FastAPI
@@ -21,7 +20,7 @@ from backend.api import errors, security
 from backend.api.routes import experiments, jobs, robot, runs, sim, site, view
 from backend.api.security import api_token
 from backend.services import jobs as job_service
-from backend.services import simulation
+from backend.services.compute import Compute
 from backend.services.robot import RobotService
 from backend.services.view import ViewContext, ViewFactory, ViewStarter
 from backend.settings import Settings
@@ -40,17 +39,22 @@ def create_app(
     run_jobs: bool = True,
     view_factory: ViewFactory | None = None,
     warm_kernels: bool = False,
+    compute: Compute | None = None,
 ) -> FastAPI:
     """The service. ``run_jobs=False`` leaves queued jobs alone (for tools that only read);
-    ``warm_kernels`` loads the simulation kernels in the background once the service is up, so
-    the first simulation does not wait for them (``parkour serve`` asks for it);
+    ``warm_kernels`` starts the compute workers and loads the kernels in them once the service
+    is up, so the first simulation does not wait for them (``parkour serve`` asks for it);
+    ``compute`` lends the service worker pools that outlive it (tests share one set; by default
+    it makes its own and stops them at shutdown);
     ``view_factory`` builds the 3D view at start-up, in the background (``cli.serve`` passes the
     viser one); ``app.state.view_starter`` holds it once built."""
     settings.data_dir.mkdir(parents=True, exist_ok=True)
     engine = make_engine(settings.database_url)
     sessions = session_factory(engine)
     token, _ = api_token(settings.data_dir)
-    runner = job_service.JobRunner(sessions, dask_address=settings.dask_address)
+    owns_compute = compute is None
+    compute = compute or Compute()
+    runner = job_service.JobRunner(sessions, compute.jobs, dask_address=settings.dask_address)
     robot_service = RobotService(sessions)
 
     @contextlib.asynccontextmanager
@@ -58,7 +62,7 @@ def create_app(
         migrate(engine)
         robot_service.recover()  # live runs the previous process died during: stored as interrupted, nothing re-armed
         if warm_kernels:
-            threading.Thread(target=simulation.warm_up, name="warm-kernels", daemon=True).start()
+            compute.warm()
         if run_jobs:
             runner.start()
         if view_factory is not None:
@@ -69,6 +73,8 @@ def create_app(
             await asyncio.to_thread(app.state.view_starter.close)  # may wait for a view still starting
         robot_service.close()
         runner.stop()
+        if owns_compute:
+            compute.close()
         engine.dispose()
 
     app = FastAPI(
@@ -86,6 +92,7 @@ def create_app(
     app.state.token = token
     app.state.runner = runner if run_jobs else None
     app.state.robot = robot_service
+    app.state.compute = compute
     app.state.view_starter = None
     security.limit_request_size(app, settings.max_request_bytes)
     errors.install(app)

@@ -14,6 +14,7 @@ from sqlalchemy.orm import Session
 from backend import schemas
 from backend.api.security import require_token
 from backend.services import jobs, records
+from backend.services.compute import ComputePool
 from backend.services.robot import RobotService
 
 VIEW_NOT_STARTED = "the 3D view is not running (it starts with `parkour serve`)"
@@ -59,6 +60,11 @@ async def robot_service(request: Request) -> RobotService:
     return request.app.state.robot
 
 
+async def quick_compute(request: Request) -> ComputePool:
+    """The worker pool for API calls that compute (async: it must not wait for a request thread)."""
+    return request.app.state.compute.quick
+
+
 def job_runner(request: Request) -> jobs.JobRunner | None:
     """The service's job runner, or None when it runs no jobs (``create_app(run_jobs=False)``)."""
     return request.app.state.runner
@@ -82,6 +88,7 @@ Db = Annotated[Session, Depends(get_session)]
 RunQuery = Annotated[records.RunFilter, Depends(run_filter)]
 Robot = Annotated[RobotService, Depends(robot_service)]
 Runner = Annotated[jobs.JobRunner | None, Depends(job_runner)]
+QuickCompute = Annotated[ComputePool, Depends(quick_compute)]
 SceneView = Annotated[object, Depends(scene_view)]  # frontend.viewer's view (the backend does not import it)
 AUTHORIZED = [Depends(require_token)]  # every mutating route's dependencies
 PageLimit = Annotated[int, Query(ge=1, le=records.MAX_PAGE, description="items per page")]

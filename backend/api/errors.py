@@ -11,6 +11,7 @@ from fastapi.responses import JSONResponse
 
 from backend.robot.link import LinkError
 from backend.services import records
+from backend.services.compute import ComputeBusy, ComputeFailed, ComputeTimeout
 from backend.services.robot import RobotUnavailable
 from sim_core import FixedPointNotFound, ParameterError
 
@@ -20,6 +21,9 @@ STATUS_OF: dict[type[Exception], tuple[int, str]] = {
     RobotUnavailable: (status.HTTP_409_CONFLICT, "{}"),
     LinkError: (status.HTTP_503_SERVICE_UNAVAILABLE, "robot link: {}"),
     FixedPointNotFound: (status.HTTP_422_UNPROCESSABLE_CONTENT, "{}"),
+    ComputeBusy: (status.HTTP_503_SERVICE_UNAVAILABLE, "busy: {}"),
+    ComputeTimeout: (status.HTTP_503_SERVICE_UNAVAILABLE, "{}"),
+    ComputeFailed: (status.HTTP_503_SERVICE_UNAVAILABLE, "{}"),
 }
 
 

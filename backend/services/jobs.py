@@ -2,31 +2,37 @@
 
 A job is a row. An MJTF job survives crashes trial by trial: its trials are rows with the
 idempotent key ``(job, level, index)``. The runner (one background thread) works through a
-job in chunks of trials: it computes the trials still missing, runs the chunks — in this
-process, or on the Dask cluster named by ``PARKOUR_DASK_ADDRESS`` — and commits each chunk's
-trials and the progress in one transaction as it finishes. Killed mid-job, the service finds
+job in chunks of trials: it computes the trials still missing, runs the chunks — in the
+service's job worker process (:mod:`backend.services.compute`; never in the service's own, where
+they would hold up the API), or on the Dask cluster named by ``PARKOUR_DASK_ADDRESS`` — and
+commits each chunk's trials and the progress in one transaction as it finishes. Killed mid-job, the service finds
 the job at the next start, recomputes only the missing trials — their seeds depend on
 ``(seed, level, index)`` alone — and ends with exactly the trials asked for, none lost and none
 duplicated (the unique key refuses a second copy). Sweeps, basins and gait searches are
 deterministic: they run whole through the chunk map, report progress per chunk, and store
 their result on the job when done; a restart recomputes them. Cancelling marks the job; the
-runner stops before its next chunk.
+runner sees it within ``CANCEL_POLL`` and stops the worker at once (a chunk under way is dropped:
+its trials are not committed, and nothing else depends on it).
 """
 
 from __future__ import annotations
 
+import concurrent.futures
+import functools
 import logging
 import queue
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from dataclasses import asdict
 
 import numpy as np
 from sqlalchemy import func, select, update
 from sqlalchemy.orm import Session, sessionmaker
 
-from backend.schemas import JOB_KINDS, MJTFJobCreate
+from backend.services.compute import ComputePool
+from backend.services.job_specs import decode, encode, spec_of
 from backend.services.records import fetch, get_experiment, newest_first, page
-from backend.services.simulation import KERNEL_LOCK, current_code_version, locked_chunk_map, model_params, run_study
+from backend.services.simulation import current_code_version, model_params, run_study, run_study_here
 from backend.store.models import Job, Trial, utcnow
 from experiments.cluster import as_completed_results, chunk_map_for, dask_client
 from experiments.manifest import json_safe
@@ -37,6 +43,8 @@ from sim_core.noise import NoiseModel, trial_seeds
 log = logging.getLogger("parkourlab.jobs")
 
 CHUNK_TRIALS = 32  # tens of trials per commit: a 3 ms trial alone would drown in overhead
+CANCEL_POLL = 0.2  # [s] how often the runner looks for a cancel while a worker computes
+IN_FLIGHT = 4  # chunks handed to the worker ahead of the one awaited: it never idles between chunks
 ACTIVE = ("queued", "running", "cancelling")
 FINAL = ("done", "cancelled", "failed")
 
@@ -45,12 +53,13 @@ def create_job(session: Session, body) -> Job:
     """Store a job (any of ``schemas.JOB_KINDS``); MJTF totals count trials, other kinds chunks."""
     if body.experiment_id is not None:
         get_experiment(session, body.experiment_id)
+    spec = spec_of(body)  # stored as its own versioned record: job_specs.py says why
     job = Job(
         experiment_id=body.experiment_id,
-        kind=body.kind,
-        spec=body.model_dump(mode="json"),
+        kind=spec.kind,
+        spec=encode(spec),
         state="queued",
-        total=len(body.zeta0s) * body.trials if body.kind == "mjtf" else 1,
+        total=len(spec.zeta0s) * spec.trials if spec.kind == "mjtf" else 1,
         code_version=current_code_version(),
     )
     session.add(job)
@@ -91,7 +100,7 @@ def cancel_job(session: Session, job_id: int) -> Job:
 
 def level_summaries(session: Session, job: Job) -> list[dict]:
     """Per level: trials so far, mean and standard deviation of jumps to failure, outcomes."""
-    spec = MJTFJobCreate(**job.spec)
+    spec = decode(job.spec)
     rows = session.execute(
         select(Trial.level, Trial.jumps, Trial.failure_code).where(Trial.job_id == job.id).order_by(Trial.level)
     ).all()
@@ -116,9 +125,15 @@ class JobRunner:
     """Runs jobs one at a time on a background thread, resuming unfinished ones at start."""
 
     def __init__(
-        self, sessions: sessionmaker[Session], *, chunk_trials: int = CHUNK_TRIALS, dask_address: str | None = None
+        self,
+        sessions: sessionmaker[Session],
+        pool: ComputePool,
+        *,
+        chunk_trials: int = CHUNK_TRIALS,
+        dask_address: str | None = None,
     ):
         self.sessions = sessions
+        self.pool = pool  # the job worker: chunks run there, not in this process
         self.chunk_trials = chunk_trials
         self.dask_address = dask_address
         self.queue: queue.Queue[int | None] = queue.Queue()
@@ -173,17 +188,21 @@ class JobRunner:
             if not claimed:
                 return
             job = session.get(Job, job_id)
-            kind, spec = job.kind, JOB_KINDS[job.kind](**job.spec)
+            kind, spec = job.kind, decode(job.spec)
         if kind != "mjtf":
             self._run_study(job_id, spec)
             return
         from sim_core.mjtf import level_starts  # the kernels load with the first job (simulation.py says why)
 
         model = model_params(spec.model)
-        noise = NoiseModel(**spec.noise.model_dump())
+        noise = NoiseModel(**asdict(spec.noise))
         guess = None if spec.guess is None else (spec.guess.xdot, spec.guess.ydot)
-        with KERNEL_LOCK:
-            levels = level_starts(model, np.radians(spec.psi0_deg), spec.zeta0s, guess=guess)
+        try:
+            starts = self.pool.submit(functools.partial(level_starts, guess=guess), model, np.radians(spec.psi0_deg),
+                                      spec.zeta0s)  # fmt: skip
+            levels = self._await(job_id, starts)
+        except Cancelled:
+            return
         chunks, arguments = [], []
         for index, level in enumerate(levels):
             seeds = trial_seeds(spec.seed, index, spec.trials)
@@ -192,13 +211,15 @@ class JobRunner:
                 arguments.append((model, level.schedule, level.start, noise, seeds[chunk], spec.cap))
         if self._cancelled(job_id):
             return
-        results = self._execute(arguments)
+        results = self._execute(job_id, arguments)
         try:
             for chunk, (jumps, status) in results:
                 level, zeta0, indices, seeds = chunks[chunk]
                 self._commit_chunk(job_id, level, zeta0, indices, seeds, jumps, status)
                 if self._cancelled(job_id):
                     return
+        except Cancelled:
+            return
         finally:
             results.close()  # on a Dask cluster, cancels the chunks not yet finished
         with self.sessions() as session:
@@ -220,7 +241,7 @@ class JobRunner:
 
         try:
             if self.dask_address is None:
-                result = run_study(spec, locked_chunk_map, progress)
+                result = self._await(job_id, self.pool.submit(run_study_here, spec), progress)
             else:
                 with chunk_map_for(self.dask_address) as chunk_map:
                     result = run_study(spec, chunk_map, progress)
@@ -237,18 +258,40 @@ class JobRunner:
             job.state, job.finished_at = "done", utcnow()
             session.commit()
 
-    def _execute(self, arguments: list[tuple]) -> Iterator[tuple[int, tuple[np.ndarray, np.ndarray]]]:
-        """``(chunk index, result)`` as chunks finish: here in order, or on the Dask cluster."""
+    def _execute(self, job_id: int, arguments: list[tuple]) -> Iterator[tuple[int, tuple[np.ndarray, np.ndarray]]]:
+        """``(chunk index, result)`` as chunks finish: from the job worker in order, a few handed
+        to it ahead, or from the Dask cluster. Raises Cancelled (the worker stopped) on a cancel."""
         from sim_core.mjtf import run_trials
 
-        if self.dask_address is None:
-            for index, chunk in enumerate(arguments):
-                with KERNEL_LOCK:
-                    result = run_trials(*chunk)
-                yield index, result
+        if self.dask_address is not None:
+            with dask_client(self.dask_address) as client:
+                yield from as_completed_results(client, run_trials, arguments)
             return
-        with dask_client(self.dask_address) as client:
-            yield from as_completed_results(client, run_trials, arguments)
+        in_flight: dict[int, concurrent.futures.Future] = {}
+        for index in range(len(arguments)):
+            for ahead in range(index, min(index + IN_FLIGHT, len(arguments))):
+                if ahead not in in_flight:
+                    in_flight[ahead] = self.pool.submit(run_trials, *arguments[ahead])
+            yield index, self._await(job_id, in_flight.pop(index))
+
+    def _await(self, job_id: int, future: concurrent.futures.Future, progress: Callable | None = None):
+        """The worker's result, looking every CANCEL_POLL for a cancel (then the worker is stopped
+        and Cancelled raised) and passing on the progress it reports."""
+        while True:
+            try:
+                return future.result(CANCEL_POLL)
+            except concurrent.futures.TimeoutError:
+                pass
+            finally:
+                for done, total in self.pool.progress() if progress is not None else ():
+                    progress(done, total)
+            if self._cancel_requested(job_id):
+                self.pool.restart(f"job {job_id} was cancelled")
+                raise Cancelled
+
+    def _cancel_requested(self, job_id: int) -> bool:
+        with self.sessions() as session:
+            return session.scalar(select(Job.state).where(Job.id == job_id)) == "cancelling"
 
     def _missing_chunks(self, job_id: int, level: int, trials: int) -> list[np.ndarray]:
         with self.sessions() as session:

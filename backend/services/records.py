@@ -72,10 +72,12 @@ def list_experiments(session: Session, *, limit: int, cursor: int | None) -> tup
     return page(list(session.scalars(newest_first(Experiment, limit, cursor))), limit)
 
 
-def create_run(session: Session, body: RunCreate) -> Run:
+def create_run(session: Session, body: RunCreate, compute=None) -> Run:
+    """Simulate ``body`` — in ``compute``'s workers (a :class:`~backend.services.compute.ComputePool`),
+    or here without one — and store it as a run."""
     if body.experiment_id is not None:
         get_experiment(session, body.experiment_id)
-    fields = simulate_run(body)
+    fields = simulate_run(body) if compute is None else compute.run(simulate_run, body)
     run = Run(experiment_id=body.experiment_id, **fields)
     run.run_tags = [RunTag(tag=tag) for tag in sorted(set(body.tags))]
     session.add(run)

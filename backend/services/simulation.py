@@ -1,8 +1,10 @@
 """Simulations the service runs: translating request bodies into sim_core calls and back.
 
-The compiled kernels (numba, and scipy for the fixed points) load with the first simulation, not
-with the service, so ``parkour serve`` answers before they have loaded; :func:`warm_up` loads
-them in the background at start-up. Hence the imports inside the functions below.
+The functions here are what the service's compute workers run (:mod:`backend.services.compute`):
+module-level, with picklable arguments and results. The compiled kernels (numba, and scipy for
+the fixed points) load with a worker's first call, not with the service, so ``parkour serve``
+answers before they have loaded; :func:`warm_up` loads them in each worker at start-up. Hence
+the imports inside the functions below.
 """
 
 from __future__ import annotations
@@ -31,7 +33,8 @@ if TYPE_CHECKING:
 _CODE_VERSION = None
 
 # numba's default threading layer (workqueue) aborts the process if two threads launch
-# parallel kernels at once; the service's threads take turns through this lock.
+# parallel kernels at once; threads of one process that run kernels take turns through this lock
+# (in the service's own process, only the 3D view and the robot's controller still do).
 KERNEL_LOCK = threading.Lock()
 
 
@@ -42,9 +45,11 @@ def current_code_version() -> str:
     return _CODE_VERSION
 
 
-def model_params(body: ModelIn) -> ModelParams:
-    overrides = {k: v for k, v in body.model_dump(exclude={"preset"}).items() if v is not None}
-    return replace(get_preset(body.preset).to_model(), **overrides)
+def model_params(body) -> ModelParams:
+    """A request's :class:`~backend.schemas.ModelIn` or a stored job's ModelSpec as the model."""
+    fields = body.model_dump() if isinstance(body, ModelIn) else asdict(body)
+    overrides = {k: v for k, v in fields.items() if k != "preset" and v is not None}
+    return replace(get_preset(fields["preset"]).to_model(), **overrides)
 
 
 def schedule_of(controls: list[LegIn]) -> ControlSchedule:
@@ -107,16 +112,13 @@ def _gait_of(model: ModelParams, schedule: ControlSchedule, period: int | None, 
         raise ParameterError("controls", message) from None
 
 
-def locked_chunk_map(function, arguments, progress=None) -> list:
-    """:func:`sim_core.chunks.in_process` with each chunk under :data:`KERNEL_LOCK`: chunks are the
-    parallel kernels, and holding the lock per chunk lets API calls interleave with a long study."""
-    results = []
-    for done, chunk in enumerate(arguments, start=1):
-        with KERNEL_LOCK:
-            results.append(function(*chunk))
-        if progress is not None:
-            progress(done, len(arguments))
-    return results
+def run_study_here(spec) -> dict:
+    """:func:`run_study` in the job worker: its chunks one after the other there (each uses every
+    core), progress reported to the service (:func:`backend.services.compute.report`)."""
+    from backend.services.compute import report
+    from sim_core.chunks import in_process
+
+    return run_study(spec, in_process, report)
 
 
 def run_study(spec, chunk_map, progress) -> dict:

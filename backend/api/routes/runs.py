@@ -9,7 +9,7 @@ from fastapi.responses import StreamingResponse
 from pydantic import Field
 
 from backend import schemas
-from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, RecordId, RunQuery
+from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, QuickCompute, RecordId, RunQuery
 from backend.services import records, simulation
 from backend.services.robot_records import replay_run
 
@@ -17,8 +17,9 @@ router = APIRouter(prefix="/api/v1/runs", tags=["runs"])
 
 
 @router.post("", status_code=201, dependencies=AUTHORIZED, response_model=schemas.RunDetail)
-def create_run(body: schemas.RunCreate, db: Db):
-    return run_out(records.create_run(db, body), detail=True)
+def create_run(body: schemas.RunCreate, db: Db, compute: QuickCompute):
+    """Simulate (in the quick compute worker) and store a run."""
+    return run_out(records.create_run(db, body, compute), detail=True)
 
 
 @router.get("", response_model=schemas.Page)

@@ -1,26 +1,38 @@
-"""Quick calls for the control panel: computed, not stored, bounded in size."""
+"""Quick calls for the control panel: computed, not stored, bounded in size and time.
+
+Each runs in the service's quick compute worker (backend/services/compute.py) and is awaited on
+the event loop: no request thread waits, and the service's own process computes nothing — the
+worker even encodes the JSON, which the route forwards as it is.
+"""
 
 from __future__ import annotations
 
 from fastapi import APIRouter
+from fastapi.responses import Response
 
 from backend import schemas
+from backend.api.deps import QuickCompute
 from backend.services import simulation
+from backend.services.compute import as_json
 
 router = APIRouter(prefix="/api/v1/sim", tags=["simulate"])
 
 
 @router.post("/map")
-def sim_map(body: schemas.MapIn) -> dict:
-    return simulation.map_orbit(body)
+async def sim_map(body: schemas.MapIn, compute: QuickCompute) -> Response:
+    return _json(await compute.call(as_json, simulation.map_orbit, body))
 
 
 @router.post("/trajectory")
-def sim_trajectory(body: schemas.TrajectoryIn) -> dict:
+async def sim_trajectory(body: schemas.TrajectoryIn, compute: QuickCompute) -> Response:
     """The sampled path in wall coordinates (nondimensional), for drawing; not stored."""
-    return simulation.trajectory_columns(body)
+    return _json(await compute.call(as_json, simulation.trajectory_columns, body))
 
 
 @router.post("/fixed-point")
-def sim_fixed_point(body: schemas.FixedPointIn) -> dict:
-    return simulation.fixed_point(body)
+async def sim_fixed_point(body: schemas.FixedPointIn, compute: QuickCompute) -> Response:
+    return _json(await compute.call(as_json, simulation.fixed_point, body))
+
+
+def _json(encoded: bytes) -> Response:
+    return Response(encoded, media_type="application/json")

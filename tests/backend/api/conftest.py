@@ -13,8 +13,8 @@ def settings(tmp_path):
 
 
 @pytest.fixture
-def client(settings):
-    with TestClient(create_app(settings)) as test_client:
+def client(settings, compute):
+    with TestClient(create_app(settings, compute=compute)) as test_client:
         yield test_client
 
 

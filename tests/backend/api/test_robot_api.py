@@ -11,7 +11,8 @@ from backend.robot.virtual import VirtualRobot
 from tests.helpers import answer_within, free_port
 from tests.robot_rig import PtyRobot
 
-POOL_FILLERS = 45  # more than the request thread pool's 40 threads
+POOL_THREADS = 40  # the request thread pool's (anyio's default limiter)
+POOL_FILLERS = 45  # more than the request thread pool's threads
 ANSWER_BOUND_S = 2.0  # [s] "answers instead of hanging": generous, not a latency claim
 
 CONTROLS = [{"psi0_deg": 30, "zeta0": 0.87}, {"psi0_deg": 30, "zeta0": 0.9}]
@@ -62,25 +63,39 @@ def test_estop_needs_no_token_and_reaches_the_robot(client, auth, connected):
     assert client.post("/api/v1/robot/reset").status_code == 401, "releasing it needs the token"
 
 
-def test_estop_answers_while_compute_fills_the_request_pool(client, connected):
-    from backend.services.simulation import KERNEL_LOCK
+def test_estop_answers_while_the_request_pool_is_full(client, auth, connected, monkeypatch):
+    """45 stored-run requests hold every request thread (each waits inside the route): the e-stop,
+    async and on its own thread, answers all the same. Real compute under load: test_estop_load.py."""
+    from backend.services import records
 
+    release, entered = threading.Event(), threading.Semaphore(0)
+    create_run = records.create_run
+
+    def held(*args, **kwargs):
+        entered.release()
+        release.wait(60)
+        return create_run(*args, **kwargs)
+
+    monkeypatch.setattr(records, "create_run", held)
     body = {"controls": CONTROLS[:1], "start": {"xdot": -0.9, "ydot": -0.2}, "jumps": 3}
     answers = []
 
-    def compute():
-        answers.append(client.post("/api/v1/sim/map", json=body).status_code)
+    def store():
+        answers.append(client.post("/api/v1/runs", json=body, headers=auth).status_code)
 
-    callers = [threading.Thread(target=compute, daemon=True) for _ in range(POOL_FILLERS)]
-    with KERNEL_LOCK:  # a long computation: every /sim/map call waits in the request pool's threads
-        for caller in callers:
-            caller.start()
-        time.sleep(0.5)  # they reach the lock (not a timing assertion: later ones only queue)
+    callers = [threading.Thread(target=store, daemon=True) for _ in range(POOL_FILLERS)]
+    for caller in callers:
+        caller.start()
+    try:
+        for _ in range(POOL_THREADS):  # every request thread is inside the route
+            assert entered.acquire(timeout=ANSWER_BOUND_S * 10), "the request pool did not fill"
         stopped = answer_within(ANSWER_BOUND_S, client.post, "/api/v1/robot/estop").json()
+    finally:
+        release.set()
     assert stopped["acknowledged"] is True and stopped["state"] == "estopped"
     for caller in callers:
         caller.join(60)
-    assert answers == [200] * POOL_FILLERS, "the computations were real, and held the pool"
+    assert answers == [201] * POOL_FILLERS, "the requests were real, and held the pool"
 
 
 def test_estop_without_a_robot_says_so(client):

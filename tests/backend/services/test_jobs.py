@@ -44,8 +44,8 @@ def _wait_until(sessions, job_id: int, condition) -> Job:
 
 
 @pytest.fixture
-def runner(sessions):
-    runner = jobs.JobRunner(sessions, chunk_trials=CHUNK)
+def runner(sessions, compute):
+    runner = jobs.JobRunner(sessions, compute.jobs, chunk_trials=CHUNK)
     yield runner
     runner.stop(timeout=WAIT_S)
 
@@ -75,9 +75,9 @@ def test_jobs_list_by_state_newest_first(session):
     assert [job.id for job in queued] == [made[2], made[0]]
 
 
-def test_an_mjtf_job_runs_to_the_librarys_numbers(sessions, session):
+def test_an_mjtf_job_runs_to_the_librarys_numbers(sessions, session, compute):
     job = jobs.create_job(session, MJTFJobCreate(**SMALL))
-    jobs.JobRunner(sessions, chunk_trials=CHUNK).run(job.id)
+    jobs.JobRunner(sessions, compute.jobs, chunk_trials=CHUNK).run(job.id)
     done = _job(sessions, job.id)
     assert (done.state, done.completed, done.total) == ("done", 20, 20)
     assert done.started_at is not None and done.finished_at >= done.started_at
@@ -103,11 +103,11 @@ def test_summaries_of_a_job_without_trials(session):
         assert sum(summary["outcomes"].values()) == 0
 
 
-def test_an_interrupted_job_resumes_with_only_the_missing_trials(sessions, session, runner):
+def test_an_interrupted_job_resumes_with_only_the_missing_trials(sessions, session, runner, compute):
     """As after a crash: some chunks committed, the job left ``running``. The next start finishes
     it with exactly the trials asked for and the numbers an uninterrupted run gives."""
     job = jobs.create_job(session, MJTFJobCreate(**SMALL))
-    jobs.JobRunner(sessions, chunk_trials=CHUNK).run(job.id)
+    jobs.JobRunner(sessions, compute.jobs, chunk_trials=CHUNK).run(job.id)
     uninterrupted = _trials(session, job.id)
     kept = session.scalars(select(Trial.id).where(Trial.job_id == job.id, Trial.index < CHUNK)).all()
     session.execute(delete(Trial).where(Trial.job_id == job.id, Trial.index >= CHUNK))
@@ -131,14 +131,14 @@ def test_a_job_left_cancelling_is_cancelled_at_start(sessions, session, runner):
     assert stopped.state == "cancelled" and stopped.finished_at is not None and _trials(session, job.id) == []
 
 
-def test_cancel_a_queued_job_at_once_and_leave_a_finished_one(sessions, session):
+def test_cancel_a_queued_job_at_once_and_leave_a_finished_one(sessions, session, compute):
     job = jobs.create_job(session, MJTFJobCreate(**SMALL))
     cancelled = jobs.cancel_job(session, job.id)
     assert cancelled.state == "cancelled" and cancelled.finished_at is not None
-    jobs.JobRunner(sessions).run(job.id)
+    jobs.JobRunner(sessions, compute.jobs).run(job.id)
     assert _trials(session, job.id) == [], "the runner skips a cancelled job"
     done = jobs.create_job(session, MJTFJobCreate(**(SMALL | {"trials": 1}))).id
-    jobs.JobRunner(sessions).run(done)
+    jobs.JobRunner(sessions, compute.jobs).run(done)
     with sessions() as fresh:  # as a request would: its own session, reading the finished job
         assert jobs.cancel_job(fresh, done).state == "done"
     assert _job(sessions, done).state == "done"
@@ -146,7 +146,7 @@ def test_cancel_a_queued_job_at_once_and_leave_a_finished_one(sessions, session)
         jobs.cancel_job(session, 999)
 
 
-def test_cancel_racing_the_end_of_a_job_leaves_it_done(sessions, session):
+def test_cancel_racing_the_end_of_a_job_leaves_it_done(sessions, session, compute):
     """A cancel that read "running" before the runner finished must not write "cancelling" over "done"
     (it did: the job was then marked cancelled at the next start though all its trials were in)."""
     job = jobs.create_job(session, MJTFJobCreate(**(SMALL | {"trials": 1})))
@@ -155,7 +155,7 @@ def test_cancel_racing_the_end_of_a_job_leaves_it_done(sessions, session):
     with sessions() as request:
         read = jobs.get_job(request, job.id)  # the cancel request reads the job (held, as inside cancel_job) ...
         assert read.state == "running"
-        jobs.JobRunner(sessions).run(job.id)  # ... the runner finishes it meanwhile ...
+        jobs.JobRunner(sessions, compute.jobs).run(job.id)  # ... the runner finishes it meanwhile ...
         jobs.cancel_job(request, job.id)  # ... and the cancel lands after
     assert _job(sessions, job.id).state == "done"
 
@@ -173,10 +173,10 @@ def test_cancel_stops_a_running_job_between_chunks(sessions, session, runner):
     assert len(_trials(session, job.id)) == stopped.completed, "progress counts the committed trials"
 
 
-def test_a_study_job_stores_its_result(sessions, session):
+def test_a_study_job_stores_its_result(sessions, session, compute):
     spec = GaitSearchJobCreate(kind="gaits", controls=[LegIn(psi0_deg=30.0, zeta0=0.9)], grid=2)
     job = jobs.create_job(session, spec)
-    jobs.JobRunner(sessions).run(job.id)
+    jobs.JobRunner(sessions, compute.jobs).run(job.id)
     done = _job(sessions, job.id)
     assert (done.state, done.completed, done.total) == ("done", 1, 1)
     assert done.result["gaits"][0]["period"] == 1 and done.result["gaits"][0]["stable"]
@@ -192,12 +192,12 @@ def test_a_failing_job_is_recorded_and_the_runner_goes_on(sessions, session, run
     assert _wait_until(sessions, after.id, lambda j: j.state in jobs.FINAL).state == "done"
 
 
-def test_the_runner_leaves_a_job_cancelled_before_it_starts_alone(sessions, session):
+def test_the_runner_leaves_a_job_cancelled_before_it_starts_alone(sessions, session, compute):
     """The runner claims a job with a conditional UPDATE: a cancel that came first wins."""
     job = jobs.create_job(session, MJTFJobCreate(**(SMALL | {"trials": 1})))
     cancelled = jobs.cancel_job(session, job.id)
     assert cancelled.state == "cancelled"
-    jobs.JobRunner(sessions).run(job.id)
+    jobs.JobRunner(sessions, compute.jobs).run(job.id)
     after = _job(sessions, job.id)
     assert (after.state, after.started_at, after.finished_at) == ("cancelled", None, cancelled.finished_at)
     assert _trials(session, job.id) == []

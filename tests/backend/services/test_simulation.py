@@ -10,6 +10,7 @@ from numpy.testing import assert_array_equal
 from backend.schemas import FixedPointIn, GaitSearchJobCreate, LegIn, MapIn, ModelIn, StateIn, TrajectoryIn
 from backend.services import simulation
 from sim_core import FixedPointNotFound, ParameterError, iterate_map, simulate_trajectory
+from sim_core.chunks import in_process
 from tests.backend.services.bodies import START, run_body
 
 PERIOD_1 = [LegIn(psi0_deg=30.0, zeta0=0.9)]
@@ -144,18 +145,10 @@ def test_unpacking_is_a_copy_not_a_view_of_a_closed_file():
     assert back["x"].tolist() == [7.0, 1.0, 2.0]
 
 
-def test_locked_chunk_map_keeps_order_and_reports_progress():
-    seen = []
-    results = simulation.locked_chunk_map(lambda a, b: a * b, [(1, 2), (3, 4), (5, 6)], lambda *p: seen.append(p))
-    assert results == [2, 12, 30] and seen == [(1, 3), (2, 3), (3, 3)]
-    assert simulation.locked_chunk_map(pow, [(2, 3)]) == [8], "progress is optional"
-    assert not simulation.KERNEL_LOCK.locked()
-
-
 def test_run_study_gait_search(symmetric):
     progress = []
     spec = GaitSearchJobCreate(kind="gaits", controls=PERIOD_1, grid=2)
-    result = simulation.run_study(spec, simulation.locked_chunk_map, lambda *p: progress.append(p))
+    result = simulation.run_study(spec, in_process, lambda *p: progress.append(p))
     assert result == _strict_json(result) and progress[-1] == (1, 1)
     gait = result["gaits"][0]
     assert gait["period"] == len(symmetric) and gait["motion"] == "climbing"

@@ -1,0 +1,216 @@
+"""Where the service's compute runs: worker processes, never the service's own.
+
+A simulation in the service's process holds its GIL and its request threads, so an API call, the
+live view or the e-stop would wait behind it. Every kernel call the API or a job makes goes
+instead to a :class:`ComputePool`: a small pool of worker processes (``spawn``: a fresh
+interpreter, no inherited threads or locks) that load sim_core once and keep it. The service's
+process only sends arguments and receives results.
+
+Two pools, so a long job never delays a quick call (:class:`Compute`): ``quick`` for the panel's
+``/sim/*`` calls and ``POST /runs``, ``jobs`` for job chunks. Work is bounded: a pool refuses a
+call when ``max_pending`` are already waiting (:class:`ComputeBusy`, a 503 with Retry-After), and
+a call that outlives its ``timeout`` stops its pool's workers, which start afresh for the next
+call (:class:`ComputeTimeout`). A worker that dies (out of memory, a crash) is replaced the same
+way (:class:`ComputeFailed`). ``restart`` is also how a job is cancelled mid-chunk.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import concurrent.futures
+import json
+import logging
+import multiprocessing
+import os
+import queue as queue_module
+import threading
+from collections.abc import Callable
+from concurrent.futures.process import BrokenProcessPool
+
+log = logging.getLogger("parkourlab.compute")
+
+QUICK_TIMEOUT = 60.0  # [s] the longest a quick call may take (they are bounded in size: milliseconds to seconds)
+QUICK_PENDING = 64  # quick calls waiting at most; more get a 503
+JOB_PENDING = 8  # job chunks in flight at most (the runner keeps the worker fed, no more)
+WORKER_NICENESS = 10  # added to the workers' scheduling niceness (os.nice): compute yields to the service
+
+
+class ComputeBusy(RuntimeError):
+    """The pool has ``max_pending`` calls waiting already: try again shortly."""
+
+
+class ComputeTimeout(RuntimeError):
+    """The call took longer than its limit; its pool's workers were stopped."""
+
+
+class ComputeFailed(RuntimeError):
+    """A worker process died during the call (or was stopped for another call); the pool starts afresh."""
+
+
+_progress = None  # in a worker: the queue report() puts progress on (set as the worker starts)
+
+
+def _init_worker(progress) -> None:
+    global _progress
+    _progress = progress
+    # Below the service in the OS's eyes: with every core computing, the service's own process —
+    # HTTP, the live view, the e-stop — still gets the CPU first.
+    os.nice(WORKER_NICENESS)
+
+
+def as_json(function: Callable, *args) -> bytes:
+    """In a worker: ``function(*args)`` encoded as JSON (NaN and infinities as null), so the
+    service's process only forwards the bytes instead of encoding thousands of floats itself."""
+    from experiments.manifest import json_safe
+
+    return json.dumps(json_safe(function(*args)), allow_nan=False, separators=(",", ":")).encode()
+
+
+def report(done: int, total: int) -> None:
+    """In a worker: tell the service how far the call has got (a job's chunks done of total);
+    read with :meth:`ComputePool.progress`. Anywhere else, nothing."""
+    if _progress is not None:
+        _progress.put((done, total))
+
+
+def _warm() -> None:
+    """A worker's first task: load the kernels a first request needs."""
+    from backend.services.simulation import warm_up
+
+    warm_up()
+
+
+class ComputePool:
+    """``workers`` processes running one call each at a time; :meth:`run` from a thread,
+    :meth:`call` from the event loop. Thread-safe; the executor is replaced only under its lock."""
+
+    def __init__(self, name: str, workers: int = 1, *, max_pending: int = QUICK_PENDING):
+        self.name = name
+        self.workers = workers
+        self.max_pending = max_pending
+        self.restarts = 0  # times the workers were stopped and started afresh
+        self._context = multiprocessing.get_context("spawn")
+        self._lock = threading.Lock()  # guards _executor and _pending
+        self._executor: concurrent.futures.ProcessPoolExecutor | None = None
+        self._progress = None  # the current workers' progress queue (a new one with each start)
+        self._pending = 0
+        self._closed = False
+
+    def submit(self, function: Callable, *args) -> concurrent.futures.Future:
+        """``function(*args)`` in a worker; a ComputeBusy if ``max_pending`` calls are waiting."""
+        with self._lock:
+            if self._closed:
+                raise ComputeFailed(f"the {self.name} compute pool is closed (the service is stopping)")
+            if self._pending >= self.max_pending:
+                raise ComputeBusy(f"{self._pending} {self.name} computations are waiting already; retry shortly")
+            if self._executor is None:
+                self._executor = self._start()
+            try:
+                future = self._executor.submit(function, *args)
+            except BrokenProcessPool:  # a worker died since the last call: start afresh
+                _stop(self._executor)
+                self._executor = self._start()
+                self.restarts += 1
+                future = self._executor.submit(function, *args)
+            self._pending += 1
+        future.add_done_callback(self._finished)
+        return future
+
+    def run(self, function: Callable, *args, timeout: float | None = QUICK_TIMEOUT):
+        """``function(*args)`` in a worker, waiting for it on this thread (no GIL held meanwhile)."""
+        future = self.submit(function, *args)
+        return self.result(future, timeout)
+
+    async def call(self, function: Callable, *args, timeout: float = QUICK_TIMEOUT):
+        """``function(*args)`` in a worker, awaited: no request thread is held while it computes."""
+        future = self.submit(function, *args)
+        try:
+            return await asyncio.wait_for(asyncio.wrap_future(future), timeout)
+        except TimeoutError:
+            self.restart(f"a call took longer than {timeout:g} s")
+            raise ComputeTimeout(f"the computation took longer than {timeout:g} s and was stopped") from None
+        except BrokenProcessPool:
+            self.restart("a worker died")
+            raise ComputeFailed("the computation's worker process stopped; retry") from None
+
+    def result(self, future: concurrent.futures.Future, timeout: float | None):
+        """A submitted call's result, translating timeouts and dead workers."""
+        try:
+            return future.result(timeout)
+        except concurrent.futures.TimeoutError:
+            self.restart(f"a call took longer than {timeout:g} s")
+            raise ComputeTimeout(f"the computation took longer than {timeout:g} s and was stopped") from None
+        except BrokenProcessPool:
+            self.restart("a worker died")
+            raise ComputeFailed("the computation's worker process stopped; retry") from None
+
+    def progress(self) -> list[tuple[int, int]]:
+        """What the workers have reported (:func:`report`) since the last look, oldest first."""
+        with self._lock:
+            queue = self._progress
+        reports = []
+        while queue is not None:
+            try:
+                reports.append(queue.get_nowait())
+            except queue_module.Empty:
+                break
+        return reports
+
+    def warm(self) -> None:
+        """Start the workers now and load the kernels in each (in the background)."""
+        for _ in range(self.workers):
+            self.submit(_warm)
+
+    def restart(self, why: str) -> None:
+        """Stop the workers at once (their calls fail with ComputeFailed); the next call starts new ones."""
+        with self._lock:
+            executor, self._executor = self._executor, None
+            if executor is not None:
+                self.restarts += 1
+        if executor is not None:
+            log.info("%s compute pool restarted: %s", self.name, why)
+            _stop(executor)
+
+    def close(self) -> None:
+        with self._lock:
+            self._closed = True
+            executor, self._executor = self._executor, None
+        if executor is not None:
+            _stop(executor)
+
+    def _start(self) -> concurrent.futures.ProcessPoolExecutor:
+        # A fresh progress queue with each start: a worker stopped mid-put may leave the old one locked.
+        self._progress = self._context.Queue()
+        return concurrent.futures.ProcessPoolExecutor(
+            self.workers, mp_context=self._context, initializer=_init_worker, initargs=(self._progress,)
+        )
+
+    def _finished(self, _future) -> None:
+        with self._lock:
+            self._pending -= 1
+
+
+def _stop(executor: concurrent.futures.ProcessPoolExecutor) -> None:
+    """Terminate the executor's processes and let it go (no waiting for calls under way)."""
+    processes = list((executor._processes or {}).values())  # the only handle on them: it offers no kill
+    for process in processes:
+        process.terminate()
+    executor.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        process.join(5)
+
+
+class Compute:
+    """The service's two pools: ``quick`` for API calls, ``jobs`` for job chunks."""
+
+    def __init__(self, quick: ComputePool | None = None, jobs: ComputePool | None = None):
+        self.quick = quick or ComputePool("quick", max_pending=QUICK_PENDING)
+        self.jobs = jobs or ComputePool("jobs", max_pending=JOB_PENDING)
+
+    def warm(self) -> None:
+        self.quick.warm()
+        self.jobs.warm()
+
+    def close(self) -> None:
+        self.quick.close()
+        self.jobs.close()

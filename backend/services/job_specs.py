@@ -1,0 +1,140 @@
+"""A job's spec as the store keeps it: a versioned record of its own, not the HTTP request.
+
+The request schemas (:mod:`backend.schemas`) decide what a new job may ask for, and they tighten
+over time (ranges, the work budget). A stored job was accepted under the rules of its day and
+must stay readable whatever the request schema becomes, or a restart could never resume it. So
+:func:`spec_of` turns an accepted request into a plain frozen dataclass, :func:`encode` stores it
+as ``{"version": 1, "kind": ..., ...}``, and :func:`decode` reads it back — version 1, or the
+unversioned request dumps stored before (version 0, the same field names) — without consulting
+the request schema at all.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field, fields
+
+SPEC_VERSION = 1
+
+
+@dataclass(frozen=True)
+class ModelSpec:
+    """The ``paper`` preset with optional nondimensional overrides (None: the preset's)."""
+
+    preset: str = "paper"
+    alpha: float | None = None
+    d_hat: float | None = None
+    c_zeta: float | None = None
+    c_psi: float | None = None
+    mu: float | None = None
+
+
+@dataclass(frozen=True)
+class LegSpec:
+    psi0_deg: float
+    zeta0: float
+
+
+@dataclass(frozen=True)
+class StateSpec:
+    xdot: float
+    ydot: float
+
+
+@dataclass(frozen=True)
+class NoiseSpec:
+    psi0_deg: float = 0.5
+    zeta0: float = 0.003
+    velocity: float = 0.01
+    pitch_drift_deg: float = 0.5
+    asymmetry_psi0_deg: float = 0.0
+    asymmetry_zeta0: float = 0.0
+
+
+@dataclass(frozen=True)
+class MJTFSpec:
+    zeta0s: tuple[float, ...]
+    model: ModelSpec = field(default_factory=ModelSpec)
+    psi0_deg: float = 30.0
+    trials: int = 8
+    cap: int = 1000
+    seed: int = 0
+    noise: NoiseSpec = field(default_factory=NoiseSpec)
+    guess: StateSpec | None = None
+    kind: str = "mjtf"
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    model: ModelSpec = field(default_factory=ModelSpec)
+    psi0_deg: float = 30.0
+    zeta0_low: float = 0.8
+    zeta0_high: float = 0.97
+    steps: int = 30
+    basin_grid: int = 40
+    basin_jumps: int = 60
+    guess: StateSpec | None = None
+    kind: str = "sweep"
+
+
+@dataclass(frozen=True)
+class BasinSpec:
+    controls: tuple[LegSpec, ...]
+    model: ModelSpec = field(default_factory=ModelSpec)
+    period: int | None = None
+    guess: StateSpec | None = None
+    grid: int = 100
+    jumps: int = 60
+    tolerance: float = 0.02
+    kind: str = "basin"
+
+
+@dataclass(frozen=True)
+class GaitSearchSpec:
+    controls: tuple[LegSpec, ...]
+    model: ModelSpec = field(default_factory=ModelSpec)
+    period: int | None = None
+    grid: int = 6
+    kind: str = "gaits"
+
+
+JobSpec = MJTFSpec | SweepSpec | BasinSpec | GaitSearchSpec
+SPECS: dict[str, type] = {"mjtf": MJTFSpec, "sweep": SweepSpec, "basin": BasinSpec, "gaits": GaitSearchSpec}
+_PARTS = {"model": ModelSpec, "noise": NoiseSpec, "guess": StateSpec}
+
+
+class UnreadableSpec(ValueError):
+    """A stored spec of a version or kind this code does not know."""
+
+
+def spec_of(body) -> JobSpec:
+    """An accepted job request (any of ``schemas.JOB_KINDS``) as the spec the store keeps."""
+    return decode(body.model_dump(mode="json"))
+
+
+def encode(spec: JobSpec) -> dict:
+    return {"version": SPEC_VERSION, **asdict(spec)}
+
+
+def decode(stored: dict) -> JobSpec:
+    """A stored spec, version 1 or unversioned (0); fields it does not use (``experiment_id``)
+    are left out, missing ones take the defaults of their day."""
+    version = stored.get("version", 0)
+    if version not in (0, SPEC_VERSION):
+        raise UnreadableSpec(f"job spec version {version} is newer than this code (it reads up to {SPEC_VERSION})")
+    kind = stored.get("kind", "mjtf")
+    if kind not in SPECS:
+        raise UnreadableSpec(f"unknown job kind {kind!r}")
+    cls = SPECS[kind]
+    values = {}
+    for spec_field in fields(cls):
+        if spec_field.name not in stored:
+            continue
+        value = stored[spec_field.name]
+        if spec_field.name in _PARTS and value is not None:
+            value = _PARTS[spec_field.name](**value)
+        elif spec_field.name == "controls":
+            value = tuple(LegSpec(**leg) for leg in value)
+        elif spec_field.name == "zeta0s":
+            value = tuple(value)
+        values[spec_field.name] = value
+    return cls(**values)
