@@ -60,7 +60,8 @@ for (const tab of document.querySelectorAll("nav [role=tab]")) {
     for (const panel of document.querySelectorAll("main [role=tabpanel]")) panel.hidden = panel.id !== tab.dataset.tab;
     if (tab.dataset.tab === "history") loadExperiments().then(loadRuns).catch(() => {});
     if (tab.dataset.tab === "jobs") loadJobs();
-    if (tab.dataset.tab === "robot") refreshRobot();
+    if (tab.dataset.tab === "robot") { refreshRobot().catch(() => {}); drawLive(); }
+    syncLive();  // the live websocket is open while the Robot tab is shown
     if (tab.dataset.tab === "view3d") showView();
   });
 }
@@ -434,21 +435,13 @@ on("#compare", "click", async () => {
 });
 
 // Robot --------------------------------------------------------------------------------------
-const heights = { t: [], y: [] };
-let live = null;
-let heldHeight = null;  // the closed-loop run's target height [m], drawn on the live plot
-
-function showStatus(status) {
-  const telemetry = status.telemetry || {};
-  const tracker = status.tracker || {};
-  const fields = {
-    state: status.state, link: status.url || "—", battery: telemetry.battery_mv ? `${telemetry.battery_mv} mV` : "—",
-    faults: telemetry.faults ?? "—", "tracker frames": tracker.received ?? "—", "tracker loss": tracker.loss !== undefined ? `${(100 * tracker.loss).toFixed(1)} %` : "—",
-    run: status.run ? `${status.run.active ? "running" : status.run.end_reason}, ${status.run.touchdowns} touchdowns` : "—",
-    "link faults": status.counters ? `${status.counters.foreign_frames} foreign frames, ${status.counters.bad_checksum} bad checksums, ${status.counters.write_timeouts} write timeouts` : "—",
-  };
-  $("#robot-status").replaceChildren(...Object.entries(fields).flatMap(([k, v]) => [element("dt", k), element("dd", String(v))]));
-}
+// Every status (GET /robot, each answer to a robot call, each live message) goes through
+// showStatus; every value from it reaches the page as text.
+const ARM_AND_LAUNCH = "The robot is disarmed. Starting the run arms it and launches it: it will jump. Continue?";
+const plot = { key: undefined, label: "", t: [], y: [], lastTime: null, target: null };
+let pendingTarget;  // the closed-loop target of the run this browser is starting (undefined: none)
+let runWasActive = false;
+let localRuns = 0;
 
 // An element with ``text`` as its text (never parsed as markup) and ``children`` after it.
 function element(tag, text, ...children) {
@@ -458,36 +451,164 @@ function element(tag, text, ...children) {
   return node;
 }
 
+const definitions = (entries) => entries.flatMap(([name, value]) => [element("dt", name), element("dd", String(value))]);
+
+function describeRun(run) {
+  if (!run) return "—";
+  const parts = [`${run.id !== undefined && run.id !== null ? `run ${run.id}: ` : ""}${run.active ? "running" : run.end_reason ?? "ended"}`,
+    `${run.touchdowns} touchdowns`];
+  if (run.jumps !== undefined) parts.push(`jumps ${run.jumps}`);  // as the service counts them
+  if (typeof run.started === "number") parts.push(`started ${new Date(run.started * 1000).toLocaleTimeString()}`);
+  if (run.max_seconds !== undefined) parts.push(`time limit ${run.max_seconds} s`);
+  if (!run.active && run.disarm) parts.push(`disarm: ${run.disarm}`);
+  if (run.stored_run_id !== undefined && run.stored_run_id !== null) parts.push(`stored as run ${run.stored_run_id}`);
+  return parts.join(", ");
+}
+
+function showStatus(status) {
+  if (!status || typeof status.state !== "string") return;
+  const telemetry = status.telemetry || {};
+  const tracker = status.tracker || {};
+  const state = $("#robot-state");
+  state.textContent = status.state;
+  state.dataset.state = status.state;
+  $("#robot-status").replaceChildren(...definitions([
+    ["link", status.url || "—"],
+    ["robot address", status.robot_address || "—"],
+    ["battery", telemetry.battery_mv ? `${telemetry.battery_mv} mV` : "—"],
+    ["faults", telemetry.faults ?? "—"],
+    ["tracker frames", tracker.received ?? "—"],
+    ["tracker loss", typeof tracker.loss === "number" ? `${(100 * tracker.loss).toFixed(1)} %` : "—"],
+    ["run", describeRun(status.run)],
+  ]));
+  const counters = status.counters ? Object.entries(status.counters) : [];
+  $("#robot-counters").replaceChildren(...(counters.length ? definitions(counters) : definitions([["—", "not connected"]])));
+  showLatch(status);
+  followRun(status);
+}
+
+// A latched e-stop: a banner on every tab until a status says it is released. An older service
+// sends no ``estop``: then the state says it.
+// Off the Robot tab no live messages come: while latched, a look every few seconds keeps the
+// banner true (a reset from another browser takes it away).
+let latchCheck = null;
+
+function showLatch(status) {
+  const estop = status.estop || { latched: status.state === "estopped", reason: null };
+  $("#estop-banner").hidden = !estop.latched;
+  $("#estop-reason").textContent = estop.latched && estop.reason ? `Reason: ${estop.reason}` : "";
+  if (estop.latched && latchCheck === null) {
+    latchCheck = setTimeout(() => {
+      latchCheck = null;
+      if (!liveSocket.socket && !$("#estop-banner").hidden) refreshRobot().catch(() => {});
+    }, 3000);
+  }
+}
+
+// The live height plot shows one run: a new run (a new id) starts it afresh. An older service
+// sends neither id nor start time: a run seen becoming active is then a new one.
+function followRun(status) {
+  const run = status.run;
+  let key = plot.key;
+  let label = plot.label;
+  if (run && run.id !== undefined && run.id !== null) {
+    [key, label] = [`id ${run.id}`, `run ${run.id}`];
+  } else if (run && typeof run.started === "number") {
+    [key, label] = [`started ${run.started}`, `the run started ${new Date(run.started * 1000).toLocaleTimeString()}`];
+  } else if (run && run.active && !runWasActive) {
+    [key, label] = [`seen ${++localRuns}`, "this run"];
+  }
+  runWasActive = Boolean(run && run.active);
+  const sameRun = run && typeof run.started === "number" && run.started === plot.started;  // e.g. its id just given
+  if (key !== plot.key && sameRun) {
+    Object.assign(plot, { key, label });
+  } else if (key !== plot.key) {
+    Object.assign(plot, { key, label, started: run ? run.started : undefined, t: [], y: [], lastTime: null, target: pendingTarget ?? null });
+    pendingTarget = undefined;
+    drawLive();
+  }
+  const pose = status.tracker && status.tracker.latest;
+  if (run && run.active && pose && pose.time !== plot.lastTime) {
+    plot.lastTime = pose.time;
+    plot.t.push(pose.time);
+    plot.y.push(pose.y);
+    if (plot.t.length > 1200) { plot.t.shift(); plot.y.shift(); }
+    drawLive();
+  }
+}
+
+function drawLive() {
+  if ($("#robot").hidden) return;  // Plotly sizes a hidden plot wrongly; the tab redraws when shown
+  const start = plot.t.length ? plot.t[0] : 0;
+  const shapes = plot.target === null ? [] : [{ type: "line", xref: "paper", x0: 0, x1: 1, y0: plot.target, y1: plot.target, line: { color: "#d61f1f", dash: "dash" } }];
+  const run = plot.label ? ` — ${plot.label}` : "";
+  // New arrays each time: Plotly.react redraws only what it sees change.
+  Plotly.react("live-plot", [{ x: plot.t.map((t) => t - start), y: plot.y.slice(), mode: "lines", name: "height" }],
+    layout(`Live height${run}${plot.target === null ? "" : ` (target ${plot.target} m, dashed)`}`, "time since the run's first pose [s]", "y [m]", { shapes }),
+    { responsive: true });
+}
+
 async function refreshRobot() { showStatus(await call("GET", "/robot")); }
 
-function openLive() {
-  if (live) return;
-  live = new WebSocket(`${location.protocol === "https:" ? "wss" : "ws"}://${location.host}${API}/robot/live?rate=10`);
-  live.onmessage = (event) => {
-    const status = JSON.parse(event.data);
-    showStatus(status);
-    const pose = status.tracker && status.tracker.latest;
-    if (pose) {
-      heights.t.push(pose.time); heights.y.push(pose.y);
-      if (heights.t.length > 600) { heights.t.shift(); heights.y.shift(); }
-      // New arrays each time: Plotly.react redraws only what it sees change.
-      const shapes = heldHeight === null ? [] : [{ type: "line", xref: "paper", x0: 0, x1: 1, y0: heldHeight, y1: heldHeight, line: { color: "#d61f1f", dash: "dash" } }];
-      Plotly.react("live-plot", [{ x: heights.t.slice(), y: heights.y.slice(), mode: "lines", name: "height" }],
-        layout(heldHeight === null ? "Live height" : `Live height (target ${heldHeight} m, dashed)`, "time [s]", "y [m]", { shapes }), { responsive: true });
-    }
-  };
-  live.onclose = () => { live = null; };
+// The live websocket: open while the Robot tab is shown and the page visible (so a second
+// browser follows a run it did not start), reopened with backoff when it closes.
+const liveSocket = { socket: null, retry: null, failures: 0 };
+
+const liveWanted = () => !$("#robot").hidden && document.visibilityState === "visible";
+
+function liveState(text) { $("#live-state").textContent = `live updates: ${text}`; }
+
+function syncLive() {
+  if (liveWanted()) openLive();
+  else closeLive();
 }
+
+function openLive() {
+  if (liveSocket.socket || liveSocket.retry) return;
+  liveState("connecting…");
+  const socket = new WebSocket(`${location.protocol === "https:" ? "wss" : "ws"}://${location.host}${API}/robot/live?rate=10`);
+  liveSocket.socket = socket;
+  socket.onopen = () => liveState("on");
+  socket.onmessage = (event) => {
+    liveSocket.failures = 0;
+    showStatus(JSON.parse(event.data));
+  };
+  socket.onclose = () => {
+    if (liveSocket.socket !== socket) return;  // closed on purpose
+    liveSocket.socket = null;
+    if (!liveWanted()) return liveState("off");
+    const delay = Math.min(10, 0.5 * 2 ** liveSocket.failures);
+    liveSocket.failures += 1;
+    liveState(`lost, reconnecting in ${delay} s`);
+    liveSocket.retry = setTimeout(() => { liveSocket.retry = null; if (liveWanted()) openLive(); }, delay * 1000);
+  };
+}
+
+function closeLive() {
+  clearTimeout(liveSocket.retry);
+  liveSocket.retry = null;
+  const socket = liveSocket.socket;
+  liveSocket.socket = null;
+  if (socket) { socket.onmessage = null; socket.close(); }
+  liveState("off (Robot tab not shown)");
+}
+
+document.addEventListener("visibilitychange", syncLive);
 
 on("#connect-form", "submit", async (event) => {
   event.preventDefault();
   const form = new FormData(event.target);
-  showStatus(await call("POST", "/robot/connect", { url: String(form.get("url")), tracker_port: Number(form.get("tracker_port")) }));
-  openLive();
-  say("Connected.");
+  const body = { url: String(form.get("url")).trim(), robot_address: String(form.get("robot_address")).trim(), tracker_port: Number(form.get("tracker_port")) };
+  const status = await call("POST", "/robot/connect", body);
+  showStatus(status);
+  say(`Connected to ${status.robot_address ?? body.robot_address} on ${status.url ?? body.url}.`);
 });
+on("#disconnect", "click", async () => { showStatus(await call("POST", "/robot/disconnect")); say("Disconnected."); });
 on("#arm", "click", async () => showStatus(await call("POST", "/robot/arm")));
-on("#reset", "click", async () => showStatus(await call("POST", "/robot/reset")));
+on("#disarm", "click", async () => showStatus(await call("POST", "/robot/disarm")));
+const reset = async () => { showStatus(await call("POST", "/robot/reset")); say("E-stop reset."); };
+on("#reset", "click", reset);
+on("#estop-banner-reset", "click", reset);
 
 on("#closed-loop", "change", (event) => {
   for (const name of ["target_m", "kp", "ki", "kd"]) $("#robot-run-form").elements[name].disabled = !event.target.checked;
@@ -499,27 +620,35 @@ on("#robot-run-form", "submit", async (event) => {
   const form = new FormData(event.target);
   const number = numberField(form);
   const body = { controls: legsOf(form), jumps: number("jumps"), max_seconds: number("max_seconds") };
-  heldHeight = null;
-  if (form.get("closed_loop")) {
-    body.closed_loop = { target_m: number("target_m"), kp: number("kp"), ki: number("ki"), kd: number("kd") };
-    heldHeight = body.closed_loop.target_m;
+  if (form.get("closed_loop")) body.closed_loop = { target_m: number("target_m"), kp: number("kp"), ki: number("ki"), kd: number("kd") };
+  // The robot's state now, not as last shown: a disarmed robot is armed by the run and jumps.
+  const current = await call("GET", "/robot");
+  showStatus(current);
+  if (current.state === "disarmed" && !window.confirm(ARM_AND_LAUNCH)) return say("Run not started.");
+  pendingTarget = body.closed_loop ? body.closed_loop.target_m : null;
+  try {
+    showStatus(await call("POST", "/robot/runs", body));
+  } finally {
+    pendingTarget = undefined;
   }
-  showStatus(await call("POST", "/robot/runs", body));
-  openLive();
-  say(`Run started: ${body.jumps} jumps at most, ${body.max_seconds} s at most${heldHeight === null ? "" : `, holding ${heldHeight} m`}.`);
+  say(`Run started: ${body.jumps} jumps at most, ${body.max_seconds} s at most${body.closed_loop ? `, holding ${body.closed_loop.target_m} m` : ""}.`);
 });
 on("#stop-run", "click", async () => showStatus(await call("POST", "/robot/runs/stop")));
-// The e-stop needs no token (the service allows stopping to anyone) and always answers within
-// 200 ms; it says whether the robot confirmed the stop.
-on("#estop", "click", async () => {
+
+// The e-stop needs no token (the service allows stopping to anyone; call() sends one only when
+// pasted) and always answers within 200 ms; it says whether the robot confirmed the stop.
+async function emergencyStop() {
   const result = await call("POST", "/robot/estop");
   showStatus(result);
-  if (result.acknowledged === false) {
-    say(`Emergency stop NOT acknowledged by the robot: ${result.reason}. Its heartbeats are stopped, so its watchdog disarms it within 1 s — check the robot.`, "error");
+  if (result.acknowledged) {
+    say(`Emergency stop acknowledged by the robot in ${Number(result.latency_ms).toFixed(1)} ms.`);
+  } else if (result.state === "disconnected") {
+    say(`Emergency stop NOT acknowledged: ${result.reason}. The service has no working link to the robot; without the link's heartbeats a robot disarms itself within 1 s — check the robot.`, "error");
   } else {
-    say(`Emergency stop acknowledged by the robot in ${result.latency_ms.toFixed(1)} ms.`);
+    say(`Emergency stop NOT acknowledged by the robot: ${result.reason}. Its heartbeats are stopped, so its watchdog disarms it within 1 s — check the robot.`, "error");
   }
-});
+}
+for (const button of document.querySelectorAll("button.estop")) on(button, "click", emergencyStop);
 
 // 3D view ------------------------------------------------------------------------------------
 // viser serves the view on its own port of this host; the frame loads it once and keeps it.

@@ -268,11 +268,12 @@ def test_closed_loop_run_then_emergency_stop(page, service):
     tracker_port = free_port(socket.SOCK_DGRAM)
     robot = VirtualRobot(tracker_to=("127.0.0.1", tracker_port), noise=NO_NOISE, speed=3.0).start()
     try:
+        page.on("dialog", _accept)  # "Start run" on a disarmed robot asks first: yes
         page.click("nav [data-tab=robot]")
         page.fill("input[name=url]", robot.url)
         page.fill("input[name=tracker_port]", str(tracker_port))
         page.click("#connect")
-        page.wait_for_function("document.querySelector('#robot-status').textContent.includes('disarmed')")
+        page.wait_for_function("document.querySelector('#robot-state').textContent === 'disarmed'")
         page.fill("#robot-run-form input[name=jumps]", "12")
         page.check("#closed-loop")
         page.click("#live-run")
@@ -298,4 +299,269 @@ def test_closed_loop_run_then_emergency_stop(page, service):
         )
         assert robot.firmware.state.name == "ESTOPPED"
     finally:
+        page.remove_listener("dialog", _accept)
         robot.stop()
+
+
+def _accept(dialog):
+    dialog.accept()
+
+
+# The Robot tab as an operator expects (issue 13) ---------------------------------------------
+ARM_AND_LAUNCH = "The robot is disarmed. Starting the run arms it and launches it: it will jump. Continue?"
+ROBOT_STATE = "document.querySelector('#robot-state').textContent"
+
+
+@pytest.fixture
+def robot(page, service):
+    """A virtual robot the panel (page, with the token) is connected to; disconnected afterwards."""
+    _base, token = service
+    _use_token(page, token)
+    tracker_port = free_port(socket.SOCK_DGRAM)
+    virtual = VirtualRobot(tracker_to=("127.0.0.1", tracker_port), noise=NO_NOISE, speed=3.0).start()
+    try:
+        page.click("nav [data-tab=robot]")
+        page.fill("input[name=url]", virtual.url)
+        page.fill("input[name=tracker_port]", str(tracker_port))
+        page.click("#connect")
+        page.wait_for_function(f"{ROBOT_STATE} === 'disarmed'", timeout=10_000)
+        yield virtual
+    finally:
+        httpx.post(f"{_base}/api/v1/robot/disconnect", headers={"Authorization": f"Bearer {token}"})
+        virtual.stop()
+
+
+def _use_token(page, token):
+    page.fill("#token", token)
+    page.dispatch_event("#token", "change")
+
+
+# The e-stop is fixed, large, inside the window, and what a click at its centre hits (with a modal
+# dialog open: the dialog's own e-stop, as the page behind a modal dialog is inert).
+ESTOP_ON_TOP = """() => {
+  const button = document.querySelector('#estop');
+  const box = button.getBoundingClientRect();
+  const hit = document.elementFromPoint(box.x + box.width / 2, box.y + box.height / 2)?.closest('button.estop');
+  const modal = document.querySelector('dialog[open]');
+  return getComputedStyle(button).position === 'fixed' && box.top >= 0 && box.left >= 0
+    && box.bottom <= innerHeight && box.right <= innerWidth && box.height >= 48
+    && !!hit && (modal ? modal.contains(hit) : hit === button);
+}"""
+
+
+def _click_estop_centre(page):
+    box = page.locator("#estop").bounding_box()
+    page.mouse.click(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+
+
+def test_the_estop_stays_on_screen(page):
+    for tab in ("robot", "simulate", "history"):
+        page.click(f"nav [data-tab={tab}]")
+        page.evaluate("window.scrollTo(0, document.body.scrollHeight)")
+        assert page.evaluate(ESTOP_ON_TOP), f"the e-stop is on screen and on top at the bottom of {tab}"
+    try:
+        page.set_viewport_size({"width": 390, "height": 844})  # a phone
+        page.click("nav [data-tab=robot]")
+        page.evaluate("window.scrollTo(0, document.body.scrollHeight)")
+        assert page.evaluate(ESTOP_ON_TOP), "on a 390 px screen too"
+        _shot(page, "robot_phone")
+        page.evaluate("window.scrollTo(0, 0)")
+        assert page.evaluate(ESTOP_ON_TOP)
+    finally:
+        page.set_viewport_size({"width": 1360, "height": 900})
+    # A modal dialog makes the page behind it inert: the run editor brings its own e-stop.
+    page.click("nav [data-tab=history]")
+    page.wait_for_selector("#run-table button.edit-run")
+    page.click("#run-table button.edit-run")
+    assert page.evaluate("document.querySelector('#run-editor').open")
+    assert page.evaluate(ESTOP_ON_TOP), "the e-stop is reachable over the run editor"
+    with page.expect_request(lambda request: request.url.endswith("/robot/estop")):
+        _click_estop_centre(page)
+    page.keyboard.press("Escape")
+
+
+def test_the_estop_needs_no_token(page, service):
+    base, token = service
+    httpx.post(f"{base}/api/v1/robot/disconnect", headers={"Authorization": f"Bearer {token}"}).raise_for_status()
+    _use_token(page, "")  # a colleague's browser
+    page.click("nav [data-tab=simulate]")
+    with page.expect_response(lambda response: response.url.endswith("/robot/estop")) as answer:
+        page.click("#estop")
+    assert answer.value.ok and "authorization" not in answer.value.request.headers
+    page.wait_for_function("document.querySelector('.message')?.textContent.includes('Emergency stop')")
+    message = page.inner_text(".message")
+    # The service's own answer (no robot connected: not acknowledged, and why), never "paste the token".
+    assert "token" not in message.lower(), message
+    assert "NOT acknowledged" in message and answer.value.json()["reason"] in message, message
+    _use_token(page, token)
+
+
+def test_a_latched_estop_shows_a_banner_until_reset(page, robot):
+    assert page.is_hidden("#estop-banner")
+    page.click("#estop")
+    page.wait_for_selector("#estop-banner", state="visible")
+    assert "EMERGENCY STOP latched — the robot is stopped. Reset to continue." in page.inner_text("#estop-banner")
+    page.wait_for_function(f"{ROBOT_STATE} === 'estopped'")
+    page.click("nav [data-tab=simulate]")  # on every tab
+    assert page.is_visible("#estop-banner")
+    page.evaluate("window.scrollTo(0, document.body.scrollHeight)")
+    box = page.locator("#estop-banner").bounding_box()
+    assert box["y"] >= 0 and box["y"] + box["height"] <= 900, "the banner stays at the top while scrolling"
+    page.click("nav [data-tab=robot]")
+    _shot(page, "robot_estop")
+    page.click("#estop-banner-reset")
+    page.wait_for_selector("#estop-banner", state="hidden")
+    page.wait_for_function(f"{ROBOT_STATE} === 'disarmed'")
+    assert robot.firmware.state.name == "DISARMED"
+
+
+def test_start_run_on_a_disarmed_robot_asks(page, service, robot):
+    base, _token = service
+    questions, runs = [], []
+    page.on("request", lambda request: request.method == "POST" and "/robot/runs" in request.url and runs.append(1))
+
+    def cancel(dialog):
+        questions.append((dialog.type, dialog.message))
+        dialog.dismiss()
+
+    page.on("dialog", cancel)
+    try:
+        page.fill("#robot-run-form input[name=jumps]", "3")
+        page.click("#live-run")
+        page.wait_for_function("document.querySelector('.message')?.textContent.includes('Run not started')")
+        assert questions == [("confirm", ARM_AND_LAUNCH)]
+        assert not runs, "Cancel sends no run"
+        assert httpx.get(f"{base}/api/v1/robot").json()["state"] == "disarmed"
+        # Armed: no question, the run starts.
+        page.click("#arm")
+        page.wait_for_function(f"{ROBOT_STATE} === 'armed'")
+        page.click("#live-run")
+        page.wait_for_function("document.querySelector('.message')?.textContent.includes('Run started')")
+        assert len(questions) == 1 and len(runs) == 1
+        page.click("#stop-run")
+        page.wait_for_function(f"{ROBOT_STATE} === 'disarmed'", timeout=15_000)
+    finally:
+        page.remove_listener("dialog", cancel)
+
+
+def test_disarm_and_disconnect(page, robot):
+    assert "0x0013A20040B0B0B0" in page.inner_text("#robot-status"), "the status shows the robot's address"
+    assert "frames_in" in page.inner_text("#robot-counters")
+    page.click("#arm")
+    page.wait_for_function(f"{ROBOT_STATE} === 'armed'")
+    assert robot.firmware.state.name == "ARMED"
+    page.click("#disarm")
+    page.wait_for_function(f"{ROBOT_STATE} === 'disarmed'")
+    assert robot.firmware.state.name == "DISARMED"
+    page.click("#disconnect")
+    page.wait_for_function(f"{ROBOT_STATE} === 'disconnected'")
+    assert "not connected" in page.inner_text("#robot-counters")
+
+
+def test_the_robot_address_is_sent(page, robot):
+    sent = []
+    page.on("request", lambda request: "/robot/connect" in request.url and sent.append(request.post_data_json))
+    # Another radio's address: the link drops the virtual robot's frames, so hears no telemetry.
+    page.fill("input[name=robot_address]", "0x0013A20040B0B0B1")
+    page.click("#connect")
+    page.wait_for_selector(".message.error", timeout=15_000)
+    assert "no telemetry" in page.inner_text(".message.error")
+    page.fill("input[name=robot_address]", "0x0013A20040B0B0B0")
+    page.click("#connect")
+    page.wait_for_function(f"{ROBOT_STATE} === 'disarmed'", timeout=10_000)
+    assert [body["robot_address"] for body in sent] == ["0x0013A20040B0B0B1", "0x0013A20040B0B0B0"]
+    assert "0x0013A20040B0B0B0" in page.inner_text("#robot-status")
+
+
+def test_a_second_browser_follows_live(page, service, robot):
+    base, _token = service
+    with page.context.new_page() as other:  # no token: reading needs none
+        other.goto(f"{base}/")
+        other.click("nav [data-tab=robot]")
+        other.wait_for_function(f"{ROBOT_STATE} === 'disarmed'")
+        other.wait_for_function("document.querySelector('#live-state').textContent === 'live updates: on'")
+        page.click("#arm")
+        other.wait_for_function(f"{ROBOT_STATE} === 'armed'", timeout=10_000)
+        page.click("#disarm")
+        other.wait_for_function(f"{ROBOT_STATE} === 'disarmed'", timeout=10_000)
+        page.click("#estop")
+        other.wait_for_selector("#estop-banner", state="visible", timeout=10_000)
+        page.click("#reset")
+        other.wait_for_selector("#estop-banner", state="hidden", timeout=10_000)
+        # Off the Robot tab the live socket closes; back on it, it opens again.
+        other.click("nav [data-tab=simulate]")
+        other.wait_for_function("document.querySelector('#live-state').textContent.includes('off')")
+        other.click("nav [data-tab=robot]")
+        page.click("#arm")
+        other.wait_for_function(f"{ROBOT_STATE} === 'armed'", timeout=10_000)
+        page.click("#disarm")
+        page.wait_for_function(f"{ROBOT_STATE} === 'disarmed'")
+
+
+# Every draw of the live plot, with the run it belongs to and how many points it has.
+RECORD_LIVE_DRAWS = """() => {
+  window.__draws = [];
+  const react = Plotly.react;
+  Plotly.react = (id, data, ...rest) => {
+    if (id === 'live-plot') window.__draws.push([plot.key, data[0].x.length]);
+    return react(id, data, ...rest);
+  };
+}"""
+
+
+def test_the_live_plot_starts_fresh_for_each_run(page, robot):
+    page.on("dialog", _accept)
+    try:
+        page.evaluate(RECORD_LIVE_DRAWS)
+        page.fill("#robot-run-form input[name=jumps]", "4")
+        page.uncheck("#closed-loop")
+        for _run in range(2):
+            page.click("#live-run")
+            page.wait_for_function("document.querySelector('#robot-status').textContent.includes('running')")
+            page.wait_for_function(
+                "document.querySelector('#robot-status').textContent.includes('jumps done')", timeout=30_000
+            )
+            page.wait_for_function(f"{ROBOT_STATE} === 'disarmed'")
+        draws = page.evaluate("window.__draws")
+    finally:
+        page.remove_listener("dialog", _accept)
+    keys = list(dict.fromkeys(key for key, _count in draws if key is not None))
+    assert len(keys) >= 2, draws
+    first, second = keys[-2], keys[-1]
+    counts = {key: [count for k, count in draws if k == key] for key in (first, second)}
+    assert max(counts[first]) > 5, "the first run was drawn"
+    assert counts[second][0] == 0, "the second run's plot starts empty"
+    assert max(counts[second]) > 5 and max(counts[second]) < max(counts[first]) + 50
+
+
+def test_the_status_fields_of_the_new_service_are_shown_as_text(page):
+    """``estop`` and ``run.id`` (the service's issue-13 status), fed to the panel as a live message would be."""
+    with page.expect_response(lambda response: response.url.endswith("/api/v1/robot")):
+        page.click("nav [data-tab=robot]")
+    page.wait_for_function("document.querySelector('#live-state').textContent === 'live updates: on'")
+    page.evaluate("closeLive()")  # only the statuses below from now on
+    status = {
+        "state": "estopped",
+        "url": "socket://127.0.0.1:1",
+        "robot_address": "0x0013A20040B0B0B0",
+        "counters": {"frames_in": 3, "retries": 2, "<b>odd</b>": 1},
+        "telemetry": None,
+        "tracker": {"received": 1, "loss": 0.0, "latest": {"time": 10.0, "x": 0.0, "y": 0.2}},
+        "estop": {"latched": True, "reason": MARKUP_NOTE},
+        "run": {"id": 41, "active": True, "started": 1.0e9, "touchdowns": 1, "jumps": 0, "max_seconds": 60.0},
+        "transitions": [],
+    }
+    feed = "(status) => showStatus(status)"
+    page.evaluate(feed, status)
+    assert page.is_visible("#estop-banner") and f"Reason: {MARKUP_NOTE}" in page.inner_text("#estop-banner")
+    assert "<b>odd</b>" in page.inner_text("#robot-counters") and "retries" in page.inner_text("#robot-counters")
+    assert page.query_selector("#estop-banner img, #robot-counters b") is None and page.evaluate("window.__xss") is None
+    assert "run 41: running" in page.inner_text("#robot-status")
+    for time_s in (10.1, 10.2):
+        page.evaluate(feed, {**status, "tracker": {"latest": {"time": time_s, "x": 0.0, "y": 0.3}}})
+    assert page.evaluate("[plot.key, plot.t.length]") == ["id 41", 3]
+    page.evaluate(feed, {**status, "run": {**status["run"], "id": 42, "started": 1.0e9 + 90}})
+    assert page.evaluate("[plot.key, plot.t.length]") == ["id 42", 1], "a new run id: the plot starts afresh"
+    page.evaluate(feed, {**status, "estop": {"latched": False, "reason": None}, "state": "disarmed"})
+    assert page.is_hidden("#estop-banner")
+    page.click("nav [data-tab=simulate]")  # back to the service's own statuses on the next visit
