@@ -55,6 +55,7 @@ class RunSnapshot:
     started: float  # time.time()
     jumps: int  # asked for
     max_seconds: float
+    target_m: float | None = None  # closed loop: the height held [m]
     active: bool = True
     touchdowns: tuple[Touchdown, ...] = ()
     touchdown_controls: tuple[LegControl, ...] = ()  # the controls each detected touchdown was made with
@@ -74,6 +75,7 @@ class RunSnapshot:
             "touchdowns": len(self.touchdowns),
             "jumps": self.jumps,
             "max_seconds": self.max_seconds,
+            "target_m": self.target_m,
             "commands": self.commands,
             "end_reason": self.end_reason,
             "disarm": self.disarm,
@@ -88,6 +90,7 @@ class LiveRun:
 
     jumps: int  # touchdowns to record before it ends
     max_seconds: float  # [s] from the start, at most
+    target_m: float | None = None  # closed loop: the height to hold [m]
     run_id: int | None = None
     started: float = field(default_factory=time.time)
     first_pose: int = 0  # the tracker's index of the run's first frame
@@ -104,7 +107,7 @@ class LiveRun:
     _stop_requests: queue.SimpleQueue[str] = field(default_factory=queue.SimpleQueue)
 
     def __post_init__(self) -> None:
-        self.snapshot = RunSnapshot(self.run_id, self.started, self.jumps, self.max_seconds)
+        self.snapshot = RunSnapshot(self.run_id, self.started, self.jumps, self.max_seconds, self.target_m)
 
     def stop(self, reason: str = "stopped") -> None:
         """Any thread: ask the loop to end; it sends nothing more once it has seen this (the first

@@ -13,6 +13,8 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field, fields
 
+from experiments.manifest import json_safe
+
 SPEC_VERSION = 1
 
 
@@ -112,7 +114,8 @@ def spec_of(body) -> JobSpec:
 
 
 def encode(spec: JobSpec) -> dict:
-    return {"version": SPEC_VERSION, **asdict(spec)}
+    """The spec as the store's JSON (plain lists and dicts)."""
+    return {"version": SPEC_VERSION, **json_safe(asdict(spec))}
 
 
 def decode(stored: dict) -> JobSpec:

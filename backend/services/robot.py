@@ -205,7 +205,8 @@ class RobotService:
             controller = self._controller(body, legs)
             with self.sessions() as session:
                 run_id = open_robot_run(session, body, self.robot, tracker.calibration)
-            run = LiveRun(body.jumps, body.max_seconds, run_id=run_id, first_pose=tracker.count())
+            target_m = None if body.closed_loop is None else body.closed_loop.target_m
+            run = LiveRun(body.jumps, body.max_seconds, target_m, run_id=run_id, first_pose=tracker.count())
             journal = JournalWriter(self.sessions, run, tracker, link, self.robot).start()
             self._run = run
         threading.Thread(target=execute, args=(run, link, tracker, self.robot, legs, controller, journal.finish),

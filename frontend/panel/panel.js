@@ -523,7 +523,7 @@ function followRun(status) {
   if (key !== plot.key && sameRun) {
     Object.assign(plot, { key, label });
   } else if (key !== plot.key) {
-    Object.assign(plot, { key, label, started: run ? run.started : undefined, t: [], y: [], lastTime: null, target: pendingTarget ?? null });
+    Object.assign(plot, { key, label, started: run ? run.started : undefined, t: [], y: [], lastTime: null, target: run && run.target_m != null ? run.target_m : (pendingTarget ?? null) });
     pendingTarget = undefined;
     drawLive();
   }

@@ -201,3 +201,30 @@ def test_the_runner_leaves_a_job_cancelled_before_it_starts_alone(sessions, sess
     after = _job(sessions, job.id)
     assert (after.state, after.started_at, after.finished_at) == ("cancelled", None, cancelled.finished_at)
     assert _trials(session, job.id) == []
+
+
+def test_a_stored_job_the_request_schema_now_refuses_still_resumes(sessions, session, compute):
+    """Its spec is read as stored (job_specs.py), not re-validated by today's request ranges."""
+    from backend.services.job_specs import MJTFSpec, StateSpec, encode
+
+    # Two levels at one zeta0: the request schema refuses that today (they must be distinct).
+    spec = MJTFSpec(zeta0s=(0.9, 0.9), trials=3, cap=50, guess=StateSpec(-0.93, -0.2))
+    with pytest.raises(ValueError, match="distinct"):
+        MJTFJobCreate(**{k: v for k, v in encode(spec).items() if k != "version"})
+    job = Job(kind="mjtf", spec=encode(spec), state="running", total=6, code_version="old")
+    session.add(job)
+    session.commit()
+    jobs.JobRunner(sessions, compute.jobs).run(job.id)
+    assert _job(sessions, job.id).state == "done" and len(_trials(session, job.id)) == 6
+
+
+def test_cancel_stops_the_worker_within_a_second(sessions, session, runner):
+    job = jobs.create_job(session, MJTFJobCreate(zeta0s=[0.9], trials=20_000, cap=20_000, seed=1, guess=GUESS))
+    runner.start()
+    runner.submit(job.id)
+    _wait_until(sessions, job.id, lambda j: j.completed > 0)
+    cancelled_at = time.monotonic()
+    jobs.cancel_job(session, job.id)
+    _wait_until(sessions, job.id, lambda j: j.state == "cancelled")
+    took = time.monotonic() - cancelled_at
+    assert took < 5.0, f"cancel took {took:.1f} s (the runner looks every 0.2 s and stops the worker)"

@@ -108,3 +108,19 @@ def test_bad_study_specs_are_a_422(client, auth, spec, field):
     response = client.post("/api/v1/jobs", json=spec, headers=auth)
     assert response.status_code == 422, response.text
     assert field in str(response.json()["detail"])
+
+
+@pytest.mark.parametrize(
+    ("spec", "formula"),
+    [
+        ({"zeta0s": [0.8 + 0.001 * k for k in range(100)], "trials": 100_000, "cap": 100_000}, "levels x trials x cap"),
+        ({"kind": "basin", "controls": [{"psi0_deg": 30, "zeta0": 0.9}], "grid": 1000, "jumps": 1000}, "grid"),
+        ({"kind": "sweep", "steps": 500, "basin_grid": 200, "basin_jumps": 1000}, "basin_grid"),
+    ],
+)
+def test_jobs_over_the_work_budget_are_a_422_naming_the_limit(client, auth, spec, formula):
+    response = client.post("/api/v1/jobs", json=spec, headers=auth)
+    assert response.status_code == 422, response.text
+    message = " ".join(error["msg"] for error in response.json()["detail"])
+    assert "over the limit of 5e+08" in message and formula in message, message
+    assert client.get("/api/v1/jobs").json()["items"] == [], "nothing stored, nothing queued"

@@ -1,0 +1,61 @@
+"""Stored job specs: their own versioned record, readable whatever the request schema becomes."""
+
+import pytest
+from pydantic import ValidationError
+
+from backend.schemas import JOB_KINDS, BasinJobCreate, GaitSearchJobCreate, MJTFJobCreate, SweepJobCreate
+from backend.services.job_specs import (
+    SPEC_VERSION,
+    LegSpec,
+    MJTFSpec,
+    NoiseSpec,
+    StateSpec,
+    UnreadableSpec,
+    decode,
+    encode,
+    spec_of,
+)
+
+LEGS = [{"psi0_deg": 30.0, "zeta0": 0.9}]
+REQUESTS = [
+    MJTFJobCreate(zeta0s=[0.88, 0.9], trials=4, guess={"xdot": -0.93, "ydot": -0.2}),
+    SweepJobCreate(kind="sweep", steps=3, basin_grid=0),
+    BasinJobCreate(kind="basin", controls=LEGS, grid=4, jumps=5),
+    GaitSearchJobCreate(kind="gaits", controls=LEGS, grid=2),
+]
+
+
+@pytest.mark.parametrize("request_body", REQUESTS, ids=lambda body: body.kind)
+def test_a_request_is_stored_as_a_versioned_spec_that_reads_back_the_same(request_body):
+    spec = spec_of(request_body)
+    stored = encode(spec)
+    assert stored["version"] == SPEC_VERSION and stored["kind"] == request_body.kind
+    assert decode(stored) == spec
+    assert "experiment_id" not in stored, "the job's row holds its experiment"
+
+
+def test_an_unversioned_spec_of_before_reads_as_version_0():
+    old = {"kind": "mjtf", "experiment_id": None, "model": {"preset": "paper", "alpha": None}, "psi0_deg": 30.0,
+           "zeta0s": [0.9], "trials": 8, "cap": 1000, "seed": 3, "guess": None}  # fmt: skip
+    spec = decode(old)
+    assert spec == MJTFSpec(zeta0s=(0.9,), seed=3) and spec.noise == NoiseSpec(), "missing fields: their defaults"
+
+
+def test_a_spec_the_request_schema_now_refuses_still_reads():
+    stored = encode(MJTFSpec(zeta0s=(0.9, 0.9), trials=100_000, cap=100_000))  # repeated, and over the budget
+    with pytest.raises(ValidationError):
+        JOB_KINDS["mjtf"](**{k: v for k, v in stored.items() if k != "version"})
+    assert decode(stored).zeta0s == (0.9, 0.9) and decode(stored).trials == 100_000
+
+
+def test_a_newer_or_unknown_spec_is_refused_with_a_reason():
+    with pytest.raises(UnreadableSpec, match="version 2 is newer"):
+        decode({"version": 2, "kind": "mjtf", "zeta0s": [0.9]})
+    with pytest.raises(UnreadableSpec, match="unknown job kind 'atlas'"):
+        decode({"version": 1, "kind": "atlas"})
+
+
+def test_parts_decode_to_their_types():
+    spec = decode(encode(spec_of(REQUESTS[2])))
+    assert spec.controls == (LegSpec(30.0, 0.9),) and spec.guess is None
+    assert decode(encode(spec_of(REQUESTS[0]))).guess == StateSpec(-0.93, -0.2)
