@@ -20,6 +20,7 @@ from __future__ import annotations
 import concurrent.futures
 import functools
 import logging
+import math
 import queue
 import threading
 from collections.abc import Callable, Iterator
@@ -99,23 +100,35 @@ def cancel_job(session: Session, job_id: int) -> Job:
 
 
 def level_summaries(session: Session, job: Job) -> list[dict]:
-    """Per level: trials so far, mean and standard deviation of jumps to failure, outcomes."""
+    """Per level: trials so far, mean and standard deviation of jumps to failure, outcomes —
+    counted and summed by the database (one GROUP BY), not by reading every trial."""
     spec = decode(job.spec)
-    rows = session.execute(
-        select(Trial.level, Trial.jumps, Trial.failure_code).where(Trial.job_id == job.id).order_by(Trial.level)
+    groups = session.execute(
+        select(
+            Trial.level, Trial.failure_code, func.count(), func.sum(Trial.jumps), func.sum(Trial.jumps * Trial.jumps)
+        )
+        .where(Trial.job_id == job.id)
+        .group_by(Trial.level, Trial.failure_code)
     ).all()
+    counts = [{"capped": 0} | {f.code: 0 for f in Failure} for _ in spec.zeta0s]
+    sums = [[0, 0, 0] for _ in spec.zeta0s]  # trials, sum of jumps, sum of squares: exact integers
+    for level, code, trials, total, squares in groups:
+        counts[level]["capped" if code is None else code] += trials
+        for k, value in enumerate((trials, total, squares)):
+            sums[level][k] += int(value)  # PostgreSQL sums integers as numeric: the same JSON either way
     summaries = []
     for level, zeta0 in enumerate(spec.zeta0s):
-        jumps = np.array([r.jumps for r in rows if r.level == level], dtype=float)
-        codes = [r.failure_code for r in rows if r.level == level]
-        outcomes = {"capped": codes.count(None)} | {f.code: codes.count(f.code) for f in Failure}
+        trials, total, squares = sums[level]
+        variance = (
+            (trials * squares - total * total) / (trials * (trials - 1)) if trials > 1 else 0.0
+        )  # exact numerator
         summaries.append(
             {
                 "zeta0": zeta0,
-                "trials": int(jumps.size),
-                "mean": float(jumps.mean()) if jumps.size else float("nan"),
-                "std": float(jumps.std(ddof=1)) if jumps.size > 1 else 0.0,
-                "outcomes": outcomes,
+                "trials": trials,
+                "mean": total / trials if trials else float("nan"),
+                "std": math.sqrt(max(variance, 0.0)),
+                "outcomes": counts[level],
             }
         )
     return summaries
