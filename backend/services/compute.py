@@ -94,13 +94,10 @@ class ComputePool:
         self._executor: concurrent.futures.ProcessPoolExecutor | None = None
         self._progress = None  # the current workers' progress queue (a new one with each start)
         self._pending = 0
-        self._closed = False
 
     def submit(self, function: Callable, *args) -> concurrent.futures.Future:
         """``function(*args)`` in a worker; a ComputeBusy if ``max_pending`` calls are waiting."""
         with self._lock:
-            if self._closed:
-                raise ComputeFailed(f"the {self.name} compute pool is closed (the service is stopping)")
             if self._pending >= self.max_pending:
                 raise ComputeBusy(f"{self._pending} {self.name} computations are waiting already; retry shortly")
             if self._executor is None:
@@ -172,8 +169,9 @@ class ComputePool:
             _stop(executor)
 
     def close(self) -> None:
+        """Stop the workers (the service is stopping). A later call starts new ones, as after a
+        restart: an app whose lifespan runs again (tests, schema fuzzing) keeps working."""
         with self._lock:
-            self._closed = True
             executor, self._executor = self._executor, None
         if executor is not None:
             _stop(executor)

@@ -10,6 +10,7 @@ from hypothesis import HealthCheck, settings
 
 from backend.api.app import create_app
 from backend.api.security import api_token
+from backend.services.compute import Compute
 from backend.settings import Settings
 from backend.store.database import make_engine, migrate
 
@@ -25,9 +26,18 @@ _TOKEN, _ = api_token(_DATA)
 # drives them against the virtual robot instead of fuzzing them. Without the 3D view (it is the
 # frontend's, started by `parkour serve`) its endpoints answer 503 by design;
 # tests/frontend/viewer/test_view.py drives them with a real view.
-schema = schemathesis.openapi.from_asgi("/openapi.json", create_app(_SETTINGS, run_jobs=False)).exclude(
-    path_regex=r"^/api/v1/(robot|view)|/share\.html$"
-)
+# Schemathesis runs the app's lifespan for every case: the app borrows worker pools that outlive it,
+# or each case would start fresh worker processes.
+_COMPUTE = Compute()
+schema = schemathesis.openapi.from_asgi(
+    "/openapi.json", create_app(_SETTINGS, run_jobs=False, compute=_COMPUTE)
+).exclude(path_regex=r"^/api/v1/(robot|view)|/share\.html$")
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _stop_workers():
+    yield
+    _COMPUTE.close()
 
 
 @schema.parametrize()

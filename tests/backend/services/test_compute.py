@@ -82,7 +82,7 @@ def test_workers_report_progress(pool):
     assert reports == [(1, 3), (2, 3), (3, 3)]
 
 
-def test_a_closed_pool_refuses(pool):
+def test_a_closed_pool_starts_afresh_when_called_again(pool):
+    before = pool.run(_pid, timeout=WAIT_S)
     pool.close()
-    with pytest.raises(ComputeFailed, match="closed"):
-        pool.submit(_pid)
+    assert pool.run(_pid, timeout=WAIT_S) != before
