@@ -1,8 +1,13 @@
 """A fault rig for the robot link: on a pty (``os.openpty``, no extra binaries), and a flapping radio.
 
-The link opens :attr:`PtyRobot.path` as it would a USB radio. The rig plays a robot that only
-talks: it sends TELEMETRY in ``state`` from ``source64`` every ``period`` and never reads what the
-PC sends, so the PC→robot direction fills and then blocks; :meth:`PtyRobot.jam` fills it at once.
+The link opens :attr:`PtyRobot.path` as it would a USB radio. The rig plays a robot that talks:
+it sends TELEMETRY in ``state`` from ``source64`` every ``period`` (while ``talking``). By default
+it never reads what the PC sends, so the PC→robot direction fills and then blocks;
+:meth:`PtyRobot.jam` fills it at once. With ``answers=True`` it also plays both radios: each
+Transmit Request is answered with a Transmit Status (``delivery_status``, ``retry_count``) and,
+delivered, goes to the firmware's rules (no watchdog), which reply and may change ``state``.
+It keeps what the PC put on the line (``sent``, ``frame_ids``) and what the robot got (``heard``).
+A jam pauses the reading until :meth:`PtyRobot.unjam`.
 
 :class:`Radio` flaps one TCP address between the virtual robot, nothing, a silent radio and one that
 hangs up; :class:`LinkCalls` watches who opens and closes a :class:`RobotLink`, and how many at once.
@@ -20,10 +25,20 @@ import threading
 import time
 import tty
 
+from backend.robot.firmware import Firmware
 from backend.robot.link import RobotLink
-from backend.robot.messages import RobotState, Telemetry, encode
+from backend.robot.messages import ProtocolError, RobotState, Telemetry, decode, encode
 from backend.robot.virtual import VirtualRobot
-from backend.robot.xbee import ROBOT_ADDRESS, encode_frame, rx_packet
+from backend.robot.xbee import (
+    DELIVERED,
+    ROBOT_ADDRESS,
+    FrameError,
+    FrameParser,
+    encode_frame,
+    parse_tx_request,
+    rx_packet,
+    tx_status,
+)
 from tests.helpers import free_port
 
 JAM_CHUNK = 4096  # [bytes]
@@ -41,21 +56,44 @@ def telemetry(seq: int, state: RobotState) -> Telemetry:
 
 
 class PtyRobot:
-    def __init__(self, state: RobotState = RobotState.ARMED, *, source64: int = ROBOT_ADDRESS, period: float = 0.05):
+    def __init__(
+        self,
+        state: RobotState = RobotState.ARMED,
+        *,
+        source64: int = ROBOT_ADDRESS,
+        period: float = 0.05,
+        answers: bool = False,
+    ):
         self.master, self._slave = os.openpty()
         tty.setraw(self._slave)  # no line discipline between the frames and the link
         self.path = os.ttyname(self._slave)
         self.state, self.source64, self.period = state, source64, period
+        self.talking = True
+        self.delivery_status = DELIVERED  # what the Transmit Statuses report (0x24, 0x21: not delivered)
+        self.retry_count = 0  # the retries they report
+        self.sent: list = []  # messages the PC put on the line, delivered or not, in order
+        self.frame_ids: list[int] = []  # theirs
+        self.heard: list = []  # those delivered to the robot
+        self._rules = Firmware()
+        self._parser = FrameParser()
+        self._jammed = False
+        self._read_lock = threading.Lock()  # held by the reader around each read: a jam waits for it
+        self._write_lock = threading.Lock()  # whole frames on the master, whoever writes
         self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._talk, name="pty-robot", daemon=True)
+        self._threads = [threading.Thread(target=self._talk, name="pty-robot", daemon=True)]
+        if answers:
+            self._threads.append(threading.Thread(target=self._answer, name="pty-robot-radio", daemon=True))
 
     def start(self) -> PtyRobot:
-        self._thread.start()
+        for thread in self._threads:
+            thread.start()
         return self
 
     def jam(self) -> int:
         """Fill the PC→robot buffer (nobody reads it): every write on the line now blocks. Returns
         the bytes it took."""
+        with self._read_lock:
+            self._jammed = True
         flags = fcntl.fcntl(self._slave, fcntl.F_GETFL)
         fcntl.fcntl(self._slave, fcntl.F_SETFL, flags | os.O_NONBLOCK)
         filled, settled = 0, 0
@@ -68,9 +106,15 @@ class PtyRobot:
             time.sleep(0.01)
         return filled
 
+    def unjam(self) -> None:
+        """An answering rig reads again: the jam's bytes and whatever the PC got onto the line."""
+        with self._read_lock:
+            self._jammed = False
+
     def stop(self) -> None:
         self._stop.set()
-        self._thread.join(2)
+        for thread in self._threads:
+            thread.join(2)
         os.close(self.master)
         os.close(self._slave)
 
@@ -78,8 +122,40 @@ class PtyRobot:
         seq = 0
         while not self._stop.wait(self.period):
             seq = (seq + 1) & 0xFFFF
-            with contextlib.suppress(OSError):
-                os.write(self.master, received_frame(telemetry(seq, self.state), source64=self.source64))
+            if self.talking:
+                self._put(received_frame(telemetry(seq, self.state), source64=self.source64))
+
+    def _answer(self) -> None:
+        while not self._stop.is_set():
+            chunk = b""
+            with self._read_lock, contextlib.suppress(OSError):
+                if not self._jammed and select.select([self.master], [], [], 0.01)[0]:
+                    chunk = os.read(self.master, JAM_CHUNK)
+            if self._jammed:
+                time.sleep(0.01)
+            for data in self._parser.feed(chunk):
+                with contextlib.suppress(FrameError, ProtocolError):
+                    self._radio(*parse_tx_request(data))
+
+    def _radio(self, frame_id: int, _destination: int, payload: bytes) -> None:
+        message = decode(payload)
+        self.sent.append(message)
+        self.frame_ids.append(frame_id)
+        if frame_id:
+            status = tx_status(frame_id, delivery=self.delivery_status, retries=self.retry_count)
+            self._put(encode_frame(status))
+        if self.delivery_status != DELIVERED:
+            return  # lost on the air: the robot never hears it
+        self.heard.append(message)
+        self._rules.state = self.state
+        replies = self._rules.receive(message, time.monotonic())
+        self.state = self._rules.state
+        for reply in replies:
+            self._put(received_frame(reply, source64=self.source64))
+
+    def _put(self, frame: bytes) -> None:
+        with self._write_lock, contextlib.suppress(OSError):
+            os.write(self.master, frame)
 
 
 class Radio:
