@@ -7,15 +7,24 @@ The link opens :attr:`PtyRobot.path` (or the stable symlink :attr:`PtyRobot.by_i
   reads what the PC sends, so the PC→robot direction fills and then blocks;
 - answering (``firmware=``): the robot's firmware (:class:`backend.robot.firmware.Firmware`) behind
   the line, as the virtual robot runs it — it reads the PC's frames, acknowledges, keeps its
-  watchdog and sends its own heartbeats and telemetry; :attr:`PtyRobot.received` keeps what it got.
+  watchdog and sends its own heartbeats and telemetry; :attr:`PtyRobot.received` keeps what it got;
+- playing both radios (``answers=True``): talking as above (while :attr:`~PtyRobot.talking`), and each
+  Transmit Request is answered with a Transmit Status (:attr:`~PtyRobot.delivery_status`,
+  :attr:`~PtyRobot.retry_count`) and, delivered, goes to the firmware's rules without their
+  watchdog, which reply and may change ``state``; it keeps what the PC put on the line
+  (:attr:`~PtyRobot.sent`, :attr:`~PtyRobot.frame_ids`) and what the robot got (:attr:`~PtyRobot.heard`).
+
+An answering rig's radio sends a Transmit Status for every frame with a non-zero frame id, as an
+XBee does.
 
 Faults, each on demand: :meth:`PtyRobot.jam` fills the PC→robot direction at once (every write
-blocks); :meth:`~PtyRobot.go_silent` and :meth:`~PtyRobot.resume` take the robot out of range and
-back (nothing arrives either way, the robot's watchdog runs on); :meth:`~PtyRobot.hang_up` and
-:meth:`~PtyRobot.plug_in` unplug the radio (the pty goes away, reads and writes fail, the by-id
-link disappears) and plug a new one in (a new pty behind the same by-id link); :meth:`~PtyRobot.flood`
-interleaves line noise — random bytes, broken frames, payloads that are no message — with good
-frames at many times a 57.6 kbaud line's rate, and counts exactly what the link's parser must see.
+blocks; :meth:`~PtyRobot.unjam` reads again); :meth:`~PtyRobot.go_silent` and
+:meth:`~PtyRobot.resume` take the robot out of range and back (nothing arrives either way, the
+robot's watchdog runs on); :meth:`~PtyRobot.hang_up` and :meth:`~PtyRobot.plug_in` unplug the radio
+(the pty goes away, reads and writes fail, the by-id link disappears) and plug a new one in (a new
+pty behind the same by-id link); :meth:`~PtyRobot.flood` interleaves line noise — random bytes,
+broken frames, payloads that are no message — with good frames at many times a 57.6 kbaud line's
+rate, and counts exactly what the link's parser must see.
 
 :class:`Radio` flaps one TCP address between the virtual robot, nothing, a silent radio and one that
 hangs up; :class:`LinkCalls` watches who opens and closes a :class:`RobotLink`, and how many at once;
@@ -45,6 +54,7 @@ from backend.robot.messages import Command, Kind, RobotState, Telemetry, decode,
 from backend.robot.supervisor import LinkSupervisor
 from backend.robot.virtual import VirtualRobot
 from backend.robot.xbee import (
+    DELIVERED,
     ROBOT_ADDRESS,
     START,
     FrameError,
@@ -54,6 +64,7 @@ from backend.robot.xbee import (
     escape,
     parse_tx_request,
     rx_packet,
+    tx_status,
 )
 from tests.helpers import answer_within, free_port
 
@@ -107,11 +118,21 @@ class PtyRobot:
         source64: int = ROBOT_ADDRESS,
         period: float = 0.05,
         firmware: Firmware | None = None,
+        answers: bool = False,
     ):
         """Talking only, in ``state`` every ``period`` [s]; or, given ``firmware``, answering as it
-        decides (``state`` and ``period`` are then the firmware's own)."""
+        decides (``state`` and ``period`` are then the firmware's own); or ``answers``: talking, and
+        both radios answering by the firmware's rules (no watchdog)."""
         self.state, self.source64, self.period = state, source64, period
         self.firmware = firmware
+        self.answers = answers
+        self.talking = True  # talking modes: TELEMETRY goes out
+        self.delivery_status = DELIVERED  # what the Transmit Statuses report (0x24, 0x21: not delivered)
+        self.retry_count = 0  # the retries they report
+        self.sent: list = []  # answers=True: the messages the PC put on the line, delivered or not, in order
+        self.frame_ids: list[int] = []  # theirs
+        self.heard: list = []  # those delivered to the robot
+        self._rules = Firmware()  # answers=True: the firmware's rules, its state set from ``state``
         self.received: list[tuple[float, object]] = []  # (monotonic time, message) the firmware got, heartbeats aside
         self._dir = tempfile.mkdtemp(prefix="pty-robot-")
         self.by_id = os.path.join(self._dir, "usb-XBee_rig-if00-port0")  # as /dev/serial/by-id/… names a radio
@@ -157,6 +178,10 @@ class PtyRobot:
             settled = settled + 1 if filled == before else 0
             time.sleep(0.01)
         return filled
+
+    def unjam(self) -> None:
+        """An answering rig reads again: the jam's bytes, then whatever the PC got onto the line."""
+        self._deaf = False
 
     def go_silent(self) -> None:
         """Out of range: the robot's frames stop arriving and the PC's are lost (read and dropped,
@@ -236,11 +261,12 @@ class PtyRobot:
 
     def _run(self) -> None:
         parser, seq, next_talk = FrameParser(), 0, time.monotonic()
+        reads = self.firmware is not None or self.answers
         while not self._stop.is_set():
             parser = self._serve_requests(parser)
             master = self.master
-            if self.firmware is None or master is None or self._deaf:
-                time.sleep(TICK if self.firmware is not None else max(0.0, min(TICK, next_talk - time.monotonic())))
+            if not reads or master is None or self._deaf:
+                time.sleep(TICK if reads else max(0.0, min(TICK, next_talk - time.monotonic())))
             elif select.select([master], [], [], TICK)[0]:
                 try:
                     chunk = os.read(master, 4096)
@@ -255,18 +281,36 @@ class PtyRobot:
             elif time.monotonic() >= next_talk:
                 next_talk = time.monotonic() + self.period
                 seq = (seq + 1) & 0xFFFF
-                self._send([telemetry(seq, self.state)])
+                if self.talking:
+                    self._send([telemetry(seq, self.state)])
 
     def _hear(self, data: bytes) -> None:
         try:
-            _frame_id, _destination, payload = parse_tx_request(data)
+            frame_id, _destination, payload = parse_tx_request(data)
             message = decode(payload)
         except (FrameError, ValueError):
+            return
+        if frame_id:  # the PC's radio reports delivery, as an XBee does
+            self._write(encode_frame(tx_status(frame_id, delivery=self.delivery_status, retries=self.retry_count)))
+        if self.answers:
+            self._radio(frame_id, message)
             return
         if not (isinstance(message, Command) and message.kind == Kind.HEARTBEAT):
             self.received.append((time.monotonic(), message))
         with self._firmware_lock:
             self._send(self.firmware.receive(message, time.monotonic()))
+
+    def _radio(self, frame_id: int, message) -> None:
+        """answers=True: noted, and if delivered, answered by the firmware's rules from ``state``."""
+        self.sent.append(message)
+        self.frame_ids.append(frame_id)
+        if self.delivery_status != DELIVERED:
+            return  # lost on the air: the robot never hears it
+        self.heard.append(message)
+        self._rules.state = self.state
+        replies = self._rules.receive(message, time.monotonic())
+        self.state = self._rules.state
+        self._send(replies)
 
     def _send(self, messages: list) -> None:
         if messages:

@@ -3,7 +3,8 @@
 - :mod:`~backend.robot.xbee` — XBee API frames (escaped mode) and a resynchronising parser;
 - :mod:`~backend.robot.messages` — ParkourLab's application messages (protocol v1);
 - :mod:`~backend.robot.limits` — the servo limits every leg command is checked against;
-- :mod:`~backend.robot.link` — the PC's side: a pyserial URL, heartbeats, safety;
+- :mod:`~backend.robot.link` — the PC's side: a pyserial URL, heartbeats, safety (its states,
+  error and e-stop results in :mod:`~backend.robot.link_types`);
 - :mod:`~backend.robot.supervisor` — the link's one owner: the thread that alone opens, reconnects
   and closes it, on requests from everyone else;
 - :mod:`~backend.robot.tracker` — body poses from the overhead camera (UDP datagrams, replays);

@@ -45,6 +45,8 @@ class Firmware:
     _last_telemetry_sent: float = float("-inf")
 
     def receive(self, message: Message, now: float) -> list[Message]:
+        # Any frame from the PC restarts the silence timer. The PC's repeated ESTOP does too, but
+        # ESTOP latches the e-stopped state: it never keeps an armed robot going.
         self._last_heard = now
         if isinstance(message, SetLeg):
             return [self._ack(message.seq, self._set_leg(message))]

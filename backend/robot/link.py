@@ -12,36 +12,37 @@ longer than ``WRITE_TIMEOUT`` (pyserial's ``write_timeout``; a timeout is a ``wr
 count and a :class:`LinkError`), and only Receive Packets from ``robot_address`` are heard — a
 frame from any other radio is a ``foreign_frames`` count and changes nothing. :meth:`RobotLink.estop`
 takes no lock that a command, a blocked write or a reconnect holds for longer than one bounded
-write, and gives up after its ``timeout`` with an honest :class:`EstopResult`.
+write, and gives up after its ``timeout`` with an honest :class:`EstopResult`; the heartbeat
+thread then sends that ESTOP instead of heartbeats until the robot acknowledges it.
+
+Every Transmit Request carries a frame id (1..255), so the PC's radio answers each with a
+Transmit Status: delivered or not, after how many retries (``counters``). Those come from the
+local radio, not the robot: they are neither foreign frames nor a sign of the robot's life.
 """
 
 from __future__ import annotations
 
-import enum
-import socket
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import serial
 
 from backend.robot.limits import ServoLimits
-from backend.robot.messages import (
-    Ack,
-    Command,
-    Kind,
-    Leg,
-    ProtocolError,
-    Result,
-    RobotState,
-    SetLeg,
-    Telemetry,
-    decode,
-    encode,
+from backend.robot.link_types import FROM_ROBOT, SAFE, EstopResult, LinkError, LinkState, Transition
+from backend.robot.messages import Ack, Command, Kind, Leg, ProtocolError, Result, SetLeg, Telemetry, decode, encode
+from backend.robot.ports import check_port, no_delay
+from backend.robot.xbee import (
+    ROBOT_ADDRESS,
+    TX_STATUS,
+    FrameError,
+    FrameParser,
+    TransmitLog,
+    encode_frame,
+    parse_rx_packet,
+    parse_tx_status,
+    tx_request,
 )
-from backend.robot.ports import check_port
-from backend.robot.xbee import ROBOT_ADDRESS, FrameError, FrameParser, encode_frame, parse_rx_packet, tx_request
 
 HEARTBEAT_PERIOD = 0.2  # [s]
 HEARTBEAT_TIMEOUT = 1.0  # [s]
@@ -50,48 +51,6 @@ WRITE_TIMEOUT = 0.1  # [s] the longest any write may block its caller (pyserial'
 ESTOP_TIMEOUT = 0.15  # [s] an e-stop's whole budget, blocked writes included: the API answers within 200 ms
 ESTOP_REPEAT = 0.02  # [s] between e-stop repeats until acknowledged
 READ_TIMEOUT = 0.02  # [s]
-
-
-class LinkState(enum.StrEnum):
-    DISCONNECTED = "disconnected"
-    DISARMED = "disarmed"
-    ARMED = "armed"
-    RUNNING = "running"
-    ESTOPPED = "estopped"
-
-
-_FROM_ROBOT = {
-    RobotState.DISARMED: LinkState.DISARMED,
-    RobotState.ARMED: LinkState.ARMED,
-    RobotState.RUNNING: LinkState.RUNNING,
-    RobotState.ESTOPPED: LinkState.ESTOPPED,
-}
-
-_SAFE = (RobotState.DISARMED, RobotState.ESTOPPED)  # what every ending must leave the robot in
-
-
-class LinkError(RuntimeError):
-    """The robot did not answer, refused a command, or the link is down."""
-
-
-@dataclass(frozen=True)
-class EstopResult:
-    """What an e-stop achieved: acknowledged by the robot after ``latency`` [s], or not, and why."""
-
-    acknowledged: bool
-    latency: float  # [s] from the call to the acknowledgement, or to giving up
-    reason: str | None = None  # why it was not acknowledged
-
-
-@dataclass(frozen=True)
-class Transition:
-    time: float  # time.time()
-    before: LinkState
-    after: LinkState
-    reason: str
-
-    def to_dict(self) -> dict:
-        return {"time": self.time, "from": self.before.value, "to": self.after.value, "reason": self.reason}
 
 
 class RobotLink:
@@ -118,12 +77,15 @@ class RobotLink:
         self.foreign_frames = 0  # Receive Packets from a radio that is not robot_address
         self.write_timeouts = 0
         self.estops_unacknowledged = 0
+        self.frames_out = 0  # Transmit Requests the port took whole within WRITE_TIMEOUT
+        self.estop_repeats = 0  # ESTOPs written again for an e-stop already sent (counted in "retries")
+        self.transmits = TransmitLog()  # frame ids, and the radio's Transmit Statuses for them
         self.on_lost: list[Callable[[str], None]] = []
         self._port = None
         self._seq = 0
         self._acks: dict[int, tuple[threading.Event, list[Ack]]] = {}
         self._lock = threading.Lock()
-        self._write_lock = threading.Lock()
+        self._write_lock = threading.RLock()  # reentrant: the heartbeat thread picks its frame under it
         self._last_heard = 0.0
         self._stop = threading.Event()
         self._threads: list[threading.Thread] = []
@@ -131,12 +93,15 @@ class RobotLink:
         # An unacknowledged e-stop stops the heartbeats, so the robot's own watchdog disarms it
         # even if the line is only lossy; a reset or a new connection resumes them.
         self._starved = False
+        # That e-stop, which the heartbeat thread repeats until it is acknowledged (None: none).
+        self._pending_estop: Command | None = None
 
     # Connection -----------------------------------------------------------------------------
     def connect(self, timeout: float = 3.0) -> LinkState:
         """Open the port and wait for the robot's first telemetry."""
         self.telemetry = None
         self.parser = FrameParser()
+        self._forget_estop()
         self._starved = False
         try:
             check_port(self.url)
@@ -145,7 +110,7 @@ class RobotLink:
             )
         except (serial.SerialException, ValueError, OSError) as error:
             raise LinkError(f"cannot open {self.url}: {error}") from None
-        _no_delay(self._port)
+        no_delay(self._port)
         self._stop.clear()
         self._last_heard = time.monotonic()
         self._threads = [
@@ -210,14 +175,24 @@ class RobotLink:
             self._acks.pop(message.seq, None)
         heard = self._telemetry_heard  # telemetry counted from here on was sent after the DISARM's ack
         deadline = time.monotonic() + COMMAND_TIMEOUT
-        while self._telemetry_heard == heard or self.telemetry.state not in _SAFE:
+        while self._telemetry_heard == heard or self.telemetry.state not in SAFE:
             if time.monotonic() > deadline:
                 raise LinkError(f"DISARM answered {box[0].result.name.lower()} but no telemetry confirms it")
             time.sleep(0.001)
-        return _FROM_ROBOT[self.telemetry.state]
+        return FROM_ROBOT[self.telemetry.state]
 
     def reset(self) -> None:
-        self._command(Command(self._next_seq(), Kind.RESET), expect=LinkState.DISARMED)
+        """Clear an e-stop (to disarmed). Repeats of an unacknowledged ESTOP stop before the RESET
+        is sent (none may follow it), and resume if the RESET is not confirmed."""
+        with self._write_lock:  # not between the heartbeat thread's pick of a repeat and its write
+            pending = self._forget_estop()
+        try:
+            self._command(Command(self._next_seq(), Kind.RESET), expect=LinkState.DISARMED)
+        except LinkError:
+            with self._lock:
+                if self._pending_estop is None:
+                    self._pending_estop = pending
+            raise
         self._starved = False
 
     @property
@@ -235,17 +210,24 @@ class RobotLink:
 
         Tried whatever the link believes (a link seen as lost may still reach the robot), and never
         raises: a blocked or closed port only ends the attempt sooner. Not acknowledged, the
-        heartbeats stop, so the robot's own watchdog disarms it within its heartbeat timeout."""
+        heartbeats stop, so the robot's own watchdog disarms it within its heartbeat timeout, and
+        the heartbeat thread repeats this ESTOP every HEARTBEAT_PERIOD until it is acknowledged
+        (then the link is e-stopped), a reset, or a new connection."""
         started = time.monotonic()
         deadline = started + timeout
         write_by = deadline - WRITE_TIMEOUT  # a write started by then ends, even blocked, by the deadline
         message = Command(self._next_seq(), Kind.ESTOP)
         event, _box = self._expect(message.seq)
         reason = None
+        self._forget_estop()  # this e-stop supersedes one still repeated in the background
         self._starved = True  # the line is the e-stop's; heartbeats resume only if acknowledged
+        tries = 0
         try:
             while not event.is_set() and time.monotonic() < deadline:
                 if time.monotonic() < write_by:
+                    if tries:
+                        self.estop_repeats += 1
+                    tries += 1
                     try:
                         self._write(message, deadline=write_by)
                     except LinkError as error:
@@ -261,11 +243,22 @@ class RobotLink:
             self._move(LinkState.ESTOPPED, "e-stop acknowledged")
             return EstopResult(True, latency)
         self.estops_unacknowledged += 1
+        # The heartbeat thread repeats it; its acknowledgement, whenever heard, e-stops the link.
+        self._pending_estop = message
         why = f"no acknowledgement within {timeout * 1000:.0f} ms" + (f" ({reason})" if reason else "")
         return EstopResult(False, latency, why)
 
+    @property
+    def last_delivery_failure(self) -> str | None:
+        """The last Transmit Status that said not delivered, by name and code, or None."""
+        return self.transmits.last_failure
+
     def counters(self) -> dict[str, int]:
-        """Frames and faults since the last connect (the parser's) and since this link was made."""
+        """Counts since the last connect (the parser's, ``frames_in`` to ``garbage_bytes``) and since
+        this link was made (the rest). ``frames_out``: Transmit Requests written whole;
+        ``transmit_status``: Transmit Statuses heard, ``delivery_failures`` of them not delivered
+        (the last: :attr:`last_delivery_failure`); ``retries``: the radio's retries as its
+        statuses report them plus the link's ESTOP repeats (in :meth:`estop` and the background)."""
         stats = self.parser.stats
         return {
             "frames_in": stats.frames,
@@ -277,6 +270,10 @@ class RobotLink:
             "foreign_frames": self.foreign_frames,
             "write_timeouts": self.write_timeouts,
             "estops_unacknowledged": self.estops_unacknowledged,
+            "frames_out": self.frames_out,
+            "transmit_status": self.transmits.statuses,
+            "delivery_failures": self.transmits.failures,
+            "retries": self.transmits.retries + self.estop_repeats,
         }
 
     # Internals ------------------------------------------------------------------------------
@@ -315,7 +312,7 @@ class RobotLink:
     def _write(self, message, deadline: float | None = None) -> None:
         """Send one frame, blocking at most WRITE_TIMEOUT once the port is ours; waits for the write
         lock until ``deadline`` (monotonic), or without one as long as another writer's bounded write."""
-        frame = encode_frame(tx_request(encode(message), frame_id=0, destination64=self.robot_address))
+        payload = encode(message)
         wait = -1 if deadline is None else max(0.0, deadline - time.monotonic())
         if not self._write_lock.acquire(timeout=wait):
             raise LinkError("another write is blocked on the port")
@@ -323,7 +320,10 @@ class RobotLink:
             port = self._port
             if port is None:
                 raise LinkError("the link is down")
-            port.write(frame)
+            # Ids taken under the write lock go out in order: a Transmit Status names one frame.
+            frame_id = self.transmits.next_frame_id()
+            port.write(encode_frame(tx_request(payload, frame_id=frame_id, destination64=self.robot_address)))
+            self.frames_out += 1
         except serial.SerialTimeoutException:
             # A partial frame may be on the wire: the robot's parser resynchronises on the next start byte.
             self.write_timeouts += 1
@@ -351,6 +351,10 @@ class RobotLink:
                 return
             for data in self.parser.feed(chunk):
                 try:
+                    if data[0] == TX_STATUS:
+                        # The PC's own radio on a frame it sent: not the robot's voice or heartbeat.
+                        self.transmits.heard(parse_tx_status(data))
+                        continue
                     packet = parse_rx_packet(data)
                     if packet.source64 != self.robot_address:
                         self.foreign_frames += 1  # another radio: never our robot's state or heartbeat
@@ -371,20 +375,47 @@ class RobotLink:
             if entry is not None:
                 entry[1].append(message)
                 entry[0].set()
+            if self._pending_estop is not None:
+                self._estop_acknowledged(message.acked)
         elif isinstance(message, Telemetry):
             self.telemetry = message
             self._telemetry_heard += 1
-            self._move(_FROM_ROBOT[message.state], "telemetry")
+            self._move(FROM_ROBOT[message.state], "telemetry")
 
     def _heartbeat_loop(self) -> None:
+        # An unacknowledged ESTOP goes instead of the heartbeat, so a line that clears still
+        # delivers the stop. Any frame feeds the firmware's watchdog, ESTOP too; that keeps no
+        # robot going: ESTOP latches it e-stopped, which only RESET leaves.
         while not self._stop.wait(HEARTBEAT_PERIOD):
-            if self.send_heartbeats and not self._starved:
+            with self._write_lock:  # picked and written at once: reset() forgets the repeat under it
+                message = self._pending_estop
+                if message is not None:
+                    self.estop_repeats += 1
+                elif self.send_heartbeats and not self._starved:
+                    message = Command(self._next_seq(), Kind.HEARTBEAT)
+                else:
+                    continue
                 try:
-                    self._write(Command(self._next_seq(), Kind.HEARTBEAT))
+                    self._write(message)
                 except LinkError:
                     if self._port is None:
                         return
                     # Blocked (counted): the next one may pass; if none does, the robot disarms itself.
+
+    def _forget_estop(self) -> Command | None:
+        """Stop repeating the pending e-stop: returns it, or None."""
+        with self._lock:
+            pending, self._pending_estop = self._pending_estop, None
+        return pending
+
+    def _estop_acknowledged(self, seq: int) -> None:
+        # The reader heard the robot acknowledge the pending ESTOP: as estop() on an acknowledgement.
+        with self._lock:
+            if self._pending_estop is None or self._pending_estop.seq != seq:
+                return  # reset, superseded or reconnected meanwhile
+            self._pending_estop = None
+            self._starved = False
+        self._move(LinkState.ESTOPPED, "e-stop acknowledged (repeated)")
 
     def _lost(self, reason: str) -> None:
         self._stop.set()
@@ -398,11 +429,3 @@ class RobotLink:
                 return
             self.transitions.append(Transition(time.time(), self.state, state, reason))
             self.state = state
-
-
-def _no_delay(port) -> None:
-    """TCP_NODELAY on a socket:// or rfc2217:// transport: an e-stop must not wait behind Nagle's
-    algorithm for the previous segment's ACK. pyserial keeps the socket in ``_socket``."""
-    sock = getattr(port, "_socket", None)
-    if isinstance(sock, socket.socket) and sock.family in (socket.AF_INET, socket.AF_INET6):
-        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)

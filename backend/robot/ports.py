@@ -5,13 +5,15 @@ A USB radio appears as ``/dev/ttyUSB0`` or ``/dev/ttyACM0`` (Linux), ``/dev/cu.u
 a test rig or ``socat`` gives a pty (``/dev/pts/N``); a serial server gives ``rfc2217://``; the
 virtual robot ``socket://``. The check follows symlinks and looks at what the path is, so a
 regular file is never opened, and neither is a character device that is not a serial line —
-opening ``/dev/watchdog`` arms a hardware watchdog.
+opening ``/dev/watchdog`` arms a hardware watchdog. Once open, :func:`no_delay` sets up a
+network transport for small frames.
 """
 
 from __future__ import annotations
 
 import os
 import re
+import socket
 import stat
 
 # pyserial's URLs a link may open (no options), and Windows' COM ports.
@@ -38,3 +40,11 @@ def check_port(url: str) -> str:
     if not SERIAL_DEVICE.match(target):
         raise ValueError(f"{url} ({target}) is not a serial port or a pty")
     return url
+
+
+def no_delay(port) -> None:
+    """TCP_NODELAY on a socket:// or rfc2217:// transport: an e-stop must not wait behind Nagle's
+    algorithm for the previous segment's ACK. pyserial keeps the socket in ``_socket``."""
+    sock = getattr(port, "_socket", None)
+    if isinstance(sock, socket.socket) and sock.family in (socket.AF_INET, socket.AF_INET6):
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)

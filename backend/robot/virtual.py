@@ -4,6 +4,10 @@ PC software connects with the pyserial URL ``socket://HOST:PORT`` exactly as it 
 XBee's serial port. One PC at a time; a new connection replaces the old one (like a radio
 re-association). Given a tracker address, the body moves (:mod:`backend.robot.climber`) while
 the firmware is running, and the camera's view of it streams there over UDP.
+
+The radio answers a Transmit Request with a non-zero frame id as an XBee does, with a Transmit
+Status ahead of anything the robot replies: delivered (0x00, no retries) when it is addressed to
+the robot's radio, else "address not found" (0x24) and the robot never sees it.
 """
 
 from __future__ import annotations
@@ -18,7 +22,17 @@ import time
 from backend.robot.climber import Climber
 from backend.robot.firmware import Firmware
 from backend.robot.messages import ProtocolError, RobotState, decode, encode
-from backend.robot.xbee import ROBOT_ADDRESS, FrameError, FrameParser, encode_frame, parse_tx_request, rx_packet
+from backend.robot.xbee import (
+    ADDRESS_NOT_FOUND,
+    DELIVERED,
+    ROBOT_ADDRESS,
+    FrameError,
+    FrameParser,
+    encode_frame,
+    parse_tx_request,
+    rx_packet,
+    tx_status,
+)
 
 log = logging.getLogger("parkourlab.robot")
 TICK = 0.02  # [s] watchdog and telemetry resolution
@@ -117,23 +131,36 @@ class VirtualRobot:
             return
         for data in self.parser.feed(chunk):
             try:
-                _frame_id, _destination, payload = parse_tx_request(data)
-                message = decode(payload)
-            except (FrameError, ProtocolError):
+                frame_id, destination, payload = parse_tx_request(data)
+            except FrameError:
                 self.rejected_payloads += 1
                 continue
-            with self.lock:
-                replies = self.firmware.receive(message, time.monotonic())
-            self._send(replies)
+            delivered = destination == ROBOT_ADDRESS
+            # Frame id 0 asks for no status; a payload is delivered whatever it holds (the robot judges).
+            delivery = DELIVERED if delivered else ADDRESS_NOT_FOUND
+            status = encode_frame(tx_status(frame_id, delivery=delivery)) if frame_id else b""
+            self._send(self._receive(payload) if delivered else [], status)
+
+    def _receive(self, payload: bytes) -> list:
+        """The firmware's replies to a payload its radio delivered (none to a malformed one)."""
+        try:
+            message = decode(payload)
+        except ProtocolError:
+            self.rejected_payloads += 1
+            return []
+        with self.lock:
+            return self.firmware.receive(message, time.monotonic())
 
     def _tick(self) -> list:
         with self.lock:
             return self.firmware.tick(time.monotonic())
 
-    def _send(self, messages: list) -> None:
-        if self._connection is None or not messages:
+    def _send(self, messages: list, status_frame: bytes = b"") -> None:
+        """The robot's ``messages`` as Receive Packets, after the PC radio's own ``status_frame``."""
+        if self._connection is None or not (messages or status_frame):
             return
-        data = b"".join(encode_frame(rx_packet(encode(message), source64=ROBOT_ADDRESS)) for message in messages)
+        frames = (encode_frame(rx_packet(encode(message), source64=ROBOT_ADDRESS)) for message in messages)
+        data = status_frame + b"".join(frames)
         try:
             with self._send_lock:
                 self._connection.sendall(data)

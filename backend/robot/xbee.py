@@ -8,6 +8,10 @@ checksum is computed on the unescaped data.
 :class:`FrameParser` reads a byte stream of any chunking and yields the frames' data. It
 resynchronises on the next ``0x7E`` after garbage, a bad checksum, a frame cut short by a new
 start byte, or an impossible length, and counts each kind; it never raises on input.
+
+A Transmit Request with a non-zero frame id is answered by the sending radio itself with a
+Transmit Status (0x8B): did the frame reach the destination radio, after how many retries.
+:class:`TransmitLog` hands out the frame ids and tallies those answers.
 """
 
 from __future__ import annotations
@@ -30,6 +34,33 @@ TX_REQUEST = 0x10  # frame types used by the link
 RX_PACKET = 0x90
 TX_STATUS = 0x8B
 BROADCAST_16 = 0xFFFE  # "address unknown": route by the 64-bit address
+TX_STATUS_LENGTH = 7  # type, frame id, 16-bit destination, retry count, delivery, discovery
+
+# Transmit Status delivery codes (Digi's API reference); 0x00 is the only success.
+DELIVERED = 0x00
+ADDRESS_NOT_FOUND = 0x24  # no radio with the destination's 64-bit address answered
+DELIVERY_STATUS = {
+    0x00: "success",
+    0x01: "MAC ACK failure",
+    0x02: "CCA failure",
+    0x03: "transmission purged",
+    0x04: "physical error",
+    0x15: "invalid destination endpoint",
+    0x18: "no buffers",
+    0x21: "network ACK failure",
+    0x22: "not joined to network",
+    0x23: "self-addressed",
+    0x24: "address not found",
+    0x25: "route not found",
+    0x26: "broadcast source failed to hear a neighbour relay",
+    0x2B: "invalid binding table index",
+    0x2C: "resource error",
+    0x2D: "attempted broadcast with APS transmission",
+    0x2E: "attempted unicast with APS transmission, but EE=0",
+    0x32: "resource error: lack of free buffers, timers",
+    0x74: "data payload too large",
+    0x75: "indirect message unrequested",
+}
 
 
 class FrameError(ValueError):
@@ -158,3 +189,62 @@ def parse_tx_request(data: bytes) -> tuple[int, int, bytes]:
 def rx_packet(payload: bytes, *, source64: int, source16: int = BROADCAST_16, options: int = 0x01) -> bytes:
     """Frame data of a Receive Packet (0x90), as the PC's radio delivers the robot's messages."""
     return struct.pack(">BQHB", RX_PACKET, source64, source16, options) + payload
+
+
+@dataclass(frozen=True)
+class TransmitStatus:
+    """A Transmit Status (0x8B): the local radio's report on the Transmit Request ``frame_id``."""
+
+    frame_id: int
+    destination16: int
+    retries: int  # transmission retries the radio made (the count it reports)
+    delivery: int  # 0x00 delivered; otherwise why not (DELIVERY_STATUS)
+    discovery: int  # 0x00 no discovery overhead, 0x01 address, 0x02 route, 0x03 both
+
+    @property
+    def delivered(self) -> bool:
+        return self.delivery == DELIVERED
+
+    @property
+    def delivery_name(self) -> str:
+        """``"address not found (0x24)"``: the code's name and the code, unknown codes included."""
+        return f"{DELIVERY_STATUS.get(self.delivery, 'unknown')} (0x{self.delivery:02X})"
+
+
+def parse_tx_status(data: bytes) -> TransmitStatus:
+    if len(data) != TX_STATUS_LENGTH or data[0] != TX_STATUS:
+        raise FrameError(f"not a transmit status (0x8B): {data[:1].hex() or 'empty'}, {len(data)} bytes")
+    _kind, frame_id, destination16, retries, delivery, discovery = struct.unpack(">BBHBBB", data)
+    return TransmitStatus(frame_id, destination16, retries, delivery, discovery)
+
+
+def tx_status(
+    frame_id: int, *, delivery: int = DELIVERED, retries: int = 0, discovery: int = 0, destination16: int = BROADCAST_16
+) -> bytes:
+    """Frame data of a Transmit Status (0x8B), as a radio answers a Transmit Request with ``frame_id``."""
+    return struct.pack(">BBHBBB", TX_STATUS, frame_id & 0xFF, destination16, retries, delivery, discovery)
+
+
+@dataclass
+class TransmitLog:
+    """Frame ids for the Transmit Requests one sender writes, and the Transmit Statuses heard back.
+
+    Ids cycle 1..255: frame id 0 asks the radio for no Transmit Status. One writer at a time calls
+    :meth:`next_frame_id` (the link holds its write lock) and one reader calls :meth:`heard`."""
+
+    statuses: int = 0  # Transmit Statuses heard
+    failures: int = 0  # of which not delivered
+    retries: int = 0  # the radio's transmission retries, summed over the statuses heard
+    last_failure: str | None = None  # the last failure's delivery_name
+    _frame_id: int = 0
+
+    def next_frame_id(self) -> int:
+        self._frame_id = self._frame_id % 255 + 1
+        return self._frame_id
+
+    def heard(self, status: TransmitStatus) -> None:
+        self.statuses += 1
+        self.retries += status.retries
+        if not status.delivered:
+            self.failures += 1
+            self.last_failure = status.delivery_name

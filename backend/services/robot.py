@@ -114,6 +114,7 @@ class RobotService:
                 "robot_address": None if link is None else f"0x{link.robot_address:016X}",
                 "counters": None if link is None else {**link.counters(), "reconnects": self.supervisor.reconnects},
                 "estop": _estop_latch(link),
+                "last_delivery_failure": None if link is None else link.last_delivery_failure,
                 "telemetry": None if link is None or link.telemetry is None else telemetry_dict(link.telemetry),
                 "tracker": None
                 if tracker is None

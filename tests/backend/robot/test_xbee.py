@@ -5,13 +5,18 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from backend.robot.xbee import (
+    FrameError,
     FrameParser,
+    TransmitLog,
+    TransmitStatus,
     checksum,
     encode_frame,
     parse_rx_packet,
     parse_tx_request,
+    parse_tx_status,
     rx_packet,
     tx_request,
+    tx_status,
 )
 
 # Digi's documented examples: an AT command (ATNI) and a Transmit Request "TxData0A".
@@ -46,6 +51,43 @@ def test_receive_packet_round_trip():
     data = rx_packet(b"\x01\x06\x00\x07", source64=0x0013A20040AABBCC)
     received = parse_rx_packet(data)
     assert received.source64 == 0x0013A20040AABBCC and received.payload == b"\x01\x06\x00\x07"
+
+
+def test_transmit_status_decodes_field_by_field():
+    # Frame id 1 delivered to 16-bit address 0xFFFE, no retries, no discovery: 7E 00 07 8B 01 FF FE 00 00 00 76.
+    wire = bytes.fromhex("7E 00 07 8B 01 FF FE 00 00 00 76")
+    (data,) = FrameParser().feed(wire)
+    assert parse_tx_status(data) == TransmitStatus(1, 0xFFFE, 0, 0x00, 0x00)
+    assert encode_frame(tx_status(1)) == wire
+    failed = parse_tx_status(tx_status(0x47, delivery=0x24, retries=3, discovery=0x02, destination16=0x1234))
+    assert failed == TransmitStatus(0x47, 0x1234, 3, 0x24, 0x02)
+    assert not failed.delivered and failed.delivery_name == "address not found (0x24)"
+    assert parse_tx_status(tx_status(2, delivery=0x99)).delivery_name == "unknown (0x99)"
+
+
+@pytest.mark.parametrize(
+    "data",
+    [b"", tx_status(1)[:-1], tx_status(1) + b"\x00", rx_packet(b"\x01\x06\x00\x07", source64=1), b"\x89\x01\x00"],
+    ids=["empty", "short", "long", "receive packet", "802.15.4 status"],
+)
+def test_transmit_status_refuses_other_frames(data):
+    with pytest.raises(FrameError, match="not a transmit status"):
+        parse_tx_status(data)
+
+
+def test_frame_ids_cycle_and_are_never_zero():
+    log = TransmitLog()
+    ids = [log.next_frame_id() for _ in range(600)]
+    assert ids[:3] == [1, 2, 3] and ids[254:257] == [255, 1, 2] and 0 not in ids
+
+
+def test_transmit_log_tallies_statuses():
+    log = TransmitLog()
+    assert log.last_failure is None
+    for delivery, retries in [(0x00, 0), (0x24, 2), (0x00, 1), (0x21, 0)]:
+        log.heard(parse_tx_status(tx_status(1, delivery=delivery, retries=retries)))
+    assert (log.statuses, log.failures, log.retries) == (4, 2, 3)
+    assert log.last_failure == "network ACK failure (0x21)"
 
 
 def test_parser_resynchronises_and_counts_damage():
