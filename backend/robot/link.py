@@ -31,7 +31,7 @@ import serial
 from backend.robot.limits import ServoLimits
 from backend.robot.link_types import FROM_ROBOT, SAFE, EstopResult, LinkError, LinkState, Transition
 from backend.robot.messages import Ack, Command, Kind, Leg, ProtocolError, Result, SetLeg, Telemetry, decode, encode
-from backend.robot.ports import check_port, no_delay
+from backend.robot.ports import check_port, no_delay, write_within
 from backend.robot.xbee import (
     ROBOT_ADDRESS,
     TX_STATUS,
@@ -322,7 +322,8 @@ class RobotLink:
                 raise LinkError("the link is down")
             # Ids taken under the write lock go out in order: a Transmit Status names one frame.
             frame_id = self.transmits.next_frame_id()
-            port.write(encode_frame(tx_request(payload, frame_id=frame_id, destination64=self.robot_address)))
+            frame = encode_frame(tx_request(payload, frame_id=frame_id, destination64=self.robot_address))
+            write_within(port, frame, time.monotonic() + WRITE_TIMEOUT)
             self.frames_out += 1
         except serial.SerialTimeoutException:
             # A partial frame may be on the wire: the robot's parser resynchronises on the next start byte.

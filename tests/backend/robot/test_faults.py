@@ -12,10 +12,9 @@ import os
 import time
 
 import pytest
-from serial import serialposix
 
 from backend.robot.firmware import Firmware
-from backend.robot.link import WRITE_TIMEOUT, LinkError, LinkState, RobotLink
+from backend.robot.link import WRITE_TIMEOUT, LinkState, RobotLink
 from backend.robot.messages import Kind, RobotState
 from backend.robot.supervisor import LinkSupervisor
 from tests.helpers import answer_within
@@ -127,41 +126,27 @@ def test_a_dropped_line_is_reconnected_once_and_the_robot_disarmed(how, monkeypa
     assert errors == [] and thread_errors == [], (errors, thread_errors)
 
 
-class _LateAfterWrite:
-    """pyserial's ``os`` for one port's fd: each write goes out whole at once, then the writing
-    thread is kept from running for 1.5 x WRITE_TIMEOUT — as the OS or the GIL keep a thread of a
-    busy service waiting (the service's threads waited up to 150-190 ms for the GIL while 45
-    clients kept its request pool busy; scripts/bench_estop_api.py saw a refused ARM during a flood)."""
+def test_a_write_that_went_out_is_not_a_jammed_line(answering, monkeypatch):
+    """Each write on the link's fd goes out whole at once, then the writing thread is kept from
+    running for 1.5 x WRITE_TIMEOUT — as the OS or the GIL keep a thread of a busy service waiting.
+    pyserial's bounded write called that a jammed line (it checks its timeout after the bytes have
+    gone), and an ARM the robot had received was reported as failed."""
+    rig, link = answering
+    link.disarm()
+    fd, write = link._port.fd, os.write
 
-    def __init__(self, fd: int):
-        self.fd = fd
-
-    def __getattr__(self, name):
-        return getattr(os, name)
-
-    def write(self, fd: int, data: bytes) -> int:
-        written = os.write(fd, data)
-        if fd == self.fd:
+    def late_after_write(target: int, data) -> int:
+        written = write(target, data)
+        if target == fd:
             time.sleep(WRITE_TIMEOUT * 1.5)
         return written
 
-
-@pytest.mark.xfail(
-    strict=True,
-    raises=LinkError,
-    reason="bug: a write that went out whole is reported as a jammed line when the writing thread is late "
-    "back (pyserial 3.5's write checks its write_timeout after os.write returns): the command raises "
-    "'write blocked ... jammed' and counts a write timeout, yet the robot received it and acted on it",
-)
-def test_a_write_that_went_out_is_not_a_jammed_line(answering, monkeypatch):
-    rig, link = answering
-    link.disarm()
-    monkeypatch.setattr(serialposix, "os", _LateAfterWrite(link._port.fd))
+    monkeypatch.setattr(os, "write", late_after_write)
     try:
         link.arm()  # nothing blocks: the frame is on the line at once
     finally:
         monkeypatch.undo()
-        wait_for(lambda: rig.firmware.state == RobotState.ARMED, "the robot received the ARM and armed")
+    wait_for(lambda: rig.firmware.state == RobotState.ARMED, "the robot received the ARM and armed")
     assert link.counters()["write_timeouts"] == 0
 
 
