@@ -215,6 +215,7 @@ class JobRunner:
                                       spec.zeta0s)  # fmt: skip
             levels = self._await(job_id, starts)
         except Cancelled:
+            self._cancelled(job_id)  # marks it cancelled
             return
         chunks, arguments = [], []
         for index, level in enumerate(levels):
@@ -232,6 +233,7 @@ class JobRunner:
                 if self._cancelled(job_id):
                     return
         except Cancelled:
+            self._cancelled(job_id)  # marks it cancelled
             return
         finally:
             results.close()  # on a Dask cluster, cancels the chunks not yet finished

@@ -218,13 +218,25 @@ def test_a_stored_job_the_request_schema_now_refuses_still_resumes(sessions, ses
     assert _job(sessions, job.id).state == "done" and len(_trials(session, job.id)) == 6
 
 
-def test_cancel_stops_the_worker_within_a_second(sessions, session, runner):
+def test_cancel_stops_the_worker_mid_chunk(sessions, session, compute):
+    """One chunk of 20,000 long trials (many seconds): a cancel during it stops the worker at once,
+    commits nothing of it, and the next job gets a fresh worker."""
+    runner = jobs.JobRunner(sessions, compute.jobs, chunk_trials=20_000)
     job = jobs.create_job(session, MJTFJobCreate(zeta0s=[0.9], trials=20_000, cap=20_000, seed=1, guess=GUESS))
     runner.start()
-    runner.submit(job.id)
-    _wait_until(sessions, job.id, lambda j: j.completed > 0)
-    cancelled_at = time.monotonic()
-    jobs.cancel_job(session, job.id)
-    _wait_until(sessions, job.id, lambda j: j.state == "cancelled")
-    took = time.monotonic() - cancelled_at
-    assert took < 5.0, f"cancel took {took:.1f} s (the runner looks every 0.2 s and stops the worker)"
+    try:
+        runner.submit(job.id)
+        _wait_until(sessions, job.id, lambda j: j.state == "running")
+        time.sleep(0.5)  # the chunk is in the worker
+        cancelled_at = time.monotonic()
+        jobs.cancel_job(session, job.id)
+        stopped = _wait_until(sessions, job.id, lambda j: j.state in jobs.FINAL)
+        took = time.monotonic() - cancelled_at
+        assert stopped.state == "cancelled" and stopped.completed == 0 and _trials(session, job.id) == []
+        assert took < 5.0, f"cancel took {took:.1f} s (the runner looks every 0.2 s and stops the worker)"
+        print(f"cancelled mid-chunk in {took * 1000:.0f} ms")
+        small = jobs.create_job(session, MJTFJobCreate(**(SMALL | {"trials": 2})))
+        runner.submit(small.id)
+        assert _wait_until(sessions, small.id, lambda j: j.state in jobs.FINAL).state == "done"
+    finally:
+        runner.stop(timeout=WAIT_S)
