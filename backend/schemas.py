@@ -29,7 +29,11 @@ RecordRef = Annotated[int, Field(ge=1, le=MAX_ID)]
 
 
 class Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+    """Every request body: unknown fields refused; NaN, ±Infinity (and 1e309, which JSON parsing
+    makes infinite) refused in every float field; a string with a lone surrogate (``"\\ud800"``)
+    is refused by pydantic itself (``string_unicode``) — each a 422 naming the field."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
 
 class LegIn(Strict):

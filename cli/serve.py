@@ -12,7 +12,7 @@ from typing import Annotated
 
 import typer
 
-from backend.settings import DEFAULT_HOST, DEFAULT_PORT, Settings
+from backend.settings import DEFAULT_HOST, DEFAULT_PORT, WILDCARD_ADDRESSES, Settings
 from cli.options import handles_errors, note
 
 DEFAULT_VIEW_PORT = 8001
@@ -28,7 +28,12 @@ def serve_command(
         typer.Option("--data-dir", help="Where the database and token live; default $PARKOUR_DATA_DIR or ./data."),
     ] = None,
     host: Annotated[
-        str, typer.Option("--host", help="Interface to bind (the 3D view's too); 0.0.0.0 exposes them to the network.")
+        str,
+        typer.Option(
+            "--host",
+            help="Interface to bind (the 3D view's too); 0.0.0.0 exposes them to the network. A name or address"
+            " given here is also one the service answers to; add others with $PARKOUR_ALLOWED_HOSTS.",
+        ),
     ] = DEFAULT_HOST,
     port: Annotated[
         int, typer.Option("--port", help="TCP port of the API and panel.", min=1, max=65535)
@@ -50,20 +55,25 @@ def serve_command(
     from backend.api.app import create_app
     from backend.api.security import api_token
 
-    settings = Settings.from_environment(data_dir)
+    settings = Settings.from_environment(data_dir, allowed_hosts=[host])
     token, created = api_token(settings.data_dir)
-    base = f"http://{host}:{port}"
+    # What a browser opens: a wildcard interface is no address to visit (nor a name the service answers to).
+    shown = "127.0.0.1" if host in WILDCARD_ADDRESSES else f"[{host}]" if ":" in host else host
+    base = f"http://{shown}:{port}"
 
     def climb_view(context):
         from frontend.viewer.app import ClimbView
 
-        scene_view = ClimbView(context, host=host, port=view_port, panel_url=f"{base}/panel/")
-        note(f"3D view on http://{host}:{scene_view.server.get_port()}/")
+        scene_view = ClimbView(
+            context, host=host, port=view_port, panel_url=f"{base}/panel/", allowed_hosts=settings.allowed_hosts
+        )
+        note(f"3D view on http://{shown}:{scene_view.server.get_port()}/")
         return scene_view
 
     application = create_app(settings, view_factory=climb_view if view else None, warm_kernels=True)
     note(f"ParkourLab on {base}/  (API docs: {base}/docs)")
     note(f"data: {settings.data_dir}  database: {settings.database_url.split('://')[0]}")
+    note(f"answers to Host names: {', '.join(settings.allowed_hosts)} (more: PARKOUR_ALLOWED_HOSTS=name,...)")
     if created:
         note(f"API token for changes (shown once; kept in {settings.data_dir / 'api_token'}): {token}")
     uvicorn.run(application, host=host, port=port, log_level="info")

@@ -1,5 +1,6 @@
 """Shared fixtures: the paper's model, the gaits the paper reports (docs/model.md §5), the virtual robot."""
 
+import os
 import socket
 
 import pytest
@@ -7,6 +8,10 @@ import pytest
 from sim_core import ControlSchedule, ModelParams, get_preset
 from sim_core.noise import NO_NOISE
 from tests.helpers import free_port
+
+# Starlette's TestClient calls the service "testserver" (its Host header): allowed here as a
+# deployment would name its host (backend/api/security.py refuses Host names not on the list).
+os.environ["PARKOUR_ALLOWED_HOSTS"] = "testserver"
 
 
 @pytest.fixture(scope="session")

@@ -2,7 +2,8 @@
 
 It builds the store, the job runner and the robot service, keeps them on ``app.state``, and
 mounts the routes (``backend/api/routes``: one module per resource, thin — route → service →
-repository), the error table (``errors``), the token and request limits (``security``) and the
+repository), the error table (``errors``), the middlewares every request passes first — security
+headers, the Host and Origin allow-list, the token, the body limit (``security``) — and the
 panel's static files. What a route needs it asks of ``deps``.
 """
 
@@ -94,7 +95,7 @@ def create_app(
     app.state.robot = robot_service
     app.state.compute = compute
     app.state.view_starter = None
-    security.limit_request_size(app, settings.max_request_bytes)
+    security.install(app, settings)  # headers, Host/Origin allow-list, token first, body limit
     errors.install(app)
     for module in ROUTERS:
         app.include_router(module.router)

@@ -1,19 +1,40 @@
-"""Who may change what: the API token, and the limits every request is held to.
+"""Who may change what, and what every request is held to before a route sees it.
 
 Mutating calls carry ``Authorization: Bearer <token>``; the token is created once in the data
 directory (``api_token``, mode 600). Reads are open, and so is the robot's e-stop (stopping is
-always allowed: docs/service.md). Request bodies larger than the service's limit get a 413.
+always allowed: docs/service.md). :func:`install` puts four ASGI middlewares in front of the
+routes, outermost first:
+
+- :class:`SecurityHeaders`: a Content-Security-Policy without inline script, ``nosniff``,
+  ``no-referrer``, framing by the service's own origin only — on every response;
+- :class:`HostAllowList`: a Host header not on the allow-list (the loopback names and the ones
+  the settings add) is a 400, so a DNS-rebinding page cannot talk to the service; a WebSocket
+  whose Origin is not an allowed host (http or https, any port) is refused;
+- :class:`TokenFirst`: a change without the token is a 401 before a byte of its body is read;
+- :class:`BodyLimit`: a body is counted as it arrives, chunked or not, and over the limit the
+  service answers 413 without reading the rest.
+
+Each refusal is JSON and closes the connection (the body it did not read goes with it).
 """
 
 from __future__ import annotations
 
+import re
 import secrets
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Annotated
+from urllib.parse import urlsplit
 
 from fastapi import Depends, FastAPI, HTTPException, Request, status
 from fastapi.responses import JSONResponse
+from fastapi.routing import APIRoute, RouteContext, iter_route_contexts
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
+from starlette.datastructures import Headers, MutableHeaders
+from starlette.routing import Match
+from starlette.types import ASGIApp, Receive, Scope, Send
+
+from backend.settings import Settings, host_name
 
 TOKEN_FILE = "api_token"
 bearer = HTTPBearer(auto_error=False)
@@ -34,24 +55,231 @@ def api_token(data_dir: Path) -> tuple[str, bool]:
 def require_token(
     request: Request, credentials: Annotated[HTTPAuthorizationCredentials | None, Depends(bearer)]
 ) -> None:
-    """Mutating calls carry ``Authorization: Bearer <token>``; the token is in the data directory."""
-    if credentials is None or not secrets.compare_digest(credentials.credentials, request.app.state.token):
-        raise HTTPException(
-            status.HTTP_401_UNAUTHORIZED,
-            "a valid bearer token is required for changes (see api_token in the data directory)",
-            headers={"WWW-Authenticate": "Bearer"},
+    """Mutating calls carry ``Authorization: Bearer <token>``; the token is in the data directory.
+
+    :class:`TokenFirst` has already refused a request without it before its body was read; as a
+    dependency it also puts the scheme on the route in OpenAPI (``credentials``), and
+    :class:`TokenFirst` asks the token of exactly the routes that declare it."""
+    if not token_matches(request.headers.get("authorization"), request.app.state.token):
+        raise HTTPException(status.HTTP_401_UNAUTHORIZED, TOKEN_REQUIRED, headers={"WWW-Authenticate": "Bearer"})
+
+
+MUTATING = frozenset({"POST", "PUT", "PATCH", "DELETE"})
+TOKEN_REQUIRED = "a valid bearer token is required for changes (see api_token in the data directory)"
+HOST_REFUSED = "host not allowed: the Host header must name this service (PARKOUR_ALLOWED_HOSTS adds names)"
+# A Host header (or an Origin's authority): a name or IPv4 address, or a bracketed IPv6 one; a port.
+_AUTHORITY = re.compile(r"(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+)(?::(?P<port>[0-9]{1,5}))?")
+
+
+# The one token check ---------------------------------------------------------------------------
+def token_matches(authorization: str | None, token: str) -> bool:
+    """Whether an ``Authorization`` header says ``Bearer <token>``: the one token check, for the
+    middleware and the ``require_token`` dependency alike (compared in constant time, as bytes, so
+    a header that is not ASCII is a mismatch, not an error)."""
+    scheme, _, credentials = (authorization or "").partition(" ")
+    if scheme.lower() != "bearer" or not credentials.strip():
+        return False
+    return secrets.compare_digest(credentials.strip().encode("utf-8", "replace"), token.encode())
+
+
+def open_changes(routes) -> list[RouteContext]:
+    """The mutating API routes that do not declare ``require_token`` (as FastAPI includes them:
+    its routers are included lazily, so ``app.routes`` lists routers, not their routes)."""
+    return [
+        route
+        for route in iter_route_contexts(routes)
+        if isinstance(route.original_route, APIRoute)
+        and route.methods & MUTATING
+        and not any(dependency.call is require_token for dependency in route.dependant.dependencies)
+    ]
+
+
+# Hosts and Origins --------------------------------------------------------------------------------
+def _authority(value: str | None) -> re.Match | None:
+    return None if value is None else _AUTHORITY.fullmatch(value)
+
+
+def host_allowed(host_header: str | None, allowed: Iterable[str]) -> bool:
+    """Whether a Host header (``name``, ``name:port``, ``[v6]:port``) names an allowed host."""
+    match = _authority(host_header)
+    return match is not None and host_name(match["host"]) in allowed
+
+
+def origin_allowed(origin: str, allowed: Iterable[str]) -> bool:
+    """Whether a browser's ``Origin`` is an allowed host over http or https, on any port: the
+    panel's own origin, and the 3D view's (the same host, its own port). ``null`` is not."""
+    parts = urlsplit(origin)
+    return parts.scheme in ("http", "https") and not parts.path and host_allowed(parts.netloc, allowed)
+
+
+# The responses' headers ---------------------------------------------------------------------------
+def content_security_policy(scheme: str, host_header: str | None) -> str:
+    """The policy for the service's pages: scripts and styles from the service itself (no inline
+    script; inline styles, which Plotly sets, allowed), images also from data: and blob: URLs (Plotly's
+    downloads), the live websocket of this host and port, the 3D view framed from any port of
+    this host (viser moves to the next free port), and only this origin may frame the service."""
+    match = _authority(host_header)
+    connect, frames = "connect-src 'self'", "frame-src 'self'"
+    if match is not None:  # a malformed Host gets the plain policy (its 400 comes next)
+        ws = "wss" if scheme == "https" else "ws"
+        connect += f" {ws}://{match[0]}"
+        frames += f" {'https' if scheme == 'https' else 'http'}://{match['host']}:*"
+    return "; ".join(
+        [
+            "default-src 'self'",
+            "script-src 'self'",
+            "style-src 'self' 'unsafe-inline'",
+            "img-src 'self' data: blob:",
+            "font-src 'self' data:",
+            connect,
+            frames,
+            "frame-ancestors 'self'",
+            "object-src 'none'",
+            "base-uri 'self'",
+            "form-action 'self'",
+        ]
+    )
+
+
+def security_headers(scope: Scope) -> dict[str, str]:
+    """The headers every response of the service carries."""
+    host = Headers(scope=scope).get("host")
+    return {
+        "Content-Security-Policy": content_security_policy(scope.get("scheme", "http"), host),
+        "X-Content-Type-Options": "nosniff",
+        "Referrer-Policy": "no-referrer",
+        "X-Frame-Options": "SAMEORIGIN",  # frame-ancestors' predecessor, for older browsers
+    }
+
+
+async def _refuse(scope: Scope, receive: Receive, send: Send, code: int, detail: str, **headers: str) -> None:
+    """Answer ``code`` with ``{"detail": ...}`` and close the connection: a body left unread goes with it."""
+    extra = {"Connection": "close"} | {name.replace("_", "-"): value for name, value in headers.items()}
+    await JSONResponse({"detail": detail}, status_code=code, headers=extra)(scope, receive, send)
+
+
+# The middlewares ----------------------------------------------------------------------------------
+class SecurityHeaders:
+    """Adds :func:`security_headers` to every HTTP response that does not set them itself."""
+
+    def __init__(self, app: ASGIApp) -> None:
+        self.app = app
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        extra = security_headers(scope)
+
+        async def send_with_headers(message) -> None:
+            if message["type"] == "http.response.start":
+                headers = MutableHeaders(scope=message)
+                for name, value in extra.items():
+                    headers.setdefault(name, value)
+            await send(message)
+
+        await self.app(scope, receive, send_with_headers)
+
+
+class HostAllowList:
+    """A request whose Host is not an allowed name is a 400 (a WebSocket is closed, code 1008,
+    before it is accepted: uvicorn answers its handshake 403); so is a WebSocket whose Origin
+    is not an allowed host. No Origin (a client that is not a browser) is allowed."""
+
+    def __init__(self, app: ASGIApp, allowed_hosts: Iterable[str]) -> None:
+        self.app = app
+        self.allowed = frozenset(host_name(host) for host in allowed_hosts)
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] not in ("http", "websocket"):
+            await self.app(scope, receive, send)
+            return
+        headers = Headers(scope=scope)
+        host_ok = host_allowed(headers.get("host"), self.allowed)
+        if scope["type"] == "http":
+            if host_ok:
+                await self.app(scope, receive, send)
+            else:
+                await _refuse(scope, receive, send, status.HTTP_400_BAD_REQUEST, HOST_REFUSED)
+            return
+        origin = headers.get("origin")
+        if host_ok and (origin is None or origin_allowed(origin, self.allowed)):
+            await self.app(scope, receive, send)
+        else:
+            reason = "host not allowed" if not host_ok else "origin not allowed"
+            await send({"type": "websocket.close", "code": status.WS_1008_POLICY_VIOLATION, "reason": reason})
+
+
+class TokenFirst:
+    """A change under /api/ without the token is a 401 before its body is read. The changes open
+    without it are the routes that do not declare ``require_token`` (the e-stop, the simulations);
+    anything else, an unknown path included, needs the token."""
+
+    def __init__(self, app: ASGIApp, service: FastAPI) -> None:
+        self.app, self.service = app, service
+        self._open: list[RouteContext] | None = None  # found at the first change: the routes are all in by then
+
+    def needs_token(self, scope: Scope) -> bool:
+        if scope["method"] not in MUTATING or not scope["path"].startswith("/api/"):
+            return False
+        if self._open is None:
+            self._open = open_changes(self.service.routes)  # a route added later needs the token: fails closed
+        return not any(route.matches(scope)[0] is Match.FULL for route in self._open)
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        refused = (
+            scope["type"] == "http"
+            and self.needs_token(scope)
+            and not token_matches(Headers(scope=scope).get("authorization"), self.service.state.token)
         )
+        if refused:
+            code, detail = status.HTTP_401_UNAUTHORIZED, TOKEN_REQUIRED
+            await _refuse(scope, receive, send, code, detail, WWW_Authenticate="Bearer")
+        else:
+            await self.app(scope, receive, send)
 
 
-def limit_request_size(app: FastAPI, max_bytes: int) -> None:
-    """Refuse a body whose declared length is over ``max_bytes`` (413)."""
+class BodyLimit:
+    """Reads a request's body before the route does, counting the bytes as they come (a declared
+    Content-Length or a chunked stream alike), and answers 413 at the first chunk past
+    ``max_bytes`` without reading the rest; within the limit, the route gets the body as it came.
+    At most ``max_bytes`` (and one chunk) of a body is ever held."""
 
-    @app.middleware("http")
-    async def limit(request: Request, call_next):
-        length = request.headers.get("content-length")
-        if length is not None and (not length.isdigit() or int(length) > max_bytes):
-            return JSONResponse(
-                {"detail": f"request body must be at most {max_bytes} bytes"},
-                status_code=status.HTTP_413_CONTENT_TOO_LARGE,
-            )
-        return await call_next(request)
+    def __init__(self, app: ASGIApp, max_bytes: int) -> None:
+        self.app, self.max_bytes = app, max_bytes
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        headers = Headers(scope=scope) if scope["type"] == "http" else None
+        if headers is None or ("content-length" not in headers and "transfer-encoding" not in headers):
+            await self.app(scope, receive, send)  # not HTTP, or no body
+            return
+        length = headers.get("content-length")
+        too_large = f"request body must be at most {self.max_bytes} bytes"
+        if length is not None and not (length.isascii() and length.isdigit() and int(length) <= self.max_bytes):
+            await _refuse(scope, receive, send, status.HTTP_413_CONTENT_TOO_LARGE, too_large)
+            return
+        body, size = [], 0
+        while True:
+            message = await receive()
+            if message["type"] != "http.request":
+                return  # the client went away: nobody to answer
+            size += len(message.get("body", b""))
+            if size > self.max_bytes:
+                await _refuse(scope, receive, send, status.HTTP_413_CONTENT_TOO_LARGE, too_large)
+                return
+            body.append(message)
+            if not message.get("more_body", False):
+                break
+
+        async def replay():
+            return body.pop(0) if body else await receive()
+
+        await self.app(scope, replay, send)
+
+
+def install(app: FastAPI, settings: Settings) -> None:
+    """The middlewares, outermost first: headers, Host/Origin, token, body limit."""
+    app.add_middleware(BodyLimit, max_bytes=settings.max_request_bytes)
+    app.add_middleware(TokenFirst, service=app)
+    app.add_middleware(HostAllowList, allowed_hosts=settings.allowed_hosts)
+    app.add_middleware(SecurityHeaders)

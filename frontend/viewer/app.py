@@ -20,7 +20,9 @@ import numpy as np
 import viser
 
 from backend.services.view import ViewContext
+from backend.settings import LOOPBACK_HOSTS
 from frontend.viewer.modes import LiveMode, ReplayMode, SimulateMode, show_frame
+from frontend.viewer.origins import refuse_foreign_origins
 from frontend.viewer.recordings import load_recording
 from frontend.viewer.scene import ChuteScene
 from sim_core import get_preset
@@ -48,12 +50,24 @@ class ClimbView:
         port: viser's port; 0 lets the system pick a free one.
         context: the service's database sessions and robot (for replay and live modes).
         panel_url: where the control panel is, for the link back.
+        allowed_hosts: the service's host names: a websocket from a page of any other origin is
+            refused (frontend/viewer/origins.py).
     """
 
-    def __init__(self, context: ViewContext, *, host: str = "127.0.0.1", port: int = 0, panel_url: str = "/"):
+    def __init__(
+        self,
+        context: ViewContext,
+        *,
+        host: str = "127.0.0.1",
+        port: int = 0,
+        panel_url: str = "/",
+        allowed_hosts: tuple[str, ...] = LOOPBACK_HOSTS,
+    ):
         self.context = context
         self.robot = get_preset("paper")
+        self.allowed_hosts = allowed_hosts
         self.server = viser.ViserServer(host=host, port=port, label="ParkourLab · 3D view", verbose=False)
+        refuse_foreign_origins(self.server, allowed_hosts)
         _place_camera(self.server)
         self.scene = ChuteScene(self.server.scene, self.robot)
         gui = self.server.gui
@@ -98,6 +112,7 @@ class ClimbView:
         overlay = None if overlay_run_id is None else load_recording(self.context.sessions, overlay_run_id)
         server = viser.ViserServer(host="127.0.0.1", port=0, label=recording.label, verbose=False)
         try:
+            refuse_foreign_origins(server, self.allowed_hosts)
             _place_camera(server)
             scene = ChuteScene(server.scene, recording.robot)
             serializer = server.get_scene_serializer()

@@ -47,9 +47,12 @@ def page(service):
             executable_path=CHROMIUM, args=["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
         )
         context = browser.new_context(viewport={"width": 1360, "height": 900})
+        # What the Content-Security-Policy refuses (backend/api/security.py), reported by the page.
+        context.add_init_script(CSP_LISTENER)
         view = context.new_page()
         errors = []
         view.on("pageerror", lambda error: errors.append(str(error)))
+        view.on("console", lambda message: "Content Security Policy" in message.text and errors.append(message.text))
         view.on(
             "requestfailed",
             # Closing a finished job's event stream aborts it on purpose.
@@ -59,8 +62,25 @@ def page(service):
         view.fill("#token", token)
         view.dispatch_event("#token", "change")
         yield view
+        assert view.evaluate("window.__csp_violations") == [], "the panel runs under its CSP"
         assert not errors, errors
         browser.close()
+
+
+CSP_LISTENER = """window.__csp_violations = [];
+document.addEventListener("securitypolicyviolation", (e) => window.__csp_violations.push(
+  `${e.violatedDirective} refused ${e.blockedURI} (${e.sourceFile}:${e.lineNumber})`));"""
+
+
+def _until(page, expression: str, timeout: float = 30_000) -> None:
+    """Wait until ``expression`` is true in the page. Not ``page.wait_for_function``: it evaluates
+    its predicate in the page with eval, which the panel's CSP (script-src 'self') refuses;
+    ``page.evaluate`` goes through the DevTools protocol, which the page's CSP does not govern."""
+    deadline = time.monotonic() + timeout / 1000
+    while not page.evaluate(expression):
+        if time.monotonic() > deadline:
+            pytest.fail(f"not true within {timeout / 1000:g} s: {expression}")
+        time.sleep(0.05)
 
 
 def _shot(page, name):
@@ -74,11 +94,11 @@ def test_simulate_shows_plots_and_the_gait(page):
     page.wait_for_selector("#path-plot .main-svg", timeout=20_000)
     page.wait_for_selector("#height-plot .main-svg")
     page.click("#find-gait")
-    page.wait_for_function("document.querySelector('#gait-readout').textContent.includes('stable')", timeout=20_000)
+    _until(page, "document.querySelector('#gait-readout').textContent.includes('stable')", timeout=20_000)
     assert "Period 2" in page.inner_text("#gait-readout")
     _shot(page, "simulate")
     page.click("#save-run")
-    page.wait_for_function("document.querySelector('.message.ok')?.textContent.includes('stored')")
+    _until(page, "document.querySelector('.message.ok')?.textContent.includes('stored')")
     run_id = page.inner_text(".message.ok").split()[1]
     page.click("nav [data-tab=history]")
     page.wait_for_selector(f"#run-{run_id}")
@@ -112,13 +132,14 @@ def test_a_job_runs_to_completion_with_progress(page):
     page.click("#submit-job")
     page.wait_for_selector("#job-table tbody tr .state", timeout=10_000)
     # The Simulate tab's analyses are jobs too: follow this MJTF job's own row to the end.
-    page.wait_for_function(
+    _until(
+        page,
         "document.querySelector('#job-table tbody tr:first-child td:nth-child(2)').textContent === 'mjtf'"
         " && document.querySelector('#job-table tbody tr:first-child .state').textContent === 'done'",
         timeout=60_000,
     )
     page.click("#job-table tbody tr:first-child .show")
-    page.wait_for_function("document.querySelector('#job-plot').textContent.includes('Mean Jumps To Failure')")
+    _until(page, "document.querySelector('#job-plot').textContent.includes('Mean Jumps To Failure')")
     _shot(page, "jobs")
 
 
@@ -135,14 +156,15 @@ def test_sweep_and_basin_grid_jobs_from_the_jobs_tab(page):
     # Newest first: the basin job just scheduled, then the sweep (the Simulate tab's jobs are older).
     row = "document.querySelector('#job-table tbody tr:nth-child({n}) {cell}').textContent"
     newest = [row.format(n=n, cell=cell) for n in (1, 2) for cell in ("td:nth-child(2)", ".state")]
-    page.wait_for_function(
+    _until(
+        page,
         f"{newest[0]} === 'basin' && {newest[1]} === 'done' && {newest[2]} === 'sweep' && {newest[3]} === 'done'",
         timeout=60_000,
     )
     page.click("#job-table tbody tr:nth-child(1) .show")
     page.wait_for_selector("#job-plot .heatmaplayer image", timeout=10_000)
     page.click("#job-table tbody tr:nth-child(2) .show")
-    page.wait_for_function("document.querySelector('#job-plot').textContent.includes('max |λ|')", timeout=10_000)
+    _until(page, "document.querySelector('#job-plot').textContent.includes('max |λ|')", timeout=10_000)
     page.select_option("#job-kind", "mjtf")
 
 
@@ -163,7 +185,7 @@ def test_history_compares_and_exports(page, service):
         httpx.patch(f"{base}/api/v1/runs/{run.json()['id']}", json={"notes": notes}, headers=auth).raise_for_status()
     page.click("nav [data-tab=history]")
     # The table may still show an earlier visit's rows: wait for the reload with the saved run and these two.
-    page.wait_for_function("document.querySelectorAll('#run-table tbody tr').length >= 3")
+    _until(page, "document.querySelectorAll('#run-table tbody tr').length >= 3")
     boxes = page.query_selector_all("#run-table tbody input[type=checkbox]")
     boxes[0].check()
     boxes[1].check()
@@ -194,12 +216,14 @@ def test_experiments_group_runs_in_history(page, service):
     }
     run = httpx.post(f"{base}/api/v1/runs", json=body, headers={"Authorization": f"Bearer {token}"}).json()
     page.click("#experiment-table button.show-experiment")
-    page.wait_for_function(
-        f"document.querySelectorAll('#run-table tbody tr').length === 1 && !!document.querySelector('#run-{run['id']}')"
+    _until(
+        page,
+        "document.querySelectorAll('#run-table tbody tr').length === 1"
+        f" && !!document.querySelector('#run-{run['id']}')",
     )
     page.select_option("#experiment-filter", "")
     page.click("#history-form button[type=submit]")
-    page.wait_for_function("document.querySelectorAll('#run-table tbody tr').length > 1")
+    _until(page, "document.querySelectorAll('#run-table tbody tr').length > 1")
 
 
 def test_tags_and_notes_are_edited_in_history(page, service):
@@ -211,7 +235,7 @@ def test_tags_and_notes_are_edited_in_history(page, service):
     page.fill("#run-editor input[name=tags]", "keep wet-wall")
     page.fill("#run-editor textarea[name=notes]", "Left foot slipped on jump 3; try psi0 32.")
     page.click("#run-editor-save")
-    page.wait_for_function(f"document.querySelector('#run-{run_id} .notes').textContent.includes('slipped')")
+    _until(page, f"document.querySelector('#run-{run_id} .notes').textContent.includes('slipped')")
     stored = httpx.get(f"{base}/api/v1/runs/{run_id}").json()
     assert stored["tags"] == ["keep", "wet-wall"] and stored["notes"].startswith("Left foot slipped")
     page.click(f"#run-{run_id} button.edit-run")
@@ -235,7 +259,7 @@ def test_the_3d_view_draws_the_climb(page):
     updates = []
     page.on("websocket", lambda ws: ws.on("framereceived", lambda _frame: updates.append(time.monotonic())))
     page.click("nav [data-tab=view3d]")
-    page.wait_for_function("document.querySelector('#view-status').textContent.includes('updates/s')")
+    _until(page, "document.querySelector('#view-status').textContent.includes('updates/s')")
     frame = page.frame_locator("#view-frame")
     frame.locator("text=Gait of these controls").wait_for(timeout=30_000)
     time.sleep(3)
@@ -252,7 +276,7 @@ def test_a_run_opens_in_3d_and_shares_as_a_file(page, service, tmp_path):
     page.wait_for_selector("#run-table button.open-3d")
     page.click("#run-table button.open-3d")
     page.wait_for_selector("#view3d:not([hidden])")
-    page.wait_for_function("document.querySelector('#view-status').textContent.includes('replay')")
+    _until(page, "document.querySelector('#view-status').textContent.includes('replay')")
     run_id = page.get_attribute("#run-table button.open-3d", "data-run")
     shared = page.request.get(f"{base}/api/v1/runs/{run_id}/share.html")
     assert shared.ok
@@ -273,13 +297,11 @@ def test_closed_loop_run_then_emergency_stop(page, service):
         page.fill("input[name=url]", robot.url)
         page.fill("input[name=tracker_port]", str(tracker_port))
         page.click("#connect")
-        page.wait_for_function("document.querySelector('#robot-state').textContent === 'disarmed'")
+        _until(page, "document.querySelector('#robot-state').textContent === 'disarmed'")
         page.fill("#robot-run-form input[name=jumps]", "12")
         page.check("#closed-loop")
         page.click("#live-run")
-        page.wait_for_function(
-            "document.querySelector('#robot-status').textContent.includes('jumps done')", timeout=30_000
-        )
+        _until(page, "document.querySelector('#robot-status').textContent.includes('jumps done')", timeout=30_000)
         stored = httpx.get(f"{base}/api/v1/runs?kind=robot&limit=1").json()["items"][0]
         commands = httpx.get(f"{base}/api/v1/runs/{stored['id']}").json()["results"]["commands"]
         assert sum(command["why"].startswith("pid") for command in commands) >= 8, "the PID set the legs"
@@ -288,15 +310,11 @@ def test_closed_loop_run_then_emergency_stop(page, service):
         page.uncheck("#closed-loop")
         page.fill("#robot-run-form input[name=jumps]", "200")
         page.click("#live-run")
-        page.wait_for_function(
-            "document.querySelector('#robot-status').textContent.includes('running')", timeout=10_000
-        )
+        _until(page, "document.querySelector('#robot-status').textContent.includes('running')", timeout=10_000)
         time.sleep(1.0)
         page.fill("#token", "")  # a colleague's browser: stopping needs no token
         page.click("#estop")
-        page.wait_for_function(
-            "document.querySelector('.message')?.textContent.includes('Emergency stop acknowledged')"
-        )
+        _until(page, "document.querySelector('.message')?.textContent.includes('Emergency stop acknowledged')")
         assert robot.firmware.state.name == "ESTOPPED"
     finally:
         page.remove_listener("dialog", _accept)
@@ -324,7 +342,7 @@ def robot(page, service):
         page.fill("input[name=url]", virtual.url)
         page.fill("input[name=tracker_port]", str(tracker_port))
         page.click("#connect")
-        page.wait_for_function(f"{ROBOT_STATE} === 'disarmed'", timeout=10_000)
+        _until(page, f"{ROBOT_STATE} === 'disarmed'", timeout=10_000)
         yield virtual
     finally:
         httpx.post(f"{_base}/api/v1/robot/disconnect", headers={"Authorization": f"Bearer {token}"})
@@ -388,7 +406,7 @@ def test_the_estop_needs_no_token(page, service):
     with page.expect_response(lambda response: response.url.endswith("/robot/estop")) as answer:
         page.click("#estop")
     assert answer.value.ok and "authorization" not in answer.value.request.headers
-    page.wait_for_function("document.querySelector('.message')?.textContent.includes('Emergency stop')")
+    _until(page, "document.querySelector('.message')?.textContent.includes('Emergency stop')")
     message = page.inner_text(".message")
     # The service's own answer (no robot connected: not acknowledged, and why), never "paste the token".
     assert "token" not in message.lower(), message
@@ -401,7 +419,7 @@ def test_a_latched_estop_shows_a_banner_until_reset(page, robot):
     page.click("#estop")
     page.wait_for_selector("#estop-banner", state="visible")
     assert "EMERGENCY STOP latched — the robot is stopped. Reset to continue." in page.inner_text("#estop-banner")
-    page.wait_for_function(f"{ROBOT_STATE} === 'estopped'")
+    _until(page, f"{ROBOT_STATE} === 'estopped'")
     page.click("nav [data-tab=simulate]")  # on every tab
     assert page.is_visible("#estop-banner")
     page.evaluate("window.scrollTo(0, document.body.scrollHeight)")
@@ -411,7 +429,7 @@ def test_a_latched_estop_shows_a_banner_until_reset(page, robot):
     _shot(page, "robot_estop")
     page.click("#estop-banner-reset")
     page.wait_for_selector("#estop-banner", state="hidden")
-    page.wait_for_function(f"{ROBOT_STATE} === 'disarmed'")
+    _until(page, f"{ROBOT_STATE} === 'disarmed'")
     assert robot.firmware.state.name == "DISARMED"
 
 
@@ -428,18 +446,18 @@ def test_start_run_on_a_disarmed_robot_asks(page, service, robot):
     try:
         page.fill("#robot-run-form input[name=jumps]", "3")
         page.click("#live-run")
-        page.wait_for_function("document.querySelector('.message')?.textContent.includes('Run not started')")
+        _until(page, "document.querySelector('.message')?.textContent.includes('Run not started')")
         assert questions == [("confirm", ARM_AND_LAUNCH)]
         assert not runs, "Cancel sends no run"
         assert httpx.get(f"{base}/api/v1/robot").json()["state"] == "disarmed"
         # Armed: no question, the run starts.
         page.click("#arm")
-        page.wait_for_function(f"{ROBOT_STATE} === 'armed'")
+        _until(page, f"{ROBOT_STATE} === 'armed'")
         page.click("#live-run")
-        page.wait_for_function("document.querySelector('.message')?.textContent.includes('Run started')")
+        _until(page, "document.querySelector('.message')?.textContent.includes('Run started')")
         assert len(questions) == 1 and len(runs) == 1
         page.click("#stop-run")
-        page.wait_for_function(f"{ROBOT_STATE} === 'disarmed'", timeout=15_000)
+        _until(page, f"{ROBOT_STATE} === 'disarmed'", timeout=15_000)
     finally:
         page.remove_listener("dialog", cancel)
 
@@ -448,13 +466,13 @@ def test_disarm_and_disconnect(page, robot):
     assert "0x0013A20040B0B0B0" in page.inner_text("#robot-status"), "the status shows the robot's address"
     assert "frames_in" in page.inner_text("#robot-counters")
     page.click("#arm")
-    page.wait_for_function(f"{ROBOT_STATE} === 'armed'")
+    _until(page, f"{ROBOT_STATE} === 'armed'")
     assert robot.firmware.state.name == "ARMED"
     page.click("#disarm")
-    page.wait_for_function(f"{ROBOT_STATE} === 'disarmed'")
+    _until(page, f"{ROBOT_STATE} === 'disarmed'")
     assert robot.firmware.state.name == "DISARMED"
     page.click("#disconnect")
-    page.wait_for_function(f"{ROBOT_STATE} === 'disconnected'")
+    _until(page, f"{ROBOT_STATE} === 'disconnected'")
     assert "not connected" in page.inner_text("#robot-counters")
 
 
@@ -468,7 +486,7 @@ def test_the_robot_address_is_sent(page, robot):
     assert "no telemetry" in page.inner_text(".message.error")
     page.fill("input[name=robot_address]", "0x0013A20040B0B0B0")
     page.click("#connect")
-    page.wait_for_function(f"{ROBOT_STATE} === 'disarmed'", timeout=10_000)
+    _until(page, f"{ROBOT_STATE} === 'disarmed'", timeout=10_000)
     assert [body["robot_address"] for body in sent] == ["0x0013A20040B0B0B1", "0x0013A20040B0B0B0"]
     assert "0x0013A20040B0B0B0" in page.inner_text("#robot-status")
 
@@ -478,24 +496,24 @@ def test_a_second_browser_follows_live(page, service, robot):
     with page.context.new_page() as other:  # no token: reading needs none
         other.goto(f"{base}/")
         other.click("nav [data-tab=robot]")
-        other.wait_for_function(f"{ROBOT_STATE} === 'disarmed'")
-        other.wait_for_function("document.querySelector('#live-state').textContent === 'live updates: on'")
+        _until(other, f"{ROBOT_STATE} === 'disarmed'")
+        _until(other, "document.querySelector('#live-state').textContent === 'live updates: on'")
         page.click("#arm")
-        other.wait_for_function(f"{ROBOT_STATE} === 'armed'", timeout=10_000)
+        _until(other, f"{ROBOT_STATE} === 'armed'", timeout=10_000)
         page.click("#disarm")
-        other.wait_for_function(f"{ROBOT_STATE} === 'disarmed'", timeout=10_000)
+        _until(other, f"{ROBOT_STATE} === 'disarmed'", timeout=10_000)
         page.click("#estop")
         other.wait_for_selector("#estop-banner", state="visible", timeout=10_000)
         page.click("#reset")
         other.wait_for_selector("#estop-banner", state="hidden", timeout=10_000)
         # Off the Robot tab the live socket closes; back on it, it opens again.
         other.click("nav [data-tab=simulate]")
-        other.wait_for_function("document.querySelector('#live-state').textContent.includes('off')")
+        _until(other, "document.querySelector('#live-state').textContent.includes('off')")
         other.click("nav [data-tab=robot]")
         page.click("#arm")
-        other.wait_for_function(f"{ROBOT_STATE} === 'armed'", timeout=10_000)
+        _until(other, f"{ROBOT_STATE} === 'armed'", timeout=10_000)
         page.click("#disarm")
-        page.wait_for_function(f"{ROBOT_STATE} === 'disarmed'")
+        _until(page, f"{ROBOT_STATE} === 'disarmed'")
 
 
 # Every draw of the live plot, with the run it belongs to and how many points it has.
@@ -517,11 +535,9 @@ def test_the_live_plot_starts_fresh_for_each_run(page, robot):
         page.uncheck("#closed-loop")
         for _run in range(2):
             page.click("#live-run")
-            page.wait_for_function("document.querySelector('#robot-status').textContent.includes('running')")
-            page.wait_for_function(
-                "document.querySelector('#robot-status').textContent.includes('jumps done')", timeout=30_000
-            )
-            page.wait_for_function(f"{ROBOT_STATE} === 'disarmed'")
+            _until(page, "document.querySelector('#robot-status').textContent.includes('running')")
+            _until(page, "document.querySelector('#robot-status').textContent.includes('jumps done')", timeout=30_000)
+            _until(page, f"{ROBOT_STATE} === 'disarmed'")
         draws = page.evaluate("window.__draws")
     finally:
         page.remove_listener("dialog", _accept)
@@ -538,7 +554,7 @@ def test_the_status_fields_of_the_new_service_are_shown_as_text(page):
     """``estop`` and ``run.id`` (the service's issue-13 status), fed to the panel as a live message would be."""
     with page.expect_response(lambda response: response.url.endswith("/api/v1/robot")):
         page.click("nav [data-tab=robot]")
-    page.wait_for_function("document.querySelector('#live-state').textContent === 'live updates: on'")
+    _until(page, "document.querySelector('#live-state').textContent === 'live updates: on'")
     page.evaluate("closeLive()")  # only the statuses below from now on
     status = {
         "state": "estopped",

@@ -56,7 +56,9 @@ def job_results(job_id: RecordId, db: Db):
 async def job_events(
     job_id: RecordId,
     request: Request,
-    timeout: Annotated[float, Query(gt=0, le=86_400, description="close the stream after this many seconds")] = 3600,
+    timeout: Annotated[
+        float, Query(gt=0, le=86_400, allow_inf_nan=False, description="close the stream after this many seconds")
+    ] = 3600,
 ):
     """Server-sent events: a ``progress`` event whenever the job's state or count changes; the
     stream ends after the job's final state (done, cancelled, failed) or ``timeout``."""

@@ -21,7 +21,8 @@ def robot_status(robot: Robot) -> dict:
 
 @router.websocket("/live")
 async def robot_live(
-    websocket: WebSocket, rate: Annotated[float, Query(gt=0, le=50, description="messages per second")] = 20
+    websocket: WebSocket,
+    rate: Annotated[float, Query(gt=0, le=50, allow_inf_nan=False, description="messages per second")] = 20,
 ):
     """Live state for the panel: link state, telemetry, the latest tracked pose, the run's
     newest touchdowns — ``rate`` messages per second until the client goes away."""

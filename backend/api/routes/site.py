@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import html
+import json
 from pathlib import Path
 
 import fastapi_offline
 import plotly
 from fastapi import APIRouter, Request
-from fastapi.openapi.docs import get_swagger_ui_html
-from fastapi.responses import FileResponse, HTMLResponse, RedirectResponse
+from fastapi.openapi.docs import swagger_ui_default_parameters
+from fastapi.responses import FileResponse, HTMLResponse, RedirectResponse, Response
 from sqlalchemy import select
 
 from backend.api.deps import Db
@@ -30,15 +32,43 @@ def plotly_js() -> FileResponse:
     return FileResponse(PLOTLY_JS, media_type="text/javascript")
 
 
+# Swagger UI's page with its start-up script in a file of its own, not inline (FastAPI's
+# get_swagger_ui_html writes it inline): /docs runs under the same Content-Security-Policy as
+# every other page of the service (script-src 'self').
+DOCS_PAGE = """<!doctype html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<title>{title}</title>
+<link rel="stylesheet" href="/static/swagger/swagger-ui.css">
+<link rel="icon" href="/static/swagger/favicon.png">
+</head>
+<body>
+<div id="swagger-ui"></div>
+<script src="/static/swagger/swagger-ui-bundle.js"></script>
+<script src="/static/swagger-init.js"></script>
+</body>
+</html>
+"""
+
+
 @router.get("/docs", include_in_schema=False)
 def docs(request: Request) -> HTMLResponse:
-    return get_swagger_ui_html(
-        openapi_url=request.app.openapi_url,
-        title="ParkourLab API",
-        swagger_js_url="/static/swagger/swagger-ui-bundle.js",
-        swagger_css_url="/static/swagger/swagger-ui.css",
-        swagger_favicon_url="/static/swagger/favicon.png",
+    return HTMLResponse(DOCS_PAGE.format(title=html.escape(f"{request.app.title} API")))
+
+
+@router.get("/static/swagger-init.js", include_in_schema=False)
+def swagger_init(request: Request) -> Response:
+    """Starts Swagger UI on the service's OpenAPI document (FastAPI's default options)."""
+    options = json.dumps({"url": request.app.openapi_url, **swagger_ui_default_parameters}, indent=2)
+    script = (
+        '"use strict";\n'
+        f"const options = {options};\n"
+        "options.presets = [SwaggerUIBundle.presets.apis, SwaggerUIBundle.SwaggerUIStandalonePreset];\n"
+        "window.ui = SwaggerUIBundle(options);\n"
     )
+    return Response(script, media_type="text/javascript")
 
 
 @router.get("/api/v1/health", tags=["service"])

@@ -1,0 +1,61 @@
+"""The 3D view's websocket answers only pages of the service's own hosts.
+
+A page from anywhere else that the lab's browser opens (another site, a DNS-rebinding one) could
+otherwise connect to ``ws://localhost:8001`` — a browser sends the page's ``Origin`` but leaves
+the check to the server — and read the scene (the robot's live pose) or drive the shared GUI. The
+rule is the service's own (``backend.api.security.origin_allowed``): an Origin whose host is on
+the allow-list, over http or https, any port; no Origin at all (a client that is not a browser)
+is allowed.
+
+viser 1.1.1 has no hook for its websocket handshake: ``WebsockServer._background_worker`` calls
+``websockets.asyncio.server.serve`` with its own ``process_request`` (the static-file handler, a
+closure) and neither ``origins=`` nor ``process_response``, and ``ViserServer.__init__`` starts
+that server before it returns. What it does offer is ``WebsockServer.on_client_connect``: its
+callbacks run right after the handshake, before viser sends the client anything or reads a
+message from it, and the handshake's request is on the connection viser keeps per client
+(``_live_connections``). So the check runs there, and a connection from a foreign Origin is
+closed (1008, policy violation) with nothing exchanged. The handshake itself has succeeded by
+then (the browser sees an open socket, then the close), and the names used here are viser's
+private ones: :func:`refuse_foreign_origins` fails loudly, and the view does not start, if they
+are gone.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+from collections.abc import Iterable
+
+import viser
+
+from backend.api.security import origin_allowed
+from backend.settings import host_name
+
+log = logging.getLogger("parkourlab.view")
+POLICY_VIOLATION = 1008
+
+
+def refuse_foreign_origins(server: viser.ViserServer, allowed_hosts: Iterable[str]) -> None:
+    """Close every websocket of ``server`` whose Origin is not an allowed host, from now on and
+    any already open (the server was listening before this could be installed)."""
+    allowed = frozenset(host_name(host) for host in allowed_hosts)
+    websock = getattr(server, "_websock_server", None)
+    live = getattr(websock, "_live_connections", None)
+    if websock is None or not isinstance(live, dict):
+        raise RuntimeError(f"viser {viser.__version__}: no per-client connections to check Origins on")
+
+    def foreign(connection) -> str | None:
+        origin = connection.request.headers.get("Origin")
+        return origin if origin is not None and not origin_allowed(origin, allowed) else None
+
+    async def check(client) -> None:
+        connection = live[client.client_id]  # a KeyError here closes the connection too (1011)
+        if (origin := foreign(connection)) is not None:
+            log.warning("3D view: refused a websocket from origin %.200r", origin)
+            await connection.close(POLICY_VIOLATION, "origin not allowed")
+
+    websock.on_client_connect(check)
+    loop = websock._background_event_loop
+    for connection in list(live.values()):
+        if foreign(connection) is not None and loop is not None:
+            asyncio.run_coroutine_threadsafe(connection.close(POLICY_VIOLATION, "origin not allowed"), loop)
