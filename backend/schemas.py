@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import datetime
+import enum
 import math
 from typing import Annotated, Literal
 
@@ -26,6 +27,28 @@ MAX_PATH_SAMPLES = 100_000
 WORK_BUDGET_JUMPS = 500_000_000
 MAX_ID = 2**31 - 1  # integer keys: the smallest range among the supported databases (PostgreSQL)
 RecordRef = Annotated[int, Field(ge=1, le=MAX_ID)]
+
+
+class RunKind(enum.StrEnum):
+    SIM = "sim"  # simulated by the service
+    ROBOT = "robot"  # a live run on the robot
+    REPLAY = "replay"  # a robot run's frames analysed again
+
+
+class RunStatus(enum.StrEnum):
+    DONE = "done"  # a physical failure (the robot fell) is still a run done
+    FAILED = "failed"  # it could not be carried out
+    RUNNING = "running"  # a live robot run, stored from its start
+    INTERRUPTED = "interrupted"  # a live run the service died during, kept to its last journal entry
+
+
+class JobState(enum.StrEnum):
+    QUEUED = "queued"
+    RUNNING = "running"
+    CANCELLING = "cancelling"
+    CANCELLED = "cancelled"
+    DONE = "done"
+    FAILED = "failed"
 
 
 class Strict(BaseModel):
@@ -88,8 +111,8 @@ class RunUpdate(Strict):
 class RunOut(BaseModel):
     id: int
     experiment_id: int | None
-    kind: str
-    status: str
+    kind: RunKind
+    status: RunStatus
     created_at: datetime.datetime
     duration_s: float
     code_version: str
@@ -259,7 +282,7 @@ class JobOut(BaseModel):
     id: int
     experiment_id: int | None
     kind: str
-    state: str
+    state: JobState
     total: int
     completed: int
     progress: float

@@ -27,8 +27,8 @@ def get_session(request: Request) -> Iterator[Session]:
 
 def run_filter(
     experiment_id: Annotated[int | None, Query(ge=1, le=schemas.MAX_ID)] = None,
-    kind: Annotated[str | None, Query(pattern="^(sim|robot|replay)$")] = None,
-    status_: Annotated[str | None, Query(alias="status", pattern="^(done|failed|running|interrupted)$")] = None,
+    kind: schemas.RunKind | None = None,
+    status_: Annotated[schemas.RunStatus | None, Query(alias="status")] = None,
     tag: Annotated[str | None, Query(max_length=64)] = None,
     failure_code: Annotated[str | None, Query(max_length=32)] = None,
     zeta0_min: Annotated[float | None, Query(ge=0.0, le=1.0, allow_inf_nan=False)] = None,

@@ -33,7 +33,7 @@ def list_jobs(
     db: Db,
     limit: PageLimit = 50,
     cursor: Cursor = None,
-    state: Annotated[str | None, Query(pattern="^(queued|running|cancelling|cancelled|done|failed)$")] = None,
+    state: schemas.JobState | None = None,
 ):
     rows, next_cursor = jobs.list_jobs(db, state=state, limit=limit, cursor=cursor)
     return {"items": [job_out(row) for row in rows], "next_cursor": next_cursor}

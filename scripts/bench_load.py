@@ -1,0 +1,161 @@
+"""The service under load: many clients reading and writing runs, idle and while a job computes.
+
+Seeds ``--runs`` runs into a fresh SQLite store, starts the real ``parkour serve`` on it (its own
+process, as in the lab), then for each client count runs two phases of ``--seconds`` each:
+idle, and while a job computes (``--job mjtf``: 12,000 trials; ``--job basin``: a 200 x 200 grid,
+1000 jumps). Each client loops: four filtered ``GET /api/v1/runs`` pages for every ``POST
+/api/v1/runs`` (4 jumps, stored). The clients run in processes of their own (a few threads each),
+so the bench's own GIL is not what is measured.
+
+Prints, per phase, throughput and p50/p95/max latency of the reads and the writes, and the
+ratio of each phase's p95 to idle. ``--json`` for the numbers alone.
+Usage: python scripts/bench_load.py [--runs 20000] [--clients 20 50] [--seconds 20] [--job mjtf]
+"""
+
+from __future__ import annotations
+
+import argparse
+import concurrent.futures
+import json
+import multiprocessing
+import os
+import random
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+import httpx
+from bench_store import QUERIES, seed  # scripts/ is on the path when this script runs
+
+ROOT = Path(__file__).resolve().parents[1]
+RUN = {"controls": [{"psi0_deg": 30, "zeta0": 0.9}], "start": {"xdot": -0.93, "ydot": -0.17}, "jumps": 4}
+JOBS = {
+    "mjtf": {"zeta0s": [0.86, 0.88, 0.9, 0.92], "trials": 3000, "cap": 1000, "seed": 1,
+             "guess": {"xdot": -0.93, "ydot": -0.2}},
+    "basin": {"kind": "basin", "controls": [{"psi0_deg": 30, "zeta0": 0.9}], "grid": 200, "jumps": 1000},
+}  # fmt: skip
+CLIENT_PROCESSES = 4
+
+
+def _client(base: str, token: str, seconds: float, seed_value: int) -> list[tuple[str, float, int]]:
+    """One client thread: (kind, latency [s], status) of each request until ``seconds`` have passed."""
+    rng, out = random.Random(seed_value), []
+    auth = {"Authorization": f"Bearer {token}"}
+    deadline = time.monotonic() + seconds
+    with httpx.Client(base_url=base, timeout=60) as client:
+        while time.monotonic() < deadline:
+            write = rng.random() < 0.2
+            started = time.perf_counter()
+            if write:
+                status = client.post("/api/v1/runs", json=RUN, headers=auth).status_code
+            else:
+                params = rng.choice(QUERIES) | {"limit": 50}
+                status = client.get("/api/v1/runs", params=params).status_code
+            out.append(("write" if write else "read", time.perf_counter() - started, status))
+    return out
+
+
+def _client_process(base: str, token: str, seconds: float, threads: int, first_seed: int) -> list:
+    with concurrent.futures.ThreadPoolExecutor(threads) as pool:
+        results = pool.map(lambda k: _client(base, token, seconds, first_seed + k), range(threads))
+        return [request for client in results for request in client]
+
+
+def phase(base: str, token: str, clients: int, seconds: float) -> dict:
+    per_process = [clients // CLIENT_PROCESSES + (k < clients % CLIENT_PROCESSES) for k in range(CLIENT_PROCESSES)]
+    context = multiprocessing.get_context("spawn")
+    with concurrent.futures.ProcessPoolExecutor(CLIENT_PROCESSES, mp_context=context) as pool:
+        futures = [
+            pool.submit(_client_process, base, token, seconds, n, 1000 * k) for k, n in enumerate(per_process) if n
+        ]
+        requests = [request for future in futures for request in future.result()]
+    summary = {"requests": len(requests), "per_s": len(requests) / seconds, "errors": {}}
+    for kind in ("read", "write"):
+        times = sorted(latency for name, latency, status in requests if name == kind)
+        if times:
+            summary[kind] = {
+                "count": len(times),
+                "p50_ms": 1e3 * statistics.median(times),
+                "p95_ms": 1e3 * times[int(0.95 * (len(times) - 1))],
+                "max_ms": 1e3 * times[-1],
+            }
+    for _name, _latency, status in requests:
+        if status >= 400:
+            summary["errors"][str(status)] = summary["errors"].get(str(status), 0) + 1
+    return summary
+
+
+def start_service(data_dir: Path, port: int) -> subprocess.Popen:
+    command = [sys.executable, "-m", "cli", "serve", "--data-dir", str(data_dir), "--port", str(port), "--no-view"]
+    process = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                               env={**os.environ, "PYTHONPATH": str(ROOT)})  # fmt: skip
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        try:
+            if httpx.get(f"http://127.0.0.1:{port}/api/v1/health", timeout=1).status_code == 200:
+                return process
+        except httpx.HTTPError:
+            time.sleep(0.2)
+    process.kill()
+    raise SystemExit("the service did not start within 60 s")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=20_000)
+    parser.add_argument("--clients", type=int, nargs="+", default=[20, 50])
+    parser.add_argument("--seconds", type=float, default=20.0)
+    parser.add_argument("--job", choices=sorted(JOBS), default="mjtf")
+    parser.add_argument("--port", type=int, default=8765)
+    parser.add_argument("--json", action="store_true")
+    args = parser.parse_args()
+    data_dir = Path(tempfile.mkdtemp(prefix="parkourlab-load-"))
+    seed(f"sqlite:///{data_dir / 'parkourlab.sqlite3'}", args.runs, random.Random(0))
+    process = start_service(data_dir, args.port)
+    base, token = f"http://127.0.0.1:{args.port}", (data_dir / "api_token").read_text().strip()
+    auth = {"Authorization": f"Bearer {token}"}
+    results = {"runs": args.runs, "job": args.job, "seconds": args.seconds, "phases": []}
+    try:
+        phase(base, token, 2, 3.0)  # warm: the workers' kernels, the database's pages
+        for clients in args.clients:
+            idle = phase(base, token, clients, args.seconds)
+            job = httpx.post(f"{base}/api/v1/jobs", json=JOBS[args.job], headers=auth).json()["id"]
+            while httpx.get(f"{base}/api/v1/jobs/{job}").json()["state"] != "running":
+                time.sleep(0.1)
+            busy = phase(base, token, clients, args.seconds)
+            state = httpx.get(f"{base}/api/v1/jobs/{job}").json()
+            httpx.post(f"{base}/api/v1/jobs/{job}/cancel", headers=auth)
+            busy["job_state_at_end"], busy["job_completed"] = state["state"], state["completed"]
+            results["phases"].append({"clients": clients, "idle": idle, "job": busy})
+    finally:
+        process.terminate()
+        process.wait(30)
+        shutil.rmtree(data_dir, ignore_errors=True)
+    if args.json:
+        print(json.dumps(results))
+        return
+    print(f"{args.runs} runs; phases of {args.seconds:g} s; job: {args.job}")
+    header = ("clients", "phase", "req/s", "read p50", "p95", "max", "write p50", "p95", "max", "p95 x idle (r/w)")
+    print(" ".join(f"{name:>{width}}" for name, width in zip(header, (7, 5, 7, 9, 7, 7, 10, 7, 7, 17), strict=True)))
+    for entry in results["phases"]:
+        for name in ("idle", "job"):
+            row = entry[name]
+            ratio = "" if name == "idle" else " / ".join(
+                f"{row[kind]['p95_ms'] / entry['idle'][kind]['p95_ms']:.1f}" for kind in ("read", "write"))  # fmt: skip
+            read, write = row["read"], row["write"]
+            print(
+                f"{entry['clients']:>7} {name:>5} {row['per_s']:>7.0f} {read['p50_ms']:>9.1f} {read['p95_ms']:>7.1f} "
+                f"{read['max_ms']:>7.0f} {write['p50_ms']:>10.1f} {write['p95_ms']:>7.1f} {write['max_ms']:>7.0f} "
+                f"{ratio:>17}  {row['errors'] or ''}"
+            )
+        print(f"{'':>7} job: {entry['job']['job_state_at_end']}, {entry['job']['job_completed']} done during the phase")
+
+
+if __name__ == "__main__":
+    threading.current_thread().name = "bench-load"
+    main()
