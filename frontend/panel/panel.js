@@ -84,6 +84,13 @@ function simControls() {
   return { controls: legsOf(form), start: { xdot: number("xdot"), ydot: number("ydot") }, jumps: number("jumps") };
 }
 
+// Every plot's config: nothing leaves for Plotly's cloud (v4's "Share chart..." button is on by
+// default), no Chart Studio link, no Plotly logo linking out.
+const PLOT_CONFIG = Object.freeze({
+  responsive: true, displaylogo: false, showLink: false, showSendToCloud: false, showEditInChartStudio: false,
+  modeBarButtonsToRemove: Object.freeze(["sendChartToCloud", "sendDataToCloud", "editInChartStudio"]),
+});
+
 const layout = (title, x, y, extra = {}) => ({
   title: { text: title, font: { size: 14 } }, margin: { l: 55, r: 15, t: 40, b: 45 },
   xaxis: { title: { text: x } }, yaxis: { title: { text: y } }, ...extra,
@@ -97,9 +104,9 @@ on("#sim-form", "submit", async (event) => {
   Plotly.react("path-plot", [{ x: c.x, y: c.y, mode: "lines", name: "body" },
     { x: c.foot_x, y: c.foot_y, mode: "markers", marker: { size: 3 }, name: "foot" }],
     layout("Path between the walls", "x [l0]", "height y [l0]", { yaxis: { scaleanchor: "x", title: { text: "height y [l0]" } } }),
-    { responsive: true });
+    PLOT_CONFIG);
   Plotly.react("height-plot", [{ x: c.time, y: c.y, mode: "lines", name: "height" }],
-    layout("Height over time", "time [sqrt(l0/g)]", "y [l0]"), { responsive: true });
+    layout("Height over time", "time [sqrt(l0/g)]", "y [l0]"), PLOT_CONFIG);
   const failure = path.failure ? `, failed: ${path.failure.code} at jump ${path.failure.jump}` : "";
   say(`${spec.jumps} jumps simulated${failure}.`);
 });
@@ -117,7 +124,7 @@ on("#find-gait", "click", async () => {
   Plotly.react("eig-plot", [
     { x: circle.map(Math.cos), y: circle.map(Math.sin), mode: "lines", name: "|λ| = 1", line: { color: "#999" } },
     { x: gait.eigenvalues.map((e) => e[0]), y: gait.eigenvalues.map((e) => e[1]), mode: "markers", name: "eigenvalues", marker: { size: 11, color: gait.stable ? "#2a9d4b" : "#d61f1f" } },
-  ], layout("Eigenvalues on the unit circle", "Re λ", "Im λ", { yaxis: { scaleanchor: "x", title: { text: "Im λ" } } }), { responsive: true });
+  ], layout("Eigenvalues on the unit circle", "Re λ", "Im λ", { yaxis: { scaleanchor: "x", title: { text: "Im λ" } } }), PLOT_CONFIG);
   $("#gait-readout").textContent = `Period ${gait.period} ${gait.motion} gait at (${gait.state.map((v) => v.toFixed(4)).join(", ")}): ` +
     `max |λ| = ${gait.max_abs_eigenvalue.toFixed(4)} (${gait.stable ? "stable" : "unstable"}), climb ${gait.climb_per_period.toFixed(4)} l0 per period.`;
 });
@@ -143,7 +150,7 @@ function plotSweep(target, result, title) {
   Plotly.react(target, traces, layout(title, "zeta0 [l0] (smaller: more energy)", "climb per jump [l0]", {
     yaxis2: { title: { text: "max |λ|, basin area" }, overlaying: "y", side: "right", range: [0, 1.15], dtick: 0.25, showgrid: false },
     shapes: [...inPlace, unit], legend: { orientation: "h", y: -0.32 }, margin: { l: 55, r: 55, t: 40, b: 105 },
-  }), { responsive: true });
+  }), PLOT_CONFIG);
 }
 
 function plotBasin(target, result, title, start) {
@@ -162,7 +169,7 @@ function plotBasin(target, result, title, start) {
   ];
   if (start) traces.push({ x: [start.xdot], y: [start.ydot], mode: "markers", name: "start", marker: { symbol: "circle-open", size: 12, color: "#111" } });
   Plotly.react(target, traces, layout(`${title}: ${(100 * result.fraction).toFixed(1)} % converge (grey: fails)`, "xdot at the section [sqrt(g l0)]", "ydot [sqrt(g l0)]",
-    { legend: { orientation: "h", y: -0.32 }, margin: { l: 55, r: 15, t: 40, b: 105 } }), { responsive: true });
+    { legend: { orientation: "h", y: -0.32 }, margin: { l: 55, r: 15, t: 40, b: 105 } }), PLOT_CONFIG);
 }
 
 const jobStatus = (job) => `${job.kind} job ${job.id}: ${job.state}${job.total ? `, ${job.completed}/${job.total}` : ""}${job.error ? ` — ${job.error}` : ""}`;
@@ -203,15 +210,16 @@ function describeJob(job) {
 }
 
 function jobRow(job) {
-  const row = document.createElement("tr");
+  const progress = attributes(element("progress", null), { max: 1, value: job.progress, "aria-label": `job ${job.id} progress` });
+  const state = attributes(element("td", job.state), { class: "state" });
+  if (job.error) state.title = job.error;
+  const cancel = ["queued", "running"].includes(job.state) ? [attributes(element("button", "Cancel"), { class: "cancel", "data-id": job.id })] : [];
+  const row = element("tr", null,
+    element("td", String(job.id)), element("td", job.kind), attributes(element("td", describeJob(job)), { class: "what" }), state,
+    attributes(element("td", null, progress, ` ${job.completed}/${job.total}`), { class: "progress" }),
+    element("td", null, attributes(element("button", "Show"), { class: "show", "data-id": job.id, "data-kind": job.kind })),
+    element("td", null, ...cancel));
   row.id = `job-${job.id}`;
-  const progress = `<progress max="1" value="${job.progress}" aria-label="job ${job.id} progress"></progress> ${job.completed}/${job.total}`;
-  row.innerHTML = `<td>${job.id}</td><td>${job.kind}</td><td class="what"></td><td class="state"></td><td class="progress">${progress}</td>` +
-    `<td><button class="show" data-id="${job.id}" data-kind="${job.kind}">Show</button></td>` +
-    `<td>${["queued", "running"].includes(job.state) ? `<button class="cancel" data-id="${job.id}">Cancel</button>` : ""}</td>`;
-  $(".what", row).textContent = describeJob(job);
-  $(".state", row).textContent = job.state;
-  if (job.error) $(".state", row).title = job.error;
   return row;
 }
 
@@ -287,7 +295,7 @@ on("#job-table", "click", async (event) => {
     Plotly.react("job-plot", [{
       x: results.levels.map((l) => l.zeta0), y: results.levels.map((l) => l.mean), mode: "lines+markers", name: "MJTF",
       error_y: { type: "data", array: results.levels.map((l) => l.std), visible: true },
-    }], layout(`Job ${id}: Mean Jumps To Failure`, "zeta0 [l0]", "jumps to failure"), { responsive: true });
+    }], layout(`Job ${id}: Mean Jumps To Failure`, "zeta0 [l0]", "jumps to failure"), PLOT_CONFIG);
   } else if (!results.result) {
     say(`Job ${id} is ${job.state}: no result${job.error ? ` (${job.error})` : " yet"}.`, job.state === "failed" ? "error" : "ok");
   } else if (job.kind === "sweep") {
@@ -311,19 +319,19 @@ function runQuery() {
 const shownRuns = new Map();  // id -> the run as last listed: what the editor starts from
 
 function runRow(run) {
-  const row = document.createElement("tr");
-  row.id = `run-${run.id}`;
   const controls = run.controls.map((c) => `${c[0]}°/${c[1]}`).join(", ");
-  row.innerHTML = `<td><input type="checkbox" value="${run.id}" aria-label="select run ${run.id}"></td><td>${run.id}</td><td>${run.kind}</td>` +
-    `<td>${controls}</td><td>${run.jumps_completed}/${run.jumps}</td><td>${run.climb.toFixed(3)}</td>` +
-    `<td>${run.failure_code ?? ""}</td><td class="tags"></td><td class="notes"></td><td>${new Date(run.created_at).toLocaleString()}</td>` +
-    `<td class="actions"><button type="button" class="edit-run" data-run="${run.id}" aria-label="edit the tags and notes of run ${run.id}">edit</button> ` +
-    `<button type="button" class="open-3d" data-run="${run.id}" aria-label="open run ${run.id} in the 3D view">3D</button> ` +
-    `<a href="${API}/runs/${run.id}/share.html" download aria-label="share run ${run.id} as a standalone HTML file">share</a></td>`;
-  // User text goes in as text, never as markup.
-  $(".tags", row).textContent = run.tags.join(" ");
-  $(".notes", row).textContent = run.notes.length > 60 ? `${run.notes.slice(0, 60)}…` : run.notes;
-  $(".notes", row).title = run.notes;
+  const select = attributes(element("input", null), { type: "checkbox", value: run.id, "aria-label": `select run ${run.id}` });
+  const notes = attributes(element("td", run.notes.length > 60 ? `${run.notes.slice(0, 60)}…` : run.notes), { class: "notes", title: run.notes });
+  const actions = attributes(element("td", null,
+    attributes(element("button", "edit"), { type: "button", class: "edit-run", "data-run": run.id, "aria-label": `edit the tags and notes of run ${run.id}` }), " ",
+    attributes(element("button", "3D"), { type: "button", class: "open-3d", "data-run": run.id, "aria-label": `open run ${run.id} in the 3D view` }), " ",
+    attributes(element("a", "share"), { href: `${API}/runs/${run.id}/share.html`, download: "", "aria-label": `share run ${run.id} as a standalone HTML file` })),
+  { class: "actions" });
+  const row = element("tr", null, element("td", null, select), element("td", String(run.id)), element("td", run.kind),
+    element("td", controls), element("td", `${run.jumps_completed}/${run.jumps}`), element("td", run.climb.toFixed(3)),
+    element("td", run.failure_code ?? ""), attributes(element("td", run.tags.join(" ")), { class: "tags" }), notes,
+    element("td", new Date(run.created_at).toLocaleString()), actions);
+  row.id = `run-${run.id}`;
   return row;
 }
 
@@ -347,15 +355,11 @@ async function loadExperiments() {
   const chosen = filter.value;
   filter.replaceChildren(new Option("any", ""), ...page.items.map((e) => new Option(`${e.id}: ${e.name}`, String(e.id))));
   filter.value = page.items.some((e) => String(e.id) === chosen) ? chosen : "";
-  $("#experiment-table tbody").replaceChildren(...page.items.map((experiment) => {
-    const row = document.createElement("tr");
-    row.innerHTML = `<td>${experiment.id}</td><td><button type="button" class="show-experiment" data-experiment="${experiment.id}"></button></td>` +
-      `<td class="description"></td><td>${experiment.runs}</td><td class="tags"></td><td>${new Date(experiment.created_at).toLocaleString()}</td>`;
-    $(".show-experiment", row).textContent = experiment.name;
-    $(".description", row).textContent = experiment.description;
-    $(".tags", row).textContent = experiment.tags.join(" ");
-    return row;
-  }));
+  $("#experiment-table tbody").replaceChildren(...page.items.map((experiment) => element("tr", null,
+    element("td", String(experiment.id)),
+    element("td", null, attributes(element("button", experiment.name), { type: "button", class: "show-experiment", "data-experiment": experiment.id })),
+    attributes(element("td", experiment.description), { class: "description" }), element("td", String(experiment.runs)),
+    attributes(element("td", experiment.tags.join(" ")), { class: "tags" }), element("td", new Date(experiment.created_at).toLocaleString()))));
 }
 
 on("#experiment-table", "click", async (event) => {
@@ -443,11 +447,19 @@ let pendingTarget;  // the closed-loop target of the run this browser is startin
 let runWasActive = false;
 let localRuns = 0;
 
-// An element with ``text`` as its text (never parsed as markup) and ``children`` after it.
+// An element with ``text`` as its text (never parsed as markup) and ``children`` after it (nodes,
+// or strings: text too). No value from the API reaches the page as markup: every row, table and
+// status is built from these two.
 function element(tag, text, ...children) {
   const node = document.createElement(tag);
   if (text !== null) node.textContent = text;
   node.append(...children);
+  return node;
+}
+
+// ``node`` with these attributes, each value set as a string (an attribute value: never markup).
+function attributes(node, values) {
+  for (const [name, value] of Object.entries(values)) node.setAttribute(name, String(value));
   return node;
 }
 
@@ -545,7 +557,7 @@ function drawLive() {
   // New arrays each time: Plotly.react redraws only what it sees change.
   Plotly.react("live-plot", [{ x: plot.t.map((t) => t - start), y: plot.y.slice(), mode: "lines", name: "height" }],
     layout(`Live height${run}${plot.target === null ? "" : ` (target ${plot.target} m, dashed)`}`, "time since the run's first pose [s]", "y [m]", { shapes }),
-    { responsive: true });
+    PLOT_CONFIG);
 }
 
 async function refreshRobot() { showStatus(await call("GET", "/robot")); }

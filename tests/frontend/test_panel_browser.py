@@ -581,3 +581,144 @@ def test_the_status_fields_of_the_new_service_are_shown_as_text(page):
     page.evaluate(feed, {**status, "estop": {"latched": False, "reason": None}, "state": "disarmed"})
     assert page.is_hidden("#estop-banner")
     page.click("nav [data-tab=simulate]")  # back to the service's own statuses on the next visit
+
+
+# Stored script stays text (issue 14) ---------------------------------------------------------
+# Markup and script in every stored string a client may write (tags allow only [\w.:/-]+: the
+# nearest they come is a tag like "x:/-"). Each would set window.__xss if the panel parsed it.
+XSS = ('<img src=x onerror="window.__xss=1">', "<script>window.__xss=1</script>", '"><svg onload=window.__xss=1>')
+XSS_TAG = "x:/-"
+# What markup made of a payload would leave behind: an element with an inline handler, a script
+# that is neither Plotly nor the panel, an <img src=x>. The page's own markup has none of them.
+INJECTED = """[...document.querySelectorAll('[onerror], [onload], img[src="x"]')].length
+  + [...document.scripts].filter((s) => !/\\/static\\/plotly\\.min\\.js$|\\/panel\\.js$/.test(s.src)).length"""
+
+
+def _no_script_ran(page, where: str) -> None:
+    assert page.evaluate("window.__xss") is None, f"a payload ran in {where}"
+    assert page.evaluate(INJECTED) == 0, f"a payload became markup in {where}"
+    assert page.evaluate("window.__csp_violations") == [], f"the CSP refused something in {where}"
+
+
+def test_stored_script_is_shown_as_text_in_every_view(page, service):
+    base, token = service
+    auth = {"Authorization": f"Bearer {token}"}
+
+    def post(path, body):
+        answer = httpx.post(f"{base}/api/v1{path}", json=body, headers=auth, timeout=60)
+        answer.raise_for_status()
+        return answer.json()
+
+    name = f"{XSS[0]} wall"
+    experiment = post("/experiments", {"name": name, "description": XSS[1], "notes": XSS[2], "tags": [XSS_TAG]})
+    runs = []
+    for zeta0, notes in zip((0.88, 0.9, 0.92), XSS, strict=True):
+        body = {"experiment_id": experiment["id"], "controls": [{"psi0_deg": 30, "zeta0": zeta0}]}
+        run = post("/runs", {**body, "start": {"xdot": -0.93, "ydot": -0.2}, "tags": [XSS_TAG, "xss"]})
+        patched = httpx.patch(f"{base}/api/v1/runs/{run['id']}", json={"notes": notes}, headers=auth, timeout=60)
+        patched.raise_for_status()
+        runs.append(patched.json())
+    # A job's spec has no free strings (numbers, and kinds from a fixed list): it joins the experiment.
+    spec = {"experiment_id": experiment["id"], "psi0_deg": 30, "zeta0s": [0.9], "trials": 1, "cap": 5}
+    job = post("/jobs", {"kind": "mjtf", **spec})
+
+    # Jobs: the list, a result drawn; a job refused for its kind, whose message quotes the payload.
+    page.click("nav [data-tab=jobs]")
+    _until(page, f"document.querySelector('#job-{job['id']} .state')?.textContent === 'done'", timeout=60_000)
+    page.click(f"#job-{job['id']} .show")
+    _until(page, f"document.querySelector('#job-plot').textContent.includes('Job {job['id']}: Mean Jumps')")
+    page.evaluate("(kind) => call('POST', '/jobs', { kind }).catch(() => {})", XSS[2])
+    page.wait_for_selector(".message.error")
+    assert XSS[2] in page.inner_text(".message.error"), "the 422 quotes the kind it refused, as text"
+    _shot_xss(page, "jobs")
+    _no_script_ran(page, "the Jobs tab")
+
+    # History: the experiments table, the experiment filter, and an experiment made in the panel.
+    page.click("nav [data-tab=history]")
+    if not page.evaluate("document.querySelector('#experiments-box').open"):
+        page.click("#experiments-box summary")
+    page.fill("#experiment-form input[name=name]", XSS[2])
+    page.fill("#experiment-form input[name=description]", XSS[0])
+    page.click("#create-experiment")
+    _until(page, "document.querySelector('.message.ok')?.textContent.includes('created')")
+    assert XSS[2] in page.inner_text(".message.ok")
+    row = f"#experiment-table tr:has(button[data-experiment='{experiment['id']}'])"
+    page.wait_for_selector(row)
+    assert page.inner_text(f"{row} button.show-experiment") == name
+    assert page.inner_text(f"{row} .description") == XSS[1] and page.inner_text(f"{row} .tags") == XSS_TAG
+    assert page.inner_text("#experiment-table tbody tr:first-child button.show-experiment") == XSS[2]
+    assert page.inner_text("#experiment-table tbody tr:first-child .description") == XSS[0]
+    options = page.evaluate("[...document.querySelectorAll('#experiment-filter option')].map((o) => o.textContent)")
+    assert f"{experiment['id']}: {name}" in options and any(option.endswith(XSS[2]) for option in options)
+    _no_script_ran(page, "the experiments table")
+
+    # The experiment's runs: notes and tags in the table, in the editor, in the comparison.
+    page.click(f"{row} button.show-experiment")
+    _until(
+        page,
+        "document.querySelectorAll('#run-table tbody tr').length === 3"
+        + "".join(f" && !!document.querySelector('#run-{run['id']}')" for run in runs),
+    )
+    for run in runs:
+        assert page.inner_text(f"#run-{run['id']} .notes") == run["notes"]
+        assert page.get_attribute(f"#run-{run['id']} .notes", "title") == run["notes"]
+        assert page.inner_text(f"#run-{run['id']} .tags") == f"{XSS_TAG} xss"
+        assert page.get_attribute(f"#run-{run['id']} input[type=checkbox]", "value") == str(run["id"])
+        assert page.get_attribute(f"#run-{run['id']} a[download]", "href").endswith(f"/runs/{run['id']}/share.html")
+    _shot_xss(page, "history")
+    _no_script_ran(page, "the runs table")
+    for run in runs:
+        page.click(f"#run-{run['id']} button.edit-run")
+        assert page.evaluate("document.querySelector('#run-editor').open")
+        assert page.input_value("#run-editor textarea[name=notes]") == run["notes"]
+        assert page.input_value("#run-editor input[name=tags]") == f"{XSS_TAG} xss"
+        if run is runs[1]:
+            _shot_xss(page, "run_editor")
+        page.keyboard.press("Escape")
+        _no_script_ran(page, f"the editor of run {run['id']}")
+    for run in runs:
+        page.check(f"#run-{run['id']} input[type=checkbox]")
+    page.click("#compare")
+    page.wait_for_selector("#compare-table")
+    compared = page.inner_text("#compare-table")
+    assert all(payload in compared for payload in XSS), compared
+    page.locator("#compare-table").scroll_into_view_if_needed()
+    _shot_xss(page, "compare")
+    _no_script_ran(page, "the comparison")
+
+    # The Robot tab shows the link's status, no stored text: nothing there may run either.
+    page.click("nav [data-tab=robot]")
+    _until(page, "document.querySelector('#robot-state').textContent !== '—'")
+    _no_script_ran(page, "the Robot tab")
+    page.click("nav [data-tab=history]")
+    page.select_option("#experiment-filter", "")
+    page.click("#history-form button[type=submit]")
+    page.click("nav [data-tab=simulate]")
+
+
+# Plotly 4 shows a "Share chart..." button (it sends the plot's data to Plotly's cloud) and a logo
+# linking to plotly.com unless a plot's config turns them off.
+CLOUD_FREE = """[...document.querySelectorAll('.js-plotly-plot')].map((plot) => [plot.id,
+  plot._context.displaylogo, plot._context.showSendToCloud, plot._context.modeBarButtonsToRemove.join(' '),
+  plot.querySelectorAll('.modebar-btn[data-title="Share chart..."], a[href*="plotly"]').length])"""
+
+
+def test_no_plot_offers_the_cloud(page):
+    page.click("nav [data-tab=simulate]")
+    page.click("#run-sim")
+    page.wait_for_selector("#path-plot .modebar", state="attached", timeout=20_000)
+    page.hover("#path-plot .main-svg")
+    page.wait_for_selector("#path-plot .modebar-btn", state="visible")
+    time.sleep(0.5)  # the mode bar fades in
+    _shot_xss(page, "plot_modebar", "#path-plot")
+    plots = page.evaluate(CLOUD_FREE)
+    assert {"path-plot", "height-plot"} <= {plot[0] for plot in plots}, plots
+    for plot_id, logo, cloud, removed, links in plots:
+        assert (logo, cloud, links) == (False, False, 0), plot_id
+        assert removed == "sendChartToCloud sendDataToCloud editInChartStudio", plot_id
+
+
+def _shot_xss(page, name, selector=None):
+    folder = Path("/tmp/xss_shots")
+    folder.mkdir(exist_ok=True)
+    (page.locator(selector) if selector else page).screenshot(path=str(folder / f"{name}.png"))

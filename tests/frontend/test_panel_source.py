@@ -1,0 +1,48 @@
+"""The panel's source, read as text (no browser): no HTML sinks, one plot config for every plot.
+
+The browser test (test_panel_browser.py) shows stored markup stays text in each view; these checks
+keep the next change from bringing a sink back in a view that test does not open.
+"""
+
+import re
+from pathlib import Path
+
+import pytest
+
+PANEL = Path(__file__).resolve().parents[2] / "frontend" / "panel"
+SOURCES = sorted(PANEL.glob("*.js")) + sorted(PANEL.glob("*.html"))
+# Every way JavaScript turns a string into markup (or script) in a document.
+SINKS = re.compile(r"innerHTML|outerHTML|insertAdjacentHTML|document\.write|createContextualFragment|DOMParser|srcdoc")
+
+
+@pytest.mark.parametrize("path", SOURCES, ids=lambda path: path.name)
+def test_no_value_reaches_the_page_as_markup(path):
+    lines = enumerate(path.read_text().splitlines(), 1)
+    hits = [f"{path.name}:{n}: {line.strip()}" for n, line in lines if SINKS.search(line)]
+    assert not hits, f"build elements with element()/attributes() (textContent), never from markup: {hits}"
+
+
+def _calls(source: str, name: str) -> list[str]:
+    """The text of every call ``name(...)`` in ``source``, up to its closing parenthesis."""
+    calls = []
+    for match in re.finditer(re.escape(name) + r"\(", source):
+        depth, end = 0, match.end() - 1
+        for end in range(match.end() - 1, len(source)):
+            depth += {"(": 1, ")": -1}.get(source[end], 0)
+            if depth == 0:
+                break
+        calls.append(source[match.start() : end + 1])
+    return calls
+
+
+def test_every_plot_gets_the_config_without_cloud_buttons():
+    source = (PANEL / "panel.js").read_text()
+    calls = [call for name in ("Plotly.react", "Plotly.newPlot", "Plotly.plot") for call in _calls(source, name)]
+    assert len(calls) >= 7, "the Simulate, Jobs and Robot tabs' plots"
+    missing = [call.splitlines()[0] for call in calls if not re.sub(r"\s+", " ", call).endswith(", PLOT_CONFIG)")]
+    assert not missing, f"every plot: Plotly.react(target, data, layout, PLOT_CONFIG): {missing}"
+    config = re.search(r"const PLOT_CONFIG = Object\.freeze\(\{(.*?)\}\);", source, re.S).group(1)
+    for setting in ("displaylogo: false", "showLink: false", "showSendToCloud: false", "showEditInChartStudio: false"):
+        assert setting in config
+    for button in ("sendChartToCloud", "sendDataToCloud", "editInChartStudio"):
+        assert f'"{button}"' in config.split("modeBarButtonsToRemove", 1)[1]
