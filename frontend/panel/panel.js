@@ -18,7 +18,10 @@ function say(text, kind = "ok") {
 
 function explain(body, status) {
   if (body && Array.isArray(body.detail)) {
-    return body.detail.map((e) => `${(e.loc || []).filter((p) => p !== "body").join(".")}: ${e.msg}`).join("; ");
+    return body.detail.map((e) => {
+      const field = (e.loc || []).filter((p) => p !== "body").join(".");
+      return field ? `${field}: ${e.msg}` : e.msg;
+    }).join("; ");
   }
   if (body && body.detail) return body.detail;
   return `HTTP ${status}`;
