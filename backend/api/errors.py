@@ -12,6 +12,7 @@ from fastapi.responses import JSONResponse
 from backend.robot.link import LinkError
 from backend.services import records
 from backend.services.robot import RobotUnavailable
+from backend.store.database import StorageFull
 from sim_core import FixedPointNotFound, ParameterError
 
 STATUS_OF: dict[type[Exception], tuple[int, str]] = {
@@ -20,6 +21,7 @@ STATUS_OF: dict[type[Exception], tuple[int, str]] = {
     RobotUnavailable: (status.HTTP_409_CONFLICT, "{}"),
     LinkError: (status.HTTP_503_SERVICE_UNAVAILABLE, "robot link: {}"),
     FixedPointNotFound: (status.HTTP_422_UNPROCESSABLE_CONTENT, "{}"),
+    StorageFull: (status.HTTP_507_INSUFFICIENT_STORAGE, "{}"),  # any write, any database (store/database.py)
 }
 
 

@@ -5,7 +5,8 @@ so a page costs the same at 100 runs or 100,000.
 
 A change that depends on what it reads (an update, a delete, a run added to an experiment) takes
 the write lock first and reads the rows fresh under it (:func:`locked`): concurrent edits of one
-record serialise, each whole, instead of interleaving their reads and writes.
+record serialise, each whole, instead of interleaving their reads and writes. Deletes also work on
+a full disk (:func:`backend.store.database.freeing_space`): deleting is how space is freed.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ from sqlalchemy.orm import Session
 
 from backend.schemas import ExperimentCreate, ExperimentUpdate, RunCreate
 from backend.services.simulation import simulate_run
-from backend.store.database import lock_for_write
+from backend.store.database import freeing_space, lock_for_write
 from backend.store.models import Experiment, Job, Run, RunTag
 from experiments.manifest import json_safe
 
@@ -60,13 +61,16 @@ def update_experiment(session: Session, experiment_id: int, body: ExperimentUpda
 
 
 def delete_experiment(session: Session, experiment_id: int) -> None:
-    experiment = locked(session, Experiment, experiment_id, "experiment")
-    if run_count(session, experiment_id):
-        raise Conflict(f"experiment {experiment_id} still has runs; delete them first")
-    if session.scalar(select(func.count()).select_from(Job).where(Job.experiment_id == experiment_id)):
-        raise Conflict(f"experiment {experiment_id} has jobs, which are kept as its record; it cannot be deleted")
-    session.delete(experiment)
-    session.commit()
+    def remove() -> None:
+        experiment = locked(session, Experiment, experiment_id, "experiment")
+        if run_count(session, experiment_id):
+            raise Conflict(f"experiment {experiment_id} still has runs; delete them first")
+        if session.scalar(select(func.count()).select_from(Job).where(Job.experiment_id == experiment_id)):
+            raise Conflict(f"experiment {experiment_id} has jobs, which are kept as its record; it cannot be deleted")
+        session.delete(experiment)
+        session.commit()
+
+    freeing_space(session, remove)
 
 
 def run_count(session: Session, experiment_id: int) -> int:
@@ -110,8 +114,11 @@ def update_run(session: Session, run_id: int, *, tags: list[str] | None = None, 
 
 
 def delete_run(session: Session, run_id: int) -> None:
-    session.delete(locked(session, Run, run_id, "run"))
-    session.commit()
+    def remove() -> None:
+        session.delete(locked(session, Run, run_id, "run"))
+        session.commit()
+
+    freeing_space(session, remove)
 
 
 @dataclass(frozen=True)
