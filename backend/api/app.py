@@ -25,7 +25,7 @@ from backend.services.compute import Compute
 from backend.services.robot import RobotService
 from backend.services.view import ViewContext, ViewFactory, ViewStarter
 from backend.settings import Settings
-from backend.store.database import make_engine, migrate, session_factory
+from backend.store.database import ensure_reserve, make_engine, migrate, session_factory
 
 log = logging.getLogger("parkourlab.api")
 # The control panel's static files (frontend/panel): located, not imported — the frontend sits above
@@ -61,6 +61,7 @@ def create_app(
     @contextlib.asynccontextmanager
     async def lifespan(app: FastAPI):
         migrate(engine)
+        ensure_reserve(engine)  # the room deletes need on a full disk (store/database.py)
         robot_service.recover()  # live runs the previous process died during: stored as interrupted, nothing re-armed
         if warm_kernels:
             compute.warm()

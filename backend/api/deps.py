@@ -16,13 +16,19 @@ from backend.api.security import require_token
 from backend.services import jobs, records
 from backend.services.compute import ComputePool
 from backend.services.robot import RobotService
+from backend.store.database import StorageFull, after_storage_full
 
 VIEW_NOT_STARTED = "the 3D view is not running (it starts with `parkour serve`)"
 
 
 def get_session(request: Request) -> Iterator[Session]:
     with request.app.state.sessions() as session:
-        yield session
+        try:
+            yield session
+        except StorageFull:  # answered 507 (errors.py); the WAL is folded so that a retry can fit
+            session.rollback()
+            after_storage_full(session.get_bind())
+            raise
 
 
 def run_filter(

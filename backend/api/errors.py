@@ -24,6 +24,7 @@ from backend.robot.link import LinkError
 from backend.services import records
 from backend.services.compute import ComputeBusy, ComputeFailed, ComputeTimeout
 from backend.services.robot import RobotUnavailable
+from backend.store.database import StorageFull
 from sim_core import FixedPointNotFound, ParameterError
 
 log = logging.getLogger("parkourlab.api")
@@ -40,6 +41,7 @@ STATUS_OF: dict[type[Exception], tuple[int, str]] = {
     ComputeBusy: (status.HTTP_503_SERVICE_UNAVAILABLE, "busy: {}"),
     ComputeTimeout: (status.HTTP_503_SERVICE_UNAVAILABLE, "{}"),
     ComputeFailed: (status.HTTP_503_SERVICE_UNAVAILABLE, "{}"),
+    StorageFull: (status.HTTP_507_INSUFFICIENT_STORAGE, "{}"),  # any write, any database (store/database.py)
 }
 
 

@@ -2,6 +2,11 @@
 
 Lists are paged on the server by ``id`` (newest first), with every filtered column indexed,
 so a page costs the same at 100 runs or 100,000.
+
+A change that depends on what it reads (an update, a delete, a run added to an experiment) takes
+the write lock first and reads the rows fresh under it (:func:`locked`): concurrent edits of one
+record serialise, each whole, instead of interleaving their reads and writes. Deletes also work on
+a full disk (:func:`backend.store.database.freeing_space`): deleting is how space is freed.
 """
 
 from __future__ import annotations
@@ -19,6 +24,7 @@ from sqlalchemy.orm import Session
 
 from backend.schemas import ExperimentCreate, ExperimentUpdate, RunCreate
 from backend.services.simulation import simulate_run
+from backend.store.database import freeing_space, lock_for_write
 from backend.store.models import Experiment, Job, Run, RunTag
 from experiments.manifest import json_safe
 
@@ -46,7 +52,7 @@ def get_experiment(session: Session, experiment_id: int) -> Experiment:
 
 
 def update_experiment(session: Session, experiment_id: int, body: ExperimentUpdate) -> Experiment:
-    experiment = get_experiment(session, experiment_id)
+    experiment = locked(session, Experiment, experiment_id, "experiment")
     for field, value in body.model_dump(exclude_unset=True).items():
         if value is not None:
             setattr(experiment, field, value)
@@ -55,13 +61,16 @@ def update_experiment(session: Session, experiment_id: int, body: ExperimentUpda
 
 
 def delete_experiment(session: Session, experiment_id: int) -> None:
-    experiment = get_experiment(session, experiment_id)
-    if run_count(session, experiment_id):
-        raise Conflict(f"experiment {experiment_id} still has runs; delete them first")
-    if session.scalar(select(func.count()).select_from(Job).where(Job.experiment_id == experiment_id)):
-        raise Conflict(f"experiment {experiment_id} has jobs, which are kept as its record; it cannot be deleted")
-    session.delete(experiment)
-    session.commit()
+    def remove() -> None:
+        experiment = locked(session, Experiment, experiment_id, "experiment")
+        if run_count(session, experiment_id):
+            raise Conflict(f"experiment {experiment_id} still has runs; delete them first")
+        if session.scalar(select(func.count()).select_from(Job).where(Job.experiment_id == experiment_id)):
+            raise Conflict(f"experiment {experiment_id} has jobs, which are kept as its record; it cannot be deleted")
+        session.delete(experiment)
+        session.commit()
+
+    freeing_space(session, remove)
 
 
 def run_count(session: Session, experiment_id: int) -> int:
@@ -77,7 +86,11 @@ def create_run(session: Session, body: RunCreate, compute=None) -> Run:
     or here without one — and store it as a run."""
     if body.experiment_id is not None:
         get_experiment(session, body.experiment_id)
-    fields = simulate_run(body) if compute is None else compute.run(simulate_run, body)
+    fields = (
+        simulate_run(body) if compute is None else compute.run(simulate_run, body)
+    )  # before the lock: it takes a while
+    if body.experiment_id is not None:  # still there (a concurrent delete waits for this commit)
+        locked(session, Experiment, body.experiment_id, "experiment")
     run = Run(experiment_id=body.experiment_id, **fields)
     run.run_tags = [RunTag(tag=tag) for tag in sorted(set(body.tags))]
     session.add(run)
@@ -90,10 +103,14 @@ def get_run(session: Session, run_id: int) -> Run:
 
 
 def update_run(session: Session, run_id: int, *, tags: list[str] | None = None, notes: str | None = None) -> Run:
-    """Relabel a run or rewrite its notes; ``None`` leaves a field as it is."""
-    run = get_run(session, run_id)
+    """Relabel a run or rewrite its notes; ``None`` leaves a field as it is. One transaction under
+    the write lock: the tags it replaces are the ones stored, not ones a concurrent edit replaced
+    since they were read (that race inserted a tag twice, a 500, or kept two edits' tags)."""
+    run = locked(session, Run, run_id, "run")
     if tags is not None:
-        run.run_tags = [RunTag(tag=tag) for tag in sorted(set(tags))]
+        wanted = set(tags)
+        kept = [row for row in run.run_tags if row.tag in wanted]  # the rest are deleted (orphans)
+        run.run_tags = kept + [RunTag(tag=tag) for tag in sorted(wanted - {row.tag for row in kept})]
     if notes is not None:
         run.notes = notes
     session.commit()
@@ -101,8 +118,11 @@ def update_run(session: Session, run_id: int, *, tags: list[str] | None = None, 
 
 
 def delete_run(session: Session, run_id: int) -> None:
-    session.delete(get_run(session, run_id))
-    session.commit()
+    def remove() -> None:
+        session.delete(locked(session, Run, run_id, "run"))
+        session.commit()
+
+    freeing_space(session, remove)
 
 
 @dataclass(frozen=True)
@@ -267,12 +287,19 @@ def aggregate_runs(session: Session, where: RunFilter, by: str) -> list[dict]:
     return groups
 
 
-def fetch(session: Session, model: type, identifier: int, what: str):
+def fetch(session: Session, model: type, identifier: int, what: str, **options):
     """The row of ``model`` with primary key ``identifier``; :class:`NotFound` names ``what`` if none."""
-    row = session.get(model, identifier)
+    row = session.get(model, identifier, **options)
     if row is None:
         raise NotFound(what, identifier)
     return row
+
+
+def locked(session: Session, model: type, identifier: int, what: str):
+    """:func:`fetch` for a change: under the write lock (SQLite), the row locked ``FOR UPDATE``
+    (PostgreSQL), read fresh even if the session holds an older copy."""
+    lock_for_write(session)
+    return fetch(session, model, identifier, what, with_for_update=True, populate_existing=True)
 
 
 def newest_first(model: type, limit: int, cursor: int | None) -> Select:

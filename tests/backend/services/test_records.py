@@ -106,6 +106,51 @@ def test_update_and_delete_a_run(session, make_run):
             call(session, run.id)
 
 
+def test_an_edit_replaces_the_stored_tags_not_the_ones_its_session_read(sessions, make_run):
+    """Two sessions, as two requests: the first read the run before the second retagged it. Its
+    edit replaces what is stored (read again under the write lock), not its stale copy — which
+    used to insert a tag still there (UNIQUE failed) or leave the other edit's tags in place."""
+    run = make_run(tags=["a", "b"])
+    with sessions() as first, sessions() as second:
+        stale = records.get_run(first, run.id)  # held: the session keeps its copy
+        assert stale.tags == ["a", "b"]
+        records.update_run(second, run.id, tags=["c", "d"], notes="second")
+        assert records.update_run(first, run.id, tags=["a", "c"]) is stale
+        assert (stale.tags, stale.notes) == (["a", "c"], "second")
+    with sessions() as fresh:
+        stored = records.get_run(fresh, run.id)
+        assert (stored.tags, stored.notes) == (["a", "c"], "second")
+
+
+def test_an_edit_waits_for_the_write_lock_and_reads_after_it(sessions, make_run):
+    """While another transaction holds the write lock, an edit does not read: it waits, then sees
+    that transaction's commit (here: the run deleted, so a 404 rather than tags for a missing run)."""
+    import threading
+
+    run = make_run(tags=["a"])
+    outcome = []
+    with sessions() as holder:
+        records.locked(holder, records.Run, run.id, "run")
+        holder.delete(holder.get(records.Run, run.id))
+        holder.flush()
+
+        def edit():
+            with sessions() as editor:
+                try:
+                    records.update_run(editor, run.id, tags=["b"])
+                    outcome.append("updated")
+                except NotFound:
+                    outcome.append("not found")
+
+        editor = threading.Thread(target=edit)
+        editor.start()
+        editor.join(0.5)
+        assert editor.is_alive(), "the edit waits for the lock"
+        holder.commit()
+    editor.join(10)
+    assert outcome == ["not found"]
+
+
 @pytest.fixture
 def stored_runs(session, make_run):
     """Five runs: zeta0 0.86 .. 0.94 at psi0 = 30°, the middle one tagged and in an experiment,
