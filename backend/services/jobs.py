@@ -12,12 +12,15 @@ duplicated (the unique key refuses a second copy). Sweeps, basins and gait searc
 deterministic: they run whole through the chunk map, report progress per chunk, and store
 their result on the job when done; a restart recomputes them. Cancelling marks the job; the
 runner sees it within ``CANCEL_POLL`` and stops the worker at once (a chunk under way is dropped:
-its trials are not committed, and nothing else depends on it).
+its trials are not committed, and nothing else depends on it). On a full disk a job pauses: what
+it computed waits in memory and is committed when there is room again (tried every
+``STORAGE_RETRY``); stopped meanwhile, it stays running and the next start resumes it.
 """
 
 from __future__ import annotations
 
 import concurrent.futures
+import contextlib
 import functools
 import logging
 import math
@@ -34,6 +37,7 @@ from backend.services.compute import ComputePool
 from backend.services.job_specs import decode, encode, spec_of
 from backend.services.records import fetch, get_experiment, newest_first, page
 from backend.services.simulation import current_code_version, model_params, run_study, run_study_here
+from backend.store.database import StorageFull, after_storage_full
 from backend.store.models import Job, Trial, utcnow
 from experiments.cluster import as_completed_results, chunk_map_for, dask_client
 from experiments.manifest import json_safe
@@ -44,6 +48,7 @@ from sim_core.noise import NoiseModel, trial_seeds
 log = logging.getLogger("parkourlab.jobs")
 
 CHUNK_TRIALS = 32  # tens of trials per commit: a 3 ms trial alone would drown in overhead
+STORAGE_RETRY = 5.0  # [s] between tries to store a paused job's results on a full disk
 CANCEL_POLL = 0.2  # [s] how often the runner looks for a cancel while a worker computes
 IN_FLIGHT = 4  # chunks handed to the worker ahead of the one awaited: it never idles between chunks
 ACTIVE = ("queued", "running", "cancelling")
@@ -134,6 +139,10 @@ def level_summaries(session: Session, job: Job) -> list[dict]:
     return summaries
 
 
+class _Stopped(Exception):
+    """The runner is stopping while a job waits for disk space."""
+
+
 class JobRunner:
     """Runs jobs one at a time on a background thread, resuming unfinished ones at start."""
 
@@ -151,6 +160,7 @@ class JobRunner:
         self.dask_address = dask_address
         self.queue: queue.Queue[int | None] = queue.Queue()
         self.thread: threading.Thread | None = None
+        self._stopping = threading.Event()  # set by stop(): a job paused on a full disk gives up its wait
 
     def start(self) -> None:
         with self.sessions() as session:
@@ -170,6 +180,7 @@ class JobRunner:
         self.queue.put(job_id)
 
     def stop(self, timeout: float = 10.0) -> None:
+        self._stopping.set()
         if self.thread is not None:
             self.queue.put(None)
             self.thread.join(timeout)
@@ -178,6 +189,8 @@ class JobRunner:
         while (job_id := self.queue.get()) is not None:
             try:
                 self.run(job_id)
+            except _Stopped:  # paused on a full disk at shutdown: still running, the next start resumes it
+                return
             except Exception as error:  # a job's failure is recorded; the runner goes on
                 log.exception("job %s failed", job_id)
                 with self.sessions() as session:
@@ -229,7 +242,7 @@ class JobRunner:
         try:
             for chunk, (jumps, status) in results:
                 level, zeta0, indices, seeds = chunks[chunk]
-                self._commit_chunk(job_id, level, zeta0, indices, seeds, jumps, status)
+                self._until_stored(job_id, self._commit_chunk, job_id, level, zeta0, indices, seeds, jumps, status)
                 if self._cancelled(job_id):
                     return
         except Cancelled:
@@ -252,7 +265,8 @@ class JobRunner:
                 if job.state == "cancelling":
                     raise Cancelled
                 job.completed, job.total = done, total
-                session.commit()
+                with contextlib.suppress(StorageFull):  # progress can wait for space; the result cannot
+                    session.commit()
 
         try:
             if self.dask_address is None:
@@ -266,12 +280,35 @@ class JobRunner:
                 job.state, job.finished_at = "cancelled", utcnow()
                 session.commit()
             return
+        self._until_stored(job_id, self._store_result, job_id, json_safe(result))
+
+    def _store_result(self, job_id: int, result: dict) -> None:
         with self.sessions() as session:
             job = session.get(Job, job_id)
-            job.result = json_safe(result)
+            job.result = result
             job.completed = job.total
             job.state, job.finished_at = "done", utcnow()
             session.commit()
+
+    def _until_stored(self, job_id: int, write: Callable, *args) -> None:
+        """``write(*args)`` (one transaction), again every STORAGE_RETRY while the disk is full: the
+        job pauses with what it computed in memory, and goes on when space returns."""
+        paused = False
+        while True:
+            try:
+                write(*args)
+            except StorageFull:
+                after_storage_full(self.sessions.kw["bind"])
+                if not paused:
+                    log.warning("job %s paused: the disk holding the database is full; it goes on when there is room",
+                                job_id)  # fmt: skip
+                    paused = True
+                if self._stopping.wait(STORAGE_RETRY):
+                    raise _Stopped from None
+                continue
+            if paused:
+                log.warning("job %s goes on: its results fit again", job_id)
+            return
 
     def _execute(self, job_id: int, arguments: list[tuple]) -> Iterator[tuple[int, tuple[np.ndarray, np.ndarray]]]:
         """``(chunk index, result)`` as chunks finish: from the job worker in order, a few handed

@@ -240,3 +240,25 @@ def test_cancel_stops_the_worker_mid_chunk(sessions, session, compute):
         assert _wait_until(sessions, small.id, lambda j: j.state in jobs.FINAL).state == "done"
     finally:
         runner.stop(timeout=WAIT_S)
+
+
+def test_a_job_pauses_on_a_full_disk_and_goes_on_when_there_is_room(sessions, session, compute, monkeypatch, caplog):
+    """Its chunks' results wait in memory while the disk is full (here: the first two commits
+    fail as SQLite fails on a full disk), and are committed once there is room: no trial lost."""
+    from backend.store.database import StorageFull
+
+    monkeypatch.setattr(jobs, "STORAGE_RETRY", 0.05)
+    commit, failures = jobs.JobRunner._commit_chunk, []
+
+    def full_twice(runner, *args):
+        if len(failures) < 2:
+            failures.append(args[0])
+            raise StorageFull("INSERT INTO trials", {}, Exception("database or disk is full"))
+        return commit(runner, *args)
+
+    monkeypatch.setattr(jobs.JobRunner, "_commit_chunk", full_twice)
+    job = jobs.create_job(session, MJTFJobCreate(**SMALL))
+    jobs.JobRunner(sessions, compute.jobs, chunk_trials=CHUNK).run(job.id)
+    done = _job(sessions, job.id)
+    assert (done.state, done.completed, len(failures)) == ("done", 20, 2)
+    assert len(_trials(session, job.id)) == 20 and "paused" in caplog.text and "goes on" in caplog.text
