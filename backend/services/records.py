@@ -12,6 +12,7 @@ a full disk (:func:`backend.store.database.freeing_space`): deleting is how spac
 from __future__ import annotations
 
 import csv
+import dataclasses
 import datetime
 import io
 import json
@@ -20,15 +21,19 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 
 from sqlalchemy import Select, func, select
-from sqlalchemy.orm import Session
+from sqlalchemy.orm import Session, defer
 
 from backend.schemas import ExperimentCreate, ExperimentUpdate, RunCreate
 from backend.services.simulation import simulate_run
 from backend.store.database import freeing_space, lock_for_write
 from backend.store.models import Experiment, Job, Run, RunTag
 from experiments.manifest import json_safe
+from sim_core.params import ModelParams
 
 MAX_PAGE = 500
+# What a list or an export of runs leaves in the database: each run's results and trajectory,
+# the bulk of a row (a page of 50 decoded them all to show none; Run.has_trajectory says if there is one).
+LISTED = (defer(Run.results), defer(Run.trajectory))
 
 
 class NotFound(LookupError):
@@ -152,12 +157,17 @@ def list_runs(
     descending = sort.startswith("-")
     column = getattr(Run, sort.lstrip("-"))
     order = [column.desc() if descending else column.asc(), Run.id.desc() if descending else Run.id.asc()]
-    query = _filtered(select(Run).order_by(*order).limit(limit + 1), where)
+    # The page's ids first, then their rows: a filter an index cannot order (a zeta0 range sorted
+    # by id) sorts only ids, not thousands of whole rows, to keep 51 of them.
+    ids = _filtered(select(Run.id).order_by(*order).limit(limit + 1), where)
     if sort.lstrip("-") == "id":
         if cursor is not None:
-            query = query.where(Run.id < cursor if descending else Run.id > cursor)
-        return page(list(session.scalars(query)), limit)
-    rows = list(session.scalars(query.offset(offset)))
+            ids = ids.where(Run.id < cursor if descending else Run.id > cursor)
+    else:
+        ids = ids.offset(offset)
+    rows = list(session.scalars(select(Run).options(*LISTED).where(Run.id.in_(ids)).order_by(*order)))
+    if sort.lstrip("-") == "id":
+        return page(rows, limit)
     return rows[:limit], (offset + limit if len(rows) > limit else None)
 
 
@@ -189,6 +199,11 @@ GROUP_BY = ("zeta0", "psi0_deg", "alpha", "kind", "failure_code", "experiment_id
 
 def run_row(run: Run) -> dict:
     """A run as one flat record: what export writes and compare lines up."""
+    return flat_record(run, run.tags)
+
+
+def flat_record(run, tags: list[str]) -> dict:
+    """The flat record of ``run`` — a stored Run, or a row of :data:`EXPORTED` columns — and its tags."""
     row = {
         "id": run.id,
         "experiment_id": run.experiment_id,
@@ -197,7 +212,7 @@ def run_row(run: Run) -> dict:
         "created_at": run.created_at.isoformat(),
         "duration_s": run.duration_s,
         "code_version": run.code_version,
-        "tags": " ".join(run.tags),
+        "tags": " ".join(tags),
         "notes": run.notes,
         "jumps": run.jumps,
         "jumps_completed": run.jumps_completed,
@@ -212,23 +227,52 @@ def run_row(run: Run) -> dict:
     return row
 
 
-def export_rows(sessions, where: RunFilter) -> Iterator[dict]:
-    """All matching runs, oldest first, read in batches in a session of their own (the response
-    streams after the request's session has closed)."""
+# What an export reads of each run (not its results or trajectory): plain rows, no ORM objects.
+EXPORTED = (Run.id, Run.experiment_id, Run.kind, Run.status, Run.created_at, Run.duration_s, Run.code_version,
+            Run.notes, Run.jumps, Run.jumps_completed, Run.failure_code, Run.climb, Run.start_state, Run.model,
+            Run.controls)  # fmt: skip
+RECORD_FIELDS = ("id", "experiment_id", "kind", "status", "created_at", "duration_s", "code_version", "tags", "notes",
+                 "jumps", "jumps_completed", "failure_code", "climb", "start_xdot", "start_ydot")  # fmt: skip
+FORMULA_START = frozenset("=+-@\t\r")  # a spreadsheet reads a cell starting with one as a formula
+
+
+def export(sessions, where: RunFilter, format_: str) -> Iterator[str]:
+    """Every matching run, oldest first, as CSV or JSON text in chunks, read in batches in a
+    session of its own (the response streams after the request's session has closed). The CSV's
+    columns are known before the first row: every model field and as many legs as the widest run."""
     with sessions() as session:
-        query = _filtered(select(Run).order_by(Run.id), where).execution_options(yield_per=EXPORT_BATCH)
-        for run in session.scalars(query):
-            yield run_row(run)
+        if format_ == "csv":
+            legs = session.scalar(_filtered(select(func.max(func.json_array_length(Run.controls))), where)) or 0
+            fields = [*RECORD_FIELDS, *(f"model.{f.name}" for f in dataclasses.fields(ModelParams))]
+            fields += [f"leg{leg}.{name}" for leg in range(legs) for name in ("psi0_deg", "zeta0")]
+            yield from rows_as_csv(_exported(session, where), fields)
+        else:
+            yield from rows_as_json(_exported(session, where))
 
 
-def rows_as_csv(rows: Iterator[dict]) -> Iterator[str]:
+def _exported(session: Session, where: RunFilter) -> Iterator[dict]:
+    query = _filtered(select(*EXPORTED).order_by(Run.id), where).execution_options(yield_per=EXPORT_BATCH)
+    for batch in session.execute(query).partitions():
+        ids = [run.id for run in batch]
+        tags: dict[int, list[str]] = {}
+        for run_id, tag in session.execute(
+            select(RunTag.run_id, RunTag.tag).where(RunTag.run_id.in_(ids)).order_by(RunTag.tag)
+        ):
+            tags.setdefault(run_id, []).append(tag)
+        for run in batch:
+            yield flat_record(run, tags.get(run.id, []))
+
+
+def rows_as_csv(rows: Iterator[dict], fields: list[str]) -> Iterator[str]:
+    """``rows`` as CSV with these columns (a row's others are dropped, its missing ones empty).
+    Text that a spreadsheet would run as a formula (starting with = + - @, a tab or a return) is
+    written with a leading apostrophe, as OWASP advises; numbers are written as they are."""
     buffer = io.StringIO()
-    writer = None
+    writer = csv.writer(buffer)
+    writer.writerow(fields)
     for row in rows:
-        if writer is None:
-            writer = csv.DictWriter(buffer, fieldnames=list(row), extrasaction="ignore", restval="")
-            writer.writeheader()
-        writer.writerow(row)
+        values = [row.get(field, "") for field in fields]
+        writer.writerow([f"'{v}" if v.__class__ is str and v[:1] in FORMULA_START else v for v in values])
         if buffer.tell() > 64_000:
             yield buffer.getvalue()
             buffer.seek(0)

@@ -23,7 +23,7 @@ from sqlalchemy import (
     TypeDecorator,
     UniqueConstraint,
 )
-from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column, relationship
+from sqlalchemy.orm import DeclarativeBase, Mapped, column_property, mapped_column, relationship
 
 
 def utcnow() -> datetime.datetime:
@@ -89,6 +89,8 @@ class Run(Base):
 
     experiment: Mapped[Experiment | None] = relationship(back_populates="runs")
     run_tags: Mapped[list[RunTag]] = relationship(cascade="all, delete-orphan", lazy="selectin")
+    # Whether it has a trajectory, without loading it: lists and exports defer the blob and results.
+    has_trajectory: Mapped[bool] = column_property(trajectory.is_not(None))
 
     @property
     def tags(self) -> list[str]:

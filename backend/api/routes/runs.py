@@ -42,9 +42,8 @@ def export_runs(
     request: Request, where: RunQuery, format_: Annotated[str, Query(alias="format", pattern="^(csv|json)$")] = "csv"
 ):
     """Every run matching the filters, streamed, with tags, timings and parameters (not the path)."""
-    rows = records.export_rows(request.app.state.sessions, where)
+    body = records.export(request.app.state.sessions, where, format_)
     media = "text/csv" if format_ == "csv" else "application/json"
-    body = records.rows_as_csv(rows) if format_ == "csv" else records.rows_as_json(rows)
     disposition = {"Content-Disposition": f'attachment; filename="runs.{format_}"'}
     return StreamingResponse(body, media_type=media, headers=disposition)
 
@@ -120,7 +119,7 @@ def run_out(run, *, detail: bool = False) -> dict:
         "climb": run.climb,
         "tags": run.tags,
         "notes": run.notes,
-        "has_trajectory": run.trajectory is not None,
+        "has_trajectory": run.has_trajectory,
     }
     if detail:
         out["results"] = run.results

@@ -11,6 +11,7 @@ from backend.schemas import ExperimentCreate, ExperimentUpdate, LegIn, MJTFJobCr
 from backend.services import records
 from backend.services.jobs import create_job
 from backend.services.records import Conflict, NotFound, RunFilter
+from experiments.manifest import json_safe
 from sim_core import ControlSchedule, get_preset, iterate_map
 from tests.backend.services.bodies import START
 
@@ -222,17 +223,28 @@ def test_run_row_flattens_model_and_legs(make_run):
     assert row["created_at"] == run.created_at.isoformat()
 
 
+def _exported(sessions, where: RunFilter, format_: str = "json"):
+    text = "".join(records.export(sessions, where, format_))
+    return json.loads(text) if format_ == "json" else list(csv.DictReader(io.StringIO(text)))
+
+
 def test_export_reads_matching_runs_oldest_first_in_its_own_session(sessions, stored_runs):
     _, runs = stored_runs
-    rows = list(records.export_rows(sessions, RunFilter(psi0_max=45.0)))
+    rows = _exported(sessions, RunFilter(psi0_max=45.0))
     assert [row["id"] for row in rows] == sorted(runs[z].id for z in (0.86, 0.88, 0.9, 0.92, 0.94))
     assert [row["leg0.zeta0"] for row in rows] == [0.86, 0.88, 0.9, 0.92, 0.94]
 
 
+def test_an_exported_record_is_the_runs_flat_record(sessions, stored_runs, session):
+    _, runs = stored_runs
+    exported = {row["id"]: row for row in _exported(sessions, RunFilter())}
+    for run in runs.values():
+        assert exported[run.id] == json.loads(json.dumps(json_safe(records.run_row(records.get_run(session, run.id)))))
+
+
 def test_csv_export_parses_back(sessions, stored_runs):
-    rows = list(records.export_rows(sessions, RunFilter()))
-    text = "".join(records.rows_as_csv(iter(rows)))
-    parsed = list(csv.DictReader(io.StringIO(text)))
+    rows = _exported(sessions, RunFilter())
+    parsed = _exported(sessions, RunFilter(), "csv")
     assert [int(row["id"]) for row in parsed] == [row["id"] for row in rows]
     assert [float(row["climb"]) for row in parsed] == [row["climb"] for row in rows]
     assert parsed[-1]["failure_code"] == "slip" and parsed[0]["failure_code"] == ""
@@ -240,26 +252,27 @@ def test_csv_export_parses_back(sessions, stored_runs):
 
 def test_csv_export_streams_in_pieces():
     rows = [{"id": i, "text": "x" * 100} for i in range(2000)]
-    pieces = list(records.rows_as_csv(iter(rows)))
+    pieces = list(records.rows_as_csv(iter(rows), ["id", "text"]))
     assert len(pieces) > 2, "a large export is written in pieces, not one string"
     parsed = list(csv.DictReader(io.StringIO("".join(pieces))))
     assert len(parsed) == 2000 and parsed[-1] == {"id": "1999", "text": "x" * 100}
-    assert "".join(records.rows_as_csv(iter([]))) == ""
+    assert "".join(records.rows_as_csv(iter([]), ["id"])) == "id\r\n", "no runs: the header alone"
 
 
-CSV_DROPS_LEGS = (
-    "bug: rows_as_csv takes its columns from the first row and ignores the rest, "
-    "so a two-leg run exported after a one-leg run loses its leg1.* controls"
-)
-
-
-@pytest.mark.xfail(strict=True, raises=AssertionError, reason=CSV_DROPS_LEGS)
 def test_csv_export_keeps_every_runs_legs(sessions, make_run):
+    """The columns are known before the first row: as many legs as the widest run (a two-leg run
+    exported after a one-leg run lost its leg1.* controls when the first row decided)."""
     make_run()
     make_run(controls=[LegIn(psi0_deg=30.0, zeta0=0.87), LegIn(psi0_deg=30.0, zeta0=0.9)])
-    text = "".join(records.rows_as_csv(records.export_rows(sessions, RunFilter())))
-    parsed = list(csv.DictReader(io.StringIO(text)))
-    assert parsed[1].get("leg1.zeta0") == "0.9"
+    parsed = _exported(sessions, RunFilter(), "csv")
+    assert parsed[1]["leg1.zeta0"] == "0.9" and parsed[0]["leg1.zeta0"] == ""
+
+
+@pytest.mark.parametrize("text", ['=HYPERLINK("http://x")', "+1+1", "-2+3", "@SUM(A1)", "\tx", "\rx"])
+def test_csv_cells_a_spreadsheet_would_run_are_escaped(sessions, make_run, session, text):
+    records.update_run(session, make_run().id, notes=text)
+    (row,) = _exported(sessions, RunFilter(), "csv")
+    assert row["notes"] == "'" + text and float(row["start_xdot"]) == -0.93, "numbers, negative ones too, as they are"
 
 
 def test_json_export_is_strict_json():
