@@ -20,7 +20,7 @@ import math
 from collections.abc import Iterator
 from dataclasses import dataclass
 
-from sqlalchemy import Select, func, select
+from sqlalchemy import Float, Integer, Select, case, cast, func, select
 from sqlalchemy.orm import Session, defer
 
 from backend.schemas import ExperimentCreate, ExperimentUpdate, RunCreate
@@ -28,6 +28,7 @@ from backend.services.simulation import simulate_run
 from backend.store.database import freeing_space, lock_for_write
 from backend.store.models import Experiment, Job, Run, RunTag
 from experiments.manifest import json_safe
+from sim_core.errors import ParameterError
 from sim_core.params import ModelParams
 
 MAX_PAGE = 500
@@ -195,6 +196,9 @@ def _filtered(query, where: RunFilter):
 EXPORT_BATCH = 1000
 MAX_COMPARE = 50
 GROUP_BY = ("zeta0", "psi0_deg", "alpha", "kind", "failure_code", "experiment_id", "tag")
+CONTINUOUS = ("zeta0", "psi0_deg", "alpha")  # grouped by exact value (at most MAX_GROUPS) or in bins
+MAX_GROUPS = 1000
+MAX_BINS = 1000
 
 
 def run_row(run: Run) -> dict:
@@ -299,25 +303,47 @@ def compare_runs(session: Session, ids: list[int], *, only_differences: bool) ->
     }
 
 
-def aggregate_runs(session: Session, where: RunFilter, by: str) -> list[dict]:
-    """Groups with count and mean/std/min/max of climb and jumps completed, computed in SQL."""
-    key = RunTag.tag if by == "tag" else getattr(Run, by)
+def aggregate_runs(session: Session, where: RunFilter, by: str, bins: int | None = None) -> list[dict]:
+    """Groups with count and mean/std/min/max of climb and jumps completed, computed in SQL; the
+    same JSON types on every database (PostgreSQL averages integers as numeric: cast to float).
+
+    A continuous parameter (:data:`CONTINUOUS`) groups by its exact values, at most
+    :data:`MAX_GROUPS` of them, or with ``bins`` into that many equal bins between the smallest
+    and largest value matching: each group's ``key`` is then its bin's centre, with ``low`` and
+    ``high`` its edges (the last bin includes its upper edge)."""
+    if bins is not None and by not in CONTINUOUS:
+        raise ParameterError("bins", f"bins group a continuous parameter ({', '.join(CONTINUOUS)}), not {by}")
+    column = RunTag.tag if by == "tag" else getattr(Run, by)
+    key, edges = column, None
+    if bins is not None:
+        low, high = session.execute(_filtered(select(func.min(column), func.max(column)), where)).one()
+        if low is None:
+            return []
+        width = (high - low) / bins or 1.0
+        key, edges = case((column >= high, bins - 1), else_=cast((column - low) / width, Integer)), (low, width)
     columns = [key.label("key"), func.count(Run.id).label("runs")]
     for name in ("climb", "jumps_completed"):
-        column = getattr(Run, name)
+        value = getattr(Run, name)
         columns += [
-            func.avg(column).label(f"{name}_mean"),
-            func.avg(column * column).label(f"{name}_mean_square"),
-            func.min(column).label(f"{name}_min"),
-            func.max(column).label(f"{name}_max"),
+            cast(func.avg(value), Float).label(f"{name}_mean"),
+            cast(func.avg(value * value), Float).label(f"{name}_mean_square"),
+            cast(func.min(value), Float).label(f"{name}_min"),
+            cast(func.max(value), Float).label(f"{name}_max"),
         ]
     query = select(*columns)
-    if by == "tag":
-        query = query.join(RunTag, RunTag.run_id == Run.id)
-    query = _filtered(query.select_from(Run) if by != "tag" else query, where).group_by(key).order_by(key)
+    query = query.join(RunTag, RunTag.run_id == Run.id) if by == "tag" else query.select_from(Run)
+    query = _filtered(query, where).group_by(key).order_by(key)
+    if by in CONTINUOUS and bins is None:
+        distinct = session.scalar(select(func.count()).select_from(query.subquery()))
+        if distinct > MAX_GROUPS:
+            raise ParameterError("bins", f"{distinct} distinct {by} values: more than {MAX_GROUPS}; ask for bins")
     groups = []
     for row in session.execute(query).mappings():
         group = {"key": row["key"], "runs": row["runs"]}
+        if edges is not None:
+            low, width = edges
+            group |= {"key": low + (row["key"] + 0.5) * width, "low": low + row["key"] * width,
+                      "high": low + (row["key"] + 1) * width}  # fmt: skip
         for name in ("climb", "jumps_completed"):
             mean = row[f"{name}_mean"]
             variance = max(row[f"{name}_mean_square"] - mean * mean, 0.0)

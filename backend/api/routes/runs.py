@@ -66,9 +66,15 @@ def aggregate_runs(
     db: Db,
     where: RunQuery,
     by: Annotated[str, Query(pattern=f"^({'|'.join(records.GROUP_BY)})$")] = "zeta0",
+    bins: Annotated[
+        int | None,
+        Query(ge=1, le=records.MAX_BINS, description="continuous parameters: equal bins over their range"),
+    ] = None,
 ) -> dict:
-    """Runs grouped by a parameter or tag: count, mean, std, min and max of climb and jumps completed."""
-    return {"by": by, "groups": records.aggregate_runs(db, where, by)}
+    """Runs grouped by a parameter or tag: count, mean, std, min and max of climb and jumps completed.
+    A continuous parameter (zeta0, psi0_deg, alpha) groups by exact value — at most 1000 — or in
+    ``bins`` equal bins (each group then has ``low`` and ``high``)."""
+    return {"by": by, "bins": bins, "groups": records.aggregate_runs(db, where, by, bins)}
 
 
 @router.get("/{run_id}", response_model=schemas.RunDetail)

@@ -144,3 +144,26 @@ def test_run_with_fixed_point_and_retagging(client, auth):
     assert client.get(f"/api/v1/runs/{run['id']}").json()["notes"] == "left foot slipped once"
     too_long = client.patch(f"/api/v1/runs/{run['id']}", json={"notes": "x" * 100_001}, headers=auth)
     assert too_long.status_code == 422 and "notes" in too_long.text
+
+
+def test_a_continuous_parameter_aggregates_in_bins(client, auth):
+    _seed_runs(client, auth)  # zeta0 0.88, 0.88, 0.92
+    response = client.get("/api/v1/runs/aggregate", params={"by": "zeta0", "bins": 2})
+    assert response.status_code == 200, response.text
+    groups = response.json()["groups"]
+    assert [group["runs"] for group in groups] == [2, 1], "the upper edge belongs to the last bin"
+    assert groups[0]["low"] == pytest.approx(0.88) and groups[1]["high"] == pytest.approx(0.92)
+    assert groups[0]["key"] == pytest.approx(0.89) and groups[1]["key"] == pytest.approx(0.91)
+    assert all(isinstance(group["jumps_completed"]["mean"], float) for group in groups), "numbers, not strings"
+    wrong = client.get("/api/v1/runs/aggregate", params={"by": "tag", "bins": 2})
+    assert wrong.status_code == 422 and "bins" in wrong.text
+
+
+def test_more_distinct_values_than_groups_allowed_ask_for_bins(client, auth, monkeypatch):
+    from backend.services import records
+
+    _seed_runs(client, auth)
+    monkeypatch.setattr(records, "MAX_GROUPS", 1)
+    response = client.get("/api/v1/runs/aggregate", params={"by": "zeta0"})
+    assert response.status_code == 422 and "ask for bins" in response.text
+    assert client.get("/api/v1/runs/aggregate", params={"by": "zeta0", "bins": 1}).json()["groups"][0]["runs"] == 3
