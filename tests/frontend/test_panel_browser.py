@@ -679,7 +679,10 @@ def test_stored_script_is_shown_as_text_in_every_view(page, service):
     for run in runs:
         page.check(f"#run-{run['id']} input[type=checkbox]")
     page.click("#compare")
-    page.wait_for_selector("#compare-table")
+    # An earlier test's table may still be on the page: wait for the one of these runs.
+    headers = " && ".join(f"text.includes('run {run['id']}')" for run in runs)
+    table = "document.querySelector('#compare-table')?.innerText ?? ''"
+    _until(page, f"(() => {{ const text = {table}; return {headers}; }})()")
     compared = page.inner_text("#compare-table")
     assert all(payload in compared for payload in XSS), compared
     page.locator("#compare-table").scroll_into_view_if_needed()
