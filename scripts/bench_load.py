@@ -18,12 +18,9 @@ import argparse
 import concurrent.futures
 import json
 import multiprocessing
-import os
 import random
 import shutil
 import statistics
-import subprocess
-import sys
 import tempfile
 import threading
 import time
@@ -31,6 +28,8 @@ from pathlib import Path
 
 import httpx
 from bench_store import QUERIES, seed  # scripts/ is on the path when this script runs
+
+from tests.helpers import start_service
 
 ROOT = Path(__file__).resolve().parents[1]
 RUN = {"controls": [{"psi0_deg": 30, "zeta0": 0.9}], "start": {"xdot": -0.93, "ydot": -0.17}, "jumps": 4}
@@ -90,21 +89,6 @@ def phase(base: str, token: str, clients: int, seconds: float) -> dict:
     return summary
 
 
-def start_service(data_dir: Path, port: int) -> subprocess.Popen:
-    command = [sys.executable, "-m", "cli", "serve", "--data-dir", str(data_dir), "--port", str(port), "--no-view"]
-    process = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                               env={**os.environ, "PYTHONPATH": str(ROOT)})  # fmt: skip
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline:
-        try:
-            if httpx.get(f"http://127.0.0.1:{port}/api/v1/health", timeout=1).status_code == 200:
-                return process
-        except httpx.HTTPError:
-            time.sleep(0.2)
-    process.kill()
-    raise SystemExit("the service did not start within 60 s")
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=20_000)
@@ -116,7 +100,7 @@ def main() -> None:
     args = parser.parse_args()
     data_dir = Path(tempfile.mkdtemp(prefix="parkourlab-load-"))
     seed(f"sqlite:///{data_dir / 'parkourlab.sqlite3'}", args.runs, random.Random(0))
-    process = start_service(data_dir, args.port)
+    process = start_service(data_dir, args.port, "--no-view")
     base, token = f"http://127.0.0.1:{args.port}", (data_dir / "api_token").read_text().strip()
     auth = {"Authorization": f"Bearer {token}"}
     results = {"runs": args.runs, "job": args.job, "seconds": args.seconds, "phases": []}
