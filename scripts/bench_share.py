@@ -3,9 +3,15 @@
 Starts the service in-process (``create_app`` with the real viser view, as ``parkour serve``
 does, on a fresh data directory), stores runs through the API and times, for each:
 
-- ``cold``: the first share of that run (the view already running, the run never shared);
-- ``warm``: the same share again (best and median of ``--repeat``);
-- ``http``: the route itself, once, through the ASGI client.
+- ``cold``: the first share of that run (the view already running, the run never shared):
+  reading it from the store, then making the file;
+- ``warm``: the same share again (best and median of ``--repeat``): the view keeps the last
+  files it made (``ClimbView.share_html``), so this is a lookup;
+- ``http``: the route itself, once, through the ASGI client;
+- ``load``: reading the run(s) from the store as the view replays them (best of ``--repeat``):
+  a sim run stored without its path is simulated again here;
+- ``build``: making the file from the loaded run(s), nothing kept (``share.share_html``: best
+  and median of ``--repeat``), what cold costs beside ``load``.
 
 Runs: a simulated run of ``--jumps`` jumps with its path stored (``trajectory_rate`` 60 per
 sqrt(l0/g)), the same run stored without a path (the view simulates it again), that run with
@@ -35,6 +41,7 @@ from backend.settings import Settings
 from backend.store.models import Run
 from frontend.viewer.app import ClimbView
 from frontend.viewer.recordings import load_recording
+from frontend.viewer.share import share_html
 
 TRACKER_RATE = 120.0  # [Hz] the lab's tracker
 PANEL_RATE = 60  # samples per sqrt(l0/g): what the panel's "Save run" stores
@@ -76,9 +83,13 @@ def _bench_case(view: ClimbView, client: TestClient, name: str, run_id: int, ove
     query = "" if overlay is None else f"?overlay_run_id={overlay}"
     http, answer = _time(lambda: client.get(f"/api/v1/runs/{run_id}/share.html{query}"))
     assert answer.status_code == 200, answer.text
+    sessions = view.context.sessions
+    runs = [run_id] if overlay is None else [run_id, overlay]
+    load, recordings = min(_time(lambda: [load_recording(sessions, i) for i in runs]) for _ in range(repeat))
+    build = [_time(lambda: share_html(*recordings))[0] for _ in range(repeat)]
     print(
-        f"{name:<44} {cold:6.2f}s {min(warm):6.2f}/{statistics.median(warm):5.2f}s"
-        f" {http:6.2f}s {len(html) / 1e6:7.2f}MB",
+        f"{name:<44} {cold:6.2f}s {min(warm):6.2f}/{statistics.median(warm):5.2f}s {http:6.2f}s"
+        f" {load:6.2f}s {min(build):6.2f}/{statistics.median(build):5.2f}s {len(html) / 1e6:7.2f}MB",
         flush=True,
     )
 
@@ -98,7 +109,7 @@ def main() -> None:
             view = app.state.view_starter.wait(120)
             assert view is not None, app.state.view_starter.unavailable_reason
             print(f"share.html, warm = best/median of {args.repeat}")
-            print(f"{'run':<44} {'cold':>7} {'warm':>15} {'http':>7} {'size':>9}")
+            print(f"{'run':<44} {'cold':>7} {'warm':>15} {'http':>7} {'load':>7} {'build':>15} {'size':>9}")
             for jumps in args.jumps:
                 body = {
                     "controls": [{"psi0_deg": 30, "zeta0": 0.87}, {"psi0_deg": 30, "zeta0": 0.9}],
