@@ -12,34 +12,26 @@ share a run as standalone HTML); ``cli.serve`` plugs it in.
 
 from __future__ import annotations
 
+import collections
 import logging
 import threading
 import time
 
-import numpy as np
 import viser
 
 from backend.services.view import ViewContext
 from backend.settings import LOOPBACK_HOSTS
-from frontend.viewer.modes import LiveMode, ReplayMode, SimulateMode, show_frame
+from frontend.viewer.modes import LiveMode, ReplayMode, SimulateMode
 from frontend.viewer.origins import refuse_foreign_origins
-from frontend.viewer.recordings import load_recording
-from frontend.viewer.scene import ChuteScene
+from frontend.viewer.recordings import load_recording, recording_key
+from frontend.viewer.scene import ChuteScene, place_camera
+from frontend.viewer.share import share_html
 from sim_core import get_preset
 
 log = logging.getLogger("parkourlab.view")
 FRAME_RATE = 60.0  # frames drawn per second (the floor the issue sets is 30)
 READOUT_PERIOD = 0.25  # [s] between readout updates: text need not move at frame rate
-EXPORT_RATE = 30.0  # frames per second of a shared (exported) replay
-MAX_EXPORT_SECONDS = 600.0
-CAMERA_POSITION = (0.0, -1.25, 0.6)  # [m] level with the robot, in front of the chute
-CAMERA_LOOK_AT = (0.0, 0.0, 0.6)
-
-
-def _place_camera(server: viser.ViserServer) -> None:
-    server.initial_camera.position = CAMERA_POSITION
-    server.initial_camera.look_at = CAMERA_LOOK_AT
-    server.initial_camera.up = (0.0, 0.0, 1.0)
+SHARED_FILES_KEPT = 8  # shared HTML files kept for the next ask (1-4 MB each)
 
 
 class ClimbView:
@@ -68,7 +60,7 @@ class ClimbView:
         self.allowed_hosts = allowed_hosts
         self.server = viser.ViserServer(host=host, port=port, label="ParkourLab · 3D view", verbose=False)
         refuse_foreign_origins(self.server, allowed_hosts)
-        _place_camera(self.server)
+        place_camera(self.server)
         self.scene = ChuteScene(self.server.scene, self.robot)
         gui = self.server.gui
         gui.add_markdown(f"[← Control panel]({panel_url}) · walls {self.robot.wall_distance:.2f} m apart")
@@ -82,6 +74,8 @@ class ClimbView:
         self.modes["replay"].share = self.share_html
         self.mode = self.modes["simulate"]
         self.gui_mode.on_update(lambda _event: self.set_mode(self.gui_mode.value))
+        self._shared: collections.OrderedDict[tuple, str] = collections.OrderedDict()
+        self._shared_lock = threading.Lock()
         self.updates_per_s = 0.0
         self.frames = 0
         self._stop = threading.Event()
@@ -107,23 +101,22 @@ class ClimbView:
 
     def share_html(self, run_id: int, overlay_run_id: int | None = None) -> str:
         """A standalone HTML file that plays stored run ``run_id`` (viser's client with the recorded
-        scene inside: it opens offline, from a file, in any browser)."""
-        recording = load_recording(self.context.sessions, run_id)
-        overlay = None if overlay_run_id is None else load_recording(self.context.sessions, overlay_run_id)
-        server = viser.ViserServer(host="127.0.0.1", port=0, label=recording.label, verbose=False)
-        try:
-            refuse_foreign_origins(server, self.allowed_hosts)
-            _place_camera(server)
-            scene = ChuteScene(server.scene, recording.robot)
-            serializer = server.get_scene_serializer()
-            end = min(max(recording.duration, overlay.duration if overlay else 0.0), MAX_EXPORT_SECONDS)
-            shown = 0
-            for t in np.arange(0.0, end + 1.0 / EXPORT_RATE, 1.0 / EXPORT_RATE):
-                shown = show_frame(scene, recording, overlay, float(t), shown)
-                serializer.insert_sleep(1.0 / EXPORT_RATE)
-            return serializer.as_html()
-        finally:
-            server.stop()
+        replay inside: it opens offline, from a file, in any browser; frontend/viewer/share.py).
+        The last :data:`SHARED_FILES_KEPT` files are kept, by what they were made of."""
+        sessions = self.context.sessions
+        key = tuple(None if i is None else recording_key(sessions, i) for i in (run_id, overlay_run_id))
+        with self._shared_lock:
+            if key in self._shared:
+                self._shared.move_to_end(key)
+                return self._shared[key]
+        recording = load_recording(sessions, run_id)
+        overlay = None if overlay_run_id is None else load_recording(sessions, overlay_run_id)
+        html = share_html(recording, overlay, allowed_hosts=self.allowed_hosts)
+        with self._shared_lock:
+            self._shared[key] = html
+            while len(self._shared) > SHARED_FILES_KEPT:
+                self._shared.popitem(last=False)
+        return html
 
     def close(self) -> None:
         self._stop.set()

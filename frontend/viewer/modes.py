@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import concurrent.futures
 import contextlib
-import math
 from dataclasses import replace
 
 import numpy as np
@@ -22,7 +21,7 @@ import viser
 
 from backend.robot.messages import Leg
 from backend.services import records
-from frontend.viewer.motion import STANCE, Controls, JumpPlan, PathClip, SimulatedClimb, model_jump
+from frontend.viewer.motion import STANCE, TRAIL_STRIDE, Controls, JumpPlan, PathClip, SimulatedClimb, model_jump
 from frontend.viewer.recordings import Recording, load_recording
 from frontend.viewer.scene import ChuteScene
 from sim_core import ControlSchedule, FixedPoint, LegControl, PhysicalParams
@@ -43,7 +42,6 @@ def _preset_label(name: str, pairs: tuple[tuple[float, float], ...]) -> str:
 GAIT_PRESETS = {_preset_label(name, pairs): (pairs[0], pairs[-1]) for name, pairs in PAPER_GAITS.items()}
 CUSTOM = "custom"
 DEFAULT_START = START_GUESS  # section state when the controls have no stable gait to start on
-TRAIL_STRIDE = 3  # every third sample of the jump under way is enough for a smooth trail
 GAIT_SEARCH_PERIOD = 4  # the readout looks for gaits of period 1, 2 and 4 (the paper's)
 
 
@@ -370,7 +368,7 @@ class ReplayMode(_Mode):
         self.overlay: Recording | None = None
         self.playing = False
         self.time = 0.0
-        self._shown = 0
+        self._marked = (0, 0)  # touchdowns of the run and of the ghost drawn so far
         self.message = ""
         self.share = None  # set by the view: run id -> standalone HTML
         self.gui_load.on_click(self._on_load)
@@ -403,7 +401,7 @@ class ReplayMode(_Mode):
             self.gui_overlay.value = overlay_id or 0
             self.gui_time.max = round(max(duration, 0.01), 2)
             self.gui_time.value = 0.0
-        self.time, self.playing, self._shown = 0.0, False, 0
+        self.time, self.playing, self._marked = 0.0, False, (0, 0)
         self.scene.robot = recording.robot
         self.scene.clear_history()
         self._plot(recording, overlay)
@@ -429,7 +427,7 @@ class ReplayMode(_Mode):
             return
         with self.lock:
             self.time = float(self.gui_time.value)
-            self._shown = 0
+            self._marked = (0, 0)
             self.scene.clear_history()
 
     def _on_playback(self, event) -> None:
@@ -445,7 +443,7 @@ class ReplayMode(_Mode):
         elif choice == "Pause":
             self.playing = False
         elif choice == "Start":
-            self.time, self._shown, self.playing = 0.0, 0, False
+            self.time, self._marked, self.playing = 0.0, (0, 0), False
             self.scene.clear_history()
 
     def _on_share(self, event) -> None:
@@ -463,7 +461,7 @@ class ReplayMode(_Mode):
             self.playing = self.time < self.gui_time.max
             with self._quietly():
                 self.gui_time.value = round(self.time, 2)
-        self._shown = show_frame(self.scene, recording, self.overlay, self.time, self._shown)
+        self._marked = show_frame(self.scene, recording, self.overlay, self.time, self._marked)
 
     def readout(self, updates_per_s: float) -> str:
         if self.recording is None:
@@ -472,24 +470,29 @@ class ReplayMode(_Mode):
         return f"{self.message}  \nt = {self.time:.2f} s · height {pose.y:.3f} m · {updates_per_s:.0f} updates/s"
 
 
-def show_frame(scene: ChuteScene, recording: Recording, overlay: Recording | None, t: float, shown: int) -> int:
-    """Draw ``recording`` at time ``t`` (and ``overlay`` as the ghost); touchdowns from ``shown`` on
-    are marked. Returns how many touchdowns are marked now. Shared by the replay and the export."""
-    clip = recording.clip
-    pose = clip.pose_at(t)
-    touchdowns = recording.touchdowns
-    for i in range(shown, len(touchdowns)):
-        time, wall, foot_height = touchdowns[i]
-        if time > t:
-            break
+def show_frame(
+    scene: ChuteScene, recording: Recording, overlay: Recording | None, t: float, marked: tuple[int, int]
+) -> tuple[int, int]:
+    """Draw ``recording`` at time ``t`` (and ``overlay`` as the ghost). ``marked``: the touchdowns
+    of each drawn so far (their markers and finished jumps' trails); returns them at ``t``.
+
+    The shared file (frontend/viewer/share.py) writes the same scene frame by frame from the
+    recording's arrays: what a frame shows is defined by :class:`Recording`'s ``touchdowns_until``,
+    ``trail`` and ``jump_trail`` for both."""
+    shown, ghost_shown = marked
+    now = int(recording.touchdowns_until(t))
+    for k in range(shown, now):
+        _time, wall, foot_height = recording.touchdowns[k]
         scene.add_touchdown(int(wall), float(foot_height))
-        if i > 0:
-            scene.add_jump_trail(clip.body_until(time, since=touchdowns[i - 1, 0])[::TRAIL_STRIDE])
-    since = recording.touchdowns[shown - 1, 0] if 0 < shown <= len(recording.touchdowns) else -math.inf
-    trail = clip.body_until(t, since=min(since, t))[::TRAIL_STRIDE]
-    scene.show(pose, recording.idle_leg(pose.leg_wall), trail, follow=True)
+        if k > 0:
+            scene.add_jump_trail(recording.jump_trail(k))
+    pose = recording.clip.pose_at(t)
+    scene.show(pose, recording.idle_leg(pose.leg_wall), recording.trail(t), follow=True)
     if overlay is None:
         scene.show_ghost(None)
-    else:
-        scene.show_ghost(overlay.clip.pose_at(t), overlay.clip.body_until(t)[::TRAIL_STRIDE])
-    return int(np.searchsorted(touchdowns[:, 0], t, side="right"))
+        return now, 0
+    ghost_now = int(overlay.touchdowns_until(t))
+    for k in range(max(ghost_shown, 1), ghost_now):
+        scene.add_ghost_jump_trail(overlay.jump_trail(k))
+    scene.show_ghost(overlay.clip.pose_at(t), overlay.trail(t))
+    return now, ghost_now

@@ -28,6 +28,7 @@ from sim_core.trajectory import STANCE
 from sim_core.walls import Wall
 
 UNKNOWN_PHASE = -1  # tracker data: the body is seen, its legs are not
+TRAIL_STRIDE = 3  # every third sample of a path is enough for a smooth trail
 
 
 @dataclass(frozen=True)
@@ -110,6 +111,32 @@ class PathClip(Samples):
             phase=int(self.phase[i]),
             leg_wall=Wall(int(self.leg_wall[i])),
             jump=int(self.jump[i]),
+        )
+
+    def sampled_at(self, times) -> PathClip:
+        """:meth:`pose_at` at each of ``times`` [s] (ascending), as a clip: row k is the pose at
+        ``times[k]`` (its ``time`` clamped to the clip's ends, as the pose's is)."""
+        t = np.asarray(times, dtype=float)
+        last = self.time.size - 1
+        i = np.clip(np.searchsorted(self.time, t, side="right") - 1, 0, last)
+        j = np.minimum(i + 1, last)
+        span = self.time[j] - self.time[i]
+        within = (span > 0.0) & (self.phase[i] == self.phase[j])
+        w = np.where(within, np.clip((t - self.time[i]) / np.where(span > 0.0, span, 1.0), 0, 1), 0.0)
+
+        def at(column: np.ndarray) -> np.ndarray:
+            return column[i] + w * (column[j] - column[i])
+
+        return PathClip(
+            time=np.clip(t, self.start, self.end),
+            x=at(self.x),
+            y=at(self.y),
+            foot_x=at(self.foot_x),
+            foot_y=at(self.foot_y),
+            zeta=at(self.zeta),
+            phase=self.phase[i],
+            leg_wall=self.leg_wall[i],
+            jump=self.jump[i],
         )
 
     def body_until(self, t: float, *, since: float = -math.inf) -> np.ndarray:

@@ -14,6 +14,7 @@ first foot touches at the floor.
 from __future__ import annotations
 
 import math
+import zlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,13 +22,17 @@ import numpy as np
 from backend.services import records
 from backend.services.simulation import unpack_trajectory
 from backend.store.models import Run
-from frontend.viewer.motion import PathClip
+from frontend.viewer.motion import TRAIL_STRIDE, PathClip
 from sim_core import ControlSchedule, LegControl, ModelParams, PhysicalParams, get_preset, simulate_trajectory
 from sim_core.climb import start_height
 from sim_core.trajectory import STANCE
 from sim_core.walls import Wall, walls_of
 
-REPLAY_SAMPLE_RATE = 200.0  # per sqrt(l0/g), when a stored sim run has no path of its own
+# Per sqrt(l0/g), when a stored sim run has no path of its own: the panel's "Save run" rate (about
+# 160 samples/s at the paper robot's size). The simulation costs the same at any rate; trails and
+# a shared file's size grow with it.
+REPLAY_SAMPLE_RATE = 60.0
+MAX_TRAIL_SECONDS = 5.0  # the trail of the jump under way reaches back this far at most (a run with no touchdowns)
 
 
 @dataclass(frozen=True)
@@ -54,6 +59,32 @@ class Recording:
     def duration(self) -> float:
         return self.clip.end
 
+    def touchdowns_until(self, t):
+        """How many touchdowns happened at or before ``t`` [s] (a float or an array of them)."""
+        return np.searchsorted(self.touchdowns[:, 0], t, side="right")
+
+    def trail_span(self, t):
+        """The body's trail at ``t`` [s] (a float or an array): samples ``[lo, hi)`` of the clip, from
+        the last touchdown at or before ``t`` (the sample before it) but at most ``MAX_TRAIL_SECONDS``
+        back, to ``t``. The trail drawn is every ``TRAIL_STRIDE``-th of them from ``lo``."""
+        t = np.asarray(t, dtype=float)
+        last_touchdown = np.r_[-np.inf, self.touchdowns[:, 0]][self.touchdowns_until(t)]
+        since = np.maximum(last_touchdown, t - MAX_TRAIL_SECONDS)
+        lo = np.maximum(np.searchsorted(self.clip.time, since, side="right") - 1, 0)
+        hi = np.searchsorted(self.clip.time, t, side="right")
+        return lo, hi
+
+    def trail(self, t: float) -> np.ndarray:
+        """The body's trail at ``t`` [s] (:meth:`trail_span`), shape (n, 2)."""
+        lo, hi = (int(v) for v in self.trail_span(t))
+        return np.column_stack([self.clip.x[lo:hi:TRAIL_STRIDE], self.clip.y[lo:hi:TRAIL_STRIDE]])
+
+    def jump_trail(self, k: int) -> np.ndarray:
+        """The body's path from touchdown ``k - 1`` to touchdown ``k`` (k >= 1), shape (n, 2): the trail
+        a finished jump leaves."""
+        since, until = self.touchdowns[k - 1, 0], self.touchdowns[k, 0]
+        return self.clip.body_until(until, since=since)[::TRAIL_STRIDE]
+
     def idle_leg(self, leg_wall: Wall) -> LegControl | None:
         """Controls of the leg not drawn by the pose (it reaches for the other wall)."""
         if self.legs is None:
@@ -76,6 +107,22 @@ def load_recording(sessions, run_id: int) -> Recording:
         if source.trajectory is None:
             raise records.Conflict(f"run {run_id} has no tracker frames to replay")
         return _tracker_recording(run, unpack_trajectory(source.trajectory))
+
+
+def recording_key(sessions, run_id: int) -> tuple:
+    """A short stand-in for what :func:`load_recording` reads of run ``run_id``: equal keys, equal
+    recordings (for a cache). Runs change only in their tags and notes, which a recording leaves
+    out, but an id is taken again after a deletion (SQLite reuses the highest), and a robot run
+    gets its frames when it ends: each run read is keyed by id, creation time, status and a
+    checksum of its stored path. Raises records.NotFound as load_recording does."""
+    with sessions() as session:
+        run = records.get_run(session, run_id)
+        read = [run]
+        if run.kind == "replay":
+            read.append(records.get_run(session, int(run.results.get("source_run_id", 0)) or run_id))
+        return tuple(
+            (r.id, r.created_at, r.status, None if r.trajectory is None else zlib.crc32(r.trajectory)) for r in read
+        )
 
 
 def _model_of(run: Run) -> ModelParams:

@@ -8,8 +8,8 @@ service's live view or a private server that records a replay for export.
 
 from __future__ import annotations
 
-import collections
 import math
+from dataclasses import dataclass
 
 import numpy as np
 import viser
@@ -40,6 +40,30 @@ TRAIL_COLOR = (150, 150, 170)
 GHOST_TRAIL_COLOR = (80, 170, 230)
 TOUCHDOWN_COLOR = (240, 150, 0)
 FOOT_COLOR = (240, 150, 0)
+RULER_COLOR = (60, 60, 60)
+CAMERA_POSITION = (0.0, -1.25, 0.6)  # [m] level with the robot, in front of the chute
+CAMERA_LOOK_AT = (0.0, 0.0, 0.6)
+
+
+def place_camera(server: viser.ViserServer) -> None:
+    """Where a browser's camera starts: in front of the chute, level with the followed robot."""
+    server.initial_camera.position = CAMERA_POSITION
+    server.initial_camera.look_at = CAMERA_LOOK_AT
+    server.initial_camera.up = (0.0, 0.0, 1.0)
+
+
+@dataclass(frozen=True)
+class Growth:
+    """What the walls and the ruler gain when they grow to ``top`` [m] (:meth:`ChuteScene.growth`):
+    the walls' new dimensions and positions, a ruler section (its node's name and segments: the
+    spine's new stretch and the new ticks) and the new height labels (name, text, position)."""
+
+    top: float
+    wall_dimensions: tuple[float, float, float]
+    wall_positions: tuple[tuple[float, float, float], ...]
+    section: str
+    segments: np.ndarray
+    labels: tuple[tuple[str, str, tuple[float, float, float]], ...]
 
 
 class ChuteScene:
@@ -68,10 +92,9 @@ class ChuteScene:
             dimensions=(robot.wall_distance + 2 * WALL_THICKNESS, DEPTH, 0.01),
             position=(0.0, 0.0, -0.005),
         )
-        self.ruler = scene.add_line_segments(
-            "/chute/ruler", points=np.zeros((1, 2, 3)), colors=(60, 60, 60), thickness=0.002
-        )
-        self.ruler_labels: list = []
+        self._wall_x = [side * (half + 0.5 * WALL_THICKNESS) for side in (-1, 1)]
+        self._ruler_sections = 0  # the ruler grows in sections: "/chute/ruler", then "/chute/ruler/part_k"
+        self._ruler_labels = 0
         self.body = scene.add_icosphere("/chute/body", radius=BODY_RADIUS, color=BODY_COLOR)
         # The legs hang from the body (drawn relative to it): a client that repaints slowly moves
         # them with the body at once, even while it is still rebuilding their shape.
@@ -91,41 +114,68 @@ class ChuteScene:
         self.ghost_trail = scene.add_line_segments(
             "/chute/ghost/trail", points=np.zeros((1, 2, 3)), colors=GHOST_TRAIL_COLOR, thickness=0.003, visible=False
         )
-        self.past_trails: collections.deque = collections.deque()
-        self.touchdowns: collections.deque = collections.deque()
-        self._trail_count = 0
-        self._marker_count = 0
+        self.touchdown_markers = NodeRing(
+            "/chute/touchdowns/",
+            TOUCHDOWN_MARKERS,
+            lambda name: scene.add_box(
+                name, color=TOUCHDOWN_COLOR, dimensions=(0.006, 0.06, 0.012), position=(0.0, 0.0, 0.0), visible=False
+            ),
+        )
+        self.jump_trails = NodeRing("/chute/trail/jump_", TRAIL_JUMPS, self._trail_maker(TRAIL_COLOR, 0.002))
+        self.ghost_jump_trails = NodeRing(
+            "/chute/ghost/jump_", TRAIL_JUMPS, self._trail_maker(GHOST_TRAIL_COLOR, 0.003)
+        )
         self.reach(1.0)
 
     # Static parts -------------------------------------------------------------------------------
+    def growth(self, height: float) -> Growth | None:
+        """What the walls and the ruler gain to reach ``height`` [m] plus headroom; None when they
+        reach that high already (they grow, never shrink)."""
+        top = float(self.top_for(height))
+        if top <= self.top:
+            return None
+        fresh, majors = ruler_ticks(top, above=self.top if self._ruler_sections else -math.inf)
+        inner, front = -0.5 * self.robot.wall_distance, -0.5 * DEPTH
+        length = np.where(np.isin(fresh, majors), 0.04, 0.02)
+        starts = np.column_stack([np.full(fresh.size, inner), np.full(fresh.size, front), fresh])
+        ends = starts + np.column_stack([length, np.zeros(fresh.size), np.zeros(fresh.size)])
+        spine = np.array([[[inner, front, self.top if self._ruler_sections else 0.0], [inner, front, top]]])
+        labels = tuple(
+            (f"/chute/ruler/label_{i}", f"{mark:.2f} m", (inner + 0.045, front, float(mark)))
+            for i, mark in enumerate(majors, start=self._ruler_labels)
+        )
+        return Growth(
+            top=top,
+            wall_dimensions=(WALL_THICKNESS, DEPTH, top),
+            wall_positions=tuple((x, 0.0, 0.5 * top) for x in self._wall_x),
+            section="/chute/ruler" if self._ruler_sections == 0 else f"/chute/ruler/part_{self._ruler_sections}",
+            segments=np.concatenate([spine, np.stack([starts, ends], axis=1)]),
+            labels=labels,
+        )
+
+    @staticmethod
+    def top_for(height):
+        """[m] how high the walls reach for the robot at ``height`` [m] (a float or an array)."""
+        return np.ceil((np.maximum(height, 0.0) + HEADROOM) * 2.0) / 2.0
+
     def reach(self, height: float) -> None:
         """Make the walls and the ruler reach ``height`` [m] plus headroom (grows, never shrinks)."""
-        top = math.ceil((max(height, 0.0) + HEADROOM) * 2.0) / 2.0
-        if top <= self.top:
+        growth = self.growth(height)
+        if growth is None:
             return
-        self.top = top
-        for wall in self.walls:
-            x = wall.position[0]
-            wall.dimensions = (WALL_THICKNESS, DEPTH, top)
-            wall.position = (x, 0.0, 0.5 * top)
-        ticks, majors = ruler_ticks(top)
-        inner = -0.5 * self.robot.wall_distance
-        length = np.where(np.isin(ticks, majors), 0.04, 0.02)
-        front = -0.5 * DEPTH
-        starts = np.column_stack([np.full(ticks.size, inner), np.full(ticks.size, front), ticks])
-        ends = starts + np.column_stack([length, np.zeros(ticks.size), np.zeros(ticks.size)])
-        spine = np.array([[[inner, front, 0.0], [inner, front, top]]])
-        self.ruler.points = np.concatenate([spine, np.stack([starts, ends], axis=1)])
-        for i, height_mark in enumerate(majors[len(self.ruler_labels) :], start=len(self.ruler_labels)):
-            self.ruler_labels.append(
-                self.scene.add_label(
-                    f"/chute/ruler/label_{i}",
-                    f"{height_mark:.2f} m",
-                    position=(inner + 0.045, front, height_mark),
-                    font_screen_scale=0.7,
-                    anchor="center-left",
-                )
-            )
+        for wall, position in zip(self.walls, growth.wall_positions, strict=True):
+            wall.dimensions = growth.wall_dimensions
+            wall.position = position
+        self.scene.add_line_segments(growth.section, points=growth.segments, colors=RULER_COLOR, thickness=0.002)
+        for name, text, position in growth.labels:
+            self.scene.add_label(name, text, position=position, font_screen_scale=0.7, anchor="center-left")
+        self.grew(growth)
+
+    def grew(self, growth: Growth) -> None:
+        """``growth`` is drawn (by :meth:`reach`, or written straight into a recording)."""
+        self.top = growth.top
+        self._ruler_sections += 1
+        self._ruler_labels += len(growth.labels)
 
     # Per frame ----------------------------------------------------------------------------------
     def show(self, pose: Pose, idle_leg: LegControl | None, trail: np.ndarray, *, follow: bool) -> None:
@@ -169,43 +219,65 @@ class ChuteScene:
         leg.colors = np.broadcast_to(np.array(energy_color(zeta, self.robot), dtype=np.uint8), segments.shape).copy()
 
     # Jump history -------------------------------------------------------------------------------
+    def _trail_maker(self, color, thickness: float):
+        def make(name: str) -> viser.LineSegmentsHandle:
+            points = np.zeros((1, 2, 3))
+            return self.scene.add_line_segments(name, points=points, colors=color, thickness=thickness, visible=False)
+
+        return make
+
     def add_jump_trail(self, points: np.ndarray) -> None:
         """Keep a finished jump's path drawn (the last TRAIL_JUMPS of them)."""
-        if len(points) < 2:
-            return
-        self._trail_count += 1
-        self.past_trails.append(
-            self.scene.add_line_segments(
-                f"/chute/trail/jump_{self._trail_count}",
-                points=polyline_segments(points),
-                colors=TRAIL_COLOR,
-                thickness=0.002,
-            )
-        )
-        while len(self.past_trails) > TRAIL_JUMPS:
-            self.past_trails.popleft().remove()
+        if len(points) >= 2:
+            self.jump_trails.show_next(points=polyline_segments(points))
+
+    def add_ghost_jump_trail(self, points: np.ndarray) -> None:
+        """Keep a finished jump of the ghost's path drawn (the last TRAIL_JUMPS of them)."""
+        if len(points) >= 2:
+            self.ghost_jump_trails.show_next(points=polyline_segments(points))
 
     def add_touchdown(self, wall: int, foot_height: float) -> None:
         """Mark where a foot met ``wall`` (-1 left, +1 right) at ``foot_height`` [m]."""
-        x = wall * 0.5 * self.robot.wall_distance
-        self._marker_count += 1
-        self.touchdowns.append(
-            self.scene.add_box(
-                f"/chute/touchdowns/{self._marker_count}",
-                color=TOUCHDOWN_COLOR,
-                dimensions=(0.006, 0.06, 0.012),
-                position=(x, 0.0, foot_height),
-            )
-        )
-        while len(self.touchdowns) > TOUCHDOWN_MARKERS:
-            self.touchdowns.popleft().remove()
+        self.touchdown_markers.show_next(position=self.touchdown_position(wall, foot_height))
+
+    def touchdown_position(self, wall: int, foot_height: float) -> tuple[float, float, float]:
+        return (wall * 0.5 * self.robot.wall_distance, 0.0, foot_height)
 
     def clear_history(self) -> None:
-        """Remove trails and touchdown markers (a reset or a new run)."""
-        for handle in (*self.past_trails, *self.touchdowns):
-            handle.remove()
-        self.past_trails.clear()
-        self.touchdowns.clear()
+        """Hide trails and touchdown markers (a reset or a new run)."""
+        for ring in (self.touchdown_markers, self.jump_trails, self.ghost_jump_trails):
+            ring.clear()
         self.trail.points = np.zeros((1, 2, 3))
         self.offset = 0.0
         self.root.position = (0.0, 0.0, 0.0)
+
+
+class NodeRing:
+    """The last ``size`` of a kind of node (touchdown markers, past trails): item ``k`` is drawn by
+    node ``prefix + str(k % size)``, made by ``make(name)`` (hidden) the first time it is needed
+    and reused after; the oldest item's node shows the newest."""
+
+    def __init__(self, prefix: str, size: int, make):
+        self.prefix, self.size, self._make = prefix, size, make
+        self.nodes: list = []
+        self.count = 0  # items shown since the last clear
+
+    def node(self, k: int):
+        """The node that shows item ``k`` (made now if it is new)."""
+        slot = k % self.size
+        while len(self.nodes) <= slot:
+            self.nodes.append(self._make(f"{self.prefix}{len(self.nodes)}"))
+        return self.nodes[slot]
+
+    def show_next(self, **props) -> None:
+        """Show the next item: its node gets ``props`` (``position``, ``points``) and is made visible."""
+        node = self.node(self.count)
+        for name, value in props.items():
+            setattr(node, name, value)
+        node.visible = True
+        self.count += 1
+
+    def clear(self) -> None:
+        for node in self.nodes:
+            node.visible = False
+        self.count = 0

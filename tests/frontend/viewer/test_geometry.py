@@ -1,11 +1,14 @@
 import numpy as np
 import pytest
+from numpy.testing import assert_allclose
 
 from frontend.viewer.geometry import (
     LOADED,
     RELAXED,
     bow_leg,
+    bow_legs,
     energy_color,
+    energy_colors,
     idle_foot,
     polyline_segments,
     ruler_ticks,
@@ -53,3 +56,20 @@ def test_segments_and_ruler():
     assert segments[0, 1].tolist() == [1.0, 0.0, 2.0], "model y is scene z"
     ticks, majors = ruler_ticks(1.0)
     assert ticks.size == 21 and majors.tolist() == pytest.approx([0.0, 0.25, 0.5, 0.75, 1.0])
+
+
+def test_many_legs_and_colours_at_once_are_each_ones():
+    rng = np.random.default_rng(3)
+    chords = np.column_stack([rng.uniform(-L0, L0, 20), rng.uniform(-L0, 0, 20)])
+    chords[3] = 0.0  # a point: no bow
+    bows = bow_legs(chords, L0)
+    assert bows.shape == (20, 13, 2)
+    for chord, bow in zip(chords, bows, strict=True):
+        assert_allclose(bow, bow_leg((0.2, 0.5), (0.2 + chord[0], 0.5 + chord[1]), L0) - (0.2, 0.5), atol=1e-15)
+    zetas = np.r_[np.linspace(0.5, 1.1, 13) * L0, np.nan]
+    colours = energy_colors(zetas, ROBOT)
+    assert colours.dtype == np.uint8
+    assert [tuple(c) for c in colours] == [energy_color(z, ROBOT) for z in zetas[:-1]] + [tuple(RELAXED)]
+    stacked = polyline_segments(np.stack([chords[:5], chords[5:10]]))
+    assert stacked.shape == (2, 4, 2, 3)
+    assert_allclose(stacked[1], polyline_segments(chords[5:10]))

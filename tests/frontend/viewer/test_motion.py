@@ -111,3 +111,18 @@ def test_path_clip_interpolates_and_clamps():
     assert clip.pose_at(-1.0).y == 0.0 and clip.pose_at(9.0).y == 4.0
     assert math.isnan(clip.pose_at(0.5).zeta), "tracker data has no legs"
     assert clip.body_until(1.0).shape == (2, 2)
+
+
+def test_a_clip_sampled_at_many_times_is_its_pose_at_each():
+    climb = _climb(PERIOD_1, LegControl.from_degrees(30, 0.87))
+    climb.pose_at(3.0)
+    clip = climb.plans[2].clip  # a jump: stance then flight, the phases not interpolated across
+    times = np.r_[clip.start - 0.1, np.linspace(clip.start, clip.end, 97), clip.time[5], clip.end + 0.1]
+    sampled = clip.sampled_at(times)
+    for k, t in enumerate(times):
+        pose = clip.pose_at(t)
+        row = (sampled.time[k], sampled.x[k], sampled.y[k], sampled.foot_x[k], sampled.foot_y[k], sampled.zeta[k])
+        assert row == (pose.time, pose.x, pose.y, pose.foot_x, pose.foot_y, pose.zeta), t
+        assert (sampled.phase[k], sampled.leg_wall[k], sampled.jump[k]) == (pose.phase, pose.leg_wall, pose.jump)
+    body = PathClip.from_body([0.0, 1.0], [0.0, 1.0], [0.0, 2.0]).sampled_at([0.25, 3.0])
+    assert body.y.tolist() == [0.5, 2.0] and np.isnan(body.zeta).all()

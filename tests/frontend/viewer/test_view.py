@@ -77,6 +77,19 @@ def test_a_stored_run_replays_with_a_ghost_and_shares_as_html(service):
     assert "window.__VISER_EMBED_DATA__" in html.text
 
 
+def test_a_shared_file_is_kept_for_its_run_and_not_given_for_another_under_the_same_id(service):
+    client, auth, view = service
+    first = client.post("/api/v1/runs", json=RUN, headers=auth).json()
+    shared = client.get(f"/api/v1/runs/{first['id']}/share.html").text
+    assert client.get(f"/api/v1/runs/{first['id']}/share.html").text == shared and len(view._shared) == 1
+    assert client.delete(f"/api/v1/runs/{first['id']}", headers=auth).status_code == 204
+    other = RUN | {"controls": [{"psi0_deg": 32, "zeta0": 0.9}]}
+    second = client.post("/api/v1/runs", json=other, headers=auth).json()
+    assert second["id"] == first["id"], "SQLite gives the deleted run's id to the next"
+    again = client.get(f"/api/v1/runs/{second['id']}/share.html").text
+    assert again != shared and len(view._shared) == 2, "made again: another run's motion"
+
+
 def test_replay_errors_name_the_problem(service, tmp_path):
     client, auth, view = service
     assert client.post("/api/v1/view/replay", json={"run_id": 999}, headers=auth).status_code == 404

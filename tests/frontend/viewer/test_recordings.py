@@ -1,0 +1,36 @@
+"""What a recording's frame shows, as the replay and the shared file both take it: touchdowns passed
+and the trail of the jump under way. (Loading stored runs is tested in test_view.py.)"""
+
+import numpy as np
+from numpy.testing import assert_array_equal
+
+from frontend.viewer.motion import PathClip
+from frontend.viewer.recordings import MAX_TRAIL_SECONDS, Recording
+from sim_core import get_preset
+
+TIME = np.round(np.arange(0.0, 20.0, 0.01), 2)  # tracker frames at 100 Hz for 20 s
+CLIP = PathClip.from_body(TIME, np.sin(TIME), 0.1 * TIME)
+TOUCHDOWNS = np.array([[1.0, -1, 0.05], [2.0, 1, 0.15]])
+
+
+def _recording(touchdowns=TOUCHDOWNS) -> Recording:
+    return Recording(1, "robot", "run 1", CLIP, get_preset("paper"), None, touchdowns)
+
+
+def test_the_trail_runs_from_the_last_touchdown_passed():
+    recording = _recording()
+    assert recording.touchdowns_until(np.array([0.5, 1.0, 1.5, 2.5])).tolist() == [0, 1, 1, 2]
+    assert recording.trail_span(0.5) == (0, 51), "before the first touchdown: from the start"
+    assert recording.trail_span(1.5) == (100, 151), "from the touchdown at 1.0 s (its sample) to now"
+    trail = recording.trail(1.5)
+    assert_array_equal(trail, np.column_stack([CLIP.x[100:151:3], CLIP.y[100:151:3]]))
+    assert_array_equal(recording.jump_trail(1), CLIP.body_until(2.0, since=1.0)[::3])
+    lo, hi = recording.trail_span(np.array([0.5, 1.5]))
+    assert (lo.tolist(), hi.tolist()) == ([0, 100], [51, 151]), "many instants at once, the same"
+
+
+def test_without_touchdowns_the_trail_reaches_back_a_few_seconds_at_most():
+    recording = _recording(np.zeros((0, 3)))
+    lo, hi = recording.trail_span(12.0)
+    assert TIME[hi - 1] == 12.0 and TIME[lo] == 12.0 - MAX_TRAIL_SECONDS
+    assert recording.trail_span(3.0) == (0, 301)
