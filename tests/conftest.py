@@ -1,4 +1,5 @@
-"""Shared fixtures: the paper's model, the gaits the paper reports (docs/model.md §5), the virtual robot."""
+"""Shared fixtures: the paper's model, the gaits the paper reports (docs/model.md §5), the databases
+(SQLite, and PostgreSQL where a server can be had), the virtual robot."""
 
 import os
 import socket
@@ -40,6 +41,42 @@ def compute():
     pools = Compute()
     yield pools
     pools.close()
+
+
+@pytest.fixture(scope="session")
+def postgres():
+    """The session's PostgreSQL databases (tests/postgres.py), or a skip saying why there are none."""
+    from tests.postgres import postgres_databases, why_unavailable
+
+    reason = why_unavailable()
+    if reason:
+        pytest.skip(reason)
+    with postgres_databases() as databases:
+        yield databases
+
+
+@pytest.fixture(params=["sqlite", "postgresql"])
+def database_url(request, tmp_path) -> str | None:
+    """Each test that asks for it runs twice: on SQLite (None: the data directory's own file) and on a
+    fresh PostgreSQL database of its own (skipped where no server can be had)."""
+    if request.param == "sqlite":
+        yield None
+        return
+    with request.getfixturevalue("postgres").fresh() as url:
+        yield url
+
+
+@pytest.fixture(params=["sqlite", "postgresql"])
+def empty_database_url(request, tmp_path) -> str:
+    """An empty database's URL, on SQLite and on PostgreSQL (each test runs on both; skipped where no
+    PostgreSQL server can be had): for tests of the migrations themselves."""
+    if request.param == "sqlite":
+        from backend.store.database import sqlite_url
+
+        yield sqlite_url(tmp_path)
+        return
+    with request.getfixturevalue("postgres").fresh(migrated=False) as url:
+        yield url
 
 
 @pytest.fixture

@@ -119,6 +119,10 @@ def update_run(session: Session, run_id: int, *, tags: list[str] | None = None, 
         run.run_tags = kept + [RunTag(tag=tag) for tag in sorted(wanted - {row.tag for row in kept})]
     if notes is not None:
         run.notes = notes
+    session.flush()
+    # The flush expired ``has_trajectory`` (an SQL expression): read it again inside the transaction,
+    # since after the commit a concurrent delete may have removed the row it would be read from.
+    session.refresh(run, ["has_trajectory"])
     session.commit()
     return run
 

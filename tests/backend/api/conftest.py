@@ -1,4 +1,5 @@
-"""The real app on a real SQLite file in a temporary data directory."""
+"""The real app on a real database: a SQLite file in a temporary data directory, and a PostgreSQL
+database of its own where a server can be had (every test here runs on both)."""
 
 import pytest
 from fastapi.testclient import TestClient
@@ -8,8 +9,8 @@ from backend.settings import Settings
 
 
 @pytest.fixture
-def settings(tmp_path):
-    return Settings.from_environment(tmp_path / "data")
+def settings(tmp_path, database_url):
+    return Settings.from_environment(tmp_path / "data", database_url)
 
 
 @pytest.fixture

@@ -24,6 +24,13 @@ from tests.backend.disk import fill, tmpfs
 DESCRIPTION = "d" * 10_000
 
 
+@pytest.fixture
+def database_url():
+    """SQLite only: both ways of filling the disk are SQLite's file (PostgreSQL's disk-full error is
+    mapped to the same 507 by ``is_storage_full``, tested in tests/backend/store/test_storage.py)."""
+    return None
+
+
 def _runs(client, auth, count: int) -> list[int]:
     return [client.post("/api/v1/runs", json=RUN | {"jumps": 2}, headers=auth).json()["id"] for _ in range(count)]
 

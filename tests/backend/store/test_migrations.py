@@ -1,4 +1,5 @@
-"""Migrations build the models' schema from an empty database, and nothing is left unmigrated."""
+"""Migrations build the models' schema from an empty database, and nothing is left unmigrated: on
+SQLite and on PostgreSQL."""
 
 from alembic.autogenerate import compare_metadata
 from alembic.migration import MigrationContext
@@ -8,14 +9,15 @@ from backend.store.database import make_engine, migrate, sqlite_url
 from backend.store.models import Base
 
 
-def test_upgrade_from_empty_matches_the_models(tmp_path):
-    engine = make_engine(sqlite_url(tmp_path))
+def test_upgrade_from_empty_matches_the_models(empty_database_url):
+    engine = make_engine(empty_database_url)
     migrate(engine)
     assert set(inspect(engine).get_table_names()) >= {"experiments", "runs", "run_tags", "jobs", "trials"}
     with engine.connect() as connection:
         differences = compare_metadata(MigrationContext.configure(connection), Base.metadata)
     assert differences == [], f"models changed without a migration: {differences}"
     migrate(engine)  # idempotent at head
+    engine.dispose()
 
 
 def test_sqlite_runs_in_wal_mode_with_foreign_keys(tmp_path):
@@ -25,31 +27,34 @@ def test_sqlite_runs_in_wal_mode_with_foreign_keys(tmp_path):
         assert connection.exec_driver_sql("PRAGMA foreign_keys").scalar() == 1
 
 
-def _row_after_upgrade(tmp_path, revision: str, insert: str, select: str) -> tuple:
+def _row_after_upgrade(url: str, revision: str, insert: str, select: str) -> tuple:
     """Migrate an empty database to ``revision``, store a row the old way, upgrade to head, read it back."""
-    engine = make_engine(sqlite_url(tmp_path))
+    engine = make_engine(url)
     migrate(engine, revision)
     with engine.begin() as connection:
         connection.exec_driver_sql(insert)
     migrate(engine)
-    with engine.connect() as connection:
-        return tuple(connection.exec_driver_sql(select).one())
+    try:
+        with engine.connect() as connection:
+            return tuple(connection.exec_driver_sql(select).one())
+    finally:
+        engine.dispose()
 
 
-def test_upgrade_from_the_previous_revision_keeps_the_data(tmp_path):
+def test_upgrade_from_the_previous_revision_keeps_the_data(empty_database_url):
     insert = (
         "INSERT INTO jobs (kind, spec, state, total, completed, code_version, created_at, updated_at) "
         "VALUES ('mjtf', '{}', 'done', 8, 8, 'old', '2026-01-01 00:00:00', '2026-01-01 00:00:00')"
     )
-    row = _row_after_upgrade(tmp_path, "0001", insert, "SELECT kind, total, code_version, result FROM jobs")
+    row = _row_after_upgrade(empty_database_url, "0001", insert, "SELECT kind, total, code_version, result FROM jobs")
     assert row == ("mjtf", 8, "old", None)
 
 
-def test_runs_stored_before_notes_get_empty_notes(tmp_path):
+def test_runs_stored_before_notes_get_empty_notes(empty_database_url):
     insert = (
         "INSERT INTO runs (kind, status, created_at, duration_s, code_version, model, controls, start_state, "
         "jumps, alpha, psi0_deg, zeta0, jumps_completed, climb, results) VALUES ('sim', 'done', "
         "'2026-01-01 00:00:00', 0.1, 'old', '{}', '[[30, 0.9]]', '[-0.9, -0.2]', 4, 77.6, 30, 0.9, 4, 1.2, '{}')"
     )
-    row = _row_after_upgrade(tmp_path, "0003", insert, "SELECT code_version, climb, notes FROM runs")
+    row = _row_after_upgrade(empty_database_url, "0003", insert, "SELECT code_version, climb, notes FROM runs")
     assert row == ("old", 1.2, "")
