@@ -9,7 +9,7 @@ so the bench's own GIL is not what is measured.
 
 Prints, per phase, throughput and p50/p95/max latency of the reads and the writes, and the
 ratio of each phase's p95 to idle. ``--json`` for the numbers alone.
-Usage: python scripts/bench_load.py [--runs 20000] [--clients 20 50] [--seconds 20] [--job mjtf]
+Usage: PYTHONPATH=. python scripts/bench_load.py [--runs 20000] [--clients 20 50] [--seconds 20] [--job mjtf]
 """
 
 from __future__ import annotations

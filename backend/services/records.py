@@ -13,28 +13,25 @@ from __future__ import annotations
 
 import csv
 import dataclasses
-import datetime
 import io
 import json
 import math
 from collections.abc import Iterator
-from dataclasses import dataclass
 
 from sqlalchemy import Float, Integer, Select, case, cast, func, select
-from sqlalchemy.orm import Session, defer
+from sqlalchemy.orm import Session
 
 from backend.schemas import ExperimentCreate, ExperimentUpdate, RunCreate
 from backend.services.simulation import simulate_run
 from backend.store.database import freeing_space, lock_for_write
 from backend.store.models import Experiment, Job, Run, RunTag
+from backend.store.runs import SORTS as SORTS  # re-exported: the API's query parameters are checked against them
+from backend.store.runs import RunFilter, add_run, exported_rows, filtered, listed_page, widest_schedule
 from experiments.manifest import json_safe
 from sim_core.errors import ParameterError
 from sim_core.params import ModelParams
 
 MAX_PAGE = 500
-# What a list or an export of runs leaves in the database: each run's results and trajectory,
-# the bulk of a row (a page of 50 decoded them all to show none; Run.has_trajectory says if there is one).
-LISTED = (defer(Run.results), defer(Run.trajectory))
 
 
 class NotFound(LookupError):
@@ -92,14 +89,11 @@ def create_run(session: Session, body: RunCreate, compute=None) -> Run:
     or here without one — and store it as a run."""
     if body.experiment_id is not None:
         get_experiment(session, body.experiment_id)
-    fields = (
-        simulate_run(body) if compute is None else compute.run(simulate_run, body)
-    )  # before the lock: it takes a while
+    # Simulated before the lock is taken: it takes a while.
+    record = simulate_run(body) if compute is None else compute.run(simulate_run, body)
     if body.experiment_id is not None:  # still there (a concurrent delete waits for this commit)
         locked(session, Experiment, body.experiment_id, "experiment")
-    run = Run(experiment_id=body.experiment_id, **fields)
-    run.run_tags = [RunTag(tag=tag) for tag in sorted(set(body.tags))]
-    session.add(run)
+    run = add_run(session, dataclasses.replace(record, tags=tuple(body.tags)), experiment_id=body.experiment_id)
     session.commit()
     return run
 
@@ -135,69 +129,14 @@ def delete_run(session: Session, run_id: int) -> None:
     freeing_space(session, remove)
 
 
-@dataclass(frozen=True)
-class RunFilter:
-    experiment_id: int | None = None
-    kind: str | None = None
-    status: str | None = None
-    tag: str | None = None
-    failure_code: str | None = None
-    zeta0_min: float | None = None
-    zeta0_max: float | None = None
-    psi0_min: float | None = None
-    psi0_max: float | None = None
-    created_after: datetime.datetime | None = None
-    created_before: datetime.datetime | None = None
-
-
-SORTS = ("-id", "id", "-created_at", "created_at", "-climb", "climb", "-zeta0", "zeta0", "-duration_s", "duration_s")
-
-
 def list_runs(
     session: Session, where: RunFilter, *, limit: int, cursor: int | None, sort: str = "-id", offset: int = 0
-) -> tuple[list[Run], int | None]:
-    """A page of runs. By id (newest first by default) pages by keyset: ``cursor`` is the last id
-    of the previous page. Other orders (``-climb``: best first) page by ``offset``; the returned
-    cursor is then the next offset."""
-    descending = sort.startswith("-")
-    column = getattr(Run, sort.lstrip("-"))
-    order = [column.desc() if descending else column.asc(), Run.id.desc() if descending else Run.id.asc()]
-    # The page's ids first, then their rows: a filter an index cannot order (a zeta0 range sorted
-    # by id) sorts only ids, not thousands of whole rows, to keep 51 of them.
-    ids = _filtered(select(Run.id).order_by(*order).limit(limit + 1), where)
-    if sort.lstrip("-") == "id":
-        if cursor is not None:
-            ids = ids.where(Run.id < cursor if descending else Run.id > cursor)
-    else:
-        ids = ids.offset(offset)
-    rows = list(session.scalars(select(Run).options(*LISTED).where(Run.id.in_(ids)).order_by(*order)))
-    if sort.lstrip("-") == "id":
-        return page(rows, limit)
-    return rows[:limit], (offset + limit if len(rows) > limit else None)
+) -> tuple[list[dict], int | None]:
+    """A page of runs as the API lists them, and the cursor or offset of the next (None at the end):
+    see :func:`backend.store.runs.listed_page`."""
+    return listed_page(session, where, limit=limit, cursor=cursor, sort=sort, offset=offset)
 
 
-def _filtered(query, where: RunFilter):
-    conditions = [
-        (where.experiment_id, lambda v: Run.experiment_id == v),
-        (where.kind, lambda v: Run.kind == v),
-        (where.status, lambda v: Run.status == v),
-        (where.failure_code, lambda v: Run.failure_code == v),
-        (where.zeta0_min, lambda v: Run.zeta0 >= v),
-        (where.zeta0_max, lambda v: Run.zeta0 <= v),
-        (where.psi0_min, lambda v: Run.psi0_deg >= v),
-        (where.psi0_max, lambda v: Run.psi0_deg <= v),
-        (where.created_after, lambda v: Run.created_at >= v),
-        (where.created_before, lambda v: Run.created_at < v),
-    ]
-    for value, condition in conditions:
-        if value is not None:
-            query = query.where(condition(value))
-    if where.tag is not None:
-        query = query.where(Run.id.in_(select(RunTag.run_id).where(RunTag.tag == where.tag)))
-    return query
-
-
-EXPORT_BATCH = 1000
 MAX_COMPARE = 50
 GROUP_BY = ("zeta0", "psi0_deg", "alpha", "kind", "failure_code", "experiment_id", "tag")
 CONTINUOUS = ("zeta0", "psi0_deg", "alpha")  # grouped by exact value (at most MAX_GROUPS) or in bins
@@ -250,7 +189,7 @@ def export(sessions, where: RunFilter, format_: str) -> Iterator[str]:
     columns are known before the first row: every model field and as many legs as the widest run."""
     with sessions() as session:
         if format_ == "csv":
-            legs = session.scalar(_filtered(select(func.max(func.json_array_length(Run.controls))), where)) or 0
+            legs = widest_schedule(session, where)
             fields = [*RECORD_FIELDS, *(f"model.{f.name}" for f in dataclasses.fields(ModelParams))]
             fields += [f"leg{leg}.{name}" for leg in range(legs) for name in ("psi0_deg", "zeta0")]
             yield from rows_as_csv(_exported(session, where), fields)
@@ -259,14 +198,7 @@ def export(sessions, where: RunFilter, format_: str) -> Iterator[str]:
 
 
 def _exported(session: Session, where: RunFilter) -> Iterator[dict]:
-    query = _filtered(select(*EXPORTED).order_by(Run.id), where).execution_options(yield_per=EXPORT_BATCH)
-    for batch in session.execute(query).partitions():
-        ids = [run.id for run in batch]
-        tags: dict[int, list[str]] = {}
-        for run_id, tag in session.execute(
-            select(RunTag.run_id, RunTag.tag).where(RunTag.run_id.in_(ids)).order_by(RunTag.tag)
-        ):
-            tags.setdefault(run_id, []).append(tag)
+    for batch, tags in exported_rows(session, where, EXPORTED):
         for run in batch:
             yield flat_record(run, tags.get(run.id, []))
 
@@ -320,7 +252,7 @@ def aggregate_runs(session: Session, where: RunFilter, by: str, bins: int | None
     column = RunTag.tag if by == "tag" else getattr(Run, by)
     key, edges = column, None
     if bins is not None:
-        low, high = session.execute(_filtered(select(func.min(column), func.max(column)), where)).one()
+        low, high = session.execute(filtered(select(func.min(column), func.max(column)), where)).one()
         if low is None:
             return []
         width = (high - low) / bins or 1.0
@@ -336,7 +268,7 @@ def aggregate_runs(session: Session, where: RunFilter, by: str, bins: int | None
         ]
     query = select(*columns)
     query = query.join(RunTag, RunTag.run_id == Run.id) if by == "tag" else query.select_from(Run)
-    query = _filtered(query, where).group_by(key).order_by(key)
+    query = filtered(query, where).group_by(key).order_by(key)
     if by in CONTINUOUS and bins is None:
         distinct = session.scalar(select(func.count()).select_from(query.subquery()))
         if distinct > MAX_GROUPS:

@@ -23,7 +23,9 @@ from sqlalchemy import delete, select
 from backend.robot.touchdown import Touchdown, detect_touchdowns, height_gains
 from backend.services.records import Conflict, NotFound
 from backend.services.simulation import current_code_version, pack_trajectory, unpack_trajectory
-from backend.store.models import Run, RunJournal, RunTag
+from backend.store.models import Run, RunJournal
+from backend.store.run_record import RunRecord
+from backend.store.runs import add_run
 from experiments.manifest import json_safe
 from sim_core.controls import ControlSchedule, LegControl
 from sim_core.presets import get_preset
@@ -36,19 +38,13 @@ def open_robot_run(session, request, robot, calibration) -> int:
     """Store a live run as it starts (status ``running``); returns its id. ``request`` is the
     :class:`~backend.schemas.RobotRunCreate`, ``robot`` the physical parameters."""
     model = robot.to_model()
-    first = request.controls[0]
-    run = Run(
-        experiment_id=request.experiment_id,
+    record = RunRecord(
         kind="robot",
         status="running",
-        duration_s=0.0,
         code_version=current_code_version(),
         model=json_safe(asdict(model)),
         controls=[[leg.psi0_deg, leg.zeta0] for leg in request.controls],
         jumps=request.jumps,
-        alpha=model.alpha,
-        psi0_deg=first.psi0_deg,
-        zeta0=first.zeta0,
         **touchdown_columns([], {"rises": []}),
         results=json_safe(
             {
@@ -57,10 +53,9 @@ def open_robot_run(session, request, robot, calibration) -> int:
                 "closed_loop": None if request.closed_loop is None else request.closed_loop.model_dump(),
             }
         ),
-        trajectory=None,
+        tags=tuple(request.tags),
     )
-    run.run_tags = [RunTag(tag=tag) for tag in sorted(set(request.tags))]
-    session.add(run)
+    run = add_run(session, record, experiment_id=request.experiment_id)
     session.commit()
     return run.id
 
@@ -171,24 +166,18 @@ def replay_run(session, run_id: int, robot=None) -> Run:
 
     touchdowns = detect_touchdowns(frames["time"], frames["x"], frames["y"], robot, leg_for)
     analysis = touchdown_results(touchdowns, [leg_for(k) for k in range(len(touchdowns))], robot)
-    replay = Run(
-        experiment_id=source.experiment_id,
+    record = RunRecord(
         kind="replay",
         status="done",
-        duration_s=0.0,
         code_version=current_code_version(),
         model=source.model,
         controls=source.controls,
         jumps=source.jumps,
-        alpha=source.alpha,
-        psi0_deg=source.psi0_deg,
-        zeta0=source.zeta0,
         **touchdown_columns(touchdowns, analysis),
         results=json_safe({"source_run_id": run_id, **analysis}),
-        trajectory=None,
+        tags=(*source.tags, "replay"),
     )
-    replay.run_tags = [RunTag(tag=tag) for tag in sorted({*source.tags, "replay"})]
-    session.add(replay)
+    replay = add_run(session, record, experiment_id=source.experiment_id)
     session.commit()
     return replay
 

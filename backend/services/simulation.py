@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from backend.schemas import FixedPointIn, LegIn, MapIn, ModelIn, RunCreate, TrajectoryIn
+from backend.store.run_record import RunRecord
 from experiments.manifest import code_version, json_safe
 from sim_core.basin_grid import DEFAULT_BASIN_WINDOW, BasinGrid
 from sim_core.controls import ControlSchedule
@@ -163,8 +164,8 @@ def run_study(spec, chunk_map, progress) -> dict:
     return basin.to_dict()
 
 
-def simulate_run(body: RunCreate) -> dict:
-    """Run the map (and the sampled path if asked); the fields of a stored run."""
+def simulate_run(body: RunCreate) -> RunRecord:
+    """Run the map (and the sampled path if asked): the run to store (its tags are the caller's)."""
     from sim_core.poincare import iterate_map
     from sim_core.trajectory import simulate_trajectory
 
@@ -180,24 +181,21 @@ def simulate_run(body: RunCreate) -> dict:
     results = orbit.to_dict()
     if body.fixed_point:
         results["fixed_point"] = _gait_near(model, schedule, start)
-    return {
-        "kind": "sim",
-        "status": "done",
-        "duration_s": time.perf_counter() - began,
-        "code_version": current_code_version(),
-        "model": asdict(model) | {"mu": model.mu if np.isfinite(model.mu) else None},
-        "controls": [[leg.psi0_deg, leg.zeta0] for leg in body.controls],
-        "start_state": list(start),
-        "jumps": body.jumps,
-        "alpha": model.alpha,
-        "psi0_deg": body.controls[0].psi0_deg,
-        "zeta0": body.controls[0].zeta0,
-        "failure_code": None if orbit.failure is None else orbit.failure.code,
-        "jumps_completed": orbit.jumps_completed,
-        "climb": float(np.sum(orbit.rises)),
-        "results": json_safe(results),
-        "trajectory": trajectory,
-    }
+    return RunRecord(
+        kind="sim",
+        status="done",
+        duration_s=time.perf_counter() - began,
+        code_version=current_code_version(),
+        model=asdict(model) | {"mu": model.mu if np.isfinite(model.mu) else None},
+        controls=[[leg.psi0_deg, leg.zeta0] for leg in body.controls],
+        start_state=list(start),
+        jumps=body.jumps,
+        failure_code=None if orbit.failure is None else orbit.failure.code,
+        jumps_completed=orbit.jumps_completed,
+        climb=float(np.sum(orbit.rises)),
+        results=json_safe(results),
+        trajectory=trajectory,
+    )
 
 
 def _gait_near(model, schedule, start) -> dict:

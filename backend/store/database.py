@@ -34,7 +34,7 @@ if TYPE_CHECKING:
 MIGRATIONS = Path(__file__).resolve().parent / "migrations"
 # The newest migration's revision. tests/backend/store/test_database.py fails when a migration is
 # added without moving this: a stale value would let a database one revision behind start unmigrated.
-SCHEMA_HEAD = "0005"
+SCHEMA_HEAD = "0006"
 
 log = logging.getLogger("parkourlab.store")
 T = TypeVar("T")
@@ -199,6 +199,12 @@ def _space_returned(database: Path) -> bool:
         return reserved >= RESERVE_BYTES and free_bytes(database.parent) >= JOURNAL_SIZE_LIMIT
     except OSError:
         return False
+
+
+def ping(session: Session) -> str:
+    """Ask the database for something (``SELECT 1``): its dialect's name, or the driver's error."""
+    session.execute(text("SELECT 1"))
+    return session.get_bind().dialect.name
 
 
 def lock_for_write(session: Session) -> None:

@@ -78,7 +78,7 @@ class Run(Base):
     jumps: Mapped[int]
     # Indexed copies for filtering.
     alpha: Mapped[float] = mapped_column(index=True)
-    psi0_deg: Mapped[float] = mapped_column(index=True)  # first leg
+    psi0_deg: Mapped[float]  # first leg; indexed with zeta0 (below)
     zeta0: Mapped[float] = mapped_column(index=True)  # first leg
     failure_code: Mapped[str | None] = mapped_column(String(32), index=True)
     jumps_completed: Mapped[int]
@@ -91,6 +91,9 @@ class Run(Base):
     run_tags: Mapped[list[RunTag]] = relationship(cascade="all, delete-orphan", lazy="selectin")
     # Whether it has a trajectory, without loading it: lists and exports defer the blob and results.
     has_trajectory: Mapped[bool] = column_property(trajectory.is_not(None))
+
+    # psi0 and zeta0 ranges together read this index alone; psi0 alone uses its prefix.
+    __table_args__ = (Index("ix_runs_psi0_deg_zeta0", "psi0_deg", "zeta0"),)
 
     @property
     def tags(self) -> list[str]:

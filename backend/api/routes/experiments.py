@@ -17,7 +17,7 @@ def create_experiment(body: schemas.ExperimentCreate, db: Db):
     return experiment_out(db, records.create_experiment(db, body))
 
 
-@router.get("", response_model=schemas.Page)
+@router.get("", response_model=schemas.ExperimentPage)
 def list_experiments(db: Db, limit: PageLimit = 50, cursor: Cursor = None):
     rows, next_cursor = records.list_experiments(db, limit=limit, cursor=cursor)
     return {"items": [experiment_out(db, row) for row in rows], "next_cursor": next_cursor}

@@ -28,7 +28,7 @@ def create_job(body: schemas.JobCreate, db: Db, runner: Runner):
     return job_out(job)
 
 
-@router.get("", response_model=schemas.Page)
+@router.get("", response_model=schemas.JobPage)
 def list_jobs(
     db: Db,
     limit: PageLimit = 50,

@@ -22,7 +22,7 @@ def create_run(body: schemas.RunCreate, db: Db, compute: QuickCompute):
     return run_out(records.create_run(db, body, compute), detail=True)
 
 
-@router.get("", response_model=schemas.Page)
+@router.get("", response_model=schemas.RunPage)
 def list_runs(
     db: Db,
     where: RunQuery,
@@ -34,7 +34,7 @@ def list_runs(
     """Runs matching the filters. Sorted by id, ``next_cursor`` pages by keyset; sorted by another
     field, pass ``next_cursor`` back as ``offset``."""
     rows, next_cursor = records.list_runs(db, where, limit=limit, cursor=cursor, sort=sort, offset=offset)
-    return {"items": [run_out(row) for row in rows], "next_cursor": next_cursor}
+    return {"items": rows, "next_cursor": next_cursor}
 
 
 @router.get("/export", response_class=StreamingResponse)
@@ -48,7 +48,7 @@ def export_runs(
     return StreamingResponse(body, media_type=media, headers=disposition)
 
 
-@router.get("/compare")
+@router.get("/compare", response_model=schemas.RunComparison)
 def compare_runs(
     db: Db,
     ids: Annotated[
@@ -56,12 +56,12 @@ def compare_runs(
         Query(min_length=2, max_length=records.MAX_COMPARE, description="run ids"),
     ],
     only_differences: bool = True,
-) -> dict:
+):
     """Runs side by side as flat fields; by default only the fields whose values differ."""
     return records.compare_runs(db, ids, only_differences=only_differences)
 
 
-@router.get("/aggregate")
+@router.get("/aggregate", response_model=schemas.RunAggregate)
 def aggregate_runs(
     db: Db,
     where: RunQuery,
@@ -70,7 +70,7 @@ def aggregate_runs(
         int | None,
         Query(ge=1, le=records.MAX_BINS, description="continuous parameters: equal bins over their range"),
     ] = None,
-) -> dict:
+):
     """Runs grouped by a parameter or tag: count, mean, std, min and max of climb and jumps completed.
     A continuous parameter (zeta0, psi0_deg, alpha) groups by exact value — at most 1000 — or in
     ``bins`` equal bins (each group then has ``low`` and ``high``)."""
@@ -82,8 +82,8 @@ def get_run(run_id: RecordId, db: Db):
     return run_out(records.get_run(db, run_id), detail=True)
 
 
-@router.get("/{run_id}/trajectory")
-def get_trajectory(run_id: RecordId, db: Db) -> dict:
+@router.get("/{run_id}/trajectory", response_model=schemas.RunTrajectory)
+def get_trajectory(run_id: RecordId, db: Db):
     run = records.get_run(db, run_id)
     if run.trajectory is None:
         raise records.NotFound("trajectory of run", run_id)

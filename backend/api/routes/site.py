@@ -11,10 +11,11 @@ import plotly
 from fastapi import APIRouter, Request
 from fastapi.openapi.docs import swagger_ui_default_parameters
 from fastapi.responses import FileResponse, HTMLResponse, RedirectResponse, Response
-from sqlalchemy import select
 
+from backend import schemas
 from backend.api.deps import Db
 from backend.services import simulation
+from backend.store.database import ping
 
 SWAGGER_ASSETS = Path(fastapi_offline.__file__).parent / "static"  # Swagger UI 5: reads OpenAPI 3.1
 PLOTLY_JS = Path(plotly.__file__).parent / "package_data" / "plotly.min.js"  # served locally: no CDN
@@ -71,7 +72,6 @@ def swagger_init(request: Request) -> Response:
     return Response(script, media_type="text/javascript")
 
 
-@router.get("/api/v1/health", tags=["service"])
-def health(db: Db) -> dict:
-    db.execute(select(1))
-    return {"status": "ok", "database": db.get_bind().dialect.name, "code_version": simulation.current_code_version()}
+@router.get("/api/v1/health", tags=["service"], response_model=schemas.Health)
+def health(db: Db):
+    return {"status": "ok", "database": ping(db), "code_version": simulation.current_code_version()}

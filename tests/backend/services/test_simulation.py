@@ -92,36 +92,36 @@ def test_fixed_point_errors():
     assert error.value.field == "period"
 
 
-def test_simulate_run_gives_a_runs_fields(paper, symmetric):
-    fields = simulation.simulate_run(run_body(0.9, jumps=4, trajectory_rate=40.0))
+def test_simulate_run_gives_the_run_to_store(paper, symmetric):
+    run = simulation.simulate_run(run_body(0.9, jumps=4, trajectory_rate=40.0))
     orbit = iterate_map(paper, symmetric, (START.xdot, START.ydot), 4)
-    assert (fields["kind"], fields["status"], fields["failure_code"], fields["jumps_completed"]) == (
+    assert (run.kind, run.status, run.failure_code, run.jumps_completed) == (
         "sim",
         "done",
         None,
         4,
     )
-    assert fields["climb"] == pytest.approx(float(orbit.rises.sum()), rel=1e-12)
-    assert fields["results"] == _strict_json(orbit.to_dict()) and "fixed_point" not in fields["results"]
-    assert fields["model"]["alpha"] == paper.alpha and fields["code_version"] == simulation.current_code_version()
-    assert fields["duration_s"] >= 0 and fields["controls"] == [[30.0, 0.9]]
-    path = simulation.unpack_trajectory(fields["trajectory"])
+    assert run.climb == pytest.approx(float(orbit.rises.sum()), rel=1e-12)
+    assert run.results == _strict_json(orbit.to_dict()) and "fixed_point" not in run.results
+    assert run.model["alpha"] == paper.alpha and run.code_version == simulation.current_code_version()
+    assert run.duration_s >= 0 and run.controls == [[30.0, 0.9]]
+    path = simulation.unpack_trajectory(run.trajectory)
     assert set(path) == set(simulate_trajectory(paper, symmetric, (START.xdot, START.ydot), 4).COLUMNS)
 
 
 def test_simulate_run_stores_infinite_friction_as_null():
     # The API refuses Infinity (strict JSON); a model can still have it (a stored job's, the CLI's).
-    fields = simulation.simulate_run(run_body(model=ModelIn.model_construct(preset="paper", mu=math.inf)))
-    assert fields["model"]["mu"] is None and fields["trajectory"] is None
-    assert fields["model"] == _strict_json(fields["model"])
+    run = simulation.simulate_run(run_body(model=ModelIn.model_construct(preset="paper", mu=math.inf)))
+    assert run.model["mu"] is None and run.trajectory is None
+    assert run.model == _strict_json(run.model)
 
 
 def test_simulate_run_with_the_gait_near_its_start():
-    found = simulation.simulate_run(run_body(fixed_point=True))["results"]["fixed_point"]
+    found = simulation.simulate_run(run_body(fixed_point=True)).results["fixed_point"]
     assert found["found"] and found["max_abs_eigenvalue"] == pytest.approx(PERIOD_1_EIGENVALUE, abs=EIGENVALUE_ATOL)
     lost = simulation.simulate_run(run_body(fixed_point=True, start=StateIn(xdot=-0.3, ydot=5.0)))
-    assert lost["failure_code"] == "no_flight"
-    assert lost["results"]["fixed_point"]["found"] is False and lost["results"]["fixed_point"]["reason"]
+    assert lost.failure_code == "no_flight"
+    assert lost.results["fixed_point"]["found"] is False and lost.results["fixed_point"]["reason"]
 
 
 def test_trajectory_blob_round_trip():

@@ -1,0 +1,67 @@
+"""What every resource's bodies share: the strict base of a request, the leg, model and state
+inputs, the limits, record references and the page of a list."""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Generic, Literal, TypeVar
+
+from pydantic import BaseModel, ConfigDict, Field
+
+Psi0Deg = Annotated[float, Field(gt=0.0, lt=90.0, description="leg angle at touchdown [degrees], in (0, 90)")]
+Zeta0 = Annotated[float, Field(gt=0.0, lt=1.0, description="leg length at touchdown [l0], in (0, 1)")]
+Label = Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[\w.:/-]+$")]  # a tag
+
+MAX_JUMPS = 10_000
+MAX_TRIALS = 100_000
+MAX_LEVELS = 100
+MAX_PATH_SAMPLES = 100_000
+MAX_ID = 2**31 - 1  # integer keys: the smallest range among the supported databases (PostgreSQL)
+RecordRef = Annotated[int, Field(ge=1, le=MAX_ID)]
+Item = TypeVar("Item")  # what a Page lists
+
+
+class Strict(BaseModel):
+    """Every request body: unknown fields refused; NaN, ±Infinity (and 1e309, which JSON parsing
+    makes infinite) refused in every float field; a string with a lone surrogate (``"\\ud800"``)
+    is refused by pydantic itself (``string_unicode``) — each a 422 naming the field."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+
+class LegIn(Strict):
+    psi0_deg: Psi0Deg
+    zeta0: Zeta0
+
+
+class ModelIn(Strict):
+    """The ``paper`` preset with optional nondimensional overrides (docs/model.md §1)."""
+
+    preset: Literal["paper"] = "paper"
+    alpha: Annotated[float, Field(gt=0.0, le=1e4)] | None = None
+    d_hat: Annotated[float, Field(gt=0.0, le=100.0)] | None = None
+    c_zeta: Annotated[float, Field(ge=0.0, le=1e3)] | None = None
+    c_psi: Annotated[float, Field(ge=0.0, le=1e3)] | None = None
+    mu: Annotated[float, Field(gt=0.0)] | None = Field(None, description="friction coefficient; omit for the preset")
+
+
+class StateIn(Strict):
+    xdot: Annotated[float, Field(lt=0.0, ge=-100.0, description="section xdot [sqrt(g l0)], < 0")]
+    ydot: Annotated[float, Field(ge=-100.0, le=100.0)]
+
+
+class Health(BaseModel):
+    status: Literal["ok"]
+    database: str = Field(description="the database's dialect: sqlite or postgresql")
+    code_version: str
+
+
+class Page(BaseModel, Generic[Item]):
+    """One page of a list, newest first unless sorted otherwise."""
+
+    items: list[Item]
+    next_cursor: int | None = Field(None, description="pass as ?cursor= for the next page; null at the end")
+
+
+def finite_or_none(value: float) -> float | None:
+    return value if math.isfinite(value) else None

@@ -1,0 +1,186 @@
+"""Batch jobs: the four kinds a client can ask for (MJTF, energy sweep, basin, gait search), each
+bounded by a work budget, and what a job and its results look like."""
+
+from __future__ import annotations
+
+import datetime
+import enum
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, Discriminator, Field, field_validator, model_validator
+from pydantic import Tag as KindTag
+
+from backend.schemas.common import (
+    MAX_LEVELS,
+    MAX_TRIALS,
+    LegIn,
+    ModelIn,
+    Page,
+    Psi0Deg,
+    RecordRef,
+    StateIn,
+    Strict,
+    Zeta0,
+)
+
+# A job's work, in jumps at its worst (every trial to its cap, every basin point to its jump limit):
+# about an hour of the job worker on the lab's machine (1.35e5-1.6e5 jumps/s measured by
+# scripts/bench_job_rate.py on 2 cores). Larger jobs are refused with a 422 naming the limit.
+WORK_BUDGET_JUMPS = 500_000_000
+
+
+class JobState(enum.StrEnum):
+    QUEUED = "queued"
+    RUNNING = "running"
+    CANCELLING = "cancelling"
+    CANCELLED = "cancelled"
+    DONE = "done"
+    FAILED = "failed"
+
+
+class NoiseIn(Strict):
+    psi0_deg: Annotated[float, Field(ge=0.0, lt=30.0)] = 0.5
+    zeta0: Annotated[float, Field(ge=0.0, lt=0.2)] = 0.003
+    velocity: Annotated[float, Field(ge=0.0, lt=1.0)] = 0.01
+    pitch_drift_deg: Annotated[float, Field(ge=0.0, lt=30.0)] = 0.5
+    asymmetry_psi0_deg: Annotated[float, Field(gt=-30.0, lt=30.0)] = 0.0
+    asymmetry_zeta0: Annotated[float, Field(gt=-0.5, lt=0.5)] = 0.0
+
+
+class MJTFJobCreate(Strict):
+    """Mean Jumps To Failure: ``levels`` zeta0 values x ``trials`` noisy trials each."""
+
+    kind: Literal["mjtf"] = "mjtf"
+    experiment_id: RecordRef | None = None
+    model: ModelIn = ModelIn()
+    psi0_deg: Psi0Deg = 30.0
+    zeta0s: Annotated[list[Zeta0], Field(min_length=1, max_length=MAX_LEVELS)]
+    trials: Annotated[int, Field(ge=1, le=MAX_TRIALS)] = 8
+    cap: Annotated[int, Field(ge=1, le=100_000)] = 1000
+    seed: Annotated[int, Field(ge=0, lt=2**63)] = 0
+    noise: NoiseIn = NoiseIn()
+    guess: StateIn | None = None
+
+    @field_validator("zeta0s")
+    @classmethod
+    def _distinct(cls, values: list[float]) -> list[float]:
+        if len(set(values)) != len(values):
+            raise ValueError("zeta0 values must be distinct")
+        return values
+
+    @model_validator(mode="after")
+    def _within_budget(self) -> MJTFJobCreate:
+        return _within_budget(self, len(self.zeta0s) * self.trials * self.cap, "levels x trials x cap")
+
+
+class SweepJobCreate(Strict):
+    """An energy sweep: the gait followed over zeta0, with basin areas (``basin_grid`` 0: none)."""
+
+    kind: Literal["sweep"]
+    experiment_id: RecordRef | None = None
+    model: ModelIn = ModelIn()
+    psi0_deg: Psi0Deg = 30.0
+    zeta0_low: Zeta0 = 0.8
+    zeta0_high: Zeta0 = 0.97
+    steps: Annotated[int, Field(ge=2, le=500)] = 30
+    basin_grid: Annotated[int, Field(ge=0, le=200)] = 40
+    basin_jumps: Annotated[int, Field(ge=1, le=1000)] = 60
+    guess: StateIn | None = None
+
+    @model_validator(mode="after")
+    def _ordered(self) -> SweepJobCreate:
+        if not self.zeta0_low < self.zeta0_high:
+            raise ValueError(f"zeta0_low must be below zeta0_high, got {self.zeta0_low:g} >= {self.zeta0_high:g}")
+        if self.basin_grid == 1:
+            raise ValueError("basin_grid must be 0 (no basins) or at least 2")
+        return _within_budget(
+            self, self.steps * self.basin_grid**2 * self.basin_jumps, "steps x basin_grid² x basin_jumps"
+        )
+
+
+class BasinJobCreate(Strict):
+    """The basin of attraction of a gait over a grid of section states."""
+
+    kind: Literal["basin"]
+    experiment_id: RecordRef | None = None
+    model: ModelIn = ModelIn()
+    controls: Annotated[list[LegIn], Field(min_length=1, max_length=16)]
+    period: Annotated[int, Field(ge=1, le=16)] | None = None
+    guess: StateIn | None = None
+    grid: Annotated[int, Field(ge=2, le=1000)] = 100
+    jumps: Annotated[int, Field(ge=1, le=1000)] = 60
+    tolerance: Annotated[float, Field(gt=0.0, lt=10.0)] = 0.02
+
+    @model_validator(mode="after")
+    def _within_budget(self) -> BasinJobCreate:
+        return _within_budget(self, self.grid**2 * self.jumps, "grid² x jumps")
+
+
+class GaitSearchJobCreate(Strict):
+    """Distinct gaits of one control schedule, from a grid of guesses."""
+
+    kind: Literal["gaits"]
+    experiment_id: RecordRef | None = None
+    model: ModelIn = ModelIn()
+    controls: Annotated[list[LegIn], Field(min_length=1, max_length=16)]
+    period: Annotated[int, Field(ge=1, le=16)] | None = None
+    grid: Annotated[int, Field(ge=1, le=20)] = 6
+
+
+def _within_budget(job, jumps: int, formula: str):
+    """``job`` if its worst-case work (``jumps``, counted as ``formula``) fits the budget."""
+    if jumps > WORK_BUDGET_JUMPS:
+        raise ValueError(
+            f"the job would take up to {jumps:.3g} jumps ({formula}), over the limit of {WORK_BUDGET_JUMPS:.3g} "
+            "(about an hour of the job worker); ask for less, or split it into several jobs"
+        )
+    return job
+
+
+def _job_kind(value) -> str:
+    """The job's ``kind``; MJTF when absent (the first kind, which clients may leave out)."""
+    if isinstance(value, dict):
+        return value.get("kind", "mjtf")
+    return getattr(value, "kind", "mjtf")
+
+
+JobCreate = Annotated[
+    Annotated[MJTFJobCreate, KindTag("mjtf")]
+    | Annotated[SweepJobCreate, KindTag("sweep")]
+    | Annotated[BasinJobCreate, KindTag("basin")]
+    | Annotated[GaitSearchJobCreate, KindTag("gaits")],
+    Discriminator(_job_kind),
+]
+JOB_KINDS = {"mjtf": MJTFJobCreate, "sweep": SweepJobCreate, "basin": BasinJobCreate, "gaits": GaitSearchJobCreate}
+
+
+class JobOut(BaseModel):
+    id: int
+    experiment_id: int | None
+    kind: str
+    state: JobState
+    total: int
+    completed: int
+    progress: float
+    error: str | None
+    spec: dict
+    created_at: datetime.datetime
+    started_at: datetime.datetime | None
+    finished_at: datetime.datetime | None
+
+
+JobPage = Page[JobOut]
+
+
+class MJTFLevelOut(BaseModel):
+    zeta0: float
+    trials: int
+    mean: float
+    std: float
+    outcomes: dict[str, int]
+
+
+class JobResults(BaseModel):
+    job: JobOut
+    levels: list[MJTFLevelOut] | None = Field(None, description="MJTF jobs: per energy level")
+    result: dict | None = Field(None, description="other jobs: the study's result, once done")

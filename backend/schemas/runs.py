@@ -1,0 +1,135 @@
+"""Runs: what a client sends to simulate and store one, edits of its labels, and what comes back
+(a listed run, a run in full, a page, a comparison, an aggregate, a sampled path)."""
+
+from __future__ import annotations
+
+import datetime
+import enum
+from typing import Annotated
+
+from pydantic import BaseModel, Field, model_validator
+
+from backend.schemas.common import MAX_JUMPS, MAX_PATH_SAMPLES, Label, LegIn, ModelIn, Page, RecordRef, StateIn, Strict
+
+Tags = Annotated[list[Label], Field(max_length=32)]
+Notes = Annotated[str, Field(max_length=100_000)]
+Jumps = Annotated[int, Field(ge=1, le=MAX_JUMPS)]
+
+
+class RunKind(enum.StrEnum):
+    SIM = "sim"  # simulated by the service
+    ROBOT = "robot"  # a live run on the robot
+    REPLAY = "replay"  # a robot run's frames analysed again
+
+
+class RunStatus(enum.StrEnum):
+    DONE = "done"  # a physical failure (the robot fell) is still a run done
+    FAILED = "failed"  # it could not be carried out
+    RUNNING = "running"  # a live robot run, stored from its start
+    INTERRUPTED = "interrupted"  # a live run the service died during, kept to its last journal entry
+
+
+class RunBase(BaseModel):
+    """What a run is asked for with and keeps: its experiment, length and labels."""
+
+    experiment_id: RecordRef | None = None
+    jumps: Jumps = 20
+    tags: Tags = []
+
+
+class RunCreate(RunBase, Strict):
+    """Simulate a run and store it: the model, each leg's controls, the first section state."""
+
+    model: ModelIn = ModelIn()
+    controls: Annotated[list[LegIn], Field(min_length=1, max_length=16)]
+    start: StateIn
+    trajectory_rate: Annotated[float, Field(gt=0.0, le=1000.0)] | None = Field(
+        None, description="also store the sampled path, samples per sqrt(l0/g)"
+    )
+    fixed_point: bool = Field(False, description="also find the gait near the start state and store its eigenvalues")
+
+    @model_validator(mode="after")
+    def _bounded_path(self) -> RunCreate:
+        # A jump lasts about 1.5 time units: this caps a stored path near 150,000 samples.
+        if self.trajectory_rate is not None and self.trajectory_rate * self.jumps > MAX_PATH_SAMPLES:
+            samples = self.trajectory_rate * self.jumps
+            raise ValueError(f"trajectory_rate x jumps must be at most {MAX_PATH_SAMPLES:,}, got {samples:g}")
+        return self
+
+
+class RunUpdate(Strict):
+    """Runs are records of what happened: only their labels and notes change. Fields left out stay."""
+
+    tags: Tags | None = None
+    notes: Notes | None = None
+
+
+class RunOut(RunBase):
+    """A run as listed: everything but its results and path (``has_trajectory`` says if it has one).
+    ``model`` is the nondimensional parameters, ``controls`` ``[[psi0_deg, zeta0], …]`` per leg,
+    ``start_state`` ``[xdot, ydot]``, ``climb`` the total height gain [l0]."""
+
+    # Outputs are not held to today's input ranges: a run stored under older limits still reads.
+    id: int
+    experiment_id: int | None
+    jumps: int
+    kind: RunKind
+    status: RunStatus
+    created_at: datetime.datetime
+    duration_s: float
+    code_version: str
+    model: dict
+    controls: list
+    start_state: list
+    jumps_completed: int
+    failure_code: str | None
+    climb: float
+    tags: list[str]
+    notes: str
+    has_trajectory: bool
+
+
+class RunDetail(RunOut):
+    """A run in full: with its results (section states, rises, failure, a fixed point if asked)."""
+
+    results: dict
+
+
+RunPage = Page[RunOut]
+
+
+class RunComparison(BaseModel):
+    """Runs side by side as flat records (``model.alpha``, ``leg0.zeta0`` …)."""
+
+    fields: list[str]
+    differing: list[str] = Field(description="the fields whose values differ between the runs")
+    runs: list[dict[str, str | float | int | None]]
+
+
+class Stats(BaseModel):
+    mean: float
+    std: float = Field(description="population standard deviation over the group")
+    min: float
+    max: float
+
+
+class RunGroup(BaseModel):
+    key: str | float | int | None = Field(description="the group's value; a bin's centre when binned")
+    runs: int
+    low: float | None = Field(None, description="binned: the bin's lower edge")
+    high: float | None = Field(None, description="binned: the bin's upper edge (the last bin includes it)")
+    climb: Stats
+    jumps_completed: Stats
+
+
+class RunAggregate(BaseModel):
+    by: str
+    bins: int | None
+    groups: list[RunGroup]
+
+
+class RunTrajectory(BaseModel):
+    """A run's sampled path, column by column (time, phase, x, y, xdot, ydot …)."""
+
+    units: str
+    columns: dict[str, list[float | int]]

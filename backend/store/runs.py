@@ -1,0 +1,134 @@
+"""Runs in the database: the one place a run's row is built, and the SQL that reads runs back.
+
+A new run is a :class:`RunRecord` (what a simulation, a live robot run or a replay produced);
+:func:`add_run` turns it into the row, with the indexed copies of its parameters (alpha, the first
+leg's psi0 and zeta0) derived here and nowhere else. Lists and exports read plain rows of the
+columns they show (:data:`LISTED`), never ORM objects or the results and trajectory blobs: a page
+of 50 costs a fraction of a millisecond of SQL and no JSON it does not return.
+"""
+
+from __future__ import annotations
+
+import datetime
+from collections.abc import Iterable, Iterator
+from dataclasses import asdict, dataclass
+
+from sqlalchemy import Select, func, select
+from sqlalchemy.orm import Session
+
+from backend.store.models import Run, RunTag
+from backend.store.run_record import RunRecord
+
+# The columns of a listed run (the API's RunOut less its tags), read as plain rows.
+LISTED = (Run.id, Run.experiment_id, Run.kind, Run.status, Run.created_at, Run.duration_s, Run.code_version,
+          Run.model, Run.controls, Run.start_state, Run.jumps, Run.jumps_completed, Run.failure_code, Run.climb,
+          Run.notes, Run.trajectory.is_not(None).label("has_trajectory"))  # fmt: skip
+SORTS = ("-id", "id", "-created_at", "created_at", "-climb", "climb", "-zeta0", "zeta0", "-duration_s", "duration_s")
+EXPORT_BATCH = 1000
+
+
+def add_run(session: Session, record: RunRecord, *, experiment_id: int | None = None) -> Run:
+    """Add ``record`` to the session as a new run row (the caller commits); its tags deduplicated
+    and sorted, its filter columns copied from its model and first leg."""
+    columns = asdict(record)
+    tags = columns.pop("tags")
+    psi0_deg, zeta0 = record.controls[0]
+    run = Run(experiment_id=experiment_id, alpha=record.model["alpha"], psi0_deg=psi0_deg, zeta0=zeta0, **columns)
+    run.run_tags = [RunTag(tag=tag) for tag in sorted(set(tags))]
+    session.add(run)
+    return run
+
+
+@dataclass(frozen=True)
+class RunFilter:
+    """Which runs a list, export or aggregate covers; None leaves a criterion out. Ranges are
+    inclusive; ``created_before`` is exclusive."""
+
+    experiment_id: int | None = None
+    kind: str | None = None
+    status: str | None = None
+    tag: str | None = None
+    failure_code: str | None = None
+    zeta0_min: float | None = None
+    zeta0_max: float | None = None
+    psi0_min: float | None = None
+    psi0_max: float | None = None
+    created_after: datetime.datetime | None = None
+    created_before: datetime.datetime | None = None
+
+
+def filtered(query: Select, where: RunFilter) -> Select:
+    """``query`` restricted to the runs ``where`` selects (every criterion has an index)."""
+    conditions = [
+        (where.experiment_id, lambda v: Run.experiment_id == v),
+        (where.kind, lambda v: Run.kind == v),
+        (where.status, lambda v: Run.status == v),
+        (where.failure_code, lambda v: Run.failure_code == v),
+        (where.zeta0_min, lambda v: Run.zeta0 >= v),
+        (where.zeta0_max, lambda v: Run.zeta0 <= v),
+        (where.psi0_min, lambda v: Run.psi0_deg >= v),
+        (where.psi0_max, lambda v: Run.psi0_deg <= v),
+        (where.created_after, lambda v: Run.created_at >= v),
+        (where.created_before, lambda v: Run.created_at < v),
+    ]
+    for value, condition in conditions:
+        if value is not None:
+            query = query.where(condition(value))
+    if where.tag is not None:
+        query = query.where(Run.id.in_(select(RunTag.run_id).where(RunTag.tag == where.tag)))
+    return query
+
+
+def listed_page(
+    session: Session, where: RunFilter, *, limit: int, cursor: int | None, sort: str = "-id", offset: int = 0
+) -> tuple[list[dict], int | None]:
+    """A page of listed runs (dicts of :data:`LISTED` and ``tags``) and what fetches the next:
+    sorted by id (newest first by default) a keyset ``cursor`` (the last id of this page); by
+    another column (``-climb``: best first) the next ``offset``. None at the end."""
+    name = sort.lstrip("-")
+    if sort not in SORTS:
+        raise ValueError(f"sort must be one of {', '.join(SORTS)}, got {sort!r}")
+    descending = sort.startswith("-")
+    column = getattr(Run, name)
+    order = [column.desc() if descending else column.asc(), Run.id.desc() if descending else Run.id.asc()]
+    # The page's ids first, then their rows: a filter an index cannot order (a zeta0 range sorted
+    # by id) sorts only ids, not thousands of whole rows, to keep 51 of them.
+    ids = filtered(select(Run.id).order_by(*order).limit(limit + 1), where)
+    if name == "id":
+        if cursor is not None:
+            ids = ids.where(Run.id < cursor if descending else Run.id > cursor)
+    else:
+        ids = ids.offset(offset)
+    rows = [dict(row) for row in session.execute(select(*LISTED).where(Run.id.in_(ids)).order_by(*order)).mappings()]
+    tags = tags_of(session, [row["id"] for row in rows])
+    for row in rows:
+        row["tags"] = tags.get(row["id"], [])
+    more = len(rows) > limit
+    rows = rows[:limit]
+    if name == "id":
+        return rows, rows[-1]["id"] if more else None
+    return rows, offset + limit if more else None
+
+
+def tags_of(session: Session, run_ids: Iterable[int]) -> dict[int, list[str]]:
+    """Each run's tags, sorted; runs without tags are left out."""
+    tags: dict[int, list[str]] = {}
+    ids = list(run_ids)
+    if ids:
+        query = select(RunTag.run_id, RunTag.tag).where(RunTag.run_id.in_(ids)).order_by(RunTag.run_id, RunTag.tag)
+        for run_id, tag in session.execute(query):
+            tags.setdefault(run_id, []).append(tag)
+    return tags
+
+
+def exported_rows(session: Session, where: RunFilter, columns) -> Iterator[tuple[list, dict[int, list[str]]]]:
+    """Every matching run's ``columns`` (``Run.id`` first), oldest first, in batches of
+    :data:`EXPORT_BATCH` rows with their tags: what an export streams, never all in memory."""
+    query = filtered(select(*columns).order_by(Run.id), where).execution_options(yield_per=EXPORT_BATCH)
+    for batch in session.execute(query).partitions():
+        yield batch, tags_of(session, (row[0] for row in batch))
+
+
+def widest_schedule(session: Session, where: RunFilter) -> int:
+    """The most legs any matching run's schedule has (0 when none match)."""
+    return session.scalar(filtered(select(func.max(func.json_array_length(Run.controls))), where)) or 0
