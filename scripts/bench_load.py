@@ -8,7 +8,9 @@ idle, and while a job computes (``--job mjtf``: 12,000 trials; ``--job basin``: 
 so the bench's own GIL is not what is measured.
 
 Prints, per phase, throughput and p50/p95/max latency of the reads and the writes, and the
-ratio of each phase's p95 to idle. ``--json`` for the numbers alone.
+ratio of each phase's p95 to idle, and the CPU time the service's own process spent per request
+answered (its compute workers not counted): what bounds its throughput. ``--json`` for the
+numbers alone.
 Usage: PYTHONPATH=. python scripts/bench_load.py [--runs 20000] [--clients 20 50] [--seconds 20] [--job mjtf]
 """
 
@@ -18,6 +20,7 @@ import argparse
 import concurrent.futures
 import json
 import multiprocessing
+import os
 import random
 import shutil
 import statistics
@@ -65,7 +68,15 @@ def _client_process(base: str, token: str, seconds: float, threads: int, first_s
         return [request for client in results for request in client]
 
 
-def phase(base: str, token: str, clients: int, seconds: float) -> dict:
+def cpu_seconds(pid: int) -> float:
+    """The CPU time (user + system) process ``pid`` has used so far, without its children (the
+    compute workers): what the service's own process spends (Linux /proc)."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def phase(base: str, token: str, clients: int, seconds: float, service_pid: int | None = None) -> dict:
+    cpu_before = cpu_seconds(service_pid) if service_pid else None
     per_process = [clients // CLIENT_PROCESSES + (k < clients % CLIENT_PROCESSES) for k in range(CLIENT_PROCESSES)]
     context = multiprocessing.get_context("spawn")
     with concurrent.futures.ProcessPoolExecutor(CLIENT_PROCESSES, mp_context=context) as pool:
@@ -74,6 +85,8 @@ def phase(base: str, token: str, clients: int, seconds: float) -> dict:
         ]
         requests = [request for future in futures for request in future.result()]
     summary = {"requests": len(requests), "per_s": len(requests) / seconds, "errors": {}}
+    if service_pid:  # the service's own CPU per request answered: what bounds its throughput
+        summary["service_cpu_ms_per_request"] = 1e3 * (cpu_seconds(service_pid) - cpu_before) / max(len(requests), 1)
     for kind in ("read", "write"):
         times = sorted(latency for name, latency, status in requests if name == kind)
         if times:
@@ -107,11 +120,11 @@ def main() -> None:
     try:
         phase(base, token, 2, 3.0)  # warm: the workers' kernels, the database's pages
         for clients in args.clients:
-            idle = phase(base, token, clients, args.seconds)
+            idle = phase(base, token, clients, args.seconds, process.pid)
             job = httpx.post(f"{base}/api/v1/jobs", json=JOBS[args.job], headers=auth).json()["id"]
             while httpx.get(f"{base}/api/v1/jobs/{job}").json()["state"] != "running":
                 time.sleep(0.1)
-            busy = phase(base, token, clients, args.seconds)
+            busy = phase(base, token, clients, args.seconds, process.pid)
             state = httpx.get(f"{base}/api/v1/jobs/{job}").json()
             httpx.post(f"{base}/api/v1/jobs/{job}/cancel", headers=auth)
             busy["job_state_at_end"], busy["job_completed"] = state["state"], state["completed"]
@@ -124,8 +137,10 @@ def main() -> None:
         print(json.dumps(results))
         return
     print(f"{args.runs} runs; phases of {args.seconds:g} s; job: {args.job}")
-    header = ("clients", "phase", "req/s", "read p50", "p95", "max", "write p50", "p95", "max", "p95 x idle (r/w)")
-    print(" ".join(f"{name:>{width}}" for name, width in zip(header, (7, 5, 7, 9, 7, 7, 10, 7, 7, 17), strict=True)))
+    header = ("clients", "phase", "req/s", "read p50", "p95", "max", "write p50", "p95", "max", "p95 x idle (r/w)",
+              "cpu ms/req")  # fmt: skip
+    widths = (7, 5, 7, 9, 7, 7, 10, 7, 7, 17, 11)
+    print(" ".join(f"{name:>{width}}" for name, width in zip(header, widths, strict=True)))
     for entry in results["phases"]:
         for name in ("idle", "job"):
             row = entry[name]
@@ -135,7 +150,7 @@ def main() -> None:
             print(
                 f"{entry['clients']:>7} {name:>5} {row['per_s']:>7.0f} {read['p50_ms']:>9.1f} {read['p95_ms']:>7.1f} "
                 f"{read['max_ms']:>7.0f} {write['p50_ms']:>10.1f} {write['p95_ms']:>7.1f} {write['max_ms']:>7.0f} "
-                f"{ratio:>17}  {row['errors'] or ''}"
+                f"{ratio:>17} {row['service_cpu_ms_per_request']:>11.1f}  {row['errors'] or ''}"
             )
         print(f"{'':>7} job: {entry['job']['job_state_at_end']}, {entry['job']['job_completed']} done during the phase")
 

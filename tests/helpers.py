@@ -17,7 +17,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]  # the checkout
 SERVICE_START_TIMEOUT = 60.0  # [s] a cold start compiles nothing, but CI machines are slow
-POOL_FILLERS = 45  # more than the request thread pool's 40 threads (anyio's default)
+POOL_FILLERS = 45  # more requests than the service has request threads (backend/api/app.py), and anyio's 40
 # A /sim/map call of 1000 jumps: a few ms of kernel under the service's kernel lock, back to back.
 MAP_BODY = {"controls": [{"psi0_deg": 30, "zeta0": 0.87}], "start": {"xdot": -0.9, "ydot": -0.2}, "jumps": 1000}
 # A heavy MJTF job: 11 energy levels x 4096 trials of up to 1000 jumps, 1408 chunks of 32 trials

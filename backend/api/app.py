@@ -14,6 +14,7 @@ import contextlib
 import logging
 from pathlib import Path
 
+import anyio.to_thread
 from fastapi import FastAPI
 from fastapi.staticfiles import StaticFiles
 
@@ -32,6 +33,12 @@ log = logging.getLogger("parkourlab.api")
 # the backend in the layers, and the backend only serves its files.
 PANEL_DIR = Path(__file__).resolve().parents[2] / "frontend" / "panel"
 ROUTERS = (site, experiments, runs, jobs, robot, view, sim)
+# Threads that run the sync routes (database work; compute is awaited in worker processes, the
+# e-stop is async). anyio's default is 40: under load 40 threads ping-pong the GIL once per row
+# SQLite steps, and on this 2-core machine 20 clients got 116 pages/s, p95 378 ms; with 4, 143
+# pages/s, p95 199 ms (scripts/bench_load.py). Nothing a sync route does waits long: a request
+# that would (a simulation, a job's compute) awaits a worker instead.
+REQUEST_THREADS = 4
 
 
 def create_app(
@@ -60,6 +67,7 @@ def create_app(
 
     @contextlib.asynccontextmanager
     async def lifespan(app: FastAPI):
+        anyio.to_thread.current_default_thread_limiter().total_tokens = REQUEST_THREADS
         migrate(engine)
         ensure_reserve(engine)  # the room deletes need on a full disk (store/database.py)
         robot_service.recover()  # live runs the previous process died during: stored as interrupted, nothing re-armed

@@ -3,6 +3,7 @@ shared path and query parameters (ids, pages, the run filters)."""
 
 from __future__ import annotations
 
+import contextlib
 import datetime
 from collections.abc import Iterator
 from typing import Annotated
@@ -21,14 +22,22 @@ from backend.store.database import StorageFull, after_storage_full
 VIEW_NOT_STARTED = "the 3D view is not running (it starts with `parkour serve`)"
 
 
-def get_session(request: Request) -> Iterator[Session]:
-    with request.app.state.sessions() as session:
+@contextlib.contextmanager
+def request_session(sessions) -> Iterator[Session]:
+    """A session for one request's database work (the ``Db`` dependency's, or an async route's in
+    a thread): on a full disk — answered 507 (errors.py) — the WAL is folded so that a retry can fit."""
+    with sessions() as session:
         try:
             yield session
-        except StorageFull:  # answered 507 (errors.py); the WAL is folded so that a retry can fit
+        except StorageFull:
             session.rollback()
             after_storage_full(session.get_bind())
             raise
+
+
+def get_session(request: Request) -> Iterator[Session]:
+    with request_session(request.app.state.sessions) as session:
+        yield session
 
 
 def run_filter(

@@ -25,6 +25,7 @@ from backend.schemas import ExperimentCreate, ExperimentUpdate, RunCreate
 from backend.services.simulation import simulate_run
 from backend.store.database import freeing_space, lock_for_write
 from backend.store.models import Experiment, Job, Run, RunTag
+from backend.store.run_record import RunRecord
 from backend.store.runs import SORTS as SORTS  # re-exported: the API's query parameters are checked against them
 from backend.store.runs import RunFilter, add_run, exported_rows, filtered, listed_page, widest_schedule
 from experiments.manifest import json_safe
@@ -86,11 +87,22 @@ def list_experiments(session: Session, *, limit: int, cursor: int | None) -> tup
 
 def create_run(session: Session, body: RunCreate, compute=None) -> Run:
     """Simulate ``body`` — in ``compute``'s workers (a :class:`~backend.services.compute.ComputePool`),
-    or here without one — and store it as a run."""
-    if body.experiment_id is not None:
-        get_experiment(session, body.experiment_id)
+    or here without one — and store it as a run. (The API awaits the simulation instead of holding a
+    request thread: it calls :func:`check_run_request`, the worker, then :func:`store_run`.)"""
+    check_run_request(session, body)
     # Simulated before the lock is taken: it takes a while.
     record = simulate_run(body) if compute is None else compute.run(simulate_run, body)
+    return store_run(session, body, record)
+
+
+def check_run_request(session: Session, body: RunCreate) -> None:
+    """What a run request names exists (its experiment): checked before the simulation is paid for."""
+    if body.experiment_id is not None:
+        get_experiment(session, body.experiment_id)
+
+
+def store_run(session: Session, body: RunCreate, record: RunRecord) -> Run:
+    """Store ``record``, simulated for ``body``, with the request's experiment and tags."""
     if body.experiment_id is not None:  # still there (a concurrent delete waits for this commit)
         locked(session, Experiment, body.experiment_id, "experiment")
     run = add_run(session, dataclasses.replace(record, tags=tuple(body.tags)), experiment_id=body.experiment_id)

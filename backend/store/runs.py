@@ -10,19 +10,23 @@ of 50 costs a fraction of a millisecond of SQL and no JSON it does not return.
 from __future__ import annotations
 
 import datetime
+import json
 from collections.abc import Iterable, Iterator
 from dataclasses import asdict, dataclass
 
-from sqlalchemy import Select, func, select
+from sqlalchemy import Select, Text, func, select, type_coerce
 from sqlalchemy.orm import Session
 
 from backend.store.models import Run, RunTag
 from backend.store.run_record import RunRecord
 
-# The columns of a listed run (the API's RunOut less its tags), read as plain rows.
+# The columns of a listed run (the API's RunOut less its tags), read as plain rows; its JSON
+# columns come as text (LISTED_JSON) and a page decodes them in one call (listed_page).
+LISTED_JSON = ("model", "controls", "start_state")
 LISTED = (Run.id, Run.experiment_id, Run.kind, Run.status, Run.created_at, Run.duration_s, Run.code_version,
-          Run.model, Run.controls, Run.start_state, Run.jumps, Run.jumps_completed, Run.failure_code, Run.climb,
-          Run.notes, Run.trajectory.is_not(None).label("has_trajectory"))  # fmt: skip
+          Run.jumps, Run.jumps_completed, Run.failure_code, Run.climb, Run.notes,
+          Run.trajectory.is_not(None).label("has_trajectory"),
+          *(type_coerce(getattr(Run, name), Text).label(name) for name in LISTED_JSON))  # fmt: skip
 SORTS = ("-id", "id", "-created_at", "created_at", "-climb", "climb", "-zeta0", "zeta0", "-duration_s", "duration_s")
 EXPORT_BATCH = 1000
 
@@ -100,8 +104,11 @@ def listed_page(
     else:
         ids = ids.offset(offset)
     rows = [dict(row) for row in session.execute(select(*LISTED).where(Run.id.in_(ids)).order_by(*order)).mappings()]
-    tags = tags_of(session, [row["id"] for row in rows])
-    for row in rows:
+    # A page's JSON in one decode: 150 json.loads through the column type cost more than the SQL.
+    decoded = json.loads("[" + ",".join(row[name] for row in rows for name in LISTED_JSON) + "]")
+    tags = _tags_where(session, RunTag.run_id.in_(ids))  # the page's id query again, not 50 parameters
+    for index, row in enumerate(rows):
+        row.update(zip(LISTED_JSON, decoded[len(LISTED_JSON) * index : len(LISTED_JSON) * (index + 1)], strict=True))
         row["tags"] = tags.get(row["id"], [])
     more = len(rows) > limit
     rows = rows[:limit]
@@ -112,12 +119,17 @@ def listed_page(
 
 def tags_of(session: Session, run_ids: Iterable[int]) -> dict[int, list[str]]:
     """Each run's tags, sorted; runs without tags are left out."""
-    tags: dict[int, list[str]] = {}
     ids = list(run_ids)
-    if ids:
-        query = select(RunTag.run_id, RunTag.tag).where(RunTag.run_id.in_(ids)).order_by(RunTag.run_id, RunTag.tag)
-        for run_id, tag in session.execute(query):
-            tags.setdefault(run_id, []).append(tag)
+    return _tags_where(session, RunTag.run_id.in_(ids)) if ids else {}
+
+
+def _tags_where(session: Session, condition) -> dict[int, list[str]]:
+    """The tags of the runs ``condition`` selects (on RunTag), by run, sorted."""
+    tags: dict[int, list[str]] = {}
+    for run_id, tag in session.execute(
+        select(RunTag.run_id, RunTag.tag).where(condition).order_by(RunTag.run_id, RunTag.tag)
+    ):
+        tags.setdefault(run_id, []).append(tag)
     return tags
 
 

@@ -5,11 +5,12 @@ from __future__ import annotations
 from typing import Annotated
 
 from fastapi import APIRouter, Query, Request
+from fastapi.concurrency import run_in_threadpool
 from fastapi.responses import StreamingResponse
 from pydantic import Field
 
 from backend import schemas
-from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, QuickCompute, RecordId, RunQuery
+from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, QuickCompute, RecordId, RunQuery, request_session
 from backend.services import records, simulation
 from backend.services.robot_records import replay_run
 
@@ -17,9 +18,22 @@ router = APIRouter(prefix="/api/v1/runs", tags=["runs"])
 
 
 @router.post("", status_code=201, dependencies=AUTHORIZED, response_model=schemas.RunDetail)
-def create_run(body: schemas.RunCreate, db: Db, compute: QuickCompute):
-    """Simulate (in the quick compute worker) and store a run."""
-    return run_out(records.create_run(db, body, compute), detail=True)
+async def create_run(body: schemas.RunCreate, request: Request, compute: QuickCompute):
+    """Simulate (in the quick compute worker) and store a run. Async: the simulation is awaited, so
+    no request thread waits for it; the database work before and after takes one briefly."""
+    sessions = request.app.state.sessions
+
+    def check() -> None:
+        with request_session(sessions) as session:
+            records.check_run_request(session, body)
+
+    def store(record) -> dict:
+        with request_session(sessions) as session:
+            return run_out(records.store_run(session, body, record), detail=True)
+
+    await run_in_threadpool(check)
+    record = await compute.call(simulation.simulate_run, body)
+    return await run_in_threadpool(store, record)
 
 
 @router.get("", response_model=schemas.RunPage)

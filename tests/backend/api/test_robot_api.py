@@ -6,12 +6,13 @@ import time
 
 import pytest
 
+from backend.api.app import REQUEST_THREADS
 from backend.robot.messages import RobotState
 from backend.robot.virtual import VirtualRobot
 from tests.helpers import answer_within, free_port
 from tests.robot_rig import PtyRobot
 
-POOL_THREADS = 40  # the request thread pool's (anyio's default limiter)
+POOL_THREADS = REQUEST_THREADS  # the request thread pool's
 POOL_FILLERS = 45  # more than the request thread pool's threads
 ANSWER_BOUND_S = 2.0  # [s] "answers instead of hanging": generous, not a latency claim
 
@@ -64,19 +65,20 @@ def test_estop_needs_no_token_and_reaches_the_robot(client, auth, connected):
 
 
 def test_estop_answers_while_the_request_pool_is_full(client, auth, connected, monkeypatch):
-    """45 stored-run requests hold every request thread (each waits inside the route): the e-stop,
-    async and on its own thread, answers all the same. Real compute under load: test_estop_load.py."""
+    """45 stored-run requests hold every request thread (each waits inside the route, storing its
+    run): the e-stop, async and on its own thread, answers all the same. Real compute under load:
+    test_estop_load.py."""
     from backend.services import records
 
     release, entered = threading.Event(), threading.Semaphore(0)
-    create_run = records.create_run
+    store_run = records.store_run
 
     def held(*args, **kwargs):
         entered.release()
         release.wait(60)
-        return create_run(*args, **kwargs)
+        return store_run(*args, **kwargs)
 
-    monkeypatch.setattr(records, "create_run", held)
+    monkeypatch.setattr(records, "store_run", held)
     body = {"controls": CONTROLS[:1], "start": {"xdot": -0.9, "ydot": -0.2}, "jumps": 3}
     answers = []
 
