@@ -3,8 +3,9 @@
 Seeds ``--runs`` runs into a fresh SQLite store, starts the real ``parkour serve`` on it (its own
 process, as in the lab), then for each client count runs two phases of ``--seconds`` each:
 idle, and while a job computes (``--job mjtf``: 12,000 trials; ``--job basin``: a 200 x 200 grid,
-1000 jumps). Each client loops: four filtered ``GET /api/v1/runs`` pages for every ``POST
-/api/v1/runs`` (4 jumps, stored). The clients run in processes of their own (a few threads each),
+1000 jumps), and with ``--export`` a third while one more client exports every run as CSV. Each
+client loops: four filtered ``GET /api/v1/runs`` pages for every ``POST /api/v1/runs`` (4 jumps,
+stored). The clients run in processes of their own (a few threads each),
 so the bench's own GIL is not what is measured.
 
 Prints, per phase, throughput and p50/p95/max latency of the reads and the writes, and the
@@ -102,6 +103,33 @@ def phase(base: str, token: str, clients: int, seconds: float, service_pid: int 
     return summary
 
 
+class Exporting:
+    """While in its ``with``: one client downloading ``GET /api/v1/runs/export?format=csv`` (every
+    run) back to back; :attr:`done` counts whole exports."""
+
+    def __init__(self, base: str):
+        self.base, self.done = base, 0
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._export, name="bench-export", daemon=True)
+
+    def _export(self) -> None:
+        with httpx.Client(base_url=self.base, timeout=120) as client:
+            while not self._stop.is_set():
+                with client.stream("GET", "/api/v1/runs/export", params={"format": "csv"}) as response:
+                    for _ in response.iter_bytes():
+                        if self._stop.is_set():
+                            return
+                self.done += 1
+
+    def __enter__(self) -> Exporting:
+        self._thread.start()
+        return self
+
+    def __exit__(self, *_) -> None:
+        self._stop.set()
+        self._thread.join(30)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=20_000)
@@ -109,6 +137,7 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=20.0)
     parser.add_argument("--job", choices=sorted(JOBS), default="mjtf")
     parser.add_argument("--port", type=int, default=8765)
+    parser.add_argument("--export", action="store_true", help="a third phase: one client exporting every run as CSV")
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
     data_dir = Path(tempfile.mkdtemp(prefix="parkourlab-load-"))
@@ -129,6 +158,10 @@ def main() -> None:
             httpx.post(f"{base}/api/v1/jobs/{job}/cancel", headers=auth)
             busy["job_state_at_end"], busy["job_completed"] = state["state"], state["completed"]
             results["phases"].append({"clients": clients, "idle": idle, "job": busy})
+            if args.export:
+                with Exporting(base) as exporting:
+                    results["phases"][-1]["export"] = phase(base, token, clients, args.seconds, process.pid)
+                results["phases"][-1]["export"]["exports_done"] = exporting.done
     finally:
         process.terminate()
         process.wait(30)
@@ -142,7 +175,9 @@ def main() -> None:
     widths = (7, 5, 7, 9, 7, 7, 10, 7, 7, 17, 11)
     print(" ".join(f"{name:>{width}}" for name, width in zip(header, widths, strict=True)))
     for entry in results["phases"]:
-        for name in ("idle", "job"):
+        for name in ("idle", "job", "export"):
+            if name not in entry:
+                continue
             row = entry[name]
             ratio = "" if name == "idle" else " / ".join(
                 f"{row[kind]['p95_ms'] / entry['idle'][kind]['p95_ms']:.1f}" for kind in ("read", "write"))  # fmt: skip
@@ -153,6 +188,8 @@ def main() -> None:
                 f"{ratio:>17} {row['service_cpu_ms_per_request']:>11.1f}  {row['errors'] or ''}"
             )
         print(f"{'':>7} job: {entry['job']['job_state_at_end']}, {entry['job']['job_completed']} done during the phase")
+        if "export" in entry:
+            print(f"{'':>7} export: {entry['export']['exports_done']} whole CSV exports of every run during the phase")
 
 
 if __name__ == "__main__":

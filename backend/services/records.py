@@ -11,26 +11,22 @@ a full disk (:func:`backend.store.database.freeing_space`): deleting is how spac
 
 from __future__ import annotations
 
-import csv
 import dataclasses
-import io
 import json
 import math
-from collections.abc import Iterator
 
 from sqlalchemy import Float, Integer, Select, case, cast, func, select
 from sqlalchemy.orm import Session
 
 from backend.schemas import ExperimentCreate, ExperimentUpdate, RunCreate
+from backend.services.exports import flat_record
 from backend.services.simulation import simulate_run
 from backend.store.database import freeing_space, lock_for_write
 from backend.store.models import Experiment, Job, Run, RunTag
 from backend.store.run_record import RunRecord
 from backend.store.runs import SORTS as SORTS  # re-exported: the API's query parameters are checked against them
-from backend.store.runs import RunFilter, add_run, exported_rows, filtered, listed_page, widest_schedule
-from experiments.manifest import json_safe
+from backend.store.runs import RunFilter, add_run, filtered, listed_page
 from sim_core.errors import ParameterError
-from sim_core.params import ModelParams
 
 MAX_PAGE = 500
 
@@ -156,91 +152,8 @@ MAX_GROUPS = 1000
 MAX_BINS = 1000
 
 
-def run_row(run: Run) -> dict:
-    """A run as one flat record: what export writes and compare lines up."""
-    return flat_record(run, run.tags)
-
-
-def flat_record(run, tags: list[str]) -> dict:
-    """The flat record of ``run`` — a stored Run, or a row of :data:`EXPORTED` columns — and its tags."""
-    row = {
-        "id": run.id,
-        "experiment_id": run.experiment_id,
-        "kind": run.kind,
-        "status": run.status,
-        "created_at": run.created_at.isoformat(),
-        "duration_s": run.duration_s,
-        "code_version": run.code_version,
-        "tags": " ".join(tags),
-        "notes": run.notes,
-        "jumps": run.jumps,
-        "jumps_completed": run.jumps_completed,
-        "failure_code": run.failure_code,
-        "climb": run.climb,
-        "start_xdot": run.start_state[0],
-        "start_ydot": run.start_state[1],
-    }
-    row |= {f"model.{name}": value for name, value in run.model.items()}
-    for leg, (psi0_deg, zeta0) in enumerate(run.controls):
-        row |= {f"leg{leg}.psi0_deg": psi0_deg, f"leg{leg}.zeta0": zeta0}
-    return row
-
-
-# What an export reads of each run (not its results or trajectory): plain rows, no ORM objects.
-EXPORTED = (Run.id, Run.experiment_id, Run.kind, Run.status, Run.created_at, Run.duration_s, Run.code_version,
-            Run.notes, Run.jumps, Run.jumps_completed, Run.failure_code, Run.climb, Run.start_state, Run.model,
-            Run.controls)  # fmt: skip
-RECORD_FIELDS = ("id", "experiment_id", "kind", "status", "created_at", "duration_s", "code_version", "tags", "notes",
-                 "jumps", "jumps_completed", "failure_code", "climb", "start_xdot", "start_ydot")  # fmt: skip
-FORMULA_START = frozenset("=+-@\t\r")  # a spreadsheet reads a cell starting with one as a formula
-
-
-def export(sessions, where: RunFilter, format_: str) -> Iterator[str]:
-    """Every matching run, oldest first, as CSV or JSON text in chunks, read in batches in a
-    session of its own (the response streams after the request's session has closed). The CSV's
-    columns are known before the first row: every model field and as many legs as the widest run."""
-    with sessions() as session:
-        if format_ == "csv":
-            legs = widest_schedule(session, where)
-            fields = [*RECORD_FIELDS, *(f"model.{f.name}" for f in dataclasses.fields(ModelParams))]
-            fields += [f"leg{leg}.{name}" for leg in range(legs) for name in ("psi0_deg", "zeta0")]
-            yield from rows_as_csv(_exported(session, where), fields)
-        else:
-            yield from rows_as_json(_exported(session, where))
-
-
-def _exported(session: Session, where: RunFilter) -> Iterator[dict]:
-    for batch, tags in exported_rows(session, where, EXPORTED):
-        for run in batch:
-            yield flat_record(run, tags.get(run.id, []))
-
-
-def rows_as_csv(rows: Iterator[dict], fields: list[str]) -> Iterator[str]:
-    """``rows`` as CSV with these columns (a row's others are dropped, its missing ones empty).
-    Text that a spreadsheet would run as a formula (starting with = + - @, a tab or a return) is
-    written with a leading apostrophe, as OWASP advises; numbers are written as they are."""
-    buffer = io.StringIO()
-    writer = csv.writer(buffer)
-    writer.writerow(fields)
-    for row in rows:
-        values = [row.get(field, "") for field in fields]
-        writer.writerow([f"'{v}" if v.__class__ is str and v[:1] in FORMULA_START else v for v in values])
-        if buffer.tell() > 64_000:
-            yield buffer.getvalue()
-            buffer.seek(0)
-            buffer.truncate()
-    yield buffer.getvalue()
-
-
-def rows_as_json(rows: Iterator[dict]) -> Iterator[str]:
-    yield "["
-    for index, row in enumerate(rows):
-        yield ("," if index else "") + json.dumps(json_safe(row))
-    yield "]"
-
-
 def compare_runs(session: Session, ids: list[int], *, only_differences: bool) -> dict:
-    runs = [run_row(get_run(session, run_id)) for run_id in ids]
+    runs = [flat_record(run, run.tags) for run in (get_run(session, run_id) for run_id in ids)]
     fields = list(dict.fromkeys(key for run in runs for key in run))
     differing = [key for key in fields if len({json.dumps(run.get(key)) for run in runs}) > 1]
     shown = [key for key in fields if key == "id" or not only_differences or key in differing]

@@ -14,7 +14,7 @@ import json
 from collections.abc import Iterable, Iterator
 from dataclasses import asdict, dataclass
 
-from sqlalchemy import Select, Text, func, select, type_coerce
+from sqlalchemy import Select, Text, cast, func, select
 from sqlalchemy.orm import Session
 
 from backend.store.models import Run, RunTag
@@ -26,7 +26,7 @@ LISTED_JSON = ("model", "controls", "start_state")
 LISTED = (Run.id, Run.experiment_id, Run.kind, Run.status, Run.created_at, Run.duration_s, Run.code_version,
           Run.jumps, Run.jumps_completed, Run.failure_code, Run.climb, Run.notes,
           Run.trajectory.is_not(None).label("has_trajectory"),
-          *(type_coerce(getattr(Run, name), Text).label(name) for name in LISTED_JSON))  # fmt: skip
+          *(cast(getattr(Run, name), Text).label(name) for name in LISTED_JSON))  # fmt: skip
 SORTS = ("-id", "id", "-created_at", "created_at", "-climb", "climb", "-zeta0", "zeta0", "-duration_s", "duration_s")
 EXPORT_BATCH = 1000
 
@@ -124,21 +124,21 @@ def tags_of(session: Session, run_ids: Iterable[int]) -> dict[int, list[str]]:
 
 
 def _tags_where(session: Session, condition) -> dict[int, list[str]]:
-    """The tags of the runs ``condition`` selects (on RunTag), by run, sorted."""
+    """The tags of the runs ``condition`` selects (on RunTag), by run, sorted (plain Core rows)."""
     tags: dict[int, list[str]] = {}
-    for run_id, tag in session.execute(
-        select(RunTag.run_id, RunTag.tag).where(condition).order_by(RunTag.run_id, RunTag.tag)
-    ):
+    query = select(RunTag.run_id, RunTag.tag).where(condition).order_by(RunTag.run_id, RunTag.tag)
+    for run_id, tag in session.connection().execute(query):
         tags.setdefault(run_id, []).append(tag)
     return tags
 
 
 def exported_rows(session: Session, where: RunFilter, columns) -> Iterator[tuple[list, dict[int, list[str]]]]:
     """Every matching run's ``columns`` (``Run.id`` first), oldest first, in batches of
-    :data:`EXPORT_BATCH` rows with their tags: what an export streams, never all in memory."""
+    :data:`EXPORT_BATCH` rows with their tags: what an export streams, never all in memory. Plain
+    Core rows (no ORM loading); a batch's tags are read by its id range, not a thousand parameters."""
     query = filtered(select(*columns).order_by(Run.id), where).execution_options(yield_per=EXPORT_BATCH)
-    for batch in session.execute(query).partitions():
-        yield batch, tags_of(session, (row[0] for row in batch))
+    for batch in session.connection().execute(query).partitions():
+        yield batch, _tags_where(session, RunTag.run_id.between(batch[0][0], batch[-1][0]))
 
 
 def widest_schedule(session: Session, where: RunFilter) -> int:

@@ -11,7 +11,7 @@ from pydantic import Field
 
 from backend import schemas
 from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, QuickCompute, RecordId, RunQuery, request_session
-from backend.services import records, simulation
+from backend.services import exports, records, simulation
 from backend.services.robot_records import replay_run
 
 router = APIRouter(prefix="/api/v1/runs", tags=["runs"])
@@ -56,7 +56,7 @@ def export_runs(
     request: Request, where: RunQuery, format_: Annotated[str, Query(alias="format", pattern="^(csv|json)$")] = "csv"
 ):
     """Every run matching the filters, streamed, with tags, timings and parameters (not the path)."""
-    body = records.export(request.app.state.sessions, where, format_)
+    body = exports.export(request.app.state.sessions, where, format_)
     media = "text/csv" if format_ == "csv" else "application/json"
     disposition = {"Content-Disposition": f'attachment; filename="runs.{format_}"'}
     return StreamingResponse(body, media_type=media, headers=disposition)

@@ -2,6 +2,7 @@
 
 import pytest
 
+from backend.schemas import ExperimentCreate
 from backend.services import records
 from backend.store.database import make_engine, migrate, session_factory, sqlite_url
 from backend.store.models import Run
@@ -52,3 +53,16 @@ def connected(service, virtual):
     status = service.connect(RobotConnect(url=robot.url, tracker_port=tracker_port))
     assert status["state"] == "disarmed", status
     return service
+
+
+@pytest.fixture
+def stored_runs(session, make_run):
+    """Five runs: zeta0 0.86 .. 0.94 at psi0 = 30°, the middle one tagged and in an experiment,
+    and one slipping run at psi0 = 60°."""
+    experiment = records.create_experiment(session, ExperimentCreate(name="energy"))
+    runs = {}
+    for zeta0 in (0.86, 0.88, 0.9, 0.92, 0.94):
+        tags = ["middle"] if zeta0 == 0.9 else []
+        runs[zeta0] = make_run(zeta0=zeta0, tags=tags, experiment_id=experiment.id if zeta0 == 0.9 else None)
+    runs["slip"] = make_run(psi0_deg=60.0, tags=["middle"])
+    return experiment, runs

@@ -1,18 +1,14 @@
 """The records service called directly: experiments and runs, filters, pages, export and comparison."""
 
-import csv
-import io
-import json
 import math
 
 import pytest
 
-from backend.schemas import ExperimentCreate, ExperimentUpdate, LegIn, MJTFJobCreate
+from backend.schemas import ExperimentCreate, ExperimentUpdate, MJTFJobCreate
 from backend.services import records
 from backend.services.jobs import create_job
 from backend.services.records import Conflict, NotFound, RunFilter
-from experiments.manifest import json_safe
-from sim_core import ControlSchedule, get_preset, iterate_map
+from sim_core import ControlSchedule, iterate_map
 from tests.backend.services.bodies import START
 
 CLIMB_RTOL = 1e-12  # a stored climb is the sum of the map's rises, rounded once more
@@ -153,19 +149,6 @@ def test_an_edit_waits_for_the_write_lock_and_reads_after_it(sessions, make_run)
     assert outcome == ["not found"]
 
 
-@pytest.fixture
-def stored_runs(session, make_run):
-    """Five runs: zeta0 0.86 .. 0.94 at psi0 = 30°, the middle one tagged and in an experiment,
-    and one slipping run at psi0 = 60°."""
-    experiment = records.create_experiment(session, ExperimentCreate(name="energy"))
-    runs = {}
-    for zeta0 in (0.86, 0.88, 0.9, 0.92, 0.94):
-        tags = ["middle"] if zeta0 == 0.9 else []
-        runs[zeta0] = make_run(zeta0=zeta0, tags=tags, experiment_id=experiment.id if zeta0 == 0.9 else None)
-    runs["slip"] = make_run(psi0_deg=60.0, tags=["middle"])
-    return experiment, runs
-
-
 @pytest.mark.parametrize(
     ("where", "expected"),
     [
@@ -212,76 +195,6 @@ def test_other_orders_page_by_offset(session, stored_runs):
     assert len(rest) == 2 and end is None and max(run["climb"] for run in rest) <= climbs[-1]
     by_zeta0, _ = records.list_runs(session, RunFilter(psi0_max=45.0), limit=10, cursor=None, sort="zeta0")
     assert [run["controls"][0][1] for run in by_zeta0] == [0.86, 0.88, 0.9, 0.92, 0.94]
-
-
-def test_run_row_flattens_model_and_legs(make_run):
-    run = make_run(zeta0=0.9, tags=["b", "a"])
-    row = records.run_row(run)
-    assert row["id"] == run.id and row["tags"] == "a b" and row["climb"] == run.climb
-    assert (row["leg0.psi0_deg"], row["leg0.zeta0"]) == (30.0, 0.9) and "leg1.zeta0" not in row
-    assert row["model.alpha"] == pytest.approx(get_preset("paper").to_model().alpha)
-    assert (row["start_xdot"], row["start_ydot"]) == (-0.93, -0.17)
-    assert row["created_at"] == run.created_at.isoformat()
-
-
-def _exported(sessions, where: RunFilter, format_: str = "json"):
-    text = "".join(records.export(sessions, where, format_))
-    return json.loads(text) if format_ == "json" else list(csv.DictReader(io.StringIO(text)))
-
-
-def test_export_reads_matching_runs_oldest_first_in_its_own_session(sessions, stored_runs):
-    _, runs = stored_runs
-    rows = _exported(sessions, RunFilter(psi0_max=45.0))
-    assert [row["id"] for row in rows] == sorted(runs[z].id for z in (0.86, 0.88, 0.9, 0.92, 0.94))
-    assert [row["leg0.zeta0"] for row in rows] == [0.86, 0.88, 0.9, 0.92, 0.94]
-
-
-def test_an_exported_record_is_the_runs_flat_record(sessions, stored_runs, session):
-    _, runs = stored_runs
-    exported = {row["id"]: row for row in _exported(sessions, RunFilter())}
-    for run in runs.values():
-        assert exported[run.id] == json.loads(json.dumps(json_safe(records.run_row(records.get_run(session, run.id)))))
-
-
-def test_csv_export_parses_back(sessions, stored_runs):
-    rows = _exported(sessions, RunFilter())
-    parsed = _exported(sessions, RunFilter(), "csv")
-    assert [int(row["id"]) for row in parsed] == [row["id"] for row in rows]
-    assert [float(row["climb"]) for row in parsed] == [row["climb"] for row in rows]
-    assert parsed[-1]["failure_code"] == "slip" and parsed[0]["failure_code"] == ""
-
-
-def test_csv_export_streams_in_pieces():
-    rows = [{"id": i, "text": "x" * 100} for i in range(2000)]
-    pieces = list(records.rows_as_csv(iter(rows), ["id", "text"]))
-    assert len(pieces) > 2, "a large export is written in pieces, not one string"
-    parsed = list(csv.DictReader(io.StringIO("".join(pieces))))
-    assert len(parsed) == 2000 and parsed[-1] == {"id": "1999", "text": "x" * 100}
-    assert "".join(records.rows_as_csv(iter([]), ["id"])) == "id\r\n", "no runs: the header alone"
-
-
-def test_csv_export_keeps_every_runs_legs(sessions, make_run):
-    """The columns are known before the first row: as many legs as the widest run (a two-leg run
-    exported after a one-leg run lost its leg1.* controls when the first row decided)."""
-    make_run()
-    make_run(controls=[LegIn(psi0_deg=30.0, zeta0=0.87), LegIn(psi0_deg=30.0, zeta0=0.9)])
-    parsed = _exported(sessions, RunFilter(), "csv")
-    assert parsed[1]["leg1.zeta0"] == "0.9" and parsed[0]["leg1.zeta0"] == ""
-
-
-@pytest.mark.parametrize("text", ['=HYPERLINK("http://x")', "+1+1", "-2+3", "@SUM(A1)", "\tx", "\rx"])
-def test_csv_cells_a_spreadsheet_would_run_are_escaped(sessions, make_run, session, text):
-    records.update_run(session, make_run().id, notes=text)
-    (row,) = _exported(sessions, RunFilter(), "csv")
-    assert row["notes"] == "'" + text and float(row["start_xdot"]) == -0.93, "numbers, negative ones too, as they are"
-
-
-def test_json_export_is_strict_json():
-    rows = [{"id": 1, "climb": math.nan, "mu": math.inf}, {"id": 2, "climb": 1.5, "mu": 2.0}]
-    text = "".join(records.rows_as_json(iter(rows)))
-    assert json.loads(text) == [{"id": 1, "climb": None, "mu": None}, {"id": 2, "climb": 1.5, "mu": 2.0}]
-    assert json.loads(text, parse_constant=pytest.fail) is not None, "no NaN or Infinity literals"
-    assert "".join(records.rows_as_json(iter([]))) == "[]"
 
 
 def test_compare_lines_runs_up_and_can_show_only_differences(session, stored_runs):
