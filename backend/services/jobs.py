@@ -35,10 +35,10 @@ from sqlalchemy.orm import Session, sessionmaker
 
 from backend.services.compute import ComputePool
 from backend.services.job_specs import decode, encode, spec_of
-from backend.services.records import fetch, get_experiment, newest_first, page
+from backend.services.records import fetch, locked, newest_first, page
 from backend.services.simulation import current_code_version, model_params, run_study, run_study_here
 from backend.store.database import StorageFull, after_storage_full
-from backend.store.models import Job, Trial, utcnow
+from backend.store.models import Experiment, Job, Trial, utcnow
 from experiments.cluster import as_completed_results, chunk_map_for, dask_client
 from experiments.manifest import json_safe
 from sim_core.chunks import Cancelled
@@ -56,9 +56,11 @@ FINAL = ("done", "cancelled", "failed")
 
 
 def create_job(session: Session, body) -> Job:
-    """Store a job (any of ``schemas.JOB_KINDS``); MJTF totals count trials, other kinds chunks."""
+    """Store a job (any of ``schemas.JOB_KINDS``); MJTF totals count trials, other kinds chunks.
+    Its experiment is read under the write lock (``locked``), so a concurrent delete of it waits
+    for this commit (and then refuses: the experiment has a job) or has removed it first (404)."""
     if body.experiment_id is not None:
-        get_experiment(session, body.experiment_id)
+        locked(session, Experiment, body.experiment_id, "experiment")
     spec = spec_of(body)  # stored as its own versioned record: job_specs.py says why
     job = Job(
         experiment_id=body.experiment_id,

@@ -136,3 +136,33 @@ def test_a_run_added_to_an_experiment_being_deleted_is_stored_or_refused_never_a
             thread.join()
         outcomes[codes["POST"], codes["DELETE"]] += 1
     assert set(outcomes) <= {(201, 409), (404, 204)}, outcomes
+
+
+def test_a_job_added_to_an_experiment_being_deleted_is_stored_or_refused_never_a_500(client, auth):
+    """The same race for a job: before the fix the job's experiment was checked, then the job
+    written apart from the check, so a delete between them was a 500 (FOREIGN KEY failed) or a job
+    pointing at nothing. Now the job is stored under the experiment's lock (the delete is then a 409:
+    an experiment keeps its jobs as its record) or the experiment is gone first (404, delete 204)."""
+    job = {"zeta0s": [0.9], "trials": 1, "cap": 2}
+    outcomes: collections.Counter = collections.Counter()
+    for _ in range(20):
+        experiment = client.post("/api/v1/experiments", json={"name": "doomed"}, headers=auth).json()["id"]
+        barrier = threading.Barrier(2)
+        codes = {}
+
+        def create(barrier=barrier, experiment=experiment, codes=codes):
+            barrier.wait()
+            body = job | {"experiment_id": experiment}
+            codes["POST"] = client.post("/api/v1/jobs", json=body, headers=auth).status_code
+
+        def remove(barrier=barrier, experiment=experiment, codes=codes):
+            barrier.wait()
+            codes["DELETE"] = client.delete(f"/api/v1/experiments/{experiment}", headers=auth).status_code
+
+        threads = [threading.Thread(target=create), threading.Thread(target=remove)]
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+        outcomes[codes["POST"], codes["DELETE"]] += 1
+    assert set(outcomes) <= {(202, 409), (404, 204)}, outcomes
