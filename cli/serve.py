@@ -75,5 +75,9 @@ def serve_command(
     note(f"data: {settings.data_dir}  database: {settings.database_url.split('://')[0]}")
     note(f"answers to Host names: {', '.join(settings.allowed_hosts)} (more: PARKOUR_ALLOWED_HOSTS=name,...)")
     if created:
-        note(f"API token for changes (shown once; kept in {settings.data_dir / 'api_token'}): {token}")
+        note(f"API token for changes (kept in {settings.data_dir / 'api_token'}): {token}")
+    # As Jupyter does: a link that signs the browser in. The token rides in the fragment, which a
+    # browser never sends to a server (so it is in no access log); the panel keeps it and takes it
+    # out of the address bar.
+    note(f"sign in to make changes: {base}/panel/#token={token}")
     uvicorn.run(application, host=host, port=port, log_level="info")

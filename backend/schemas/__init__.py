@@ -21,6 +21,7 @@ from backend.schemas.common import (
     RecordRef,
     StateIn,
     Strict,
+    TokenAccepted,
     Zeta0,
     finite_or_none,
 )
@@ -72,5 +73,6 @@ __all__ = [
     "JobState", "Label", "LegIn", "MJTFJobCreate", "MJTFLevelOut", "MapIn", "ModelIn", "NoiseIn", "Page", "Psi0Deg",
     "RecordRef", "RobotConnect", "RobotRunCreate", "RunAggregate", "RunBase", "RunComparison", "RunCreate",
     "RunDetail", "RunGroup", "RunKind", "RunOut", "RunPage", "RunStatus", "RunTrajectory", "RunUpdate", "StateIn",
-    "Stats", "Strict", "SweepJobCreate", "TrajectoryIn", "ViewOut", "ViewReplay", "Zeta0", "finite_or_none",
+    "Stats", "Strict", "SweepJobCreate", "TokenAccepted", "TrajectoryIn", "ViewOut", "ViewReplay", "Zeta0",
+    "finite_or_none",
 ]  # fmt: skip

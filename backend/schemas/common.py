@@ -56,6 +56,10 @@ class Health(BaseModel):
     code_version: str
 
 
+class TokenAccepted(BaseModel):
+    accepted: Literal[True]
+
+
 class Page(BaseModel, Generic[Item]):
     """One page of a list, newest first unless sorted otherwise."""
 

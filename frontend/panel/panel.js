@@ -4,9 +4,43 @@
 
 const API = "/api/v1";
 const $ = (selector, root = document) => root.querySelector(selector);
+const TOKEN_KEY = "parkourlab-token";
 const tokenInput = $("#token");
-tokenInput.value = localStorage.getItem("parkourlab-token") || "";
-tokenInput.addEventListener("change", () => localStorage.setItem("parkourlab-token", tokenInput.value.trim()));
+const tokenStatus = $("#token-status");
+
+// Sign-in: `parkour serve` prints the panel's address with the token in the fragment
+// (#token=…), which browsers never send to the service. Keep it and take it out of the address
+// bar (and so out of the history and of what is copied from it).
+const fromLink = new URLSearchParams(location.hash.slice(1)).get("token");
+if (fromLink) {
+  localStorage.setItem(TOKEN_KEY, fromLink.trim());
+  history.replaceState(null, "", location.pathname + location.search);
+}
+tokenInput.value = localStorage.getItem(TOKEN_KEY) || "";
+tokenInput.addEventListener("change", () => {
+  localStorage.setItem(TOKEN_KEY, tokenInput.value.trim());
+  checkToken();
+});
+
+// Whether the service accepts the token in the field, shown beside it (reads need none).
+async function checkToken() {
+  const token = tokenInput.value.trim();
+  let state = "none", text = "none: you can look, not change";
+  if (token) {
+    try {
+      const response = await fetch(`${API}/auth`, { headers: { Authorization: `Bearer ${token}` } });
+      state = response.ok ? "accepted" : "refused";
+      text = response.ok ? "accepted" : "not accepted: open the link parkour serve prints";
+    } catch (error) {
+      state = "unknown";
+      text = "could not be checked: the service did not answer";
+    }
+  }
+  tokenStatus.dataset.state = state;
+  tokenStatus.textContent = text;
+  tokenInput.setAttribute("aria-invalid", state === "refused" ? "true" : "false");
+}
+checkToken();
 
 function say(text, kind = "ok") {
   const box = document.createElement("div");
@@ -41,7 +75,10 @@ async function call(method, path, body) {
   const text = await response.text();
   const data = text ? JSON.parse(text) : null;
   if (!response.ok) {
-    const message = response.status === 401 ? "Paste the API token (data/api_token) into the field at the top." : explain(data, response.status);
+    const message = response.status === 401
+      ? "This needs the API token: open the sign-in link parkour serve prints, or paste data/api_token into the field at the top."
+      : explain(data, response.status);
+    if (response.status === 401) checkToken();
     say(`${method} ${path}: ${message}`, "error");
     throw new Error(message);
   }

@@ -88,6 +88,34 @@ def _shot(page, name):
     page.screenshot(path=str(target / f"{name}.png"), full_page=False)
 
 
+def test_the_sign_in_link_keeps_the_token_out_of_the_address_bar_and_says_it_is_accepted(page, service):
+    """The link `parkour serve` prints (/panel/#token=…) signs a new browser in: the token is kept,
+    gone from the address bar, and shown as accepted; a wrong one is marked at the field."""
+    base, token = service
+    context = page.context.browser.new_context()
+    context.add_init_script(CSP_LISTENER)
+    fresh = context.new_page()
+    try:
+        fresh.goto(f"{base}/panel/#token={token}")
+        status = "document.querySelector('#token-status').dataset.state"
+        _until(fresh, f"{status} === 'accepted'")
+        assert token not in fresh.url and "#" not in fresh.url, "the token left the address bar"
+        assert fresh.evaluate("localStorage.getItem('parkourlab-token')") == token
+        assert fresh.input_value("#token") == token and fresh.inner_text("#token-status") == "accepted"
+        assert fresh.get_attribute("#token", "aria-invalid") == "false"
+        fresh.fill("#token", "not-the-token")
+        fresh.dispatch_event("#token", "change")
+        _until(fresh, f"{status} === 'refused'")
+        assert fresh.get_attribute("#token", "aria-invalid") == "true"
+        assert "not accepted" in fresh.inner_text("#token-status")
+        fresh.fill("#token", "")
+        fresh.dispatch_event("#token", "change")
+        _until(fresh, f"{status} === 'none'")
+        assert fresh.evaluate("window.__csp_violations") == []
+    finally:
+        context.close()
+
+
 def test_simulate_shows_plots_and_the_gait(page):
     assert page.title() == "ParkourLab control panel"
     page.click("#run-sim")

@@ -13,7 +13,7 @@ from fastapi.openapi.docs import swagger_ui_default_parameters
 from fastapi.responses import FileResponse, HTMLResponse, RedirectResponse, Response
 
 from backend import schemas
-from backend.api.deps import Db
+from backend.api.deps import AUTHORIZED, Db
 from backend.services import simulation
 from backend.store.database import ping
 
@@ -75,3 +75,10 @@ def swagger_init(request: Request) -> Response:
 @router.get("/api/v1/health", tags=["service"], response_model=schemas.Health)
 def health(db: Db):
     return {"status": "ok", "database": ping(db), "code_version": simulation.current_code_version()}
+
+
+@router.get("/api/v1/auth", tags=["service"], dependencies=AUTHORIZED, response_model=schemas.TokenAccepted)
+async def check_token():
+    """Whether the bearer token is the service's: 200 if so, 401 if not. The panel shows it beside
+    the token field; reads need no token, changes do."""
+    return {"accepted": True}
