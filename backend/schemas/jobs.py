@@ -182,5 +182,7 @@ class MJTFLevelOut(BaseModel):
 
 class JobResults(BaseModel):
     job: JobOut
-    levels: list[MJTFLevelOut] | None = Field(None, description="MJTF jobs: per energy level")
+    partial: bool = Field(description="not done (queued, running, cancelled or failed): not every trial is in")
+    levels: list[MJTFLevelOut] | None = Field(None, description="MJTF jobs: the energy levels with trials so far")
+    missing_zeta0s: list[float] | None = Field(None, description="MJTF jobs: the levels without a trial yet")
     result: dict | None = Field(None, description="other jobs: the study's result, once done")

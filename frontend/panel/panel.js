@@ -332,10 +332,14 @@ on("#job-table", "click", async (event) => {
   const results = await call("GET", `/jobs/${id}/results`);
   const job = results.job;
   if (results.levels) {
+    // Only the levels with trials are drawn; a job that is not done says so in the title.
+    const missing = results.missing_zeta0s || [];
+    const partial = results.partial ? ` — partial (${job.state}: ${job.completed} of ${job.total} trials${
+      missing.length ? `; no trials at zeta0 ${missing.join(", ")}` : ""})` : "";
     Plotly.react("job-plot", [{
       x: results.levels.map((l) => l.zeta0), y: results.levels.map((l) => l.mean), mode: "lines+markers", name: "MJTF",
       error_y: { type: "data", array: results.levels.map((l) => l.std), visible: true },
-    }], layout(`Job ${id}: Mean Jumps To Failure`, "zeta0 [l0]", "jumps to failure"), PLOT_CONFIG);
+    }], layout(`Job ${id}: Mean Jumps To Failure${partial}`, "zeta0 [l0]", "jumps to failure"), PLOT_CONFIG);
   } else if (!results.result) {
     say(`Job ${id} is ${job.state}: no result${job.error ? ` (${job.error})` : " yet"}.`, job.state === "failed" ? "error" : "ok");
   } else if (job.kind === "sweep") {

@@ -171,6 +171,26 @@ def test_a_job_runs_to_completion_with_progress(page):
     _shot(page, "jobs")
 
 
+def test_a_cancelled_jobs_chart_says_partial_and_leaves_out_levels_that_never_ran(page, service):
+    base, token = service
+    auth = {"Authorization": f"Bearer {token}"}
+    spec = {"zeta0s": [0.84, 0.86, 0.88], "trials": 3000, "cap": 2000}
+    job = httpx.post(f"{base}/api/v1/jobs", json=spec, headers=auth).json()["id"]
+    httpx.post(f"{base}/api/v1/jobs/{job}/cancel", headers=auth)
+    while httpx.get(f"{base}/api/v1/jobs/{job}").json()["state"] != "cancelled":
+        time.sleep(0.05)
+    page.click("nav [data-tab=jobs]")
+    page.click("nav [data-tab=simulate]")  # shown again: the list reloads with the cancelled job
+    page.click("nav [data-tab=jobs]")
+    page.wait_for_selector(f"#job-table .show[data-id='{job}']")
+    page.click(f"#job-table .show[data-id='{job}']")
+    _until(page, f"document.querySelector('#job-plot').textContent.includes('Job {job}:')")
+    title = page.evaluate("document.querySelector('#job-plot .gtitle').textContent")
+    assert "partial (cancelled" in title and "no trials at zeta0" in title
+    drawn = page.evaluate("document.querySelector('#job-plot').data[0].x")
+    assert 0.88 not in drawn, "a level that never ran is not drawn"
+
+
 def test_sweep_and_basin_grid_jobs_from_the_jobs_tab(page):
     page.click("nav [data-tab=jobs]")
     page.select_option("#job-kind", "sweep")

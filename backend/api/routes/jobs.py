@@ -48,8 +48,14 @@ def get_job(job_id: RecordId, db: Db):
 def job_results(job_id: RecordId, db: Db):
     job = jobs.get_job(db, job_id)
     if job.kind != "mjtf":
-        return {"job": job_out(job), "result": job.result}
-    return {"job": job_out(job), "levels": [_finite(level) for level in jobs.level_summaries(db, job)]}
+        return {"job": job_out(job), "partial": job.state != "done", "result": job.result}
+    summaries = jobs.level_summaries(db, job)
+    return {
+        "job": job_out(job),
+        "partial": job.state != "done",
+        "levels": [_finite(level) for level in summaries if level["trials"]],
+        "missing_zeta0s": [level["zeta0"] for level in summaries if not level["trials"]],
+    }
 
 
 @router.get("/{job_id}/events", response_class=StreamingResponse)
@@ -108,6 +114,6 @@ def job_out(job) -> dict:
 
 
 def _finite(level: dict) -> dict:
-    """JSON has no NaN: a level without trials yet reports mean 0 with trials 0."""
+    """JSON has no NaN (a level is listed once it has a trial, so its mean is a number)."""
     mean = level["mean"]
     return level | {"mean": mean if mean == mean else 0.0}

@@ -27,7 +27,9 @@ def test_mjtf_job_gives_the_library_numbers(client, auth):
     job = client.post("/api/v1/jobs", json=spec, headers=auth)
     assert job.status_code == 202 and job.json()["total"] == 80
     assert _wait(client, job.json()["id"])["state"] == "done"
-    levels = client.get(f"/api/v1/jobs/{job.json()['id']}/results").json()["levels"]
+    results = client.get(f"/api/v1/jobs/{job.json()['id']}/results").json()
+    assert results["partial"] is False and results["missing_zeta0s"] == []
+    levels = results["levels"]
     study = mjtf_study(
         get_preset("paper").to_model(), math.radians(30), [0.88, 0.94], noise=NoiseModel(), trials=40, cap=200, seed=5,
         guess=(-0.93, -0.2),
@@ -60,6 +62,13 @@ def test_cancel_stops_a_job(client, auth):
     client.post(f"/api/v1/jobs/{job_id}/cancel", headers=auth)
     job = _wait(client, job_id)
     assert job["state"] == "cancelled" and job["completed"] < job["total"]
+    # Its results say partial and list only the levels that have trials: a level that never ran
+    # is not a level whose robot fell at once (the chart used to plot it at MJTF = 0).
+    results = client.get(f"/api/v1/jobs/{job_id}/results").json()
+    assert results["partial"] is True
+    assert all(level["trials"] > 0 for level in results["levels"])
+    listed = [level["zeta0"] for level in results["levels"]] + results["missing_zeta0s"]
+    assert sorted(listed) == [0.84, 0.86, 0.88] and results["missing_zeta0s"], "3000 x 3 trials: cancelled early"
 
 
 @pytest.mark.parametrize(
