@@ -94,9 +94,31 @@ function on(target, event, handler) {
 }
 
 // Tabs ---------------------------------------------------------------------------------------
-for (const tab of document.querySelectorAll("nav [role=tab]")) {
+// The WAI-ARIA tabs pattern: each tab controls its panel, only the selected one is in the Tab
+// order, and the arrow keys (Home, End) move between tabs.
+const tabs = [...document.querySelectorAll("nav [role=tab]")];
+for (const tab of tabs) {
+  tab.id = `tab-${tab.dataset.tab}`;
+  tab.setAttribute("aria-controls", tab.dataset.tab);
+  tab.tabIndex = tab.getAttribute("aria-selected") === "true" ? 0 : -1;
+  $(`#${tab.dataset.tab}`).setAttribute("aria-labelledby", tab.id);
+}
+on("nav[role=tablist]", "keydown", (event) => {
+  const at = tabs.indexOf(document.activeElement);
+  if (at < 0) return;
+  const to = { ArrowRight: at + 1, ArrowLeft: at - 1, Home: 0, End: tabs.length - 1 }[event.key];
+  if (to === undefined) return;
+  event.preventDefault();
+  const next = tabs[(to + tabs.length) % tabs.length];
+  next.focus();
+  next.click();
+});
+for (const tab of tabs) {
   on(tab, "click", () => {
-    for (const other of document.querySelectorAll("nav [role=tab]")) other.setAttribute("aria-selected", String(other === tab));
+    for (const other of tabs) {
+      other.setAttribute("aria-selected", String(other === tab));
+      other.tabIndex = other === tab ? 0 : -1;
+    }
     for (const panel of document.querySelectorAll("main [role=tabpanel]")) panel.hidden = panel.id !== tab.dataset.tab;
     if (tab.dataset.tab === "history") loadExperiments().then(loadRuns).catch(() => {});
     if (tab.dataset.tab === "jobs") loadJobs();
@@ -288,7 +310,7 @@ function watch(job, onFinal, onProgress) {
 
 async function loadJobs() {
   const page = await call("GET", "/jobs?limit=20");
-  $("#job-table tbody").replaceChildren(...page.items.map(jobRow));
+  fillTable("#job-table", page.items.map(jobRow), "No jobs yet: schedule one above.");
   page.items.forEach((job) => watch(job));
 }
 
@@ -387,10 +409,11 @@ async function loadRuns() {
   $("#export-json").href = `${API}/runs/export?format=json&${params}`;
   shownRuns.clear();
   page.items.forEach((run) => shownRuns.set(run.id, run));
-  $("#run-table tbody").replaceChildren(...page.items.map(runRow));
+  fillTable("#run-table", page.items.map(runRow), "No runs match these filters.");
 }
 
 on("#history-form", "submit", (event) => { event.preventDefault(); loadRuns(); });
+on("#history-form select[name=sort]", "change", () => loadRuns());  // a new order applies at once
 
 // Experiments group runs (and jobs) under a name; picking one filters the runs below.
 async function loadExperiments() {
@@ -399,11 +422,12 @@ async function loadExperiments() {
   const chosen = filter.value;
   filter.replaceChildren(new Option("any", ""), ...page.items.map((e) => new Option(`${e.id}: ${e.name}`, String(e.id))));
   filter.value = page.items.some((e) => String(e.id) === chosen) ? chosen : "";
-  $("#experiment-table tbody").replaceChildren(...page.items.map((experiment) => element("tr", null,
+  fillTable("#experiment-table", page.items.map((experiment) => element("tr", null,
     element("td", String(experiment.id)),
     element("td", null, attributes(element("button", experiment.name), { type: "button", class: "show-experiment", "data-experiment": experiment.id })),
     attributes(element("td", experiment.description), { class: "description" }), element("td", String(experiment.runs)),
-    attributes(element("td", experiment.tags.join(" ")), { class: "tags" }), element("td", new Date(experiment.created_at).toLocaleString()))));
+    attributes(element("td", experiment.tags.join(" ")), { class: "tags" }), element("td", new Date(experiment.created_at).toLocaleString()))),
+    "No experiments yet: name one above.");
 }
 
 on("#experiment-table", "click", async (event) => {
@@ -466,6 +490,22 @@ on("#run-table", "click", async (event) => {
   say(`Run ${runId} is on the 3D view's timeline${others.length ? ` with run ${others[0]} as a ghost` : ""}.`);
 });
 
+// Compare in a person's terms: legs by side, dates in local time, numbers to 6 significant digits.
+const LEG_SIDES = ["left", "right"];
+const COMPARE_LABELS = { created_at: "created", duration_s: "computed in [s]", climb: "climb [l0]",
+  start_xdot: "start xdot [√(g l0)]", start_ydot: "start ydot [√(g l0)]", jumps_completed: "jumps completed",
+  failure_code: "failure", code_version: "code version", experiment_id: "experiment" };
+function compareLabel(field) {
+  if (COMPARE_LABELS[field]) return COMPARE_LABELS[field];
+  return field.replace(/^leg(\d+)\./, (_, leg) => `${LEG_SIDES[Number(leg)] ?? `leg ${leg}`} leg `).replace(/^model\./, "model ");
+}
+function compareValue(field, value) {
+  if (value === null || value === undefined || value === "") return "—";
+  if (field === "created_at") return new Date(value).toLocaleString();
+  if (typeof value === "number" && !Number.isInteger(value)) return String(Number(value.toPrecision(6)));
+  return String(value);
+}
+
 on("#compare", "click", async () => {
   const ids = [...document.querySelectorAll("#run-table input:checked")].map((box) => box.value);
   if (ids.length < 2) return say("Select two or more runs to compare.", "error");
@@ -475,7 +515,8 @@ on("#compare", "click", async () => {
   table.id = "compare-table";
   table.append(element("tr", null, element("th", "field"), ...result.runs.map((r) => element("th", `run ${r.id}`))));
   for (const field of result.fields.filter((f) => f !== "id")) {
-    const row = element("tr", null, element("td", field), ...result.runs.map((r) => element("td", String(r[field] ?? ""))));
+    const cells = result.runs.map((r) => element("td", compareValue(field, r[field])));
+    const row = element("tr", null, element("td", compareLabel(field)), ...cells);
     row.className = "differs";
     table.append(row);
   }
@@ -499,6 +540,16 @@ function element(tag, text, ...children) {
   if (text !== null) node.textContent = text;
   node.append(...children);
   return node;
+}
+
+// A table's rows, or one row across every column saying why there are none.
+function fillTable(selector, rows, emptyText) {
+  const table = $(selector);
+  if (!rows.length) {
+    const columns = table.querySelectorAll("thead th").length || 1;
+    rows = [element("tr", null, attributes(element("td", emptyText), { colspan: columns, class: "empty" }))];
+  }
+  table.querySelector("tbody").replaceChildren(...rows);
 }
 
 // ``node`` with these attributes, each value set as a string (an attribute value: never markup).

@@ -13,6 +13,7 @@ share a run as standalone HTML); ``cli.serve`` plugs it in.
 from __future__ import annotations
 
 import collections
+import html
 import logging
 import threading
 import time
@@ -63,7 +64,10 @@ class ClimbView:
         place_camera(self.server)
         self.scene = ChuteScene(self.server.scene, self.robot)
         gui = self.server.gui
-        gui.add_markdown(f"[← Control panel]({panel_url}) · walls {self.robot.wall_distance:.2f} m apart")
+        # target="_top": the panel embeds this view in a frame, and a plain link loaded a second
+        # panel (and a second e-stop) inside it. viser renders a markdown's HTML as it is.
+        link = f'<a href="{html.escape(panel_url, quote=True)}" target="_top">← Control panel</a>'
+        gui.add_markdown(f"{link} · walls {self.robot.wall_distance:.2f} m apart")
         self.gui_mode = gui.add_dropdown("Mode", ("simulate", "live", "replay"), initial_value="simulate")
         self.lock = threading.RLock()  # the loop and GUI callbacks take turns on the modes
         self.modes = {

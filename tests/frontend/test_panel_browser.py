@@ -5,6 +5,7 @@ Set PARKOUR_SCREENSHOTS=1 to refresh docs/screenshots/ from this run.
 
 import io
 import os
+import re
 import shutil
 import socket
 import time
@@ -219,6 +220,38 @@ def test_sweep_and_basin_grid_jobs_from_the_jobs_tab(page):
 MARKUP_NOTE = "<img src=x onerror=window.__xss=1>"
 
 
+def test_tabs_keys_an_empty_result_and_sort_at_once(page, service):
+    """The tabs pattern (aria-controls, arrow keys); an empty filter result says so; a new sort
+    order lists at once, without pressing Filter."""
+    base, token = service
+    body = {"controls": [{"psi0_deg": 30, "zeta0": 0.9}], "start": {"xdot": -0.93, "ydot": -0.2}, "jumps": 2}
+    httpx.post(f"{base}/api/v1/runs", json=body, headers={"Authorization": f"Bearer {token}"}).raise_for_status()
+    page.click("nav [data-tab=simulate]")
+    assert page.get_attribute("#tab-simulate", "aria-controls") == "simulate"
+    assert page.get_attribute("#simulate", "aria-labelledby") == "tab-simulate"
+    page.focus("#tab-simulate")
+    page.keyboard.press("ArrowRight")
+    assert page.get_attribute("#tab-jobs", "aria-selected") == "true" and page.is_visible("#jobs")
+    assert page.evaluate("document.activeElement.id") == "tab-jobs"
+    assert (page.get_attribute("#tab-simulate", "tabindex"), page.get_attribute("#tab-jobs", "tabindex")) == ("-1", "0")
+    page.keyboard.press("ArrowRight")
+    page.keyboard.press("ArrowLeft")
+    assert page.get_attribute("#tab-jobs", "aria-selected") == "true"
+    page.keyboard.press("End")
+    assert page.get_attribute("#tab-view3d", "aria-selected") == "true"
+    page.keyboard.press("Home")
+    assert page.get_attribute("#tab-simulate", "aria-selected") == "true"
+    page.click("nav [data-tab=history]")
+    page.fill("#history-form input[name=tag]", "no-such-tag")
+    page.click("#history-form button[type=submit]")
+    _until(page, "document.querySelector('#run-table td.empty')?.textContent === 'No runs match these filters.'")
+    page.fill("#history-form input[name=tag]", "")
+    with page.expect_response(lambda response: "sort=-climb" in response.url):
+        page.select_option("#history-form select[name=sort]", "-climb")
+    _until(page, "!document.querySelector('#run-table td.empty')")
+    page.select_option("#history-form select[name=sort]", "-id")
+
+
 def test_history_compares_and_exports(page, service):
     base, token = service
     auth = {"Authorization": f"Bearer {token}"}
@@ -239,7 +272,15 @@ def test_history_compares_and_exports(page, service):
     boxes[1].check()
     page.click("#compare")
     page.wait_for_selector("#compare-table")
-    assert "leg0.zeta0" in page.inner_text("#compare-table")
+    compared = page.inner_text("#compare-table")
+    assert "left leg zeta0" in compared and "leg0" not in compared, "legs by side"
+    numbers = re.findall(r"\d+\.\d+", compared)
+    too_long = [n for n in numbers if len(n.replace(".", "").lstrip("0")) > 6]
+    assert numbers and not too_long, f"numbers to 6 significant digits: {too_long}"
+    assert "T" not in page.evaluate(
+        "[...document.querySelectorAll('#compare-table tr')].find((r) => r.cells[0].textContent === 'created')"
+        "?.cells[1].textContent ?? ''"
+    ), "the date in local time, not ISO"
     # A note is shown as the text it is: no element made of it, no script run.
     assert MARKUP_NOTE in page.inner_text("#compare-table")
     assert page.query_selector("#compare-table img") is None and page.evaluate("window.__xss") is None
@@ -315,6 +356,8 @@ def test_the_3d_view_draws_the_climb(page):
     late = [t for t in updates if t > updates[-1] - 2.0]
     print(f"3D view: {len(late) / 2.0:.0f} websocket updates/s reached the browser")  # measured, not asserted
     assert "stable" in frame.locator("text=Gait of these controls").locator("..").inner_text()
+    back = frame.locator("a", has_text="Control panel")
+    assert back.get_attribute("target") == "_top", "the link back opens the panel at top level, not inside it"
     _shot(page, "view3d")
 
 
