@@ -61,7 +61,8 @@ function explain(body, status) {
   return `HTTP ${status}`;
 }
 
-async function call(method, path, body) {
+// ``fields``: {form, locations} puts a 422's errors at their fields (Fields.markApiErrors).
+async function call(method, path, body, fields) {
   const headers = { "Content-Type": "application/json" };
   const token = tokenInput.value.trim();
   if (token) headers.Authorization = `Bearer ${token}`;
@@ -74,6 +75,12 @@ async function call(method, path, body) {
   }
   const text = await response.text();
   const data = text ? JSON.parse(text) : null;
+  if (!response.ok && response.status === 422 && fields && data) {
+    const left = Fields.markApiErrors(fields.form, data.detail, fields.locations);
+    const message = left.length ? left.join("; ") : "the service refused the marked field(s)";
+    say(left.length ? `${method} ${path}: ${message}` : "Fix the marked field(s): the service refused them.", "error");
+    throw new Error(message);
+  }
   if (!response.ok) {
     const message = response.status === 401
       ? "This needs the API token: open the sign-in link parkour serve prints, or paste data/api_token into the field at the top."
@@ -130,20 +137,38 @@ for (const tab of tabs) {
 
 function selectTab(name) { $(`nav [data-tab=${name}]`).click(); }
 
-// Forms --------------------------------------------------------------------------------------
-const numberField = (form) => (name) => Number(form.get(name));
+// Simulate -----------------------------------------------------------------------------------
+// Each action checks the fields it sends against the request body it sends them in (jumps: up
+// to 50 for a drawn trajectory, 10,000 for a stored run), from the API's own ranges (fields.js).
+const SQRT_GL0 = "√(g l0)";
+const LEG_FIELDS = [
+  { name: "psiL", rule: "LegIn.psi0_deg", unit: "°" }, { name: "zetaL", rule: "LegIn.zeta0", unit: "l0" },
+  { name: "psiR", rule: "LegIn.psi0_deg", unit: "°" }, { name: "zetaR", rule: "LegIn.zeta0", unit: "l0" },
+];
+const START_FIELDS = [{ name: "xdot", rule: "StateIn.xdot", unit: SQRT_GL0 }, { name: "ydot", rule: "StateIn.ydot", unit: SQRT_GL0 }];
+const SIM_LOCATIONS = {
+  "controls.0.psi0_deg": "psiL", "controls.0.zeta0": "zetaL", "controls.1.psi0_deg": "psiR", "controls.1.zeta0": "zetaR",
+  "start.xdot": "xdot", "start.ydot": "ydot", "guess.xdot": "xdot", "guess.ydot": "ydot", jumps: "jumps", psi0_deg: "psiL",
+};
+const simFields = () => ({ form: $("#sim-form"), locations: SIM_LOCATIONS });
 
-// [left, right] legs from a form's psiL/zetaL/psiR/zetaR fields (the Simulate and Robot forms).
-function legsOf(form) {
-  const number = numberField(form);
-  return [{ psi0_deg: number("psiL"), zeta0: number("zetaL") }, { psi0_deg: number("psiR"), zeta0: number("zetaR") }];
+// The checked values of ``fields`` in ``form``, or null (the bad ones are marked; the banner says so).
+async function checked(form, fields) {
+  const values = await Fields.readFields(form, fields);
+  if (values === null) say("Fix the marked field(s) first: nothing was sent.", "error");
+  else for (const banner of document.querySelectorAll("#messages .message.error")) banner.remove();
+  return values;
 }
 
-// Simulate -----------------------------------------------------------------------------------
-function simControls() {
-  const form = new FormData($("#sim-form"));
-  const number = numberField(form);
-  return { controls: legsOf(form), start: { xdot: number("xdot"), ydot: number("ydot") }, jumps: number("jumps") };
+// The Simulate form's legs and start (and ``jumps`` by ``jumpsRule``), or null.
+async function simControls(jumpsRule) {
+  const fields = [...LEG_FIELDS, ...START_FIELDS, ...(jumpsRule ? [{ name: "jumps", rule: jumpsRule, unit: "jumps" }] : [])];
+  const v = await checked($("#sim-form"), fields);
+  if (v === null) return null;
+  return {
+    controls: [{ psi0_deg: v.psiL, zeta0: v.zetaL }, { psi0_deg: v.psiR, zeta0: v.zetaR }],
+    start: { xdot: v.xdot, ydot: v.ydot }, jumps: v.jumps,
+  };
 }
 
 // Every plot's config: nothing leaves for Plotly's cloud (v4's "Share chart..." button is on by
@@ -160,8 +185,9 @@ const layout = (title, x, y, extra = {}) => ({
 
 on("#sim-form", "submit", async (event) => {
   event.preventDefault();
-  const spec = simControls();
-  const path = await call("POST", "/sim/trajectory", { ...spec, rate: 60 });
+  const spec = await simControls("TrajectoryIn.jumps");
+  if (!spec) return;
+  const path = await call("POST", "/sim/trajectory", { ...spec, rate: 60 }, simFields());
   const c = path.columns;
   Plotly.react("path-plot", [{ x: c.x, y: c.y, mode: "lines", name: "body" },
     { x: c.foot_x, y: c.foot_y, mode: "markers", marker: { size: 3 }, name: "foot" }],
@@ -174,14 +200,16 @@ on("#sim-form", "submit", async (event) => {
 });
 
 on("#save-run", "click", async () => {
-  const spec = simControls();
-  const run = await call("POST", "/runs", { ...spec, trajectory_rate: 60, tags: ["panel"] });
+  const spec = await simControls("RunCreate.jumps");
+  if (!spec) return;
+  const run = await call("POST", "/runs", { ...spec, trajectory_rate: 60, tags: ["panel"] }, simFields());
   say(`Run ${run.id} stored: ${run.jumps_completed}/${run.jumps} jumps, climb ${run.climb.toFixed(3)} l0. It is in History (tag "panel").`);
 });
 
 on("#find-gait", "click", async () => {
-  const spec = simControls();
-  const gait = await call("POST", "/sim/fixed-point", { controls: spec.controls, guess: spec.start });
+  const spec = await simControls();
+  if (!spec) return;
+  const gait = await call("POST", "/sim/fixed-point", { controls: spec.controls, guess: spec.start }, simFields());
   const circle = Array.from({ length: 101 }, (_, i) => 2 * Math.PI * i / 100);
   Plotly.react("eig-plot", [
     { x: circle.map(Math.cos), y: circle.map(Math.sin), mode: "lines", name: "|λ| = 1", line: { color: "#999" } },
@@ -248,13 +276,16 @@ async function analyse(spec, draw) {
 }
 
 on("#run-basin", "click", async () => {
-  const spec = simControls();
+  const spec = await simControls();
+  if (!spec) return;
   await analyse({ kind: "basin", controls: spec.controls, guess: spec.start, grid: 80, jumps: 60 },
     (result) => plotBasin("basin-plot", result, "Basin of attraction", spec.start));
 });
 
 on("#run-sweep", "click", async () => {
-  const psi0 = simControls().controls[0].psi0_deg;
+  const spec = await simControls();
+  if (!spec) return;
+  const psi0 = spec.controls[0].psi0_deg;
   await analyse({ kind: "sweep", psi0_deg: psi0, zeta0_low: 0.8, zeta0_high: 0.97, steps: 35, basin_grid: 20 },
     (result) => plotSweep("sweep-plot", result, `Symmetric gait at psi0 = ${psi0}° over zeta0`));
 });
@@ -322,24 +353,43 @@ on("#job-kind", "change", (event) => {
 });
 $("#job-kind").dispatchEvent(new Event("change"));  // also after the browser restores a form
 
-function jobSpec(form) {
-  const number = numberField(form);
-  const kind = form.get("kind");
+// The job form's fields by kind: each checked against its job's request body (fields.js).
+const JOB_FIELDS = {
+  mjtf: [{ name: "psi0", rule: "MJTFJobCreate.psi0_deg", unit: "°" }, { name: "zeta0s", rule: "MJTFJobCreate.zeta0s", unit: "l0", list: true },
+    { name: "trials", rule: "MJTFJobCreate.trials" }, { name: "cap", rule: "MJTFJobCreate.cap", unit: "jumps" }, { name: "seed", rule: "MJTFJobCreate.seed" }],
+  sweep: [{ name: "sweep_psi0", rule: "SweepJobCreate.psi0_deg", unit: "°" }, { name: "zeta0_low", rule: "SweepJobCreate.zeta0_low", unit: "l0" },
+    { name: "zeta0_high", rule: "SweepJobCreate.zeta0_high", unit: "l0" }, { name: "steps", rule: "SweepJobCreate.steps" },
+    { name: "basin_grid", rule: "SweepJobCreate.basin_grid" }],
+  basin: [{ name: "grid", rule: "BasinJobCreate.grid" }, { name: "basin_jumps", rule: "BasinJobCreate.jumps", unit: "jumps" },
+    { name: "tolerance", rule: "BasinJobCreate.tolerance", unit: SQRT_GL0 }],
+};
+const JOB_LOCATIONS = { psi0_deg: "psi0", zeta0s: "zeta0s", trials: "trials", cap: "cap", seed: "seed", zeta0_low: "zeta0_low",
+  zeta0_high: "zeta0_high", steps: "steps", basin_grid: "basin_grid", grid: "grid", jumps: "basin_jumps", tolerance: "tolerance" };
+
+// The job to schedule from the form — {body, locations: body field -> input} — or null (a bad
+// field is marked).
+async function jobSpec(form) {
+  const kind = form.elements.kind.value;
+  const v = await checked(form, JOB_FIELDS[kind]);
+  if (v === null) return null;
   if (kind === "mjtf") {
-    return { kind, psi0_deg: number("psi0"), trials: number("trials"), cap: number("cap"), seed: number("seed"),
-      zeta0s: String(form.get("zeta0s")).split(",").map((v) => Number(v.trim())) };
+    return { body: { kind, psi0_deg: v.psi0, trials: v.trials, cap: v.cap, seed: v.seed, zeta0s: v.zeta0s }, locations: JOB_LOCATIONS };
   }
   if (kind === "sweep") {
-    return { kind, psi0_deg: number("sweep_psi0"), zeta0_low: number("zeta0_low"), zeta0_high: number("zeta0_high"),
-      steps: number("steps"), basin_grid: number("basin_grid") };
+    const body = { kind, psi0_deg: v.sweep_psi0, zeta0_low: v.zeta0_low, zeta0_high: v.zeta0_high, steps: v.steps, basin_grid: v.basin_grid };
+    return { body, locations: { ...JOB_LOCATIONS, psi0_deg: "sweep_psi0" } };
   }
-  const sim = simControls();
-  return { kind, controls: sim.controls, guess: sim.start, grid: number("grid"), jumps: number("basin_jumps"), tolerance: number("tolerance") };
+  const sim = await simControls();
+  if (!sim) return null;
+  const body = { kind, controls: sim.controls, guess: sim.start, grid: v.grid, jumps: v.basin_jumps, tolerance: v.tolerance };
+  return { body, locations: JOB_LOCATIONS };
 }
 
 on("#job-form", "submit", async (event) => {
   event.preventDefault();
-  const job = await call("POST", "/jobs", jobSpec(new FormData(event.target)));
+  const spec = await jobSpec(event.target);
+  if (!spec) return;
+  const job = await call("POST", "/jobs", spec.body, { form: event.target, locations: spec.locations });
   say(`Job ${job.id} scheduled: ${describeJob(job)}.`);
   await loadJobs();
 });
@@ -722,19 +772,29 @@ on("#closed-loop", "change", (event) => {
 });
 $("#closed-loop").dispatchEvent(new Event("change"));
 
+// A live run's fields, checked against the robot run's request body (fields.js); the gains only
+// when the loop is closed.
+const ROBOT_RUN_FIELDS = [...LEG_FIELDS, { name: "jumps", rule: "RobotRunCreate.jumps", unit: "jumps" },
+  { name: "max_seconds", rule: "RobotRunCreate.max_seconds", unit: "s" }];
+const CLOSED_LOOP_FIELDS = [{ name: "target_m", rule: "ClosedLoopIn.target_m", unit: "m" }, { name: "kp", rule: "ClosedLoopIn.kp" },
+  { name: "ki", rule: "ClosedLoopIn.ki" }, { name: "kd", rule: "ClosedLoopIn.kd" }];
+const ROBOT_RUN_LOCATIONS = { ...SIM_LOCATIONS, max_seconds: "max_seconds", "closed_loop.target_m": "target_m",
+  "closed_loop.kp": "kp", "closed_loop.ki": "ki", "closed_loop.kd": "kd" };
+
 on("#robot-run-form", "submit", async (event) => {
   event.preventDefault();
-  const form = new FormData(event.target);
-  const number = numberField(form);
-  const body = { controls: legsOf(form), jumps: number("jumps"), max_seconds: number("max_seconds") };
-  if (form.get("closed_loop")) body.closed_loop = { target_m: number("target_m"), kp: number("kp"), ki: number("ki"), kd: number("kd") };
+  const closed = event.target.elements.closed_loop.checked;
+  const v = await checked(event.target, closed ? [...ROBOT_RUN_FIELDS, ...CLOSED_LOOP_FIELDS] : ROBOT_RUN_FIELDS);
+  if (v === null) return;
+  const body = { controls: [{ psi0_deg: v.psiL, zeta0: v.zetaL }, { psi0_deg: v.psiR, zeta0: v.zetaR }], jumps: v.jumps, max_seconds: v.max_seconds };
+  if (closed) body.closed_loop = { target_m: v.target_m, kp: v.kp, ki: v.ki, kd: v.kd };
   // The robot's state now, not as last shown: a disarmed robot is armed by the run and jumps.
   const current = await call("GET", "/robot");
   showStatus(current);
   if (current.state === "disarmed" && !window.confirm(ARM_AND_LAUNCH)) return say("Run not started.");
   pendingTarget = body.closed_loop ? body.closed_loop.target_m : null;
   try {
-    showStatus(await call("POST", "/robot/runs", body));
+    showStatus(await call("POST", "/robot/runs", body, { form: event.target, locations: ROBOT_RUN_LOCATIONS }));
   } finally {
     pendingTarget = undefined;
   }

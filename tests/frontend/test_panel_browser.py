@@ -146,12 +146,74 @@ def test_basin_and_sweep_are_jobs_drawn_in_simulate(page):
     _shot(page, "simulate_analyses")
 
 
-def test_bad_input_shows_the_field_and_range(page):
-    page.fill("input[name=zetaL]", "1.5")
-    page.click("#find-gait")
-    page.wait_for_selector(".message.error")
-    assert "zeta0" in page.inner_text(".message.error")
+def _sent(page, action, path: str) -> list[str]:
+    """Run ``action`` and give the URLs of the requests to ``path`` it sent (within half a second)."""
+    sent = []
+
+    def record(request):
+        if path in request.url:
+            sent.append(request.url)
+
+    page.on("request", record)
+    action()
+    page.wait_for_timeout(500)
+    page.remove_listener("request", record)
+    return sent
+
+
+SIM_ACTIONS = [("#run-sim", "/sim/trajectory"), ("#save-run", "/runs"), ("#find-gait", "/sim/fixed-point"),
+               ("#run-basin", "/jobs"), ("#run-sweep", "/jobs")]  # fmt: skip
+
+
+BAD_ZETA0 = [("1.5", "must be more than 0 and less than 1 l0"), ("", "enter a number")]
+
+
+@pytest.mark.parametrize(("value", "message"), BAD_ZETA0)
+def test_a_bad_value_is_marked_at_its_field_and_nothing_is_sent(page, value, message):
+    """Every Simulate action checks its fields from the API's own ranges before it sends: the bad
+    field is marked (aria-invalid, the message beside it, in its units), the others are not, and
+    the marks and the banner go when the next action succeeds."""
+    page.click("nav [data-tab=simulate]")
+    page.fill("input[name=zetaL]", value)
+    for button, path in SIM_ACTIONS:
+        assert _sent(page, lambda button=button: page.click(button), path) == [], f"{button} sent a bad value"
+        assert page.get_attribute("input[name=zetaL]", "aria-invalid") == "true"
+        assert page.inner_text("#zetaL-error") == message
+        assert page.get_attribute("input[name=zetaR]", "aria-invalid") in (None, "false")
+        assert "nothing was sent" in page.inner_text(".message.error")
     page.fill("input[name=zetaL]", "0.87")
+    page.fill("input[name=jumps]", "51")  # a drawn trajectory takes at most 50 jumps
+    page.click("#run-sim")
+    _until(page, "document.querySelector('#jumps-error')?.textContent === 'must be at least 1 and at most 50 jumps'")
+    assert page.get_attribute("input[name=zetaL]", "aria-invalid") == "false", "the fixed field is unmarked"
+    page.fill("input[name=jumps]", "8")
+    page.click("#run-sim")
+    _until(page, "document.querySelector('.message.ok')?.textContent.includes('jumps simulated')")
+    assert page.query_selector("#sim-form .field-error") is None and page.query_selector(".message.error") is None
+
+
+def test_the_job_form_marks_its_own_fields(page):
+    page.click("nav [data-tab=jobs]")
+    page.fill("input[name=trials]", "0")
+    page.fill("input[name=zeta0s]", "0.86, abc")
+    assert _sent(page, lambda: page.click("#submit-job"), "/api/v1/jobs") == []
+    assert page.inner_text("#trials-error") == "must be at least 1 and at most 100000"
+    assert page.inner_text("#zeta0s-error") == 'each "abc" is not a number'
+    page.fill("input[name=trials]", "40")
+    page.fill("input[name=zeta0s]", "0.86, 0.9, 0.94")
+
+
+def test_the_robot_run_form_marks_its_own_fields(page):
+    """A live run with a bad field is never sent: the robot is not armed on a guess."""
+    page.click("nav [data-tab=robot]")
+    page.fill("#robot-run-form input[name=max_seconds]", "")
+    page.fill("#robot-run-form input[name=psiR]", "95")
+    assert _sent(page, lambda: page.click("#live-run"), "/api/v1/robot/runs") == []
+    assert page.inner_text("#max_seconds-error") == "enter a number"
+    assert page.inner_text("#psiR-error") == "must be more than 0 and less than 90 °"
+    page.fill("#robot-run-form input[name=max_seconds]", "60")
+    page.fill("#robot-run-form input[name=psiR]", "35")
+    page.click("nav [data-tab=simulate]")
 
 
 def test_a_job_runs_to_completion_with_progress(page):
@@ -682,7 +744,7 @@ XSS_TAG = "x:/-"
 # What markup made of a payload would leave behind: an element with an inline handler, a script
 # that is neither Plotly nor the panel, an <img src=x>. The page's own markup has none of them.
 INJECTED = """[...document.querySelectorAll('[onerror], [onload], img[src="x"]')].length
-  + [...document.scripts].filter((s) => !/\\/static\\/plotly\\.min\\.js$|\\/panel\\.js$/.test(s.src)).length"""
+  + [...document.scripts].filter((s) => !/\\/static\\/plotly\\.min\\.js$|\\/(panel|fields)\\.js$/.test(s.src)).length"""
 
 
 def _no_script_ran(page, where: str) -> None:

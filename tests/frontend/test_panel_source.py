@@ -46,3 +46,15 @@ def test_every_plot_gets_the_config_without_cloud_buttons():
         assert setting in config
     for button in ("sendChartToCloud", "sendDataToCloud", "editInChartStudio"):
         assert f'"{button}"' in config.split("modeBarButtonsToRemove", 1)[1]
+
+
+@pytest.mark.parametrize("form", ["sim-form", "job-form", "robot-run-form"])
+def test_the_checked_forms_hold_no_second_copy_of_the_ranges(form):
+    """Their ranges come from the API's OpenAPI document (fields.js), one source: a hand-written
+    min/max here would drift from it, and the browser's own checks (required, min, max) would
+    answer before the panel could mark the field in its words."""
+    page = (PANEL / "index.html").read_text()
+    start = page.index(f'<form id="{form}"')
+    markup = page[start : page.index("</form>", start)]
+    assert "novalidate" in markup.split(">", 1)[0]
+    assert not re.search(r"<input[^>]*\s(min|max|required)(=|\s|>)", markup), "ranges only from the schema"
