@@ -81,15 +81,22 @@ def trajectory_columns(body: TrajectoryIn) -> dict:
     from sim_core.trajectory import simulate_trajectory
 
     start = (body.start.xdot, body.start.ydot)
-    path = simulate_trajectory(
-        model_params(body.model), schedule_of(body.controls), start, body.jumps, sample_rate=body.rate
-    )
+    model = model_params(body.model)
+    path = simulate_trajectory(model, schedule_of(body.controls), start, body.jumps, sample_rate=body.rate)
+    scales = get_preset(body.model.preset).scales  # l0 and g are the preset's: they set the units
     return json_safe(
         {
             "units": path.units,
             "columns": path.columns(),
             "touchdown_times": path.touchdown_times,
             "failure": None if path.failure is None else {"code": path.failure.code, "jump": path.failed_jump},
+            "walls_x": [-model.d_hat / 2, model.d_hat / 2],  # docs/model.md §2.1: x = 0 on the centre line
+            "si": {
+                "preset": body.model.preset,
+                "l0_m": scales.length,
+                "time_s": scales.time,
+                "speed_m_per_s": scales.velocity,
+            },
         }
     )
 

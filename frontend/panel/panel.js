@@ -189,12 +189,18 @@ on("#sim-form", "submit", async (event) => {
   if (!spec) return;
   const path = await call("POST", "/sim/trajectory", { ...spec, rate: 60 }, simFields());
   const c = path.columns;
+  // Nondimensional, with what a unit is for the preset's robot: l0 in m, sqrt(l0/g) in s.
+  const l0 = `l0 = ${path.si.l0_m.toFixed(3)} m`, unitTime = `√(l0/g) = ${path.si.time_s.toFixed(3)} s`;
+  const walls = path.walls_x.map((x) => ({ type: "line", x0: x, x1: x, yref: "paper", y0: 0, y1: 1, line: { color: "#444", width: 3 } }));
   Plotly.react("path-plot", [{ x: c.x, y: c.y, mode: "lines", name: "body" },
     { x: c.foot_x, y: c.foot_y, mode: "markers", marker: { size: 3 }, name: "foot" }],
-    layout("Path between the walls", "x [l0]", "height y [l0]", { yaxis: { scaleanchor: "x", title: { text: "height y [l0]" } } }),
+    layout("Path between the walls (grey: the walls)", `x [${l0}]`, `height y [${l0}]`,
+      { yaxis: { scaleanchor: "x", title: { text: `height y [${l0}]` } }, shapes: walls }),
     PLOT_CONFIG);
   Plotly.react("height-plot", [{ x: c.time, y: c.y, mode: "lines", name: "height" }],
-    layout("Height over time", "time [sqrt(l0/g)]", "y [l0]"), PLOT_CONFIG);
+    layout("Height over time", `time [${unitTime}]`, `y [${l0}]`), PLOT_CONFIG);
+  $("#sim-units").textContent = `Units (the ${path.si.preset} robot): length ${l0}, time ${unitTime}, ` +
+    `velocity √(g l0) = ${path.si.speed_m_per_s.toFixed(3)} m/s.`;
   const failure = path.failure ? `, failed: ${path.failure.code} at jump ${path.failure.jump}` : "";
   say(`${spec.jumps} jumps simulated${failure}.`);
 });

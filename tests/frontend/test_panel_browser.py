@@ -122,6 +122,8 @@ def test_simulate_shows_plots_and_the_gait(page):
     page.click("#run-sim")
     page.wait_for_selector("#path-plot .main-svg", timeout=20_000)
     page.wait_for_selector("#height-plot .main-svg")
+    assert page.evaluate("document.querySelector('#path-plot').layout.shapes.length") == 2, "the walls are drawn"
+    assert "l0 = 0.223 m" in page.inner_text("#sim-units") and "s" in page.inner_text("#sim-units")
     page.click("#find-gait")
     _until(page, "document.querySelector('#gait-readout').textContent.includes('stable')", timeout=20_000)
     assert "Period 2" in page.inner_text("#gait-readout")

@@ -2,6 +2,7 @@
 
 import pytest
 
+from sim_core.presets import get_preset
 from tests.backend.api.bodies import RUN
 
 
@@ -16,3 +17,11 @@ def test_quick_trajectory(client):
     path = client.post("/api/v1/sim/trajectory", json=body).json()
     assert path["units"] == "nondimensional" and len(path["touchdown_times"]) == 3
     assert len(path["columns"]["x"]) == len(path["columns"]["time"]) > 50 and path["failure"] is None
+    # What the panel draws and labels with: the walls, and the units in metres and seconds.
+    assert path["walls_x"] == pytest.approx([-1.21, 1.21])
+    assert max(abs(x) for x in path["columns"]["x"]) < 1.21
+    si = path["si"]
+    assert si["preset"] == "paper" and si["l0_m"] == pytest.approx(0.2231, abs=1e-4)
+    gravity = get_preset("paper").gravity  # reduced: the robot climbs a tilted air table
+    assert si["time_s"] == pytest.approx((si["l0_m"] / gravity) ** 0.5), "the time unit sqrt(l0/g)"
+    assert si["speed_m_per_s"] == pytest.approx(si["l0_m"] / si["time_s"])
