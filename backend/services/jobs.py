@@ -79,10 +79,14 @@ def get_job(session: Session, job_id: int) -> Job:
     return fetch(session, Job, job_id, "job")
 
 
-def list_jobs(session: Session, *, state: str | None, limit: int, cursor: int | None) -> tuple[list[Job], int | None]:
+def list_jobs(
+    session: Session, *, state: str | None, limit: int, cursor: int | None, experiment_id: int | None = None
+) -> tuple[list[Job], int | None]:
     query = newest_first(Job, limit, cursor)
     if state is not None:
         query = query.where(Job.state == state)
+    if experiment_id is not None:
+        query = query.where(Job.experiment_id == experiment_id)
     return page(list(session.scalars(query)), limit)
 
 

@@ -21,9 +21,9 @@ import numpy as np
 from sqlalchemy import delete, select
 
 from backend.robot.touchdown import Touchdown, detect_touchdowns, height_gains
-from backend.services.records import Conflict, NotFound
+from backend.services.records import Conflict, NotFound, locked
 from backend.services.simulation import current_code_version, pack_trajectory, unpack_trajectory
-from backend.store.models import Run, RunJournal
+from backend.store.models import Experiment, Run, RunJournal
 from backend.store.run_record import RunRecord
 from backend.store.runs import add_run
 from experiments.manifest import json_safe
@@ -38,6 +38,8 @@ def open_robot_run(session, request, robot, calibration) -> int:
     """Store a live run as it starts (status ``running``); returns its id. ``request`` is the
     :class:`~backend.schemas.RobotRunCreate`, ``robot`` the physical parameters."""
     model = robot.to_model()
+    if request.experiment_id is not None:  # before anything moves: a 404, and the robot stays as it is
+        locked(session, Experiment, request.experiment_id, "experiment")
     record = RunRecord(
         kind="robot",
         status="running",

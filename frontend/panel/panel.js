@@ -137,6 +137,13 @@ for (const tab of tabs) {
 
 function selectTab(name) { $(`nav [data-tab=${name}]`).click(); }
 
+// The experiment a form files its run or job under (the form's "in experiment" choice), as the
+// request's experiment_id; none: not filed.
+function filedUnder(form) {
+  const value = form.elements.experiment_id?.value;
+  return value ? { experiment_id: Number(value) } : {};
+}
+
 // Simulate -----------------------------------------------------------------------------------
 // Each action checks the fields it sends against the request body it sends them in (jumps: up
 // to 50 for a drawn trajectory, 10,000 for a stored run), from the API's own ranges (fields.js).
@@ -208,7 +215,7 @@ on("#sim-form", "submit", async (event) => {
 on("#save-run", "click", async () => {
   const spec = await simControls("RunCreate.jumps");
   if (!spec) return;
-  const run = await call("POST", "/runs", { ...spec, trajectory_rate: 60, tags: ["panel"] }, simFields());
+  const run = await call("POST", "/runs", { ...spec, trajectory_rate: 60, tags: ["panel"], ...filedUnder($("#sim-form")) }, simFields());
   say(`Run ${run.id} stored: ${run.jumps_completed}/${run.jumps} jumps, climb ${run.climb.toFixed(3)} l0. It is in History (tag "panel").`);
 });
 
@@ -395,7 +402,7 @@ on("#job-form", "submit", async (event) => {
   event.preventDefault();
   const spec = await jobSpec(event.target);
   if (!spec) return;
-  const job = await call("POST", "/jobs", spec.body, { form: event.target, locations: spec.locations });
+  const job = await call("POST", "/jobs", { ...spec.body, ...filedUnder(event.target) }, { form: event.target, locations: spec.locations });
   say(`Job ${job.id} scheduled: ${describeJob(job)}.`);
   await loadJobs();
 });
@@ -478,6 +485,11 @@ async function loadExperiments() {
   const chosen = filter.value;
   filter.replaceChildren(new Option("any", ""), ...page.items.map((e) => new Option(`${e.id}: ${e.name}`, String(e.id))));
   filter.value = page.items.some((e) => String(e.id) === chosen) ? chosen : "";
+  for (const choice of document.querySelectorAll("select.experiment-choice")) {
+    const kept = choice.value;
+    choice.replaceChildren(new Option("none", ""), ...page.items.map((e) => new Option(`${e.id}: ${e.name}`, String(e.id))));
+    choice.value = page.items.some((e) => String(e.id) === kept) ? kept : "";
+  }
   fillTable("#experiment-table", page.items.map((experiment) => element("tr", null,
     element("td", String(experiment.id)),
     element("td", null, attributes(element("button", experiment.name), { type: "button", class: "show-experiment", "data-experiment": experiment.id })),
@@ -486,12 +498,24 @@ async function loadExperiments() {
     "No experiments yet: name one above.");
 }
 
+loadExperiments().catch(() => {});  // the forms' "in experiment" choices, from the start
+
 on("#experiment-table", "click", async (event) => {
   const button = event.target.closest("button.show-experiment");
   if (!button) return;
   $("#experiment-filter").value = button.dataset.experiment;
-  await loadRuns();
+  await Promise.all([loadRuns(), showExperimentJobs(button.dataset.experiment, button.textContent)]);
 });
+
+// An experiment's jobs, under the experiments (its runs are the runs list, filtered to it).
+async function showExperimentJobs(id, name) {
+  const page = await call("GET", `/jobs?limit=100&experiment_id=${id}`);
+  const table = $("#experiment-jobs");
+  table.querySelector("caption").textContent = `Jobs in experiment ${id}: ${name}`;
+  fillTable("#experiment-jobs", page.items.map((job) => element("tr", null, element("td", String(job.id)), element("td", job.kind),
+    element("td", describeJob(job)), element("td", job.state))), "No jobs in this experiment.");
+  table.hidden = false;
+}
 
 on("#experiment-form", "submit", async (event) => {
   event.preventDefault();
@@ -794,6 +818,7 @@ on("#robot-run-form", "submit", async (event) => {
   if (v === null) return;
   const body = { controls: [{ psi0_deg: v.psiL, zeta0: v.zetaL }, { psi0_deg: v.psiR, zeta0: v.zetaR }], jumps: v.jumps, max_seconds: v.max_seconds };
   if (closed) body.closed_loop = { target_m: v.target_m, kp: v.kp, ki: v.ki, kd: v.kd };
+  Object.assign(body, filedUnder(event.target));
   // The robot's state now, not as last shown: a disarmed robot is armed by the run and jumps.
   const current = await call("GET", "/robot");
   showStatus(current);

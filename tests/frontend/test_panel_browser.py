@@ -316,6 +316,39 @@ def test_tabs_keys_an_empty_result_and_sort_at_once(page, service):
     page.select_option("#history-form select[name=sort]", "-id")
 
 
+def test_runs_and_jobs_filed_under_an_experiment_appear_on_its_page(page, service):
+    base, token = service
+    auth = {"Authorization": f"Bearer {token}"}
+    experiment = httpx.post(f"{base}/api/v1/experiments", json={"name": "energy study"}, headers=auth).json()["id"]
+    page.reload()  # the forms' experiment choices are read when the panel opens
+    page.click("nav [data-tab=simulate]")
+    _until(page, f"!!document.querySelector('#sim-form select.experiment-choice option[value=\"{experiment}\"]')")
+    page.select_option("#sim-form select.experiment-choice", str(experiment))
+    page.click("#save-run")
+    _until(page, "document.querySelector('.message.ok')?.textContent.includes('stored')")
+    run_id = int(page.inner_text(".message.ok").split()[1])
+    page.click("nav [data-tab=jobs]")
+    page.select_option("#job-form select.experiment-choice", str(experiment))
+    page.fill("input[name=trials]", "4")
+    page.fill("input[name=cap]", "20")
+    page.click("#submit-job")
+    _until(page, "document.querySelector('.message.ok')?.textContent.includes('scheduled')")
+    job_id = int(page.inner_text(".message.ok").split()[1])
+    page.click("nav [data-tab=history]")
+    page.click("#experiments-box summary")
+    page.click(f"#experiment-table button[data-experiment='{experiment}']")
+    only_its_run = (
+        f"!!document.querySelector('#run-{run_id}') && document.querySelectorAll('#run-table tbody tr').length === 1"
+    )
+    _until(page, only_its_run)
+    _until(page, "!document.querySelector('#experiment-jobs').hidden")
+    assert page.inner_text("#experiment-jobs caption") == f"Jobs in experiment {experiment}: energy study"
+    assert page.inner_text("#experiment-jobs tbody tr td:first-child") == str(job_id)
+    assert httpx.get(f"{base}/api/v1/runs/{run_id}").json()["experiment_id"] == experiment
+    page.select_option("#history-form select[name=experiment_id]", "")
+    page.click("#experiments-box summary")
+
+
 def test_history_compares_and_exports(page, service):
     base, token = service
     auth = {"Authorization": f"Bearer {token}"}

@@ -34,8 +34,9 @@ def list_jobs(
     limit: PageLimit = 50,
     cursor: Cursor = None,
     state: schemas.JobState | None = None,
+    experiment_id: Annotated[int | None, Query(ge=1, le=schemas.MAX_ID, description="only this experiment's")] = None,
 ):
-    rows, next_cursor = jobs.list_jobs(db, state=state, limit=limit, cursor=cursor)
+    rows, next_cursor = jobs.list_jobs(db, state=state, limit=limit, cursor=cursor, experiment_id=experiment_id)
     return {"items": [job_out(row) for row in rows], "next_cursor": next_cursor}
 
 

@@ -166,6 +166,18 @@ def test_open_loop_live_run_is_stored_with_the_model_beside_it(client, auth, con
     assert len(frames["time"]) > 100, "raw tracker frames are kept"
 
 
+def test_a_live_run_is_filed_under_its_experiment_and_a_missing_one_moves_nothing(client, auth, connected):
+    body = {"controls": CONTROLS, "jumps": 2, "experiment_id": 999}
+    missing = client.post("/api/v1/robot/runs", json=body, headers=auth)
+    assert missing.status_code == 404 and "experiment 999" in missing.json()["detail"]
+    assert client.get("/api/v1/robot").json()["state"] == "disarmed", "nothing was armed for it"
+    experiment = client.post("/api/v1/experiments", json={"name": "live"}, headers=auth).json()["id"]
+    body["experiment_id"] = experiment
+    assert client.post("/api/v1/robot/runs", json=body, headers=auth).status_code == 202
+    status = _finish(client)
+    assert client.get(f"/api/v1/runs/{status['run']['stored_run_id']}").json()["experiment_id"] == experiment
+
+
 def test_estop_during_a_run_ends_it_and_keeps_the_data(client, auth, connected):
     client.post("/api/v1/robot/runs", json={"controls": CONTROLS, "jumps": 1000}, headers=auth)
     _wait_for_touchdowns(client, 3)

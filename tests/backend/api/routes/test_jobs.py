@@ -133,3 +133,14 @@ def test_jobs_over_the_work_budget_are_a_422_naming_the_limit(client, auth, spec
     message = " ".join(error["msg"] for error in response.json()["detail"])
     assert "over the limit of 5e+08" in message and formula in message, message
     assert client.get("/api/v1/jobs").json()["items"] == [], "nothing stored, nothing queued"
+
+
+def test_jobs_list_by_experiment(client, auth):
+    experiment = client.post("/api/v1/experiments", json={"name": "e"}, headers=auth).json()["id"]
+    spec = {"zeta0s": [0.9], "trials": 1, "cap": 2}
+    filed = client.post("/api/v1/jobs", json=spec | {"experiment_id": experiment}, headers=auth).json()["id"]
+    client.post("/api/v1/jobs", json=spec, headers=auth)
+    listed = client.get("/api/v1/jobs", params={"experiment_id": experiment}).json()["items"]
+    assert [job["id"] for job in listed] == [filed]
+    assert len(client.get("/api/v1/jobs").json()["items"]) == 2
+    assert client.get("/api/v1/jobs", params={"experiment_id": 0}).status_code == 422
