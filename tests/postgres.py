@@ -109,10 +109,11 @@ class Databases:
 
     def __init__(self, admin_url: str):
         from sqlalchemy import create_engine
+        from sqlalchemy.pool import NullPool
 
         self.admin_url = admin_url
         # CREATE/DROP DATABASE cannot run in a transaction: autocommit.
-        self._admin = create_engine(admin_url, isolation_level="AUTOCOMMIT", poolclass=_null_pool())
+        self._admin = create_engine(admin_url, isolation_level="AUTOCOMMIT", poolclass=NullPool)
         self._prefix = f"parkour_test_{os.getpid()}_"
         self._create_template()
 
@@ -148,12 +149,6 @@ class Databases:
     def close(self) -> None:
         self._execute(f'DROP DATABASE IF EXISTS "{self.template}" WITH (FORCE)')
         self._admin.dispose()
-
-
-def _null_pool():
-    from sqlalchemy.pool import NullPool
-
-    return NullPool
 
 
 @contextmanager

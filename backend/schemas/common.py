@@ -11,6 +11,8 @@ from pydantic import BaseModel, ConfigDict, Field
 Psi0Deg = Annotated[float, Field(gt=0.0, lt=90.0, description="leg angle at touchdown [degrees], in (0, 90)")]
 Zeta0 = Annotated[float, Field(gt=0.0, lt=1.0, description="leg length at touchdown [l0], in (0, 1)")]
 Label = Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[\w.:/-]+$")]  # a tag
+Tags = Annotated[list[Label], Field(max_length=32)]
+Notes = Annotated[str, Field(max_length=100_000)]
 
 MAX_JUMPS = 10_000
 MAX_TRIALS = 100_000

@@ -7,12 +7,10 @@ from typing import Annotated
 
 from pydantic import BaseModel, Field
 
-from backend.schemas.common import Label, Page, Strict
+from backend.schemas.common import Notes, Page, Strict, Tags
 
 Name = Annotated[str, Field(min_length=1, max_length=200)]
 Description = Annotated[str, Field(max_length=10_000)]
-Notes = Annotated[str, Field(max_length=100_000)]
-Tags = Annotated[list[Label], Field(max_length=32)]
 
 
 class ExperimentBase(BaseModel):

@@ -8,7 +8,7 @@ from pydantic import Field, field_validator
 
 from backend.robot.ports import check_port
 from backend.robot.xbee import ROBOT_ADDRESS
-from backend.schemas.common import Label, LegIn, Psi0Deg, RecordRef, Strict, Zeta0
+from backend.schemas.common import LegIn, Psi0Deg, RecordRef, Strict, Tags, Zeta0
 
 
 class RobotConnect(Strict):
@@ -62,4 +62,4 @@ class RobotRunCreate(Strict):
     jumps: Annotated[int, Field(ge=1, le=10_000)] = 20
     max_seconds: Annotated[float, Field(gt=0.0, le=3600.0)] = 60.0
     closed_loop: ClosedLoopIn | None = None
-    tags: Annotated[list[Label], Field(max_length=32)] = []
+    tags: Tags = []

@@ -9,10 +9,19 @@ from typing import Annotated
 
 from pydantic import BaseModel, Field, model_validator
 
-from backend.schemas.common import MAX_JUMPS, MAX_PATH_SAMPLES, Label, LegIn, ModelIn, Page, RecordRef, StateIn, Strict
+from backend.schemas.common import (
+    MAX_JUMPS,
+    MAX_PATH_SAMPLES,
+    LegIn,
+    ModelIn,
+    Notes,
+    Page,
+    RecordRef,
+    StateIn,
+    Strict,
+    Tags,
+)
 
-Tags = Annotated[list[Label], Field(max_length=32)]
-Notes = Annotated[str, Field(max_length=100_000)]
 Jumps = Annotated[int, Field(ge=1, le=MAX_JUMPS)]
 
 

@@ -20,7 +20,7 @@ from sqlalchemy import Text, cast
 from sqlalchemy.orm import Session
 
 from backend.store.models import Run
-from backend.store.runs import RunFilter, exported_rows, widest_schedule
+from backend.store.runs import RunFilter, decode_json_texts, exported_rows, widest_schedule
 from experiments.manifest import json_safe
 from sim_core.params import ModelParams
 
@@ -59,9 +59,13 @@ def record_values(run, model: dict, controls: Sequence, start_state: Sequence, t
 
 def flat_record(run, tags: Iterable[str]) -> dict:
     """A stored run as one flat record: its own legs only."""
-    legs = len(run.controls)
-    values = record_values(run, run.model, run.controls, run.start_state, tags, legs)
-    return dict(zip(record_fields(legs), values, strict=True))
+    return _record(run, run.model, run.controls, run.start_state, tags)
+
+
+def _record(run, model: dict, controls: Sequence, start_state: Sequence, tags: Iterable[str]) -> dict:
+    """:func:`record_values` as a dict, with the run's own legs."""
+    values = record_values(run, model, controls, start_state, tags, len(controls))
+    return dict(zip(record_fields(len(controls)), values, strict=True))
 
 
 def export(sessions, where: RunFilter, format_: str) -> Iterator[str]:
@@ -80,8 +84,7 @@ def export(sessions, where: RunFilter, format_: str) -> Iterator[str]:
 def _decoded_batches(session: Session, where: RunFilter):
     """Batches of (row, model, controls, start_state, tags) — a batch's JSON decoded in one call."""
     for batch, tags in exported_rows(session, where, EXPORTED):
-        text = ",".join(f"[{row.model},{row.controls},{row.start_state}]" for row in batch)
-        decoded = json.loads(f"[{text}]")
+        decoded = decode_json_texts([[getattr(row, name) for name in JSON_COLUMNS] for row in batch])
         yield [(row, *columns, tags.get(row.id, ())) for row, columns in zip(batch, decoded, strict=True)]
 
 
@@ -92,11 +95,7 @@ def _values(session: Session, where: RunFilter, legs: int) -> Iterator[list[list
 
 def _records(session: Session, where: RunFilter) -> Iterator[list[dict]]:
     for batch in _decoded_batches(session, where):
-        records = []
-        for row, model, controls, start, tags in batch:
-            values = record_values(row, model, controls, start, tags, len(controls))
-            records.append(dict(zip(record_fields(len(controls)), values, strict=True)))
-        yield records
+        yield [_record(row, model, controls, start, tags) for row, model, controls, start, tags in batch]
 
 
 def csv_text(batches: Iterable[list[list]], fields: Sequence[str], text_columns=TEXT_COLUMNS) -> Iterator[str]:

@@ -54,7 +54,7 @@ def job_results(job_id: RecordId, db: Db):
     return {
         "job": job_out(job),
         "partial": job.state != "done",
-        "levels": [_finite(level) for level in summaries if level["trials"]],
+        "levels": [level for level in summaries if level["trials"]],  # a level with trials has a mean
         "missing_zeta0s": [level["zeta0"] for level in summaries if not level["trials"]],
     }
 
@@ -112,9 +112,3 @@ def job_out(job) -> dict:
         "started_at": job.started_at,
         "finished_at": job.finished_at,
     }
-
-
-def _finite(level: dict) -> dict:
-    """JSON has no NaN (a level is listed once it has a trial, so its mean is a number)."""
-    mean = level["mean"]
-    return level | {"mean": mean if mean == mean else 0.0}
