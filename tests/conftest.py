@@ -80,12 +80,16 @@ def empty_database_url(request, tmp_path) -> str:
 
 
 @pytest.fixture
-def virtual():
-    """``(robot, tracker_port)``: a noiseless virtual robot at 4x speed streaming its tracker poses
-    to a free local UDP port; stopped afterwards."""
+def virtual(request):
+    """``(robot, tracker_port)``: a noiseless virtual robot streaming its tracker poses to a free
+    local UDP port; stopped afterwards. It climbs at 4x real time unless the test is marked
+    ``robot_speed(s)``: a closed loop must answer each touchdown within the next stance, so a
+    test of one runs in real time, as the robot does, not with a quarter of the robot's margin."""
     from backend.robot.virtual import VirtualRobot  # only the tests that use the robot load the backend
 
+    marker = request.node.get_closest_marker("robot_speed")
+    speed = marker.args[0] if marker else 4.0
     port = free_port(socket.SOCK_DGRAM)
-    robot = VirtualRobot(tracker_to=("127.0.0.1", port), noise=NO_NOISE, speed=4.0, seed=2).start()
+    robot = VirtualRobot(tracker_to=("127.0.0.1", port), noise=NO_NOISE, speed=speed, seed=2).start()
     yield robot, port
     robot.stop()

@@ -210,14 +210,16 @@ def test_commands_beyond_the_servo_limits_are_a_422(client, auth, connected):
 
 
 @pytest.mark.slow
+@pytest.mark.robot_speed(1.0)
+@pytest.mark.parametrize("database_url", [None], ids=["sqlite"])  # a control test: one database is enough
 def test_closed_loop_live_run_holds_a_height(client, auth, connected):
-    body = {"controls": [{"psi0_deg": 35, "zeta0": 0.9}] * 2, "jumps": 45, "closed_loop": {"target_m": 0.4}}
+    body = {"controls": [{"psi0_deg": 35, "zeta0": 0.9}] * 2, "jumps": 25, "closed_loop": {"target_m": 0.4}}
     client.post("/api/v1/robot/runs", json=body, headers=auth)
-    status = _finish(client, timeout=60)
+    status = _finish(client, timeout=90)
     results = client.get(f"/api/v1/runs/{status['run']['stored_run_id']}").json()["results"]
     heights = [td["body_height"] for td in results["touchdowns"]]
     assert abs(heights[-1] - 0.4) < 0.02 and max(abs(h - 0.4) for h in heights[-8:]) < 0.03, heights
-    assert sum(c["why"].startswith("pid") for c in results["commands"]) >= 40
+    assert sum(c["why"].startswith("pid") for c in results["commands"]) >= 20
 
 
 @pytest.mark.parametrize("url", ["/dev/sda", "/dev/watchdog", "/dev/null", "http://robot", "socket://a b:1"])
