@@ -1,24 +1,30 @@
-"""Frame rate of the 3D view at real-time playback (simulate mode), as a browser receives it.
+"""Updates per second of the 3D view, per browser, with 1, 2 and 4 browsers connected.
 
-Starts a ClimbView on a free port, opens it in headless Chromium (SwiftShader WebGL: no GPU
-needed) and reports, over ``--seconds``: frames the view's loop drew per second, WebSocket
-messages per second that reached the browser, and the frames per second the browser painted
-(``requestAnimationFrame``; software WebGL paints far slower than a GPU would).
+Starts a ClimbView on a free port. Each browser has its own view (simulate mode at real-time
+playback, its own climb and GUI), so the view's loop draws a frame for each of them. For each
+count in ``--clients`` this connects that many headless browsers (websocket clients that speak
+to the view as viser's web client does: tests/frontend/viewer/headless.py) and reports, over
+``--seconds``: frames the loop drew per second, and per browser the updates (websocket
+messages) and kB that reached it, and the service process's CPU per second.
 
-    .venv/bin/python scripts/bench_view.py [--seconds 10] [--width 1280 --height 800]
+``--browser`` adds one real browser (headless Chromium, SwiftShader WebGL: no GPU needed) beside
+the headless ones, and reports the frames per second it painted (``requestAnimationFrame``).
+
+    PYTHONPATH=. .venv/bin/python scripts/bench_view.py [--clients 1 2 4] [--seconds 10] [--browser]
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import shutil
 import time
 
-from playwright.sync_api import sync_playwright
-
 from backend.services.view import ViewContext
 from frontend.viewer.app import ClimbView
+from tests.frontend.viewer.headless import HeadlessViewer
 
+WARM_UP_S = 3.0  # the first scene, and each new view's first gait search
 PAINT_RATE_JS = """(seconds) => new Promise((done) => {
   let frames = 0; const start = performance.now();
   const tick = (now) => {
@@ -30,34 +36,77 @@ PAINT_RATE_JS = """(seconds) => new Promise((done) => {
 })"""
 
 
+@contextlib.contextmanager
+def _chromium_page(port: int):
+    """One real browser on the view (its painted frame rate), or None when not asked for."""
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as playwright:
+        software_webgl = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+        browser = playwright.chromium.launch(executable_path=shutil.which("chromium"), args=software_webgl)
+        page = browser.new_page(viewport={"width": 1280, "height": 800})
+        page.goto(f"http://127.0.0.1:{port}/")
+        page.wait_for_selector("canvas")
+        try:
+            yield page
+        finally:
+            browser.close()
+
+
+def measure(view: ClimbView, clients: int, seconds: float, browser: bool) -> dict:
+    port = view.server.get_port()
+    viewers = [HeadlessViewer(port, f"bench-{clients}-{i}") for i in range(clients)]
+    painted = None
+    try:
+        with contextlib.ExitStack() as stack:
+            page = stack.enter_context(_chromium_page(port)) if browser else None
+            time.sleep(WARM_UP_S)
+            frames, cpu, start = view.frames, time.process_time(), time.monotonic()
+            if page is not None:
+                painted = page.evaluate(PAINT_RATE_JS, seconds)
+            else:
+                time.sleep(seconds)
+            end = time.monotonic()
+            elapsed = end - start
+            rates = [viewer.updates_per_s(start, end) for viewer in viewers]
+            return {
+                "clients": clients,
+                "sessions": len(view.sessions),
+                "drawn": (view.frames - frames) / elapsed,
+                "per_client": rates,
+                "kb_per_s": [viewer.bytes / 1000 / (end - start + WARM_UP_S) for viewer in viewers],
+                "cpu": (time.process_time() - cpu) / elapsed,
+                "painted": painted,
+            }
+    finally:
+        for viewer in viewers:
+            viewer.close()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--clients", type=int, nargs="+", default=[1, 2, 4])
     parser.add_argument("--seconds", type=float, default=10.0)
-    parser.add_argument("--width", type=int, default=1280)
-    parser.add_argument("--height", type=int, default=800)
+    parser.add_argument("--browser", action="store_true", help="add one headless Chromium and report its paint rate")
     args = parser.parse_args()
     view = ClimbView(ViewContext(sessions=None, robot_service=None), port=0)
     try:
-        with sync_playwright() as playwright:
-            software_webgl = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
-            browser = playwright.chromium.launch(executable_path=shutil.which("chromium"), args=software_webgl)
-            page = browser.new_page(viewport={"width": args.width, "height": args.height})
-            received: list[float] = []
-            page.on("websocket", lambda ws: ws.on("framereceived", lambda _f: received.append(time.monotonic())))
-            page.goto(f"http://127.0.0.1:{view.server.get_port()}/")
-            page.wait_for_selector("canvas")
-            time.sleep(3.0)  # the first scene and shader compilation
-            frames_before, start = view.frames, time.monotonic()
-            painted = page.evaluate(PAINT_RATE_JS, args.seconds)
-            elapsed = time.monotonic() - start
-            drawn = (view.frames - frames_before) / elapsed
-            messages = sum(1 for t in received if t >= start) / elapsed
-            browser.close()
+        print("browsers | views | loop frames/s | updates/s per browser (min-max) | kB/s each | CPU [cores]")
+        for clients in args.clients:
+            result = measure(view, clients, args.seconds, args.browser)
+            rates = result["per_client"]
+            print(
+                f"{clients:8d} | {result['sessions']:5d} | {result['drawn']:13.1f} | "
+                f"{min(rates):14.1f} - {max(rates):5.1f}           | {sum(result['kb_per_s']) / clients:9.0f} | "
+                f"{result['cpu']:.2f}"
+            )
+            if result["painted"] is not None:
+                print(f"         Chromium beside them painted {result['painted']:.1f} frames/s (software WebGL)")
+            deadline = time.monotonic() + 10
+            while view.sessions and time.monotonic() < deadline:  # the next count starts from none
+                time.sleep(0.05)
     finally:
         view.close()
-    print(f"view loop:  {drawn:6.1f} frames/s drawn and sent")
-    print(f"browser:    {messages:6.1f} WebSocket messages/s received")
-    print(f"browser:    {painted:6.1f} frames/s painted ({args.width}x{args.height}, software WebGL)")
 
 
 if __name__ == "__main__":

@@ -64,15 +64,17 @@ from backend.schemas.runs import (
     Stats,
 )
 from backend.schemas.sim import FixedPointIn, MapIn, TrajectoryIn
-from backend.schemas.view import ViewOut, ViewReplay
+from backend.schemas.view import VIEWER_ID_PATTERN, ViewerId, ViewOut, ViewReplay
 
 __all__ = [
-    "JOB_KINDS", "MAX_ID", "MAX_JUMPS", "MAX_LEVELS", "MAX_PATH_SAMPLES", "MAX_TRIALS", "WORK_BUDGET_JUMPS",
+    "JOB_KINDS", "MAX_ID", "MAX_JUMPS", "MAX_LEVELS", "MAX_PATH_SAMPLES", "MAX_TRIALS", "VIEWER_ID_PATTERN",
+    "WORK_BUDGET_JUMPS",
     "BasinJobCreate", "ClosedLoopIn", "ExperimentBase", "ExperimentCreate", "ExperimentOut", "ExperimentPage",
     "ExperimentUpdate", "FixedPointIn", "GaitSearchJobCreate", "Health", "JobCreate", "JobOut", "JobPage", "JobResults",
     "JobState", "Label", "LegIn", "MJTFJobCreate", "MJTFLevelOut", "MapIn", "ModelIn", "NoiseIn", "Page", "Psi0Deg",
     "RecordRef", "RobotConnect", "RobotRunCreate", "RunAggregate", "RunBase", "RunComparison", "RunCreate",
     "RunDetail", "RunGroup", "RunKind", "RunOut", "RunPage", "RunStatus", "RunTrajectory", "RunUpdate", "StateIn",
-    "Stats", "Strict", "SweepJobCreate", "TokenAccepted", "TrajectoryIn", "ViewOut", "ViewReplay", "Zeta0",
+    "Stats", "Strict", "SweepJobCreate", "TokenAccepted", "TrajectoryIn", "ViewOut", "ViewReplay", "ViewerId",
+    "Zeta0",
     "finite_or_none",
 ]  # fmt: skip

@@ -27,12 +27,16 @@ class ViewContext:
 
 
 class SceneView(Protocol):
-    def info(self) -> dict:
-        """``available``, ``port``, ``mode``, ``run_id``, ``updates_per_s``, ``clients``."""
+    """A view per browser; a control panel names the one it embeds by a viewer id."""
+
+    def info(self, viewer: str | None = None) -> dict:
+        """``available``, ``port``, ``updates_per_s``, ``clients``; ``mode`` and ``run_id`` of the
+        view of panel ``viewer``."""
         ...
 
-    def open_run(self, run_id: int, overlay_run_id: int | None = None) -> dict:
-        """Replay a stored run (records.NotFound / records.Conflict when it cannot be); returns info()."""
+    def open_run(self, viewer: str, run_id: int, overlay_run_id: int | None = None) -> dict:
+        """Replay a stored run in panel ``viewer``'s view only (records.NotFound /
+        records.Conflict when it cannot be); returns info(viewer)."""
         ...
 
     def share_html(self, run_id: int, overlay_run_id: int | None = None) -> str:

@@ -565,7 +565,7 @@ on("#run-table", "click", async (event) => {
   if (!button) return;
   const runId = Number(button.dataset.run);
   const others = [...document.querySelectorAll("#run-table input:checked")].map((box) => Number(box.value)).filter((id) => id !== runId);
-  await call("POST", "/view/replay", { run_id: runId, overlay_run_id: others[0] ?? null });
+  await call("POST", "/view/replay", { viewer: VIEWER, run_id: runId, overlay_run_id: others[0] ?? null });
   selectTab("view3d");
   say(`Run ${runId} is on the 3D view's timeline${others.length ? ` with run ${others[0]} as a ghost` : ""}.`);
 });
@@ -850,15 +850,26 @@ for (const button of document.querySelectorAll("button.estop")) on(button, "clic
 
 // 3D view ------------------------------------------------------------------------------------
 // viser serves the view on its own port of this host; the frame loads it once and keeps it.
+// Each browser's view is its own. This page names its view with a random id, carried in the
+// view's websocket path (viser's client connects to the address in its `websocket` parameter),
+// so History → "3D" opens the replay here and nowhere else.
+const VIEWER = Array.from(crypto.getRandomValues(new Uint8Array(12)), (byte) => byte.toString(16).padStart(2, "0")).join("");
+
 async function showView() {
-  const info = await call("GET", "/view");
+  const info = await call("GET", `/view?viewer=${VIEWER}`);
   if (!info.available) {
     $("#view-status").textContent = info.reason;
     if (info.starting) setTimeout(showView, 1000); // built in the background at start-up
     return;
   }
-  const url = `${location.protocol}//${location.hostname}:${info.port}/`;
-  $("#view-open").href = url;
-  if ($("#view-frame").src !== url) $("#view-frame").src = url;
-  $("#view-status").textContent = `Mode: ${info.mode}${info.run_id ? `, run ${info.run_id}` : ""} · ${info.updates_per_s} updates/s · the scene is shared by everyone viewing it.`;
+  const page = `${location.protocol}//${location.hostname}:${info.port}/`;
+  const socket = `${location.protocol === "https:" ? "wss:" : "ws:"}//${location.hostname}:${info.port}/viewer/${VIEWER}`;
+  $("#view-open").href = page; // a window of its own is a view of its own
+  const frame = $("#view-frame");
+  if (frame.dataset.viewer !== VIEWER) {
+    frame.dataset.viewer = VIEWER;
+    frame.src = `${page}?websocket=${socket}`;
+  }
+  const showing = info.mode ? `Mode: ${info.mode}${info.run_id ? `, run ${info.run_id}` : ""}` : "Connecting…";
+  $("#view-status").textContent = `${showing} · ${info.updates_per_s} updates/s · this view is yours: what you do in it shows in your browser only.`;
 }

@@ -1,38 +1,60 @@
-"""The 3D view: a viser server inside the service process, its GUI, and the frame loop.
+"""The 3D view: a viser server inside the service process, a view per browser, and the frame loop.
 
 :class:`ClimbView` runs viser's web server in viser's own thread on its own port (viser moves to
 the next port when the one asked for is busy; :meth:`ClimbView.info` says which) and one loop
-thread that draws a frame of the current mode :data:`FRAME_RATE` times a second. The scene and
-GUI are shared by everyone who opens the view, like a monitor on the lab wall. The view only
-reads: it never commands the robot.
+thread that draws a frame :data:`FRAME_RATE` times a second for every browser connected. Each
+browser has a view of its own (:class:`frontend.viewer.session.ViewerSession`: scene, GUI,
+modes, play state), built when it connects and dropped when it leaves, so nothing is drawn or
+computed for nobody. The view only reads: it never commands the robot.
 
-The service talks to it through ``backend.services.view.SceneView`` (info, replay a stored run,
-share a run as standalone HTML); ``cli.serve`` plugs it in.
+The service talks to it through ``backend.services.view.SceneView`` (info, replay a stored run
+in one panel's view, share a run as standalone HTML); ``cli.serve`` plugs it in.
+
+Threads: the sessions are kept as an immutable mapping, replaced whole (under a lock) when a
+browser comes or goes; the loop and the service read whichever mapping is current.
 """
 
 from __future__ import annotations
 
 import collections
-import html
 import logging
 import threading
 import time
+import warnings
+from dataclasses import dataclass
+from types import MappingProxyType
 
 import viser
 
 from backend.services.view import ViewContext
 from backend.settings import LOOPBACK_HOSTS
-from frontend.viewer.modes import LiveMode, ReplayMode, SimulateMode
-from frontend.viewer.origins import refuse_foreign_origins
-from frontend.viewer.recordings import load_recording, recording_key
-from frontend.viewer.scene import ChuteScene, place_camera
+from frontend.viewer.handshake import refuse_foreign_origins, viewer_of
+from frontend.viewer.recordings import Recording, load_recording, recording_key
+from frontend.viewer.scene import place_camera
+from frontend.viewer.session import ViewerSession
 from frontend.viewer.share import share_html
 from sim_core import get_preset
 
 log = logging.getLogger("parkourlab.view")
-FRAME_RATE = 60.0  # frames drawn per second (the floor the issue sets is 30)
+# Between a browser's websocket closing and viser calling on_client_disconnect, the loop may draw
+# one more frame for it; viser warns that those messages go nowhere, which is all they do.
+warnings.filterwarnings("ignore", message="Queued a .* on a closed connection", category=UserWarning)
+FRAME_RATE = 60.0  # frames drawn per second, per browser (the floor the issue sets is 30)
 READOUT_PERIOD = 0.25  # [s] between readout updates: text need not move at frame rate
 SHARED_FILES_KEPT = 8  # shared HTML files kept for the next ask (1-4 MB each)
+PENDING_REPLAY_S = 60.0  # [s] a replay asked for a panel whose view has not connected yet waits this long
+PENDING_REPLAYS_KEPT = 32
+
+
+@dataclass(frozen=True)
+class _Replay:
+    """A stored run, read and ready to put on a timeline."""
+
+    run_id: int
+    overlay_id: int | None
+    recording: Recording
+    overlay: Recording | None
+    asked: float  # time.monotonic() when it was asked for
 
 
 class ClimbView:
@@ -44,7 +66,7 @@ class ClimbView:
         context: the service's database sessions and robot (for replay and live modes).
         panel_url: where the control panel is, for the link back.
         allowed_hosts: the service's host names: a websocket from a page of any other origin is
-            refused (frontend/viewer/origins.py).
+            refused (frontend/viewer/handshake.py).
     """
 
     def __init__(
@@ -59,49 +81,86 @@ class ClimbView:
         self.context = context
         self.robot = get_preset("paper")
         self.allowed_hosts = allowed_hosts
+        self.panel_url = panel_url
         self.server = viser.ViserServer(host=host, port=port, label="ParkourLab · 3D view", verbose=False)
         refuse_foreign_origins(self.server, allowed_hosts)
         place_camera(self.server)
-        self.scene = ChuteScene(self.server.scene, self.robot)
-        gui = self.server.gui
-        # target="_top": the panel embeds this view in a frame, and a plain link loaded a second
-        # panel (and a second e-stop) inside it. viser renders a markdown's HTML as it is.
-        link = f'<a href="{html.escape(panel_url, quote=True)}" target="_top">← Control panel</a>'
-        gui.add_markdown(f"{link} · walls {self.robot.wall_distance:.2f} m apart")
-        self.gui_mode = gui.add_dropdown("Mode", ("simulate", "live", "replay"), initial_value="simulate")
-        self.lock = threading.RLock()  # the loop and GUI callbacks take turns on the modes
-        self.modes = {
-            "simulate": SimulateMode(self.server, self.scene, self.lock, self.robot),
-            "live": LiveMode(self.server, self.scene, self.lock, context.robot_service),
-            "replay": ReplayMode(self.server, self.scene, self.lock, context.sessions),
-        }
-        self.modes["replay"].share = self.share_html
-        self.mode = self.modes["simulate"]
-        self.gui_mode.on_update(lambda _event: self.set_mode(self.gui_mode.value))
+        self._sessions_lock = threading.Lock()  # orders comings and goings; readers need no lock
+        self.sessions: MappingProxyType[int, ViewerSession] = MappingProxyType({})
+        self._pending: collections.OrderedDict[str, _Replay] = collections.OrderedDict()
         self._shared: collections.OrderedDict[tuple, str] = collections.OrderedDict()
         self._shared_lock = threading.Lock()
         self.updates_per_s = 0.0
         self.frames = 0
         self._stop = threading.Event()
+        self.server.on_client_connect(self._connect)
+        self.server.on_client_disconnect(self._disconnect)
         self._thread = threading.Thread(target=self._loop, name="view-loop", daemon=True)
         self._thread.start()
 
+    # Browsers coming and going ------------------------------------------------------------------
+    def _connect(self, client: viser.ClientHandle) -> None:
+        session = ViewerSession(client, viewer_of(self.server, client), self.context, self.robot,
+                                panel_url=self.panel_url, share=self.share_html)  # fmt: skip
+        with self._sessions_lock:
+            if self._stop.is_set():
+                return
+            self.sessions = MappingProxyType({**self.sessions, client.client_id: session})
+            pending = self._pending.pop(session.viewer, None) if session.viewer else None
+        if pending is not None and time.monotonic() - pending.asked <= PENDING_REPLAY_S:
+            session.replay(pending.run_id, pending.overlay_id, pending.recording, pending.overlay)
+
+    def _disconnect(self, client: viser.ClientHandle) -> None:
+        with self._sessions_lock:
+            remaining = dict(self.sessions)
+            session = remaining.pop(client.client_id, None)
+            self.sessions = MappingProxyType(remaining)
+        if session is not None:
+            session.close()
+
+    def sessions_of(self, viewer: str) -> list[ViewerSession]:
+        """The connected views of the panel called ``viewer`` (usually one)."""
+        return [session for session in self.sessions.values() if session.viewer == viewer]
+
     # What the service asks --------------------------------------------------------------------
-    def info(self) -> dict:
+    def info(self, viewer: str | None = None) -> dict:
+        """Where the view is and how it runs; with ``viewer``, what that panel's view shows
+        (``mode`` and ``run_id`` are None for a panel whose view is not connected)."""
+        mode = run_id = None
+        if viewer is not None:
+            sessions = self.sessions_of(viewer)
+            pending = self._pending.get(viewer)
+            if sessions:
+                mode, run_id = sessions[0].mode.name, sessions[0].run_id
+            elif pending is not None:
+                mode, run_id = "replay", pending.run_id
         return {
             "available": True,
             "port": self.server.get_port(),
-            "mode": self.mode.name,
-            "run_id": None if self.modes["replay"].recording is None else self.modes["replay"].recording.run_id,
+            "mode": mode,
+            "run_id": run_id,
             "updates_per_s": round(self.updates_per_s, 1),
-            "clients": len(self.server.get_clients()),
+            "clients": len(self.sessions),
         }
 
-    def open_run(self, run_id: int, overlay_run_id: int | None = None) -> dict:
-        """Replay stored run ``run_id`` (records.NotFound / records.Conflict when it cannot be)."""
-        self.modes["replay"].load(run_id, overlay_run_id)
-        self.set_mode("replay")
-        return self.info()
+    def open_run(self, viewer: str, run_id: int, overlay_run_id: int | None = None) -> dict:
+        """Replay stored run ``run_id`` in the view of the panel called ``viewer`` only
+        (records.NotFound / records.Conflict when it cannot be). A view still loading gets it
+        when it connects, within :data:`PENDING_REPLAY_S`."""
+        sessions = self.context.sessions
+        recording = load_recording(sessions, run_id)
+        overlay = None if overlay_run_id is None else load_recording(sessions, overlay_run_id)
+        replay = _Replay(run_id, overlay_run_id, recording, overlay, time.monotonic())
+        targets = self.sessions_of(viewer)
+        for session in targets:
+            session.replay(run_id, overlay_run_id, recording, overlay)
+        if not targets:
+            with self._sessions_lock:
+                self._pending[viewer] = replay
+                self._pending.move_to_end(viewer)
+                while len(self._pending) > PENDING_REPLAYS_KEPT:
+                    self._pending.popitem(last=False)
+        return self.info(viewer)
 
     def share_html(self, run_id: int, overlay_run_id: int | None = None) -> str:
         """A standalone HTML file that plays stored run ``run_id`` (viser's client with the recorded
@@ -123,44 +182,35 @@ class ClimbView:
         return html
 
     def close(self) -> None:
-        self._stop.set()
+        with self._sessions_lock:
+            self._stop.set()
+            sessions, self.sessions = self.sessions, MappingProxyType({})
         self._thread.join(timeout=2.0)
+        for session in sessions.values():
+            session.close()
         self.server.stop()
 
-    # Modes and the loop -----------------------------------------------------------------------
-    def set_mode(self, name: str) -> None:
-        with self.lock:
-            if name == self.mode.name:
-                return
-            self.mode.deactivate()
-            self.mode = self.modes[name]
-            self.scene.clear_history()
-            self.scene.show_ghost(None)
-            if name != "replay":
-                self.scene.robot = self.robot
-            self.mode.activate()
-            if self.gui_mode.value != name:
-                self.gui_mode.value = name  # its callback comes back here and returns at once
-
+    # The loop -----------------------------------------------------------------------------------
     def _loop(self) -> None:
         period = 1.0 / FRAME_RATE
         last = next_tick = time.monotonic()
         window_start, window_frames, last_readout = last, 0, 0.0
-        failing = False
+        failing: set[int] = set()  # sessions whose last frame failed: said once per streak
         while not self._stop.wait(max(0.0, next_tick - time.monotonic())):
             now = time.monotonic()
             dt, last = min(now - last, 0.1), now  # a stall does not make the robot jump ahead
-            try:
-                with self.lock, self.server.atomic():
-                    self.mode.frame(dt)
-                    if now - last_readout >= READOUT_PERIOD:
-                        self.mode.gui_readout.content = self.mode.readout(self.updates_per_s)
-                        last_readout = now
-                failing = False
-            except Exception:  # one bad frame must not end the view; say it once per streak
-                if not failing:
-                    log.exception("3D view: drawing a frame failed")
-                failing = True
+            readout_rate = self.updates_per_s if now - last_readout >= READOUT_PERIOD else None
+            if readout_rate is not None:
+                last_readout = now
+            for client_id, session in self.sessions.items():
+                try:
+                    session.frame(dt, readout_rate=readout_rate)
+                    failing.discard(client_id)
+                except Exception:  # one bad frame must not end anyone's view
+                    if client_id not in failing:
+                        log.exception("3D view: drawing a frame failed")
+                    failing.add(client_id)
+            failing &= set(self.sessions)
             self.frames += 1
             window_frames += 1
             if now - window_start >= 1.0:

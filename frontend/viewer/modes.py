@@ -1,5 +1,9 @@
 """The 3D view's three modes, each a GUI folder plus a ``frame(dt)`` the view's loop calls.
 
+Every browser has its own three (:mod:`frontend.viewer.session`): the GUI and scene they draw
+are that browser's (``client.gui``, ``client.scene``), so one person's sliders, play state and
+replay are theirs alone.
+
 - :class:`SimulateMode` — the model climbs in real time; sliders act from the next touchdown;
 - :class:`LiveMode` — the body follows the robot's tracker stream, the model's prediction of
   the jump under way beside it as a ghost;
@@ -14,6 +18,7 @@ from __future__ import annotations
 
 import concurrent.futures
 import contextlib
+import math
 from dataclasses import replace
 
 import numpy as np
@@ -42,14 +47,22 @@ def _preset_label(name: str, pairs: tuple[tuple[float, float], ...]) -> str:
 GAIT_PRESETS = {_preset_label(name, pairs): (pairs[0], pairs[-1]) for name, pairs in PAPER_GAITS.items()}
 CUSTOM = "custom"
 DEFAULT_START = START_GUESS  # section state when the controls have no stable gait to start on
+PLOT_SAMPLES = 400  # the replay's height plot: samples over the run (the dot moves sample by sample)
+CURSOR_PERIOD = 0.1  # [s] the plot's dot moves at most this often
 GAIT_SEARCH_PERIOD = 4  # the readout looks for gaits of period 1, 2 and 4 (the paper's)
 
 
-class _Mode:
-    """``lock`` is the view's: the loop holds it for each frame, callbacks for each change."""
+def _range_words(low, high) -> str:
+    if low is not None and high is not None:
+        return f"{low:g} to {high:g}"
+    return f"at least {low:g}" if low is not None else f"at most {high:g}"
 
-    def __init__(self, server: viser.ViserServer, scene: ChuteScene, lock):
-        self.server, self.scene, self.lock = server, scene, lock
+
+class _Mode:
+    """``lock`` is the browser's session's: the loop holds it for each frame, callbacks for each change."""
+
+    def __init__(self, client: viser.ClientHandle, scene: ChuteScene, lock):
+        self.client, self.scene, self.lock = client, scene, lock
         self._quiet = False
 
     @contextlib.contextmanager
@@ -63,6 +76,26 @@ class _Mode:
     def activate(self) -> None:
         self.folder.visible = True
 
+    @staticmethod
+    def _out_of_range(handles) -> str | None:
+        """Why the values in ``handles`` (sliders, number boxes) cannot be used yet, or None. A
+        number box sends what is typed as it is typed: "0" on the way to "0.9", or nothing."""
+        problems = []
+        for handle in handles:
+            value, low, high = handle.value, handle.min, handle.max
+            usable = isinstance(value, int | float) and math.isfinite(value)
+            if not usable or (low is not None and value < low) or (high is not None and value > high):
+                problems.append(f"{handle.label} must be {_range_words(low, high)}")
+        return "; ".join(problems) or None
+
+    @staticmethod
+    def _clamped(handle, default: float) -> float:
+        """A slider's value held to its range (``default`` where it holds no number)."""
+        value = handle.value
+        if not isinstance(value, int | float) or not math.isfinite(value):
+            return default
+        return float(min(max(value, handle.min), handle.max))
+
     def deactivate(self) -> None:
         self.folder.visible = False
 
@@ -72,10 +105,10 @@ class SimulateMode(_Mode):
 
     name = "simulate"
 
-    def __init__(self, server: viser.ViserServer, scene: ChuteScene, lock, robot: PhysicalParams):
-        super().__init__(server, scene, lock)
+    def __init__(self, client: viser.ClientHandle, scene: ChuteScene, lock, robot: PhysicalParams):
+        super().__init__(client, scene, lock)
         self.base_robot = robot
-        gui = server.gui
+        gui = client.gui
         (left, right) = next(iter(GAIT_PRESETS.values()))
         with gui.add_folder("Simulate") as self.folder:
             self.gui_preset = gui.add_dropdown(
@@ -95,19 +128,22 @@ class SimulateMode(_Mode):
             self.gui_playback = gui.add_button_group("Playback", ("Play", "Pause", "Step jump", "Restart"))
             self.gui_speed = gui.add_slider("speed [×]", 0.1, 4.0, 0.1, 1.0)
             self.gui_readout = gui.add_markdown("")
-        for handle in (self.gui_psi0_left, self.gui_zeta0_left, self.gui_psi0_right, self.gui_zeta0_right,
-                       self.gui_gravity, self.gui_damping):  # fmt: skip
+        self._control_handles = (self.gui_psi0_left, self.gui_zeta0_left, self.gui_psi0_right,
+                                 self.gui_zeta0_right, self.gui_gravity, self.gui_damping)  # fmt: skip
+        for handle in self._control_handles:
             handle.on_update(self._on_control)
         self.gui_symmetric.on_update(self._on_control)
         self.gui_preset.on_update(self._on_preset)
         self.gui_playback.on_click(self._on_playback)
         self.playing = True
         self.time = 0.0
+        self.input_note: str | None = None  # why what was typed is not in use (half-typed, out of range)
+        self.applied = self.controls()  # the controls in use: the sliders' last usable values
         self.gait: FixedPoint | None = None
         self.gait_note = "searching…"
         self._gait_worker = concurrent.futures.ThreadPoolExecutor(max_workers=1, thread_name_prefix="gait")
         self._gait_generation = 0
-        self.climb = SimulatedClimb(self.controls(), DEFAULT_START)
+        self.climb = SimulatedClimb(self.applied, DEFAULT_START)
         self._shown = 0  # jumps whose touchdown marker and trail are drawn
         self._find_gait(restart=True)
 
@@ -141,6 +177,10 @@ class SimulateMode(_Mode):
     def _on_control(self, _event) -> None:
         if self._quiet:
             return
+        with self.lock:
+            self.input_note = self._out_of_range(self._control_handles)
+        if self.input_note is not None:
+            return  # the climb goes on with the controls in use until the value is whole
         with self.lock, self._quietly():
             self.gui_preset.value = CUSTOM
             if self.gui_symmetric.value:
@@ -153,7 +193,9 @@ class SimulateMode(_Mode):
 
     def _controls_changed(self, *, restart: bool) -> None:
         self.gui_psi0_right.disabled = self.gui_zeta0_right.disabled = self.gui_symmetric.value
-        self.climb.set_controls(self.controls())
+        self.input_note = None
+        self.applied = self.controls()
+        self.climb.set_controls(self.applied)
         self._find_gait(restart=restart)
 
     def _on_playback(self, event) -> None:
@@ -180,7 +222,7 @@ class SimulateMode(_Mode):
     def _restart(self) -> None:
         gait = self.gait
         start = tuple(gait.state) if gait is not None and gait.stable else DEFAULT_START
-        self.climb.set_controls(self.controls())
+        self.climb.set_controls(self.applied)
         self.climb.reset(start)
         self.scene.clear_history()
         self.time, self._shown, self.playing = 0.0, 0, True
@@ -189,24 +231,31 @@ class SimulateMode(_Mode):
     def _find_gait(self, *, restart: bool) -> None:
         """Look for the gait of the current controls in the background (the newest request wins)."""
         self._gait_generation += 1
-        generation, controls = self._gait_generation, self.controls()
+        generation, controls = self._gait_generation, self.applied
         self.gait_note = "searching…"
         guess = self.climb.current.state
 
         def search() -> None:
             gait, note = find_gait(controls, guess)
-            if generation != self._gait_generation:
-                return
-            self.gait, self.gait_note = gait, note
-            if restart:
-                self.restart()
+            with self.lock:  # the session's: a browser that left has bumped the generation under it
+                if generation != self._gait_generation:
+                    return
+                self.gait, self.gait_note = gait, note
+                if restart:
+                    self._restart()
 
-        self._gait_worker.submit(search)
+        with contextlib.suppress(RuntimeError):  # closed: the browser has gone
+            self._gait_worker.submit(search)
+
+    def close(self) -> None:
+        """Compute nothing more: a search under way is not waited for and its answer is dropped."""
+        self._gait_generation += 1
+        self._gait_worker.shutdown(wait=False, cancel_futures=True)
 
     # Per frame ----------------------------------------------------------------------------------
     def frame(self, dt: float) -> None:
         if self.playing:
-            self.time += dt * float(self.gui_speed.value)
+            self.time += dt * self._clamped(self.gui_speed, 1.0)
         pose = self.climb.pose_at(self.time)
         plans = self.climb.plans
         for k in range(self._shown, pose.jump + 1):
@@ -232,7 +281,8 @@ class SimulateMode(_Mode):
         failed = plan.failure is not None and t >= plan.clip.end
         failure = f"**{plan.failure.code}** at jump {pose.jump + 1}: {plan.failure.message}" if failed else "none"
         robot = self.climb.controls.robot
-        return (
+        typed = f"**Not in use yet:** {self.input_note}  \n" if self.input_note else ""
+        return typed + (
             f"**Jump** {pose.jump + 1} · **height** {pose.y:.3f} m · **climb/jump** {last}  \n"
             f"**Failure:** {failure}  \n"
             f"**Gait of these controls:** {self.gait_note}  \n"
@@ -265,10 +315,10 @@ class LiveMode(_Mode):
     name = "live"
     TRAIL_SECONDS = 3.0
 
-    def __init__(self, server: viser.ViserServer, scene: ChuteScene, lock, robot_service):
-        super().__init__(server, scene, lock)
+    def __init__(self, client: viser.ClientHandle, scene: ChuteScene, lock, robot_service):
+        super().__init__(client, scene, lock)
         self.robot_service = robot_service
-        gui = server.gui
+        gui = client.gui
         with gui.add_folder("Live", visible=False) as self.folder:
             self.gui_ghost = gui.add_checkbox(
                 "Model ghost", initial_value=True, hint="the model's jump from each touchdown"
@@ -350,10 +400,10 @@ class ReplayMode(_Mode):
 
     name = "replay"
 
-    def __init__(self, server: viser.ViserServer, scene: ChuteScene, lock, sessions):
-        super().__init__(server, scene, lock)
+    def __init__(self, client: viser.ClientHandle, scene: ChuteScene, lock, sessions):
+        super().__init__(client, scene, lock)
         self.sessions = sessions
-        gui = server.gui
+        gui = client.gui
         with gui.add_folder("Replay", visible=False) as self.folder:
             self.gui_run = gui.add_number("Run id", 1, min=1, step=1)
             self.gui_overlay = gui.add_number("Overlay run id (0: none)", 0, min=0, step=1)
@@ -364,6 +414,9 @@ class ReplayMode(_Mode):
             self.gui_share = gui.add_button("Share this run (HTML)", hint="a standalone file that plays this replay")
             self.gui_readout = gui.add_markdown("Pick a run and press Load (History → “3D” does it for you).")
         self.plot = None
+        self._curves: tuple[np.ndarray, ...] = ()  # the plot's time grid [s] and heights [m]
+        self._cursor_at: int | None = None  # the grid sample the plot's dot is on
+        self._cursor_wait = 0.0  # [s] until the dot may move again
         self.recording: Recording | None = None
         self.overlay: Recording | None = None
         self.playing = False
@@ -377,6 +430,10 @@ class ReplayMode(_Mode):
         self.gui_share.on_click(self._on_share)
 
     def _on_load(self, _event) -> None:
+        problem = self._out_of_range((self.gui_run, self.gui_overlay))
+        if problem is not None:
+            self.message = f"**Cannot replay:** {problem}"
+            return
         with contextlib.suppress(records.NotFound, records.Conflict):  # the readout says why
             self.load(int(self.gui_run.value), int(self.gui_overlay.value) or None)
 
@@ -390,6 +447,10 @@ class ReplayMode(_Mode):
             self.message = f"**Cannot replay:** {error}"
             self.recording = None
             raise
+        self.show(run_id, overlay_id, recording, overlay)
+
+    def show(self, run_id, overlay_id, recording: Recording, overlay: Recording | None) -> None:
+        """Put ``recording`` (stored run ``run_id``) on the timeline, ``overlay`` as its ghost."""
         with self.lock:
             self._show(run_id, overlay_id, recording, overlay)
 
@@ -408,25 +469,55 @@ class ReplayMode(_Mode):
         self.message = f"**{recording.label}**" + (f" · ghost: {overlay.label}" if overlay else "")
 
     def _plot(self, recording: Recording, overlay: Recording | None) -> None:
+        """The body's height over the run, with a dot at the replay's time (:meth:`_move_cursor`)."""
         if self.plot is not None:
             self.plot.remove()
         clips = [recording.clip] + ([overlay.clip] if overlay else [])
         end = max(clip.end for clip in clips)
-        grid = np.linspace(0.0, end, 400)
-        data = [grid] + [np.interp(grid, clip.time, clip.y, right=np.nan) for clip in clips]
+        grid = np.linspace(0.0, end, PLOT_SAMPLES)
+        self._curves = (grid, *(np.interp(grid, clip.time, clip.y, right=np.nan) for clip in clips))
         series = [{"label": "t [s]"}, {"label": f"run {recording.run_id} height [m]", "stroke": "#23303c", "width": 2}]
         if overlay:
             series.append({"label": f"run {overlay.run_id} [m]", "stroke": "#50aae6", "width": 2})
+        series.append({"label": "now", "stroke": "#e8590c", "width": 0,
+                       "points": {"show": True, "size": 10, "fill": "#e8590c"}})  # fmt: skip
+        self._cursor_at = None
         with self.folder:
-            self.plot = self.server.gui.add_uplot(
-                tuple(data), tuple(series), title="Body height", aspect=1.6, order=self.gui_readout.order - 0.5
+            self.plot = self.client.gui.add_uplot(
+                (*self._curves, self._cursor(0.0)),
+                tuple(series),
+                title="Body height",
+                aspect=1.6,
+                order=self.gui_readout.order - 0.5,
+                scales={"x": {"time": False}},  # seconds of the run, not dates
+                axes=({"label": "time [s]"}, {"label": "height [m]"}),
             )
+
+    def _cursor(self, t: float) -> np.ndarray:
+        """The "now" series: the run's height at the sample nearest ``t`` [s], nothing elsewhere."""
+        grid, height = self._curves[0], self._curves[1]
+        k = int(np.clip(np.searchsorted(grid, t), 0, grid.size - 1))
+        now = np.full(grid.size, np.nan)
+        now[k] = height[k]
+        return now
+
+    def _move_cursor(self, dt: float) -> None:
+        """Move the plot's dot with the body when it has moved a sample, at most every
+        CURSOR_PERIOD (the whole plot goes to the browser each time)."""
+        self._cursor_wait -= dt
+        if self.plot is None or self._cursor_wait > 0.0:
+            return
+        grid = self._curves[0]
+        k = int(np.clip(np.searchsorted(grid, self.time), 0, grid.size - 1))
+        if k != self._cursor_at:
+            self._cursor_at, self._cursor_wait = k, CURSOR_PERIOD
+            self.plot.data = (*self._curves, self._cursor(self.time))
 
     def _on_scrub(self, _event) -> None:
         if self._quiet or self.recording is None:
             return
         with self.lock:
-            self.time = float(self.gui_time.value)
+            self.time = self._clamped(self.gui_time, self.time)
             self._marked = (0, 0)
             self.scene.clear_history()
 
@@ -457,11 +548,12 @@ class ReplayMode(_Mode):
         if recording is None:
             return
         if self.playing:
-            self.time = min(self.time + dt * float(self.gui_speed.value), float(self.gui_time.max))
+            self.time = min(self.time + dt * self._clamped(self.gui_speed, 1.0), float(self.gui_time.max))
             self.playing = self.time < self.gui_time.max
             with self._quietly():
                 self.gui_time.value = round(self.time, 2)
         self._marked = show_frame(self.scene, recording, self.overlay, self.time, self._marked)
+        self._move_cursor(dt)
 
     def readout(self, updates_per_s: float) -> str:
         if self.recording is None:

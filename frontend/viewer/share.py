@@ -40,8 +40,8 @@ from viser.infra._infra import _append_aligned_buffers
 
 from backend.settings import LOOPBACK_HOSTS
 from frontend.viewer.geometry import bow_legs, energy_colors, polyline_segments, to_scene
+from frontend.viewer.handshake import refuse_foreign_origins
 from frontend.viewer.motion import STANCE, TRAIL_STRIDE
-from frontend.viewer.origins import refuse_foreign_origins
 from frontend.viewer.recordings import Recording
 from frontend.viewer.scene import FOLLOW_MARGIN, ChuteScene, NodeRing, place_camera
 from sim_core.walls import Wall

@@ -80,7 +80,8 @@ def _until(page, expression: str, timeout: float = 30_000) -> None:
     deadline = time.monotonic() + timeout / 1000
     while not page.evaluate(expression):
         if time.monotonic() > deadline:
-            pytest.fail(f"not true within {timeout / 1000:g} s: {expression}")
+            shown = page.evaluate("[...document.querySelectorAll('.message')].map((m) => m.textContent)")
+            pytest.fail(f"not true within {timeout / 1000:g} s: {expression} (messages shown: {shown})")
         time.sleep(0.05)
 
 
@@ -449,7 +450,7 @@ def test_the_3d_view_draws_the_climb(page):
     frame = page.frame_locator("#view-frame")
     frame.locator("text=Gait of these controls").wait_for(timeout=30_000)
     time.sleep(3)
-    assert _canvas_is_drawn(page.frame(url=page.get_attribute("#view-frame", "src")))
+    assert _canvas_is_drawn(page.query_selector("#view-frame").content_frame())
     late = [t for t in updates if t > updates[-1] - 2.0]
     print(f"3D view: {len(late) / 2.0:.0f} websocket updates/s reached the browser")  # measured, not asserted
     assert "stable" in frame.locator("text=Gait of these controls").locator("..").inner_text()
@@ -473,6 +474,26 @@ def test_a_run_opens_in_3d_and_shares_as_a_file(page, service, tmp_path):
     with page.context.new_page() as offline:  # from disk, no service: what a colleague gets by mail
         offline.goto(path.as_uri())
         assert _canvas_is_drawn(offline.main_frame)
+
+
+def test_each_person_has_their_own_3d_view(page, service):
+    base, _token = service
+    with page.context.browser.new_context(viewport={"width": 1360, "height": 900}) as elsewhere:
+        other = elsewhere.new_page()  # another person, in a browser of their own
+        other.goto(f"{base}/")
+        other.click("nav [data-tab=view3d]")
+        other_view = other.frame_locator("#view-frame")
+        other_view.locator("text=Gait of these controls").wait_for(timeout=30_000)
+        page.click("nav [data-tab=history]")
+        page.click("#run-table button.open-3d")  # History → "3D" here
+        _until(page, "document.querySelector('#view-status').textContent.includes('replay')")
+        page.frame_locator("#view-frame").locator("text=Share this run (HTML)").wait_for(timeout=30_000)
+        other.click("nav [data-tab=history]")
+        other.click("nav [data-tab=view3d]")
+        _until(other, "document.querySelector('#view-status').textContent.includes('Mode: simulate')")
+        other_view.locator("text=Gait of these controls").wait_for(timeout=10_000)
+        assert other_view.locator("text=Share this run (HTML)").is_hidden(), "their view did not switch to replay"
+        assert "yours" in other.text_content("#view-status")
 
 
 def test_closed_loop_run_then_emergency_stop(page, service):

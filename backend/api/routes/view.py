@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from fastapi import APIRouter, HTTPException, Request
+from typing import Annotated
+
+from fastapi import APIRouter, HTTPException, Query, Request
 from fastapi.responses import HTMLResponse
 
 from backend import schemas
@@ -12,10 +14,10 @@ router = APIRouter(tags=["view"])
 
 
 @router.get("/api/v1/view", response_model=schemas.ViewOut)
-def view_info(request: Request):
-    """Where the 3D view is (its own port on this host) and what it shows."""
+def view_info(request: Request, viewer: Annotated[str | None, Query(pattern=schemas.VIEWER_ID_PATTERN)] = None):
+    """Where the 3D view is (its own port on this host), and what the panel ``viewer``'s view shows."""
     try:
-        return scene_view(request).info()
+        return scene_view(request).info(viewer)
     except HTTPException:
         starter = request.app.state.view_starter
         starting = starter is not None and starter.starting
@@ -24,8 +26,9 @@ def view_info(request: Request):
 
 @router.post("/api/v1/view/replay", dependencies=AUTHORIZED, response_model=schemas.ViewOut)
 def view_replay(body: schemas.ViewReplay, view: SceneView):
-    """Show a stored run in the 3D view (replay mode), optionally with another as a ghost."""
-    return view.open_run(body.run_id, body.overlay_run_id)
+    """Show a stored run in the 3D view of the panel ``viewer`` (replay mode), optionally with
+    another as a ghost. Nobody else's view changes; a view still loading gets it when it connects."""
+    return view.open_run(body.viewer, body.run_id, body.overlay_run_id)
 
 
 @router.get("/api/v1/runs/{run_id}/share.html", response_class=HTMLResponse)

@@ -26,11 +26,11 @@ class StandInView:
         self.context = context
         self.closed = False
 
-    def info(self) -> dict:
+    def info(self, viewer: str | None = None) -> dict:
         return {"available": True, "port": None, "mode": "idle"}
 
-    def open_run(self, run_id: int, overlay_run_id: int | None = None) -> dict:
-        return self.info() | {"run_id": run_id}
+    def open_run(self, viewer: str, run_id: int, overlay_run_id: int | None = None) -> dict:
+        return self.info(viewer) | {"run_id": run_id}
 
     def share_html(self, run_id: int, overlay_run_id: int | None = None) -> str:
         return f"<p>run {run_id}</p>"
@@ -87,7 +87,8 @@ def test_the_api_answers_while_the_view_is_starting(settings):
         assert client.get("/api/v1/health").status_code == 200
         info = client.get("/api/v1/view").json()
         assert info["available"] is False and info["starting"] is True and "starting" in info["reason"]
-        assert client.post("/api/v1/view/replay", json={"run_id": 1}, headers=_auth(settings)).status_code == 503
+        replay = {"viewer": "panel-one", "run_id": 1}
+        assert client.post("/api/v1/view/replay", json=replay, headers=_auth(settings)).status_code == 503
         release.set()
         view = app.state.view_starter.wait(10)
         assert client.get("/api/v1/view").json()["mode"] == "idle"

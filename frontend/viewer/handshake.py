@@ -1,6 +1,7 @@
-"""The 3D view's websocket answers only pages of the service's own hosts.
+"""What the 3D view learns from a browser's websocket handshake: whether its page may connect at
+all (its Origin) and which control panel it belongs to (its path).
 
-A page from anywhere else that the lab's browser opens (another site, a DNS-rebinding one) could
+Origins. A page from anywhere else that the lab's browser opens (another site, a DNS-rebinding one) could
 otherwise connect to ``ws://localhost:8001`` — a browser sends the page's ``Origin`` but leaves
 the check to the server — and read the scene (the robot's live pose) or drive the shared GUI. The
 rule is the service's own (``backend.api.security.origin_allowed``): an Origin whose host is on
@@ -18,31 +19,57 @@ closed (1008, policy violation) with nothing exchanged. The handshake itself has
 then (the browser sees an open socket, then the close), and the names used here are viser's
 private ones: :func:`refuse_foreign_origins` fails loudly, and the view does not start, if they
 are gone.
+
+Viewer ids. The control panel embeds the view with ``?websocket=ws://HOST:PORT/viewer/ID`` (viser's
+client connects to the address in its ``websocket`` parameter, path included), ``ID`` a random
+id the panel made for itself. The path is on the handshake's request, so the view knows which
+panel each browser's view belongs to (:func:`viewer_of`), and History → "3D" in one panel opens
+the replay in that panel's view only. A view opened any other way has no id: it is nobody's to
+switch from outside.
 """
 
 from __future__ import annotations
 
 import asyncio
 import logging
+import re
 from collections.abc import Iterable
 
 import viser
 
 from backend.api.security import origin_allowed
+from backend.schemas.view import VIEWER_ID_PATTERN
 from backend.settings import host_name
 
 log = logging.getLogger("parkourlab.view")
 POLICY_VIOLATION = 1008
+VIEWER_PATH = re.compile(rf"/viewer/({VIEWER_ID_PATTERN.strip('^$')})/?")
+
+
+def _live_connections(server: viser.ViserServer) -> dict:
+    websock = getattr(server, "_websock_server", None)
+    live = getattr(websock, "_live_connections", None)
+    if websock is None or not isinstance(live, dict):
+        raise RuntimeError(f"viser {viser.__version__}: no per-client connections to check Origins on")
+    return live
+
+
+def viewer_of(server: viser.ViserServer, client: viser.ClientHandle) -> str | None:
+    """The viewer id in ``client``'s websocket path (``/viewer/ID``), or None (any other path, or
+    a connection already gone)."""
+    connection = _live_connections(server).get(client.client_id)
+    if connection is None:
+        return None
+    match = VIEWER_PATH.fullmatch(connection.request.path.partition("?")[0])
+    return None if match is None else match.group(1)
 
 
 def refuse_foreign_origins(server: viser.ViserServer, allowed_hosts: Iterable[str]) -> None:
     """Close every websocket of ``server`` whose Origin is not an allowed host, from now on and
     any already open (the server was listening before this could be installed)."""
     allowed = frozenset(host_name(host) for host in allowed_hosts)
-    websock = getattr(server, "_websock_server", None)
-    live = getattr(websock, "_live_connections", None)
-    if websock is None or not isinstance(live, dict):
-        raise RuntimeError(f"viser {viser.__version__}: no per-client connections to check Origins on")
+    live = _live_connections(server)
+    websock = server._websock_server
 
     def foreign(connection) -> str | None:
         origin = connection.request.headers.get("Origin")

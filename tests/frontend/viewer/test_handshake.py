@@ -1,5 +1,8 @@
-"""The 3D view's websocket refuses pages of foreign origins (frontend/viewer/origins.py), on a real
+"""What the 3D view reads from a websocket's handshake (frontend/viewer/handshake.py): pages of
+foreign origins are refused, and a panel's view is known by the viewer id in its path. A real
 viser server, with a websocket client as a browser's would connect (viser's subprotocol, an Origin)."""
+
+import time
 
 import pytest
 import viser
@@ -7,7 +10,8 @@ from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
 from backend.settings import LOOPBACK_HOSTS
-from frontend.viewer.origins import POLICY_VIOLATION, refuse_foreign_origins
+from frontend.viewer.handshake import POLICY_VIOLATION, refuse_foreign_origins, viewer_of
+from tests.frontend.viewer.headless import HeadlessViewer
 
 
 @pytest.fixture(scope="module")
@@ -42,3 +46,22 @@ def test_a_viser_without_the_per_client_connections_is_not_started_unchecked():
 
     with pytest.raises(RuntimeError, match="Origins"):
         refuse_foreign_origins(Changed(), LOOPBACK_HOSTS)
+
+
+@pytest.mark.parametrize(
+    ("path", "viewer"),
+    [("/viewer/panel-1234", "panel-1234"), ("/viewer/panel-1234/", "panel-1234"), ("/", None),
+     ("/viewer/short", None), ("/viewer/../../x", None), ("/elsewhere/panel-1234", None)],
+)  # fmt: skip
+def test_a_browser_s_view_is_known_by_its_panel_s_viewer_id_from_the_websocket_path(path, viewer):
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    found = []
+    server.on_client_connect(lambda client: found.append(viewer_of(server, client)))
+    try:
+        with HeadlessViewer(server.get_port(), path=path):
+            deadline = time.monotonic() + 10
+            while not found and time.monotonic() < deadline:
+                time.sleep(0.02)
+        assert found == [viewer]
+    finally:
+        server.stop()
