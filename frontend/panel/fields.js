@@ -104,7 +104,9 @@ const Fields = (() => {
     for (const error of Array.isArray(detail) ? detail : []) {
       const location = (error.loc || []).filter((part) => part !== "body").join(".");
       const input = form.elements[locations[location]];
-      if (input && input.getAttribute("aria-invalid") !== "true") mark(input, error.msg);
+      // pydantic prefixes a validator's own message with its kind ("Value error, …"): not the user's words.
+      const message = String(error.msg).replace(/^(Value|Assertion) error, /, "");
+      if (input && input.getAttribute("aria-invalid") !== "true") mark(input, message);
       else left.push(location ? `${location}: ${error.msg}` : error.msg);
     }
     return left;

@@ -256,22 +256,31 @@ function plotSweep(target, result, title) {
   }), PLOT_CONFIG);
 }
 
+// Failures in the basin: one grey per kind, each named in the legend (plotly heatmaps have no
+// legend entry of their own, so a marker of the same grey stands in for each).
+const FAILURE_GREYS = ["#6b7280", "#c4c9d1", "#3f4650", "#9aa1ab", "#e3e6ea"];
+const FAILURE_WORDS = { slip: "slips", collapse: "leg collapses", no_liftoff: "no lift-off", no_flight: "no flight", invalid_state: "invalid state" };
+
 function plotBasin(target, result, title, start) {
   const [x0, x1] = result.xdot_range, [y0, y1] = result.ydot_range, n = result.grid;
   const axis = (low, high) => Array.from({ length: n }, (_, i) => low + (high - low) * i / (n - 1));
+  const xs = axis(x0, x1), ys = axis(y0, y1);
   const codes = result.failure_codes;
-  const failed = result.failure.map((row) => row.map((code) => (code ? code : null)));
   const converged = result.jumps_to_converge.map((row) => row.map((jumps) => (jumps < 0 ? null : jumps)));
-  const traces = [
-    { type: "heatmap", x: axis(x0, x1), y: axis(y0, y1), z: failed, showscale: false, name: "fails",
-      colorscale: [[0, "#6b7280"], [1, "#d1d5db"]], text: result.failure.map((row) => row.map((code) => codes[String(code)] ?? "")),
-      hovertemplate: "xdot %{x:.3f}, ydot %{y:.3f}: fails (%{text})<extra></extra>" },
-    { type: "heatmap", x: axis(x0, x1), y: axis(y0, y1), z: converged, colorscale: "Viridis", reversescale: true, name: "converges",
-      colorbar: { title: { text: "jumps to<br>converge" } }, hovertemplate: "xdot %{x:.3f}, ydot %{y:.3f}: %{z} jumps<extra></extra>" },
-    { x: [result.gait.state[0]], y: [result.gait.state[1]], mode: "markers", name: `period-${result.gait.period} gait`, marker: { symbol: "x", size: 12, color: "#d61f1f" } },
-  ];
+  const kinds = [...new Set(result.failure.flat().filter(Boolean))].sort((a, b) => a - b);
+  const traces = [];
+  kinds.forEach((kind, i) => {
+    const grey = FAILURE_GREYS[i % FAILURE_GREYS.length], words = FAILURE_WORDS[codes[String(kind)]] ?? codes[String(kind)];
+    traces.push({ type: "heatmap", x: xs, y: ys, z: result.failure.map((row) => row.map((code) => (code === kind ? 1 : null))),
+      colorscale: [[0, grey], [1, grey]], showscale: false, name: `fails: ${words}`,
+      hovertemplate: `xdot %{x:.3f}, ydot %{y:.3f}: fails (${words})<extra></extra>` });
+    traces.push({ x: [null], y: [null], mode: "markers", name: `fails: ${words}`, marker: { symbol: "square", size: 12, color: grey } });
+  });
+  traces.push({ type: "heatmap", x: xs, y: ys, z: converged, colorscale: "Viridis", reversescale: true, name: "converges",
+    colorbar: { title: { text: "jumps to<br>converge" } }, hovertemplate: "xdot %{x:.3f}, ydot %{y:.3f}: %{z} jumps<extra></extra>" });
+  traces.push({ x: [result.gait.state[0]], y: [result.gait.state[1]], mode: "markers", name: `period-${result.gait.period} gait`, marker: { symbol: "x", size: 12, color: "#d61f1f" } });
   if (start) traces.push({ x: [start.xdot], y: [start.ydot], mode: "markers", name: "start", marker: { symbol: "circle-open", size: 12, color: "#111" } });
-  Plotly.react(target, traces, layout(`${title}: ${(100 * result.fraction).toFixed(1)} % converge (grey: fails)`, "xdot at the section [sqrt(g l0)]", "ydot [sqrt(g l0)]",
+  Plotly.react(target, traces, layout(`${title}: ${(100 * result.fraction).toFixed(1)} % converge`, "xdot at the section [sqrt(g l0)]", "ydot [sqrt(g l0)]",
     { legend: { orientation: "h", y: -0.32 }, margin: { l: 55, r: 15, t: 40, b: 105 } }), PLOT_CONFIG);
 }
 
@@ -279,7 +288,7 @@ const jobStatus = (job) => `${job.kind} job ${job.id}: ${job.state}${job.total ?
 
 // Schedule a job from the Simulate tab, show its progress there, draw its result when done.
 async function analyse(spec, draw) {
-  const job = await call("POST", "/jobs", spec);
+  const job = await call("POST", "/jobs", { ...spec, ...filedUnder($("#sim-form")) });
   const status = $("#analysis-status");
   status.textContent = jobStatus(job);
   watch(job, async (final) => {
@@ -784,9 +793,12 @@ document.addEventListener("visibilitychange", syncLive);
 
 on("#connect-form", "submit", async (event) => {
   event.preventDefault();
+  const numbers = await Fields.readFields(event.target, [{ name: "tracker_port", rule: "RobotConnect.tracker_port" }]);
+  if (!numbers) return;  // an empty or non-numeric port is marked at its field, never sent as 0
   const form = new FormData(event.target);
-  const body = { url: String(form.get("url")).trim(), robot_address: String(form.get("robot_address")).trim(), tracker_port: Number(form.get("tracker_port")) };
-  const status = await call("POST", "/robot/connect", body);
+  const body = { url: String(form.get("url")).trim(), robot_address: String(form.get("robot_address")).trim(), ...numbers };
+  const fields = ["url", "robot_address", "tracker_port"];
+  const status = await call("POST", "/robot/connect", body, { form: event.target, locations: Object.fromEntries(fields.map((f) => [f, f])) });
   showStatus(status);
   say(`Connected to ${status.robot_address ?? body.robot_address} on ${status.url ?? body.url}.`);
 });

@@ -142,6 +142,8 @@ def test_basin_and_sweep_are_jobs_drawn_in_simulate(page):
     page.click("#run-basin")
     page.wait_for_selector("#basin-plot .heatmaplayer image", timeout=60_000)
     assert "% converge" in page.inner_text("#basin-plot")
+    legend = page.text_content("#basin-plot .legend")  # SVG: text, not an HTML element's inner text
+    assert "fails: " in legend and "gait" in legend, f"every colour of the heatmap is named: {legend}"
     page.click("#run-sweep")
     page.wait_for_selector("#sweep-plot .scatterlayer .trace", timeout=60_000)
     assert page.inner_text("#analysis-status").startswith("sweep job") and "done" in page.inner_text("#analysis-status")
@@ -328,6 +330,9 @@ def test_runs_and_jobs_filed_under_an_experiment_appear_on_its_page(page, servic
     page.click("#save-run")
     _until(page, "document.querySelector('.message.ok')?.textContent.includes('stored')")
     run_id = int(page.inner_text(".message.ok").split()[1])
+    page.click("#run-basin")  # the Simulate tab's analyses are filed with its saved runs
+    _until(page, "document.querySelector('#analysis-status').textContent.startsWith('basin job')")
+    basin_job = int(page.inner_text("#analysis-status").split()[2].rstrip(":"))
     page.click("nav [data-tab=jobs]")
     page.select_option("#job-form select.experiment-choice", str(experiment))
     page.fill("input[name=trials]", "4")
@@ -344,7 +349,9 @@ def test_runs_and_jobs_filed_under_an_experiment_appear_on_its_page(page, servic
     _until(page, only_its_run)
     _until(page, "!document.querySelector('#experiment-jobs').hidden")
     assert page.inner_text("#experiment-jobs caption") == f"Jobs in experiment {experiment}: energy study"
-    assert page.inner_text("#experiment-jobs tbody tr td:first-child") == str(job_id)
+    first_cells = "#experiment-jobs tbody tr td:first-child"
+    filed_jobs = page.eval_on_selector_all(first_cells, "cells => cells.map((cell) => cell.textContent)")
+    assert sorted(filed_jobs) == sorted([str(job_id), str(basin_job)]), filed_jobs
     assert httpx.get(f"{base}/api/v1/runs/{run_id}").json()["experiment_id"] == experiment
     page.select_option("#history-form select[name=experiment_id]", "")
     page.click("#experiments-box summary")
@@ -698,6 +705,24 @@ def test_the_robot_address_is_sent(page, robot):
     _until(page, f"{ROBOT_STATE} === 'disarmed'", timeout=10_000)
     assert [body["robot_address"] for body in sent] == ["0x0013A20040B0B0B1", "0x0013A20040B0B0B0"]
     assert "0x0013A20040B0B0B0" in page.inner_text("#robot-status")
+
+
+def test_a_connect_form_port_that_is_not_a_port_is_marked_and_not_sent(page, robot):
+    sent = []
+    page.on("request", lambda request: "/robot/connect" in request.url and sent.append(request.post_data_json))
+    port = page.input_value("input[name=tracker_port]")
+    for typed, says in (("", "enter a number"), ("udp", '"udp" is not a number'), ("70000", "at most 65535")):
+        page.fill("input[name=tracker_port]", typed)
+        page.click("#connect")
+        _until(page, "document.querySelector('#tracker_port-error') !== null")
+        assert says in page.inner_text("#tracker_port-error"), typed
+        assert page.get_attribute("input[name=tracker_port]", "aria-invalid") == "true"
+    page.fill("input[name=tracker_port]", port)
+    page.fill("input[name=url]", "/dev/ttyUSB97")  # refused by the service: marked at its field
+    page.click("#connect")
+    _until(page, "document.querySelector('#url-error') !== null")
+    assert page.inner_text("#url-error") == "/dev/ttyUSB97 does not exist", "in the user's words, no 'Value error,'"
+    assert [body["url"] for body in sent] == ["/dev/ttyUSB97"], "nothing was sent while the port was bad"
 
 
 def test_a_second_browser_follows_live(page, service, robot):

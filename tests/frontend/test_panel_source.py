@@ -48,7 +48,7 @@ def test_every_plot_gets_the_config_without_cloud_buttons():
         assert f'"{button}"' in config.split("modeBarButtonsToRemove", 1)[1]
 
 
-@pytest.mark.parametrize("form", ["sim-form", "job-form", "robot-run-form"])
+@pytest.mark.parametrize("form", ["sim-form", "job-form", "robot-run-form", "connect-form"])
 def test_the_checked_forms_hold_no_second_copy_of_the_ranges(form):
     """Their ranges come from the API's OpenAPI document (fields.js), one source: a hand-written
     min/max here would drift from it, and the browser's own checks (required, min, max) would
