@@ -6,9 +6,7 @@
 // not a number, or out of range is marked (aria-invalid, its message beside it, in the field's
 // units) and nothing is sent. A 422 that still comes back is put at its field the same way
 // (markApiErrors). The marks clear when the form is next checked.
-"use strict";
-
-const Fields = (() => {
+export const Fields = (() => {
   let schemas = null;
   const ready = fetch("/openapi.json")
     .then((response) => response.json())

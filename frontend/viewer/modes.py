@@ -489,9 +489,20 @@ class ReplayMode(_Mode):
                 title="Body height",
                 aspect=1.6,
                 order=self.gui_readout.order - 0.5,
-                scales={"x": {"time": False}},  # seconds of the run, not dates
+                # Seconds of the run, not dates; heights on a fixed range: uPlot's own ranging
+                # turns NaN (the dot's series, a ghost that ends sooner) into a NaN scale and a
+                # blank plot once the data is sent again.
+                scales={"x": {"time": False}, "y": {"range": self._height_range()}},
                 axes=({"label": "time [s]"}, {"label": "height [m]"}),
             )
+
+    def _height_range(self) -> tuple[float, float]:
+        """[m] the plot's height axis: the curves' lowest to highest, with a margin."""
+        heights = np.concatenate(self._curves[1:])
+        heights = heights[np.isfinite(heights)]
+        low, high = (float(heights.min()), float(heights.max())) if heights.size else (0.0, 1.0)
+        margin = max(0.05 * (high - low), 0.01)
+        return (round(low - margin, 3), round(high + margin, 3))
 
     def _cursor(self, t: float) -> np.ndarray:
         """The "now" series: the run's height at the sample nearest ``t`` [s], nothing elsewhere."""

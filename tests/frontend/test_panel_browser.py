@@ -751,7 +751,10 @@ def test_a_second_browser_follows_live(page, service, robot):
 
 
 # Every draw of the live plot, with the run it belongs to and how many points it has.
-RECORD_LIVE_DRAWS = """() => {
+# The panel's modules are the page's own: a test reaches one as the page does (the same instance).
+LIVE_PLOT_SHOWS = "async () => { const { plot } = await import('/panel/robot.js'); return [plot.key, plot.t.length]; }"
+RECORD_LIVE_DRAWS = """async () => {
+  const { plot } = await import('/panel/robot.js');
   window.__draws = [];
   const react = Plotly.react;
   Plotly.react = (id, data, ...rest) => {
@@ -789,7 +792,7 @@ def test_the_status_fields_of_the_new_service_are_shown_as_text(page):
     with page.expect_response(lambda response: response.url.endswith("/api/v1/robot")):
         page.click("nav [data-tab=robot]")
     _until(page, "document.querySelector('#live-state').textContent === 'live updates: on'")
-    page.evaluate("closeLive()")  # only the statuses below from now on
+    page.evaluate("async () => (await import('/panel/robot.js')).closeLive()")  # only the statuses below
     status = {
         "state": "estopped",
         "url": "socket://127.0.0.1:1",
@@ -801,7 +804,7 @@ def test_the_status_fields_of_the_new_service_are_shown_as_text(page):
         "run": {"id": 41, "active": True, "started": 1.0e9, "touchdowns": 1, "jumps": 0, "max_seconds": 60.0},
         "transitions": [],
     }
-    feed = "(status) => showStatus(status)"
+    feed = "async (status) => (await import('/panel/robot.js')).showStatus(status)"
     page.evaluate(feed, status)
     assert page.is_visible("#estop-banner") and f"Reason: {MARKUP_NOTE}" in page.inner_text("#estop-banner")
     assert "<b>odd</b>" in page.inner_text("#robot-counters") and "retries" in page.inner_text("#robot-counters")
@@ -809,9 +812,9 @@ def test_the_status_fields_of_the_new_service_are_shown_as_text(page):
     assert "run 41: running" in page.inner_text("#robot-status")
     for time_s in (10.1, 10.2):
         page.evaluate(feed, {**status, "tracker": {"latest": {"time": time_s, "x": 0.0, "y": 0.3}}})
-    assert page.evaluate("[plot.key, plot.t.length]") == ["id 41", 3]
+    assert page.evaluate(LIVE_PLOT_SHOWS) == ["id 41", 3]
     page.evaluate(feed, {**status, "run": {**status["run"], "id": 42, "started": 1.0e9 + 90}})
-    assert page.evaluate("[plot.key, plot.t.length]") == ["id 42", 1], "a new run id: the plot starts afresh"
+    assert page.evaluate(LIVE_PLOT_SHOWS) == ["id 42", 1], "a new run id: the plot starts afresh"
     page.evaluate(feed, {**status, "estop": {"latched": False, "reason": None}, "state": "disarmed"})
     assert page.is_hidden("#estop-banner")
     page.click("nav [data-tab=simulate]")  # back to the service's own statuses on the next visit
@@ -825,7 +828,7 @@ XSS_TAG = "x:/-"
 # What markup made of a payload would leave behind: an element with an inline handler, a script
 # that is neither Plotly nor the panel, an <img src=x>. The page's own markup has none of them.
 INJECTED = """[...document.querySelectorAll('[onerror], [onload], img[src="x"]')].length
-  + [...document.scripts].filter((s) => !/\\/static\\/plotly\\.min\\.js$|\\/(panel|fields)\\.js$/.test(s.src)).length"""
+  + [...document.scripts].filter((s) => !/\\/static\\/plotly\\.min\\.js$|\\/panel\\/\\w+\\.js$/.test(s.src)).length"""
 
 
 def _no_script_ran(page, where: str) -> None:
@@ -861,7 +864,8 @@ def test_stored_script_is_shown_as_text_in_every_view(page, service):
     _until(page, f"document.querySelector('#job-{job['id']} .state')?.textContent === 'done'", timeout=60_000)
     page.click(f"#job-{job['id']} .show")
     _until(page, f"document.querySelector('#job-plot').textContent.includes('Job {job['id']}: Mean Jumps')")
-    page.evaluate("(kind) => call('POST', '/jobs', { kind }).catch(() => {})", XSS[2])
+    post_kind = "async (kind) => (await import('/panel/api.js')).call('POST', '/jobs', { kind }).catch(() => {})"
+    page.evaluate(post_kind, XSS[2])
     page.wait_for_selector(".message.error")
     assert XSS[2] in page.inner_text(".message.error"), "the 422 quotes the kind it refused, as text"
     _shot_xss(page, "jobs")

@@ -36,12 +36,12 @@ def _calls(source: str, name: str) -> list[str]:
 
 
 def test_every_plot_gets_the_config_without_cloud_buttons():
-    source = (PANEL / "panel.js").read_text()
+    source = "\n".join(path.read_text() for path in sorted(PANEL.glob("*.js")))
     calls = [call for name in ("Plotly.react", "Plotly.newPlot", "Plotly.plot") for call in _calls(source, name)]
     assert len(calls) >= 7, "the Simulate, Jobs and Robot tabs' plots"
     missing = [call.splitlines()[0] for call in calls if not re.sub(r"\s+", " ", call).endswith(", PLOT_CONFIG)")]
     assert not missing, f"every plot: Plotly.react(target, data, layout, PLOT_CONFIG): {missing}"
-    config = re.search(r"const PLOT_CONFIG = Object\.freeze\(\{(.*?)\}\);", source, re.S).group(1)
+    config = re.search(r"export const PLOT_CONFIG = Object\.freeze\(\{(.*?)\}\);", source, re.S).group(1)
     for setting in ("displaylogo: false", "showLink: false", "showSendToCloud: false", "showEditInChartStudio: false"):
         assert setting in config
     for button in ("sendChartToCloud", "sendDataToCloud", "editInChartStudio"):
@@ -58,3 +58,16 @@ def test_the_checked_forms_hold_no_second_copy_of_the_ranges(form):
     markup = page[start : page.index("</form>", start)]
     assert "novalidate" in markup.split(">", 1)[0]
     assert not re.search(r"<input[^>]*\s(min|max|required)(=|\s|>)", markup), "ranges only from the schema"
+
+
+def test_the_panel_is_modules_of_a_few_hundred_lines_each():
+    """An API module, one per tab, plots, the page's text-only DOM building, the field checks, and
+    main.js wiring them: loaded as ES modules with no build step, each a few hundred lines."""
+    page = (PANEL / "index.html").read_text()
+    assert '<script type="module" src="main.js"></script>' in page
+    sizes = {path.name: len(path.read_text().splitlines()) for path in PANEL.glob("*.js")}
+    assert {"api.js", "simulate.js", "jobs.js", "history.js", "robot.js", "view.js", "plots.js"} <= set(sizes)
+    assert max(sizes.values()) <= 300, sizes
+    for path in PANEL.glob("*.js"):
+        imported = re.findall(r'^import .*?from "\./([\w-]+\.js)";$', path.read_text(), re.M)
+        assert all((PANEL / name).exists() for name in imported), (path.name, imported)

@@ -1,0 +1,102 @@
+// The service's REST API as the panel talks to it: the token (the sign-in link, the field and
+// whether it is accepted), calls that say what went wrong (a 422 at its fields), the message
+// banner, and event handlers whose failures have already been said.
+import { Fields } from "./fields.js";
+
+export const API = "/api/v1";
+export const $ = (selector, root = document) => root.querySelector(selector);
+const TOKEN_KEY = "parkourlab-token";
+const tokenInput = $("#token");
+const tokenStatus = $("#token-status");
+
+// Sign-in: `parkour serve` prints the panel's address with the token in the fragment
+// (#token=…), which browsers never send to the service. Keep it and take it out of the address
+// bar (and so out of the history and of what is copied from it).
+const fromLink = new URLSearchParams(location.hash.slice(1)).get("token");
+if (fromLink) {
+  localStorage.setItem(TOKEN_KEY, fromLink.trim());
+  history.replaceState(null, "", location.pathname + location.search);
+}
+tokenInput.value = localStorage.getItem(TOKEN_KEY) || "";
+tokenInput.addEventListener("change", () => {
+  localStorage.setItem(TOKEN_KEY, tokenInput.value.trim());
+  checkToken();
+});
+
+// Whether the service accepts the token in the field, shown beside it (reads need none).
+async function checkToken() {
+  const token = tokenInput.value.trim();
+  let state = "none", text = "none: you can look, not change";
+  if (token) {
+    try {
+      const response = await fetch(`${API}/auth`, { headers: { Authorization: `Bearer ${token}` } });
+      state = response.ok ? "accepted" : "refused";
+      text = response.ok ? "accepted" : "not accepted: open the link parkour serve prints";
+    } catch (error) {
+      state = "unknown";
+      text = "could not be checked: the service did not answer";
+    }
+  }
+  tokenStatus.dataset.state = state;
+  tokenStatus.textContent = text;
+  tokenInput.setAttribute("aria-invalid", state === "refused" ? "true" : "false");
+}
+checkToken();
+
+export function say(text, kind = "ok") {
+  const box = document.createElement("div");
+  box.className = `message ${kind}`;
+  box.textContent = text;
+  $("#messages").replaceChildren(box);
+  if (kind === "ok") setTimeout(() => box.remove(), 4000);
+}
+
+function explain(body, status) {
+  if (body && Array.isArray(body.detail)) {
+    return body.detail.map((e) => {
+      const field = (e.loc || []).filter((p) => p !== "body").join(".");
+      return field ? `${field}: ${e.msg}` : e.msg;
+    }).join("; ");
+  }
+  if (body && body.detail) return body.detail;
+  return `HTTP ${status}`;
+}
+
+// ``fields``: {form, locations} puts a 422's errors at their fields (Fields.markApiErrors).
+export async function call(method, path, body, fields) {
+  const headers = { "Content-Type": "application/json" };
+  const token = tokenInput.value.trim();
+  if (token) headers.Authorization = `Bearer ${token}`;
+  let response;
+  try {
+    response = await fetch(API + path, { method, headers, body: body === undefined ? undefined : JSON.stringify(body) });
+  } catch (error) {
+    say(`The service did not answer: ${error}`, "error");
+    throw error;
+  }
+  const text = await response.text();
+  const data = text ? JSON.parse(text) : null;
+  if (!response.ok && response.status === 422 && fields && data) {
+    const left = Fields.markApiErrors(fields.form, data.detail, fields.locations);
+    const message = left.length ? left.join("; ") : "the service refused the marked field(s)";
+    say(left.length ? `${method} ${path}: ${message}` : "Fix the marked field(s): the service refused them.", "error");
+    throw new Error(message);
+  }
+  if (!response.ok) {
+    const message = response.status === 401
+      ? "This needs the API token: open the sign-in link parkour serve prints, or paste data/api_token into the field at the top."
+      : explain(data, response.status);
+    if (response.status === 401) checkToken();
+    say(`${method} ${path}: ${message}`, "error");
+    throw new Error(message);
+  }
+  return data;
+}
+
+// Handlers: a failed call has already told the user why (say); swallow it here so it is not
+// reported again as an uncaught error.
+export function on(target, event, handler) {
+  (typeof target === "string" ? $(target) : target).addEventListener(event, (e) => {
+    Promise.resolve(handler(e)).catch(() => {});
+  });
+}

@@ -1,0 +1,138 @@
+// The Jobs tab: the job form by kind, the jobs table with live progress (event streams), results.
+import { API, $, say, call, on } from "./api.js";
+import { filedUnder, SQRT_GL0, checked, simControls } from "./forms.js";
+import { PLOT_CONFIG, layout, plotSweep, plotBasin } from "./plots.js";
+import { element, fillTable, attributes } from "./dom.js";
+
+const streams = new Map();
+const FINAL = ["done", "cancelled", "failed"];
+
+export function describeJob(job) {
+  const spec = job.spec || {};
+  if (job.kind === "mjtf") return `psi0 ${spec.psi0_deg}°, zeta0 ${(spec.zeta0s || []).join(", ")} × ${spec.trials} trials`;
+  if (job.kind === "sweep") return `psi0 ${spec.psi0_deg}°, zeta0 ${spec.zeta0_low}–${spec.zeta0_high}, ${spec.steps} steps`;
+  const legs = (spec.controls || []).map((leg) => `${leg.psi0_deg}°/${leg.zeta0}`).join(", ");
+  return job.kind === "basin" ? `${legs}, ${spec.grid}² start states` : legs;
+}
+
+function jobRow(job) {
+  const progress = attributes(element("progress", null), { max: 1, value: job.progress, "aria-label": `job ${job.id} progress` });
+  const state = attributes(element("td", job.state), { class: "state" });
+  if (job.error) state.title = job.error;
+  const cancel = ["queued", "running"].includes(job.state) ? [attributes(element("button", "Cancel"), { class: "cancel", "data-id": job.id })] : [];
+  const row = element("tr", null,
+    element("td", String(job.id)), element("td", job.kind), attributes(element("td", describeJob(job)), { class: "what" }), state,
+    attributes(element("td", null, progress, ` ${job.completed}/${job.total}`), { class: "progress" }),
+    element("td", null, attributes(element("button", "Show"), { class: "show", "data-id": job.id, "data-kind": job.kind })),
+    element("td", null, ...cancel));
+  row.id = `job-${job.id}`;
+  return row;
+}
+
+// Follow a job's event stream: its row in the Jobs table, and the callbacks of whoever asked.
+export function watch(job, onFinal, onProgress) {
+  if (FINAL.includes(job.state)) { if (onFinal) onFinal(job); return; }
+  let entry = streams.get(job.id);
+  if (!entry) {
+    entry = { source: new EventSource(`${API}/jobs/${job.id}/events`), finals: [], progresses: [] };
+    streams.set(job.id, entry);
+    entry.source.addEventListener("progress", (event) => {
+      const update = JSON.parse(event.data);
+      $(`#job-${update.id}`)?.replaceWith(jobRow(update));
+      entry.progresses.forEach((callback) => callback(update));
+      if (FINAL.includes(update.state)) {
+        entry.source.close();
+        streams.delete(update.id);
+        say(`Job ${update.id} ${update.state}${update.error ? `: ${update.error}` : ""}.`, update.state === "failed" ? "error" : "ok");
+        entry.finals.forEach((callback) => Promise.resolve(callback(update)).catch(() => {}));
+      }
+    });
+  }
+  if (onFinal) entry.finals.push(onFinal);
+  if (onProgress) entry.progresses.push(onProgress);
+}
+
+export async function loadJobs() {
+  const page = await call("GET", "/jobs?limit=20");
+  fillTable("#job-table", page.items.map(jobRow), "No jobs yet: schedule one above.");
+  page.items.forEach((job) => watch(job));
+}
+
+on("#job-kind", "change", (event) => {
+  for (const fieldset of document.querySelectorAll("#job-form fieldset[data-kind]")) {
+    fieldset.hidden = fieldset.dataset.kind !== event.target.value;
+    fieldset.disabled = fieldset.hidden;  // hidden fields are neither validated nor sent
+  }
+});
+$("#job-kind").dispatchEvent(new Event("change"));  // also after the browser restores a form
+
+// The job form's fields by kind: each checked against its job's request body (fields.js).
+const JOB_FIELDS = {
+  mjtf: [{ name: "psi0", rule: "MJTFJobCreate.psi0_deg", unit: "°" }, { name: "zeta0s", rule: "MJTFJobCreate.zeta0s", unit: "l0", list: true },
+    { name: "trials", rule: "MJTFJobCreate.trials" }, { name: "cap", rule: "MJTFJobCreate.cap", unit: "jumps" }, { name: "seed", rule: "MJTFJobCreate.seed" }],
+  sweep: [{ name: "sweep_psi0", rule: "SweepJobCreate.psi0_deg", unit: "°" }, { name: "zeta0_low", rule: "SweepJobCreate.zeta0_low", unit: "l0" },
+    { name: "zeta0_high", rule: "SweepJobCreate.zeta0_high", unit: "l0" }, { name: "steps", rule: "SweepJobCreate.steps" },
+    { name: "basin_grid", rule: "SweepJobCreate.basin_grid" }],
+  basin: [{ name: "grid", rule: "BasinJobCreate.grid" }, { name: "basin_jumps", rule: "BasinJobCreate.jumps", unit: "jumps" },
+    { name: "tolerance", rule: "BasinJobCreate.tolerance", unit: SQRT_GL0 }],
+};
+const JOB_LOCATIONS = { psi0_deg: "psi0", zeta0s: "zeta0s", trials: "trials", cap: "cap", seed: "seed", zeta0_low: "zeta0_low",
+  zeta0_high: "zeta0_high", steps: "steps", basin_grid: "basin_grid", grid: "grid", jumps: "basin_jumps", tolerance: "tolerance" };
+
+// The job to schedule from the form — {body, locations: body field -> input} — or null (a bad
+// field is marked).
+async function jobSpec(form) {
+  const kind = form.elements.kind.value;
+  const v = await checked(form, JOB_FIELDS[kind]);
+  if (v === null) return null;
+  if (kind === "mjtf") {
+    return { body: { kind, psi0_deg: v.psi0, trials: v.trials, cap: v.cap, seed: v.seed, zeta0s: v.zeta0s }, locations: JOB_LOCATIONS };
+  }
+  if (kind === "sweep") {
+    const body = { kind, psi0_deg: v.sweep_psi0, zeta0_low: v.zeta0_low, zeta0_high: v.zeta0_high, steps: v.steps, basin_grid: v.basin_grid };
+    return { body, locations: { ...JOB_LOCATIONS, psi0_deg: "sweep_psi0" } };
+  }
+  const sim = await simControls();
+  if (!sim) return null;
+  const body = { kind, controls: sim.controls, guess: sim.start, grid: v.grid, jumps: v.basin_jumps, tolerance: v.tolerance };
+  return { body, locations: JOB_LOCATIONS };
+}
+
+on("#job-form", "submit", async (event) => {
+  event.preventDefault();
+  const spec = await jobSpec(event.target);
+  if (!spec) return;
+  const job = await call("POST", "/jobs", { ...spec.body, ...filedUnder(event.target) }, { form: event.target, locations: spec.locations });
+  say(`Job ${job.id} scheduled: ${describeJob(job)}.`);
+  await loadJobs();
+});
+
+on("#job-table", "click", async (event) => {
+  const id = event.target.dataset.id;
+  if (!id) return;
+  if (event.target.classList.contains("cancel")) {
+    await call("POST", `/jobs/${id}/cancel`);
+    return loadJobs();
+  }
+  const results = await call("GET", `/jobs/${id}/results`);
+  const job = results.job;
+  if (results.levels) {
+    // Only the levels with trials are drawn; a job that is not done says so in the title.
+    const missing = results.missing_zeta0s || [];
+    const partial = results.partial ? ` — partial (${job.state}: ${job.completed} of ${job.total} trials${
+      missing.length ? `; no trials at zeta0 ${missing.join(", ")}` : ""})` : "";
+    Plotly.react("job-plot", [{
+      x: results.levels.map((l) => l.zeta0), y: results.levels.map((l) => l.mean), mode: "lines+markers", name: "MJTF",
+      error_y: { type: "data", array: results.levels.map((l) => l.std), visible: true },
+    }], layout(`Job ${id}: Mean Jumps To Failure${partial}`, "zeta0 [l0]", "jumps to failure"), PLOT_CONFIG);
+  } else if (!results.result) {
+    say(`Job ${id} is ${job.state}: no result${job.error ? ` (${job.error})` : " yet"}.`, job.state === "failed" ? "error" : "ok");
+  } else if (job.kind === "sweep") {
+    plotSweep("job-plot", results.result, `Job ${id}: symmetric gait at psi0 = ${job.spec.psi0_deg}° over zeta0`);
+  } else if (job.kind === "basin") {
+    plotBasin("job-plot", results.result, `Job ${id}: basin of attraction`);
+  } else {
+    const gaits = results.result.gaits || [];
+    say(`Job ${id}: ${gaits.length} gait(s): ${gaits.map((g) => `period ${g.period} at (${g.state.map((v) => v.toFixed(3)).join(", ")}), max |λ| ${g.max_abs_eigenvalue.toFixed(3)}`).join("; ")}.`);
+  }
+});

@@ -1,0 +1,18 @@
+// The ParkourLab control panel: plain JavaScript modules over the service's REST API (/api/v1),
+// served by the service as they are (no build step). Every failing call shows the API's own
+// message, at its field where it has one. This module only wires the tabs to what they load;
+// each tab's module registers its own handlers when it is loaded.
+import { initTabs } from "./tabs.js";
+import { loadJobs } from "./jobs.js";
+import { loadExperiments, loadRuns } from "./history.js";
+import { drawLive, refreshRobot, syncLive } from "./robot.js";
+import "./simulate.js";
+import { showView } from "./view.js";
+
+initTabs((name) => {
+  if (name === "history") loadExperiments().then(loadRuns).catch(() => {});
+  if (name === "jobs") loadJobs();
+  if (name === "robot") { refreshRobot().catch(() => {}); drawLive(); }
+  syncLive();  // the live websocket is open while the Robot tab is shown
+  if (name === "view3d") showView();
+});

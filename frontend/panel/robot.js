@@ -1,0 +1,228 @@
+// The Robot tab: connect, arm, live runs (open and closed loop), the live plot and websocket,
+// the emergency stop (no token needed) and the latched e-stop banner.
+import { Fields } from "./fields.js";
+import { API, $, say, call, on } from "./api.js";
+import { filedUnder, LEG_FIELDS, SIM_LOCATIONS, checked } from "./forms.js";
+import { PLOT_CONFIG, layout } from "./plots.js";
+import { definitions } from "./dom.js";
+
+// Every status (GET /robot, each answer to a robot call, each live message) goes through
+// showStatus; every value from it reaches the page as text.
+const ARM_AND_LAUNCH = "The robot is disarmed. Starting the run arms it and launches it: it will jump. Continue?";
+export const plot = { key: undefined, label: "", t: [], y: [], lastTime: null, target: null };
+let pendingTarget;  // the closed-loop target of the run this browser is starting (undefined: none)
+let runWasActive = false;
+let localRuns = 0;
+
+
+
+function describeRun(run) {
+  if (!run) return "—";
+  const parts = [`${run.id !== undefined && run.id !== null ? `run ${run.id}: ` : ""}${run.active ? "running" : run.end_reason ?? "ended"}`,
+    `${run.touchdowns} touchdowns`];
+  if (run.jumps !== undefined) parts.push(`jumps ${run.jumps}`);  // as the service counts them
+  if (typeof run.started === "number") parts.push(`started ${new Date(run.started * 1000).toLocaleTimeString()}`);
+  if (run.max_seconds !== undefined) parts.push(`time limit ${run.max_seconds} s`);
+  if (!run.active && run.disarm) parts.push(`disarm: ${run.disarm}`);
+  if (run.stored_run_id !== undefined && run.stored_run_id !== null) parts.push(`stored as run ${run.stored_run_id}`);
+  return parts.join(", ");
+}
+
+export function showStatus(status) {
+  if (!status || typeof status.state !== "string") return;
+  const telemetry = status.telemetry || {};
+  const tracker = status.tracker || {};
+  const state = $("#robot-state");
+  state.textContent = status.state;
+  state.dataset.state = status.state;
+  $("#robot-status").replaceChildren(...definitions([
+    ["link", status.url || "—"],
+    ["robot address", status.robot_address || "—"],
+    ["battery", telemetry.battery_mv ? `${telemetry.battery_mv} mV` : "—"],
+    ["faults", telemetry.faults ?? "—"],
+    ["tracker frames", tracker.received ?? "—"],
+    ["tracker loss", typeof tracker.loss === "number" ? `${(100 * tracker.loss).toFixed(1)} %` : "—"],
+    ["run", describeRun(status.run)],
+  ]));
+  const counters = status.counters ? Object.entries(status.counters) : [];
+  $("#robot-counters").replaceChildren(...(counters.length ? definitions(counters) : definitions([["—", "not connected"]])));
+  showLatch(status);
+  followRun(status);
+}
+
+// A latched e-stop: a banner on every tab until a status says it is released. An older service
+// sends no ``estop``: then the state says it.
+// Off the Robot tab no live messages come: while latched, a look every few seconds keeps the
+// banner true (a reset from another browser takes it away).
+let latchCheck = null;
+
+function showLatch(status) {
+  const estop = status.estop || { latched: status.state === "estopped", reason: null };
+  $("#estop-banner").hidden = !estop.latched;
+  $("#estop-reason").textContent = estop.latched && estop.reason ? `Reason: ${estop.reason}` : "";
+  if (estop.latched && latchCheck === null) {
+    latchCheck = setTimeout(() => {
+      latchCheck = null;
+      if (!liveSocket.socket && !$("#estop-banner").hidden) refreshRobot().catch(() => {});
+    }, 3000);
+  }
+}
+
+// The live height plot shows one run: a new run (a new id) starts it afresh. An older service
+// sends neither id nor start time: a run seen becoming active is then a new one.
+function followRun(status) {
+  const run = status.run;
+  let key = plot.key;
+  let label = plot.label;
+  if (run && run.id !== undefined && run.id !== null) {
+    [key, label] = [`id ${run.id}`, `run ${run.id}`];
+  } else if (run && typeof run.started === "number") {
+    [key, label] = [`started ${run.started}`, `the run started ${new Date(run.started * 1000).toLocaleTimeString()}`];
+  } else if (run && run.active && !runWasActive) {
+    [key, label] = [`seen ${++localRuns}`, "this run"];
+  }
+  runWasActive = Boolean(run && run.active);
+  const sameRun = run && typeof run.started === "number" && run.started === plot.started;  // e.g. its id just given
+  if (key !== plot.key && sameRun) {
+    Object.assign(plot, { key, label });
+  } else if (key !== plot.key) {
+    Object.assign(plot, { key, label, started: run ? run.started : undefined, t: [], y: [], lastTime: null, target: run && run.target_m != null ? run.target_m : (pendingTarget ?? null) });
+    pendingTarget = undefined;
+    drawLive();
+  }
+  const pose = status.tracker && status.tracker.latest;
+  if (run && run.active && pose && pose.time !== plot.lastTime) {
+    plot.lastTime = pose.time;
+    plot.t.push(pose.time);
+    plot.y.push(pose.y);
+    if (plot.t.length > 1200) { plot.t.shift(); plot.y.shift(); }
+    drawLive();
+  }
+}
+
+export function drawLive() {
+  if ($("#robot").hidden) return;  // Plotly sizes a hidden plot wrongly; the tab redraws when shown
+  const start = plot.t.length ? plot.t[0] : 0;
+  const shapes = plot.target === null ? [] : [{ type: "line", xref: "paper", x0: 0, x1: 1, y0: plot.target, y1: plot.target, line: { color: "#d61f1f", dash: "dash" } }];
+  const run = plot.label ? ` — ${plot.label}` : "";
+  // New arrays each time: Plotly.react redraws only what it sees change.
+  Plotly.react("live-plot", [{ x: plot.t.map((t) => t - start), y: plot.y.slice(), mode: "lines", name: "height" }],
+    layout(`Live height${run}${plot.target === null ? "" : ` (target ${plot.target} m, dashed)`}`, "time since the run's first pose [s]", "y [m]", { shapes }),
+    PLOT_CONFIG);
+}
+
+export async function refreshRobot() { showStatus(await call("GET", "/robot")); }
+
+// The live websocket: open while the Robot tab is shown and the page visible (so a second
+// browser follows a run it did not start), reopened with backoff when it closes.
+const liveSocket = { socket: null, retry: null, failures: 0 };
+
+const liveWanted = () => !$("#robot").hidden && document.visibilityState === "visible";
+
+function liveState(text) { $("#live-state").textContent = `live updates: ${text}`; }
+
+export function syncLive() {
+  if (liveWanted()) openLive();
+  else closeLive();
+}
+
+function openLive() {
+  if (liveSocket.socket || liveSocket.retry) return;
+  liveState("connecting…");
+  const socket = new WebSocket(`${location.protocol === "https:" ? "wss" : "ws"}://${location.host}${API}/robot/live?rate=10`);
+  liveSocket.socket = socket;
+  socket.onopen = () => liveState("on");
+  socket.onmessage = (event) => {
+    liveSocket.failures = 0;
+    showStatus(JSON.parse(event.data));
+  };
+  socket.onclose = () => {
+    if (liveSocket.socket !== socket) return;  // closed on purpose
+    liveSocket.socket = null;
+    if (!liveWanted()) return liveState("off");
+    const delay = Math.min(10, 0.5 * 2 ** liveSocket.failures);
+    liveSocket.failures += 1;
+    liveState(`lost, reconnecting in ${delay} s`);
+    liveSocket.retry = setTimeout(() => { liveSocket.retry = null; if (liveWanted()) openLive(); }, delay * 1000);
+  };
+}
+
+export function closeLive() {
+  clearTimeout(liveSocket.retry);
+  liveSocket.retry = null;
+  const socket = liveSocket.socket;
+  liveSocket.socket = null;
+  if (socket) { socket.onmessage = null; socket.close(); }
+  liveState("off (Robot tab not shown)");
+}
+
+document.addEventListener("visibilitychange", syncLive);
+
+on("#connect-form", "submit", async (event) => {
+  event.preventDefault();
+  const numbers = await Fields.readFields(event.target, [{ name: "tracker_port", rule: "RobotConnect.tracker_port" }]);
+  if (!numbers) return;  // an empty or non-numeric port is marked at its field, never sent as 0
+  const form = new FormData(event.target);
+  const body = { url: String(form.get("url")).trim(), robot_address: String(form.get("robot_address")).trim(), ...numbers };
+  const fields = ["url", "robot_address", "tracker_port"];
+  const status = await call("POST", "/robot/connect", body, { form: event.target, locations: Object.fromEntries(fields.map((f) => [f, f])) });
+  showStatus(status);
+  say(`Connected to ${status.robot_address ?? body.robot_address} on ${status.url ?? body.url}.`);
+});
+on("#disconnect", "click", async () => { showStatus(await call("POST", "/robot/disconnect")); say("Disconnected."); });
+on("#arm", "click", async () => showStatus(await call("POST", "/robot/arm")));
+on("#disarm", "click", async () => showStatus(await call("POST", "/robot/disarm")));
+const reset = async () => { showStatus(await call("POST", "/robot/reset")); say("E-stop reset."); };
+on("#reset", "click", reset);
+on("#estop-banner-reset", "click", reset);
+
+on("#closed-loop", "change", (event) => {
+  for (const name of ["target_m", "kp", "ki", "kd"]) $("#robot-run-form").elements[name].disabled = !event.target.checked;
+});
+$("#closed-loop").dispatchEvent(new Event("change"));
+
+// A live run's fields, checked against the robot run's request body (fields.js); the gains only
+// when the loop is closed.
+const ROBOT_RUN_FIELDS = [...LEG_FIELDS, { name: "jumps", rule: "RobotRunCreate.jumps", unit: "jumps" },
+  { name: "max_seconds", rule: "RobotRunCreate.max_seconds", unit: "s" }];
+const CLOSED_LOOP_FIELDS = [{ name: "target_m", rule: "ClosedLoopIn.target_m", unit: "m" }, { name: "kp", rule: "ClosedLoopIn.kp" },
+  { name: "ki", rule: "ClosedLoopIn.ki" }, { name: "kd", rule: "ClosedLoopIn.kd" }];
+const ROBOT_RUN_LOCATIONS = { ...SIM_LOCATIONS, max_seconds: "max_seconds", "closed_loop.target_m": "target_m",
+  "closed_loop.kp": "kp", "closed_loop.ki": "ki", "closed_loop.kd": "kd" };
+
+on("#robot-run-form", "submit", async (event) => {
+  event.preventDefault();
+  const closed = event.target.elements.closed_loop.checked;
+  const v = await checked(event.target, closed ? [...ROBOT_RUN_FIELDS, ...CLOSED_LOOP_FIELDS] : ROBOT_RUN_FIELDS);
+  if (v === null) return;
+  const body = { controls: [{ psi0_deg: v.psiL, zeta0: v.zetaL }, { psi0_deg: v.psiR, zeta0: v.zetaR }], jumps: v.jumps, max_seconds: v.max_seconds };
+  if (closed) body.closed_loop = { target_m: v.target_m, kp: v.kp, ki: v.ki, kd: v.kd };
+  Object.assign(body, filedUnder(event.target));
+  // The robot's state now, not as last shown: a disarmed robot is armed by the run and jumps.
+  const current = await call("GET", "/robot");
+  showStatus(current);
+  if (current.state === "disarmed" && !window.confirm(ARM_AND_LAUNCH)) return say("Run not started.");
+  pendingTarget = body.closed_loop ? body.closed_loop.target_m : null;
+  try {
+    showStatus(await call("POST", "/robot/runs", body, { form: event.target, locations: ROBOT_RUN_LOCATIONS }));
+  } finally {
+    pendingTarget = undefined;
+  }
+  say(`Run started: ${body.jumps} jumps at most, ${body.max_seconds} s at most${body.closed_loop ? `, holding ${body.closed_loop.target_m} m` : ""}.`);
+});
+on("#stop-run", "click", async () => showStatus(await call("POST", "/robot/runs/stop")));
+
+// The e-stop needs no token (the service allows stopping to anyone; call() sends one only when
+// pasted) and always answers within 200 ms; it says whether the robot confirmed the stop.
+async function emergencyStop() {
+  const result = await call("POST", "/robot/estop");
+  showStatus(result);
+  if (result.acknowledged) {
+    say(`Emergency stop acknowledged by the robot in ${Number(result.latency_ms).toFixed(1)} ms.`);
+  } else if (result.state === "disconnected") {
+    say(`Emergency stop NOT acknowledged: ${result.reason}. The service has no working link to the robot; without the link's heartbeats a robot disarms itself within 1 s — check the robot.`, "error");
+  } else {
+    say(`Emergency stop NOT acknowledged by the robot: ${result.reason}. Its heartbeats are stopped, so its watchdog disarms it within 1 s — check the robot.`, "error");
+  }
+}
+for (const button of document.querySelectorAll("button.estop")) on(button, "click", emergencyStop);

@@ -1,0 +1,76 @@
+// The Simulate tab: a trajectory, a stored run, the fixed point, and quick basin and sweep jobs.
+import { $, say, call, on } from "./api.js";
+import { filedUnder, simFields, simControls } from "./forms.js";
+import { PLOT_CONFIG, layout, plotSweep, plotBasin } from "./plots.js";
+import { watch } from "./jobs.js";
+
+on("#sim-form", "submit", async (event) => {
+  event.preventDefault();
+  const spec = await simControls("TrajectoryIn.jumps");
+  if (!spec) return;
+  const path = await call("POST", "/sim/trajectory", { ...spec, rate: 60 }, simFields());
+  const c = path.columns;
+  // Nondimensional, with what a unit is for the preset's robot: l0 in m, sqrt(l0/g) in s.
+  const l0 = `l0 = ${path.si.l0_m.toFixed(3)} m`, unitTime = `√(l0/g) = ${path.si.time_s.toFixed(3)} s`;
+  const walls = path.walls_x.map((x) => ({ type: "line", x0: x, x1: x, yref: "paper", y0: 0, y1: 1, line: { color: "#444", width: 3 } }));
+  Plotly.react("path-plot", [{ x: c.x, y: c.y, mode: "lines", name: "body" },
+    { x: c.foot_x, y: c.foot_y, mode: "markers", marker: { size: 3 }, name: "foot" }],
+    layout("Path between the walls (grey: the walls)", `x [${l0}]`, `height y [${l0}]`,
+      { yaxis: { scaleanchor: "x", title: { text: `height y [${l0}]` } }, shapes: walls }),
+    PLOT_CONFIG);
+  Plotly.react("height-plot", [{ x: c.time, y: c.y, mode: "lines", name: "height" }],
+    layout("Height over time", `time [${unitTime}]`, `y [${l0}]`), PLOT_CONFIG);
+  $("#sim-units").textContent = `Units (the ${path.si.preset} robot): length ${l0}, time ${unitTime}, ` +
+    `velocity √(g l0) = ${path.si.speed_m_per_s.toFixed(3)} m/s.`;
+  const failure = path.failure ? `, failed: ${path.failure.code} at jump ${path.failure.jump}` : "";
+  say(`${spec.jumps} jumps simulated${failure}.`);
+});
+
+on("#save-run", "click", async () => {
+  const spec = await simControls("RunCreate.jumps");
+  if (!spec) return;
+  const run = await call("POST", "/runs", { ...spec, trajectory_rate: 60, tags: ["panel"], ...filedUnder($("#sim-form")) }, simFields());
+  say(`Run ${run.id} stored: ${run.jumps_completed}/${run.jumps} jumps, climb ${run.climb.toFixed(3)} l0. It is in History (tag "panel").`);
+});
+
+on("#find-gait", "click", async () => {
+  const spec = await simControls();
+  if (!spec) return;
+  const gait = await call("POST", "/sim/fixed-point", { controls: spec.controls, guess: spec.start }, simFields());
+  const circle = Array.from({ length: 101 }, (_, i) => 2 * Math.PI * i / 100);
+  Plotly.react("eig-plot", [
+    { x: circle.map(Math.cos), y: circle.map(Math.sin), mode: "lines", name: "|λ| = 1", line: { color: "#999" } },
+    { x: gait.eigenvalues.map((e) => e[0]), y: gait.eigenvalues.map((e) => e[1]), mode: "markers", name: "eigenvalues", marker: { size: 11, color: gait.stable ? "#2a9d4b" : "#d61f1f" } },
+  ], layout("Eigenvalues on the unit circle", "Re λ", "Im λ", { yaxis: { scaleanchor: "x", title: { text: "Im λ" } } }), PLOT_CONFIG);
+  $("#gait-readout").textContent = `Period ${gait.period} ${gait.motion} gait at (${gait.state.map((v) => v.toFixed(4)).join(", ")}): ` +
+    `max |λ| = ${gait.max_abs_eigenvalue.toFixed(4)} (${gait.stable ? "stable" : "unstable"}), climb ${gait.climb_per_period.toFixed(4)} l0 per period.`;
+});
+
+
+const jobStatus = (job) => `${job.kind} job ${job.id}: ${job.state}${job.total ? `, ${job.completed}/${job.total}` : ""}${job.error ? ` — ${job.error}` : ""}`;
+
+// Schedule a job from the Simulate tab, show its progress there, draw its result when done.
+async function analyse(spec, draw) {
+  const job = await call("POST", "/jobs", { ...spec, ...filedUnder($("#sim-form")) });
+  const status = $("#analysis-status");
+  status.textContent = jobStatus(job);
+  watch(job, async (final) => {
+    status.textContent = jobStatus(final);
+    if (final.state === "done") draw((await call("GET", `/jobs/${final.id}/results`)).result);
+  }, (update) => { status.textContent = jobStatus(update); });
+}
+
+on("#run-basin", "click", async () => {
+  const spec = await simControls();
+  if (!spec) return;
+  await analyse({ kind: "basin", controls: spec.controls, guess: spec.start, grid: 80, jumps: 60 },
+    (result) => plotBasin("basin-plot", result, "Basin of attraction", spec.start));
+});
+
+on("#run-sweep", "click", async () => {
+  const spec = await simControls();
+  if (!spec) return;
+  const psi0 = spec.controls[0].psi0_deg;
+  await analyse({ kind: "sweep", psi0_deg: psi0, zeta0_low: 0.8, zeta0_high: 0.97, steps: 35, basin_grid: 20 },
+    (result) => plotSweep("sweep-plot", result, `Symmetric gait at psi0 = ${psi0}° over zeta0`));
+});
