@@ -102,11 +102,15 @@ class ClimbView:
     def _connect(self, client: viser.ClientHandle) -> None:
         session = ViewerSession(client, viewer_of(self.server, client), self.context, self.robot,
                                 panel_url=self.panel_url, share=self.share_html)  # fmt: skip
-        with self._sessions_lock:
-            if self._stop.is_set():
-                return
-            self.sessions = MappingProxyType({**self.sessions, client.client_id: session})
-            pending = self._pending.pop(session.viewer, None) if session.viewer else None
+        pending = None
+        with self._sessions_lock:  # joined and given its pending replay at once (open_run takes it too)
+            closing = self._stop.is_set()
+            if not closing:
+                self.sessions = MappingProxyType({**self.sessions, client.client_id: session})
+                pending = self._pending.pop(session.viewer, None) if session.viewer else None
+        if closing:
+            session.close()
+            return
         if pending is not None and time.monotonic() - pending.asked <= PENDING_REPLAY_S:
             session.replay(pending.run_id, pending.overlay_id, pending.recording, pending.overlay)
 
@@ -129,7 +133,10 @@ class ClimbView:
         mode = run_id = None
         if viewer is not None:
             sessions = self.sessions_of(viewer)
-            pending = self._pending.get(viewer)
+            with self._sessions_lock:
+                pending = self._pending.get(viewer)
+            if pending is not None and time.monotonic() - pending.asked > PENDING_REPLAY_S:
+                pending = None
             if sessions:
                 mode, run_id = sessions[0].mode.name, sessions[0].run_id
             elif pending is not None:
@@ -151,15 +158,15 @@ class ClimbView:
         recording = load_recording(sessions, run_id)
         overlay = None if overlay_run_id is None else load_recording(sessions, overlay_run_id)
         replay = _Replay(run_id, overlay_run_id, recording, overlay, time.monotonic())
-        targets = self.sessions_of(viewer)
-        for session in targets:
-            session.replay(run_id, overlay_run_id, recording, overlay)
-        if not targets:
-            with self._sessions_lock:
+        with self._sessions_lock:  # against _connect: a view connecting now gets it either way
+            targets = self.sessions_of(viewer)
+            if not targets:
                 self._pending[viewer] = replay
                 self._pending.move_to_end(viewer)
                 while len(self._pending) > PENDING_REPLAYS_KEPT:
                     self._pending.popitem(last=False)
+        for session in targets:
+            session.replay(run_id, overlay_run_id, recording, overlay)
         return self.info(viewer)
 
     def share_html(self, run_id: int, overlay_run_id: int | None = None) -> str:
