@@ -56,6 +56,10 @@ class _Replay:
     overlay: Recording | None
     asked: float  # time.monotonic() when it was asked for
 
+    def waiting(self) -> bool:
+        """Still to be opened when its view connects (asked no more than PENDING_REPLAY_S ago)."""
+        return time.monotonic() - self.asked <= PENDING_REPLAY_S
+
 
 class ClimbView:
     """The service's 3D view of the chute.
@@ -111,7 +115,7 @@ class ClimbView:
         if closing:
             session.close()
             return
-        if pending is not None and time.monotonic() - pending.asked <= PENDING_REPLAY_S:
+        if pending is not None and pending.waiting():
             session.replay(pending.run_id, pending.overlay_id, pending.recording, pending.overlay)
 
     def _disconnect(self, client: viser.ClientHandle) -> None:
@@ -135,7 +139,7 @@ class ClimbView:
             sessions = self.sessions_of(viewer)
             with self._sessions_lock:
                 pending = self._pending.get(viewer)
-            if pending is not None and time.monotonic() - pending.asked > PENDING_REPLAY_S:
+            if pending is not None and not pending.waiting():
                 pending = None
             if sessions:
                 mode, run_id = sessions[0].mode.name, sessions[0].run_id

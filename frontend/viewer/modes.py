@@ -504,11 +504,15 @@ class ReplayMode(_Mode):
         margin = max(0.05 * (high - low), 0.01)
         return (round(low - margin, 3), round(high + margin, 3))
 
+    def _sample_at(self, t: float) -> int:
+        """The plot's sample at ``t`` [s] (the first at or after it, the last past the end)."""
+        grid = self._curves[0]
+        return int(np.clip(np.searchsorted(grid, t), 0, grid.size - 1))
+
     def _cursor(self, t: float) -> np.ndarray:
         """The "now" series: the run's height at the sample nearest ``t`` [s], nothing elsewhere."""
-        grid, height = self._curves[0], self._curves[1]
-        k = int(np.clip(np.searchsorted(grid, t), 0, grid.size - 1))
-        now = np.full(grid.size, np.nan)
+        height, k = self._curves[1], self._sample_at(t)
+        now = np.full(height.size, np.nan)
         now[k] = height[k]
         return now
 
@@ -518,8 +522,7 @@ class ReplayMode(_Mode):
         self._cursor_wait -= dt
         if self.plot is None or self._cursor_wait > 0.0:
             return
-        grid = self._curves[0]
-        k = int(np.clip(np.searchsorted(grid, self.time), 0, grid.size - 1))
+        k = self._sample_at(self.time)
         if k != self._cursor_at:
             self._cursor_at, self._cursor_wait = k, CURSOR_PERIOD
             self.plot.data = (*self._curves, self._cursor(self.time))
