@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import typer
 
-from cli import atlas, basin, bench, gaits, mjtf, pid, reproduce, robot, serve, simulate, sweep
+from cli import atlas, basin, bench, calibrate, gaits, mjtf, pid, reproduce, robot, serve, simulate, sweep
 
 app = typer.Typer(
     name="parkour",
@@ -22,7 +22,20 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     rich_markup_mode=None,
 )
-COMMANDS = (simulate, gaits, basin, sweep, mjtf, pid, atlas, reproduce, robot, bench, serve)  # in the order of --help
+COMMANDS = (
+    simulate,
+    gaits,
+    basin,
+    sweep,
+    mjtf,
+    pid,
+    atlas,
+    reproduce,
+    robot,
+    calibrate,
+    bench,
+    serve,
+)  # in the order of --help
 for command in COMMANDS:
     app.add_typer(command.app)
 

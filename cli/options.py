@@ -29,7 +29,7 @@ from sim_core.controls import ControlSchedule
 from sim_core.errors import FixedPointNotFound, ParameterError
 from sim_core.noise import NoiseModel
 from sim_core.params import ModelParams, PhysicalParams
-from sim_core.presets import DEFAULT_PRESET, get_preset
+from sim_core.presets import DEFAULT_PRESET, PRESETS, get_preset
 
 EXIT_USAGE = 2
 
@@ -75,7 +75,7 @@ class ModelSetup:
 
 def build_setup(preset: str, **overrides: float | None) -> ModelSetup:
     """The preset's model with any non-None nondimensional override applied."""
-    robot = get_preset(preset)
+    robot = get_preset(preset) if preset in PRESETS else stored_preset(preset)
     chosen = {name: value for name, value in overrides.items() if value is not None}
     model = replace(robot.to_model(), **chosen)
     if chosen:
@@ -83,12 +83,31 @@ def build_setup(preset: str, **overrides: float | None) -> ModelSetup:
     return ModelSetup(model=model, robot=robot)
 
 
+def stored_preset(name: str) -> PhysicalParams:
+    """A preset ``parkour calibrate`` stored, from the database of ``$PARKOUR_DATA_DIR`` (default
+    ./data) or ``$DATABASE_URL``; the unknown-preset error if there is none. A missing SQLite file
+    is not created."""
+    from backend.services.calibrations import preset_params
+    from backend.settings import Settings
+    from backend.store.database import opened_store, sqlite_file
+
+    settings = Settings.from_environment()
+    database = sqlite_file(settings.database_url)
+    if settings.database_url.startswith("sqlite") and (database is None or not database.exists()):
+        return get_preset(name)  # raises, naming the built-in presets
+    with opened_store(settings.database_url) as sessions, sessions() as session:
+        return preset_params(session, name)[0]
+
+
 _MODEL_PARAMETERS = [
     inspect.Parameter(
         "preset",
         inspect.Parameter.KEYWORD_ONLY,
         default=DEFAULT_PRESET,
-        annotation=Annotated[str, typer.Option("--preset", help="Named parameter set (docs/model.md §1).")],
+        annotation=Annotated[
+            str,
+            typer.Option("--preset", help="Named parameter set (docs/model.md §1), or one parkour calibrate stored."),
+        ],
     ),
     *(
         inspect.Parameter(

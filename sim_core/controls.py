@@ -90,3 +90,39 @@ class ControlSchedule:
     def describe(self) -> str:
         """``"30°:0.9, 35°:0.87"`` — the form people read and the CLI accepts (without °)."""
         return ", ".join(f"{leg.psi0_deg:g}°:{leg.zeta0:g}" for leg in self.legs)
+
+
+OFFSET_LIMITS = {"psi0_offset_deg": 10.0, "zeta0_offset": 0.1}  # |offset| below these: a servo's error, not a new gait
+
+
+@dataclass(frozen=True, slots=True)
+class LegOffsets:
+    """What each leg realises beyond what it is commanded: the servos' asymmetry (paper §VI).
+
+    A leg commanded ``(psi0, zeta0)`` touches down at ``(psi0 + psi0_offset_deg, zeta0 + zeta0_offset)``
+    of its side. Attributes are ``(left, right)`` pairs, the left leg standing on the left wall;
+    angles in degrees, lengths in l0. The default is a perfect robot.
+    """
+
+    psi0_offset_deg: tuple[float, float] = (0.0, 0.0)
+    zeta0_offset: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        for field, limit in OFFSET_LIMITS.items():
+            pair = getattr(self, field)
+            if len(pair) != 2:
+                raise ParameterError(field, f"must be two numbers (left, right), got {len(pair)}")
+            for side, value in zip(("left", "right"), pair, strict=True):
+                check_range(f"{field}.{side}", value, -limit, limit)
+
+    def applied(self, leg: LegControl, right_leg: bool) -> LegControl:
+        """``leg`` as the left (``right_leg`` False) or right leg realises it; a :class:`ParameterError`
+        when the offset takes it out of the control domain."""
+        side = 1 if right_leg else 0
+        return LegControl(leg.psi0 + math.radians(self.psi0_offset_deg[side]), leg.zeta0 + self.zeta0_offset[side])
+
+    def to_dict(self) -> dict:
+        return {"psi0_offset_deg": list(self.psi0_offset_deg), "zeta0_offset": list(self.zeta0_offset)}
+
+
+NO_OFFSETS = LegOffsets()

@@ -19,7 +19,7 @@ from fastapi import FastAPI
 from fastapi.staticfiles import StaticFiles
 
 from backend.api import errors, security
-from backend.api.routes import experiments, jobs, robot, runs, sim, site, view
+from backend.api.routes import calibrations, experiments, jobs, robot, runs, sim, site, view
 from backend.api.security import api_token
 from backend.services import jobs as job_service
 from backend.services.compute import Compute
@@ -32,7 +32,7 @@ log = logging.getLogger("parkourlab.api")
 # The control panel's static files (frontend/panel): located, not imported — the frontend sits above
 # the backend in the layers, and the backend only serves its files.
 PANEL_DIR = Path(__file__).resolve().parents[2] / "frontend" / "panel"
-ROUTERS = (site, experiments, runs, jobs, robot, view, sim)
+ROUTERS = (site, experiments, runs, calibrations, jobs, robot, view, sim)
 # Threads that run the sync routes (database work; compute is awaited in worker processes, the
 # e-stop is async). anyio's default is 40: under load 40 threads ping-pong the GIL once per row
 # SQLite steps, and on this 2-core machine 20 clients got 116 pages/s, p95 378 ms; with 4, 143

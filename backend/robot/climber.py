@@ -2,8 +2,9 @@
 
 A thin, threaded driver of :mod:`sim_core.climb` (the climb sequencer the 3D view runs too).
 While the firmware says ``running``, jump after jump is simulated with the legs' current
-controls plus the imperfections the paper reports (:mod:`sim_core.noise`: L/R asymmetry, control
-noise, pitch drift offsetting the leg angles, noisy section states), and the body's path is
+controls plus the imperfections the paper reports: each leg's servo offsets (``leg_offsets``, the
+truth a calibration should recover) and :mod:`sim_core.noise` (control noise, pitch drift
+offsetting the leg angles, noisy section states), and the body's path is
 streamed as tracker datagrams in real time (or ``speed`` times faster), with position noise and
 dropped frames. Each stance is streamed before the next leg is read, as the real robot positions
 that leg during the stance. The climb ends when a jump fails (slip, no flight, ...) or the body
@@ -24,6 +25,7 @@ from backend.robot.messages import Leg
 from backend.robot.tracker import Pose, encode_datagram
 from sim_core import ControlSchedule, LegControl, PhysicalParams, climb, gait_of, get_preset
 from sim_core.climb import ClimbSetup, End, Samples
+from sim_core.controls import NO_OFFSETS, LegOffsets
 from sim_core.errors import FixedPointNotFound
 from sim_core.noise import NoiseModel
 from sim_core.noise_rules import NoiseSampler
@@ -44,6 +46,7 @@ class Climber:
         *,
         robot: PhysicalParams | None = None,
         noise: NoiseModel | None = None,
+        leg_offsets: LegOffsets = NO_OFFSETS,
         tracker_noise: float = 0.001,
         drop_rate: float = 0.02,
         speed: float = 1.0,
@@ -54,6 +57,7 @@ class Climber:
         self.robot = robot or get_preset("paper")
         self.model = self.robot.to_model()
         self.noise = noise or NoiseModel()
+        self.leg_offsets = leg_offsets
         self.tracker_noise = check_range("tracker_noise", tracker_noise, 0.0, 0.1, low_open=False)
         self.drop_rate = check_range("drop_rate", drop_rate, 0.0, 1.0, low_open=False)
         self.speed = check_range("speed", speed, 0.0, 100.0)
@@ -86,8 +90,9 @@ class Climber:
                 self._stop.wait(0.01)
 
     def _commanded(self, wall: Wall) -> LegControl:
-        """What the firmware holds for the leg on ``wall`` now."""
-        return LegControl.from_degrees(*self.legs()[Leg.of(wall)])
+        """What the firmware holds for the leg on ``wall`` now, as its servos realise it (the offsets)."""
+        commanded = LegControl.from_degrees(*self.legs()[Leg.of(wall)])
+        return self.leg_offsets.applied(commanded, right_leg=wall == Wall.RIGHT)
 
     def _climb(self) -> None:
         """One climb from launch until stopped, failed or at the floor."""

@@ -6,6 +6,7 @@ Each resource is a ladder: a ``…Base`` of what its requests and records share,
 reads (not held to today's input ranges, so older records still read) and a ``…Page`` of them.
 """
 
+from backend.schemas.calibrations import CalibrationCreate, CalibrationList, CalibrationOut
 from backend.schemas.common import (
     MAX_ID,
     MAX_JUMPS,
@@ -69,7 +70,8 @@ from backend.schemas.view import VIEWER_ID_PATTERN, ViewerId, ViewOut, ViewRepla
 __all__ = [
     "JOB_KINDS", "MAX_ID", "MAX_JUMPS", "MAX_LEVELS", "MAX_PATH_SAMPLES", "MAX_TRIALS", "VIEWER_ID_PATTERN",
     "WORK_BUDGET_JUMPS",
-    "BasinJobCreate", "ClosedLoopIn", "ExperimentBase", "ExperimentCreate", "ExperimentOut", "ExperimentPage",
+    "BasinJobCreate", "CalibrationCreate", "CalibrationList", "CalibrationOut", "ClosedLoopIn", "ExperimentBase",
+    "ExperimentCreate", "ExperimentOut", "ExperimentPage",
     "ExperimentUpdate", "FixedPointIn", "GaitSearchJobCreate", "Health", "JobCreate", "JobOut", "JobPage", "JobResults",
     "JobState", "Label", "LegIn", "MJTFJobCreate", "MJTFLevelOut", "MapIn", "ModelIn", "NoiseIn", "Page", "Psi0Deg",
     "RecordRef", "RobotConnect", "RobotRunCreate", "RunAggregate", "RunBase", "RunComparison", "RunCreate",

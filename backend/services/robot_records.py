@@ -176,7 +176,13 @@ def replay_run(session, run_id: int, robot=None) -> Run:
         controls=source.controls,
         jumps=source.jumps,
         **touchdown_columns(touchdowns, analysis),
-        results=json_safe({"source_run_id": run_id, **analysis}),
+        results=json_safe(
+            {
+                "source_run_id": run_id,
+                **analysis,
+                "touchdown_controls": [[leg_for(k).psi0_deg, leg_for(k).zeta0] for k in range(len(touchdowns))],
+            }
+        ),
         tags=(*source.tags, "replay"),
     )
     replay = add_run(session, record, experiment_id=source.experiment_id)

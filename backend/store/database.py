@@ -20,7 +20,8 @@ import errno
 import logging
 import os
 import sqlite3
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, TypeVar
 
@@ -34,7 +35,7 @@ if TYPE_CHECKING:
 MIGRATIONS = Path(__file__).resolve().parent / "migrations"
 # The newest migration's revision. tests/backend/store/test_database.py fails when a migration is
 # added without moving this: a stale value would let a database one revision behind start unmigrated.
-SCHEMA_HEAD = "0006"
+SCHEMA_HEAD = "0007"
 
 log = logging.getLogger("parkourlab.store")
 T = TypeVar("T")
@@ -98,7 +99,7 @@ def sqlite_url(data_dir: Path) -> str:
 
 
 def make_engine(url: str) -> Engine:
-    database = _sqlite_file(url)  # the listeners below keep this, not the engine
+    database = sqlite_file(url)  # the listeners below keep this, not the engine
     if url.startswith("sqlite"):
         engine = create_engine(url, connect_args={"check_same_thread": False, "timeout": 30})
 
@@ -133,6 +134,18 @@ def make_engine(url: str) -> Engine:
 
 def session_factory(engine: Engine) -> sessionmaker[Session]:
     return sessionmaker(engine, expire_on_commit=False)
+
+
+@contextmanager
+def opened_store(url: str) -> Iterator[sessionmaker[Session]]:
+    """Sessions on the database at ``url``, migrated to the newest schema: a command's way in
+    (``parkour calibrate``); the service opens its own in ``create_app``."""
+    engine = make_engine(url)
+    try:
+        migrate(engine)
+        yield session_factory(engine)
+    finally:
+        engine.dispose()
 
 
 def alembic_config(engine: Engine) -> Config:
@@ -233,10 +246,11 @@ def checkpoint(engine: Engine, mode: str = "TRUNCATE") -> tuple[int, int, int] |
 
 def database_file(engine: Engine) -> Path | None:
     """The SQLite database's file, or None (another database, or one in memory)."""
-    return _sqlite_file(engine.url)
+    return sqlite_file(engine.url)
 
 
-def _sqlite_file(url) -> Path | None:
+def sqlite_file(url) -> Path | None:
+    """The SQLite database file of ``url`` (a string or URL), or None (another database, or one in memory)."""
     url = make_url(url)
     name = url.database
     if url.get_backend_name() != "sqlite" or not name or name == ":memory:" or name.startswith("file:"):

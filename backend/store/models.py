@@ -165,3 +165,25 @@ class Trial(Base):
     job: Mapped[Job] = relationship(back_populates="trials")
 
     __table_args__ = (UniqueConstraint("job_id", "level", "index", name="uq_trials_key"),)
+
+
+class ModelPreset(Base):
+    """A named model fitted to robot runs (``parkour calibrate``): a preset beside the built-in ones.
+
+    ``base`` is the built-in preset it refines; ``physical`` its fitted parameters in SI
+    (:class:`sim_core.params.PhysicalParams` fields), ``offsets`` the legs' servo offsets, ``fit``
+    the calibration's report (standard errors, correlation, residuals, noise) and ``runs`` the ids
+    it was fitted to — its provenance with ``created_at`` and ``code_version``.
+    """
+
+    __tablename__ = "model_presets"
+
+    id: Mapped[int] = mapped_column(primary_key=True)
+    name: Mapped[str] = mapped_column(String(64), unique=True)
+    base: Mapped[str] = mapped_column(String(64))
+    physical: Mapped[dict]
+    offsets: Mapped[dict]
+    fit: Mapped[dict]
+    runs: Mapped[list]
+    code_version: Mapped[str] = mapped_column(String(64))
+    created_at: Mapped[datetime.datetime] = mapped_column(default=utcnow, index=True)

@@ -3,6 +3,7 @@ tracked touchdowns follow the map."""
 
 import socket
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -20,10 +21,11 @@ from backend.robot.xbee import (
     parse_tx_status,
     tx_request,
 )
-from sim_core import ControlSchedule, LegControl, get_preset, iterate_map
+from sim_core import ControlSchedule, LegControl, PhysicalParams, get_preset, iterate_map
 from sim_core.climb import FLOOR, ClimbEnd
+from sim_core.controls import LegOffsets
 from sim_core.noise import NO_NOISE, NoiseModel
-from sim_core.walls import wall_of
+from sim_core.walls import Wall, wall_of
 
 LEGS = {Leg.LEFT: (30.0, 0.87), Leg.RIGHT: (30.0, 0.9)}
 ROBOT = get_preset("paper")
@@ -69,9 +71,9 @@ def test_the_radio_answers_transmit_status_as_an_xbee_does():
     assert robot.firmware.state == RobotState.ARMED
 
 
-def _run(noise, jumps, *, speed=6.0, seed=1, legs=LEGS):
+def _run(noise, jumps, *, speed=6.0, seed=1, legs=LEGS, **climber_options):
     tracker = UdpPoseSource()
-    robot = VirtualRobot(tracker_to=tracker.address, noise=noise, speed=speed, seed=seed).start()
+    robot = VirtualRobot(tracker_to=tracker.address, noise=noise, speed=speed, seed=seed, **climber_options).start()
     link = RobotLink(robot.url)
     try:
         link.connect()
@@ -114,6 +116,37 @@ def test_open_loop_climb_follows_the_map():
         errors.append(np.max(np.abs(predicted - found[k + 1].state)))
     assert max(errors) < 0.05, f"one-jump prediction errors {np.round(errors, 4)} (1 mm tracker noise)"
     assert tracker.stats.loss < 0.1 and robot.climber.frames_sent > 100
+
+
+def _one_jump_errors(found, model, leg_for) -> np.ndarray:
+    schedule = ControlSchedule.of(*(leg_for(k) for k in range(len(found))))
+    errors = []
+    for k in range(len(found) - 1):
+        predicted = iterate_map(model, schedule, found[k].state, 1, first_jump=k).states[-1]
+        errors.append(np.max(np.abs(predicted - found[k + 1].state)))
+    return np.array(errors)
+
+
+def test_the_robots_true_physics_and_leg_offsets_are_what_it_climbs_with():
+    # The truth a calibration is tested against (parkour robot-sim --alpha ... --psi0-offset-deg L R):
+    # the map predicts the tracked touchdowns from the truth, and not from the paper's model.
+    truth = replace(ROBOT.to_model(), alpha=85.0, c_zeta=1.4)
+    robot = PhysicalParams.from_model(truth, mass=ROBOT.mass, leg_length=ROBOT.leg_length, gravity=ROBOT.gravity)
+    offsets = LegOffsets(psi0_offset_deg=(0.8, -0.6), zeta0_offset=(0.004, -0.003))
+    tracker, _robot, _link, _state = _run(
+        NO_NOISE, jumps=8, robot=robot, leg_offsets=offsets, tracker_noise=0.0, drop_rate=0.0
+    )
+    poses = tracker.as_arrays()
+    found = detect_touchdowns(poses["time"], poses["x"], poses["y"], ROBOT, _leg_for)
+    assert len(found) >= 6
+
+    def realised(k: int) -> LegControl:
+        return offsets.applied(_leg_for(k), right_leg=found[k].wall == Wall.RIGHT)
+
+    with_truth = _one_jump_errors(found, truth, realised)
+    with_paper = _one_jump_errors(found, ROBOT.to_model(), _leg_for)
+    assert with_truth.max() < 0.01, f"the truth predicts its touchdowns: errors {np.round(with_truth, 4)}"
+    assert with_paper.min() > 3 * with_truth.max(), f"the paper's model does not: {np.round(with_paper, 4)}"
 
 
 def test_noisy_robot_eventually_falls_and_says_so():

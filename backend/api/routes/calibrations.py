@@ -1,0 +1,45 @@
+"""Calibrations: the model fitted to robot runs, stored as a named preset (docs/calibration.md)."""
+
+from __future__ import annotations
+
+import functools
+from typing import Annotated
+
+from fastapi import APIRouter, Path
+
+from backend import schemas
+from backend.api.deps import AUTHORIZED, Db, QuickCompute
+from backend.services import calibrations
+from backend.services.compute import ComputePool
+from sim_core.calibration import calibrate
+
+router = APIRouter(prefix="/api/v1/calibrations", tags=["calibrations"])
+PresetPath = Annotated[str, Path(min_length=1, max_length=64, pattern=calibrations.PRESET_NAME.pattern)]
+
+
+@router.post("", status_code=201, dependencies=AUTHORIZED, response_model=schemas.CalibrationOut)
+def create_calibration(body: schemas.CalibrationCreate, db: Db, compute: QuickCompute):
+    """Fit ``alpha``, ``c_zeta``, ``c_psi`` and the legs' offsets to the runs; stored as preset ``name``."""
+    return calibrations.calibrate_runs(
+        db, body.runs, name=body.name, base=body.preset, fit=functools.partial(_fit_in_worker, compute)
+    )
+
+
+@router.get("", response_model=schemas.CalibrationList)
+def list_calibrations(db: Db):
+    return {"items": [calibrations.preset_payload(preset) for preset in calibrations.list_presets(db)]}
+
+
+@router.get("/{name}", response_model=schemas.CalibrationOut)
+def get_calibration(name: PresetPath, db: Db):
+    return calibrations.preset_payload(calibrations.get_stored_preset(db, name))
+
+
+@router.delete("/{name}", status_code=204, dependencies=AUTHORIZED)
+def delete_calibration(name: PresetPath, db: Db) -> None:
+    calibrations.delete_preset(db, name)
+
+
+def _fit_in_worker(compute: ComputePool, series, model):
+    # Seconds of kernels at most (a few hundred pairs, two fits): the quick worker, not this thread's GIL.
+    return compute.run(calibrate, series, model)

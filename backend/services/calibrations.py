@@ -1,0 +1,201 @@
+"""Calibrations: the model fitted to stored robot runs, kept as a named preset (docs/calibration.md).
+
+:func:`calibrate_runs` reads the touchdowns of robot and replay runs (each touchdown's measured
+section state and foot height, the controls commanded for it, the body's pitch from the tracker
+frames just after it), fits the model (:func:`sim_core.calibration.calibrate`) and stores the
+result as a :class:`~backend.store.models.ModelPreset` with its provenance: the runs, the date and
+the code version. A stored preset is used by name wherever a built-in one is
+(:func:`preset_params`): the CLI's ``--preset``, the API's ``model.preset``.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Callable
+from dataclasses import asdict
+
+import numpy as np
+from sqlalchemy import select
+from sqlalchemy.exc import IntegrityError
+from sqlalchemy.orm import Session
+
+from backend.services.records import Conflict, NotFound, fetch
+from backend.services.simulation import current_code_version, unpack_trajectory
+from backend.store.database import lock_for_write
+from backend.store.models import ModelPreset, Run
+from experiments.manifest import json_safe
+from sim_core.calibration import CalibrationFit, calibrate
+from sim_core.controls import NO_OFFSETS, LegControl, LegOffsets
+from sim_core.errors import ParameterError
+from sim_core.params import ModelParams, PhysicalParams
+from sim_core.presets import PRESETS, get_preset
+from sim_core.touchdown_model import TouchdownSeries
+from sim_core.walls import Wall
+
+CALIBRATED_KINDS = ("robot", "replay")
+PRESET_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$")
+PITCH_WINDOW = 0.03  # [s] tracker frames after a touchdown whose pitch is its pitch (3 frames at 100 Hz)
+MAX_RUNS = 100
+Fitter = Callable[[list[TouchdownSeries], ModelParams], CalibrationFit]
+
+
+def check_preset_name(name: str) -> str:
+    if not PRESET_NAME.match(name):
+        raise ParameterError(
+            "name", f"must be 1 to 64 letters, digits, '_', '.' or '-', starting with a letter or digit; got {name!r}"
+        )
+    if name in PRESETS:
+        raise ParameterError("name", f"{name!r} is a built-in preset; choose another name")
+    return name
+
+
+def touchdown_series(session: Session, run: Run, robot: PhysicalParams) -> TouchdownSeries:
+    """A stored run's touchdowns as the fit reads them (heights in l0, controls in radians)."""
+    touchdowns = run.results.get("touchdowns") or []
+    controls = _touchdown_controls(session, run)
+    if len(controls) < len(touchdowns):
+        raise Conflict(
+            f"run {run.id} does not say which controls {len(touchdowns) - len(controls)} of its touchdowns had"
+        )
+    legs = [LegControl.from_degrees(*pair) for pair in controls[: len(touchdowns)]]
+    pitch = _pitch_at(_tracked(session, run), [td["time"] for td in touchdowns])
+    return TouchdownSeries.of(
+        state=[td["state"] for td in touchdowns],
+        foot_height=[td["foot_height"] / robot.leg_length for td in touchdowns],
+        commanded=[(leg.psi0, leg.zeta0) for leg in legs],
+        right_leg=[td["wall"] == Wall.RIGHT for td in touchdowns],
+        pitch=pitch,
+    )
+
+
+def calibrate_runs(
+    session: Session, run_ids: list[int], *, name: str, base: str = "paper", fit: Fitter = calibrate
+) -> dict:
+    """Fit the model to ``run_ids`` and store it as preset ``name``; the ``parkour calibrate --json`` payload.
+
+    ``fit`` is :func:`sim_core.calibration.calibrate` or a call of it elsewhere (the service's
+    compute worker): it gets the runs' :class:`TouchdownSeries` and the base model, nothing of the store.
+    """
+    check_preset_name(name)
+    if not 1 <= len(run_ids) <= MAX_RUNS:
+        raise ParameterError("runs", f"give 1 to {MAX_RUNS} run ids, got {len(run_ids)}")
+    if session.scalar(select(ModelPreset.id).where(ModelPreset.name == name)) is not None:
+        raise Conflict(f"a preset named {name!r} exists; choose another name or delete it")
+    robot = get_preset(base)
+    series = [touchdown_series(session, _calibration_run(session, run_id), robot) for run_id in run_ids]
+    session.rollback()  # no read transaction held open while the fit runs
+    fitted = fit(series, robot.to_model())
+    preset = _stored(fitted, name=name, base=base, robot=robot, run_ids=run_ids)
+    lock_for_write(session)
+    session.add(preset)
+    try:
+        session.commit()
+    except IntegrityError:  # stored by someone else meanwhile
+        session.rollback()
+        raise Conflict(f"a preset named {name!r} exists; choose another name or delete it") from None
+    return preset_payload(preset)
+
+
+def preset_payload(preset: ModelPreset) -> dict:
+    """A stored calibration as the CLI and the API give it: the fit's report and the preset's provenance."""
+    return json_safe(
+        {
+            **preset.fit,
+            "preset": {
+                "name": preset.name,
+                "base": preset.base,
+                "runs": list(preset.runs),
+                "created_at": preset.created_at.isoformat(),
+                "code_version": preset.code_version,
+                "physical": preset.physical,
+            },
+        }
+    )
+
+
+def list_presets(session: Session) -> list[ModelPreset]:
+    return list(session.scalars(select(ModelPreset).order_by(ModelPreset.id)))
+
+
+def get_stored_preset(session: Session, name: str) -> ModelPreset:
+    preset = session.scalar(select(ModelPreset).where(ModelPreset.name == name))
+    if preset is None:
+        raise NotFound("preset", name)
+    return preset
+
+
+def delete_preset(session: Session, name: str) -> None:
+    lock_for_write(session)
+    session.delete(get_stored_preset(session, name))
+    session.commit()
+
+
+def preset_params(session: Session | None, name: str) -> tuple[PhysicalParams, LegOffsets]:
+    """The robot and leg offsets of preset ``name``: a built-in one, else one stored in ``session``'s
+    database; a :class:`ParameterError` naming the known presets if neither has it."""
+    if name in PRESETS:
+        return PRESETS[name], NO_OFFSETS
+    stored = None if session is None else session.scalar(select(ModelPreset).where(ModelPreset.name == name))
+    if stored is None:
+        known = sorted(PRESETS) + ([] if session is None else [p.name for p in list_presets(session)])
+        raise ParameterError("preset", f"unknown preset {name!r}; known presets: {', '.join(known)}")
+    offsets = stored.offsets
+    return PhysicalParams(**stored.physical), LegOffsets(
+        psi0_offset_deg=tuple(offsets["psi0_offset_deg"]), zeta0_offset=tuple(offsets["zeta0_offset"])
+    )
+
+
+def _stored(fit: CalibrationFit, *, name: str, base: str, robot: PhysicalParams, run_ids: list[int]) -> ModelPreset:
+    fitted = PhysicalParams.from_model(fit.model, mass=robot.mass, leg_length=robot.leg_length, gravity=robot.gravity)
+    return ModelPreset(
+        name=name,
+        base=base,
+        physical=json_safe(asdict(fitted)),
+        offsets=fit.offsets.to_dict(),
+        fit=json_safe(fit.to_dict()),
+        runs=list(run_ids),
+        code_version=current_code_version(),
+    )
+
+
+def _calibration_run(session: Session, run_id: int) -> Run:
+    run = fetch(session, Run, run_id, "run")
+    if run.kind not in CALIBRATED_KINDS:
+        raise Conflict(f"run {run_id} is a {run.kind} run; calibration fits robot and replay runs")
+    if run.status == "running":
+        raise Conflict(f"run {run_id} is still running; calibrate once it has ended")
+    return run
+
+
+def _tracked(session: Session, run: Run) -> Run | None:
+    """The robot run whose tracker frames and commands ``run`` has: itself, or a replay's source."""
+    if run.kind == "replay":
+        return session.get(Run, run.results.get("source_run_id"))
+    return run
+
+
+def _touchdown_controls(session: Session, run: Run) -> list:
+    """The controls commanded for each touchdown: stored with the run (robot runs, replays since
+    calibration came) or with the robot run an older replay was made from."""
+    controls = run.results.get("touchdown_controls")
+    if controls is None:
+        source = _tracked(session, run)
+        controls = None if source is None else source.results.get("touchdown_controls")
+    return controls or []
+
+
+def _pitch_at(run: Run | None, times: list[float]) -> list[float]:
+    """The median tracked pitch [rad] in :data:`PITCH_WINDOW` after each time; 0 where there is none."""
+    if run is None or run.trajectory is None:
+        return [0.0] * len(times)
+    frames = unpack_trajectory(run.trajectory)
+    if "pitch" not in frames:
+        return [0.0] * len(times)
+    t, pitch = frames["time"], frames["pitch"]
+    result = []
+    for moment in times:
+        window = pitch[(t >= moment) & (t <= moment + PITCH_WINDOW)]
+        window = window[np.isfinite(window)]
+        result.append(float(np.median(window)) if window.size else 0.0)
+    return [p if math.isfinite(p) else 0.0 for p in result]

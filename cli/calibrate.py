@@ -1,0 +1,91 @@
+"""``parkour calibrate``: fit the model to stored robot runs and keep it as a named preset."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from cli.options import EXIT_USAGE, JsonOption, handles_errors, note, print_json
+from sim_core.errors import ParameterError
+from sim_core.presets import DEFAULT_PRESET
+
+app = typer.Typer(rich_markup_mode=None)
+
+DataDirOption = Annotated[
+    Path | None,
+    typer.Option(
+        "--data-dir", help="Where the database lives; default $PARKOUR_DATA_DIR or ./data ($DATABASE_URL wins)."
+    ),
+]
+
+
+def parse_run_ids(text: str) -> list[int]:
+    """``"3,4,7"`` -> [3, 4, 7]; a :class:`ParameterError` naming ``runs`` otherwise."""
+    try:
+        ids = [int(item) for item in text.split(",") if item.strip()]
+    except ValueError:
+        raise ParameterError("runs", f"expected run ids ID[,ID...], got {text!r}") from None
+    if not ids or any(run_id < 1 for run_id in ids):
+        raise ParameterError("runs", f"expected run ids >= 1 as ID[,ID...], got {text!r}")
+    return list(dict.fromkeys(ids))
+
+
+@app.command("calibrate")
+@handles_errors
+def calibrate_command(
+    runs: Annotated[str, typer.Option("--runs", help="Robot or replay runs to fit: ID[,ID...].")],
+    data_dir: DataDirOption = None,
+    name: Annotated[
+        str | None,
+        typer.Option("--name", help="Name of the preset to store (default: calibrated-<run ids>)."),
+    ] = None,
+    base: Annotated[
+        str, typer.Option("--preset", help="Built-in preset to start from; its d_hat, mu, mass, l0 and g are kept.")
+    ] = DEFAULT_PRESET,
+    json_output: JsonOption = False,
+) -> None:
+    """Fit alpha, c_zeta, c_psi and each leg's psi0/zeta0 offsets to robot runs (docs/calibration.md).
+
+    The fit is stored as a preset every command accepts (--preset NAME), with the runs, date and
+    code version it came from.
+    """
+    from backend.services.calibrations import calibrate_runs
+    from backend.services.records import Conflict, NotFound
+    from backend.settings import Settings
+    from backend.store.database import opened_store
+
+    run_ids = parse_run_ids(runs)
+    name = name or "calibrated-" + "-".join(map(str, run_ids))[:50]
+    settings = Settings.from_environment(data_dir)
+    with opened_store(settings.database_url) as sessions, sessions() as session:
+        try:
+            payload = calibrate_runs(session, run_ids, name=name, base=base)
+        except (NotFound, Conflict) as error:
+            typer.echo(f"error: {error}", err=True)
+            raise typer.Exit(EXIT_USAGE) from None
+    if json_output:
+        print_json(payload)
+        return
+    _print_report(payload)
+
+
+def _print_report(payload: dict) -> None:
+    params, stderr = payload["params"], payload["stderr"]
+    rows = [("alpha", params["alpha"], stderr["alpha"], ""), ("c_zeta", params["c_zeta"], stderr["c_zeta"], ""),
+            ("c_psi", params["c_psi"], stderr["c_psi"], "")]  # fmt: skip
+    for index, side in enumerate(("left", "right")):
+        rows.append((f"psi0 offset {side}", params["psi0_offset_deg"][index], stderr["psi0_offset_deg"][index], "deg"))
+        rows.append((f"zeta0 offset {side}", params["zeta0_offset"][index], stderr["zeta0_offset"][index], "l0"))
+    for label, value, error, unit in rows:
+        spread = "not identifiable" if error is None or not math.isfinite(error) else f"± {error:.3g}"
+        typer.echo(f"{label:<18} {value:>10.5g} {spread:<18} {unit}")
+    typer.echo(
+        f"touchdown pairs: {payload['touchdowns_used']}   one-jump state error [sqrt(g l0)]: "
+        f"{payload['rms_residual_before']:.4g} (base) -> {payload['rms_residual_after']:.4g} (fitted)"
+    )
+    if payload["unidentifiable"]:
+        note(f"the runs cannot tell these apart: {', '.join(payload['unidentifiable'])} (vary the controls more)")
+    note(f"stored as preset {payload['preset']['name']!r}: use --preset {payload['preset']['name']}")

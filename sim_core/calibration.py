@@ -1,0 +1,216 @@
+"""Calibration: the model's parameters fitted to a robot's tracked touchdowns (docs/calibration.md).
+
+What is fitted: ``alpha``, ``c_zeta``, ``c_psi`` (nondimensional, docs/model.md §1) and each leg's
+servo offsets of psi0 [deg] and zeta0 [l0] (:class:`~sim_core.controls.LegOffsets`); ``d_hat`` and
+``mu`` stay the base model's (the chute is measured; friction only shows when a foot slips).
+
+From what: touchdown-to-touchdown pairs. Each measured touchdown is mapped one jump forward by
+the model (:mod:`sim_core.touchdown_model`) and compared with the next measured one on three
+channels — ``xdot``, ``ydot`` and the rise between the feet. Least squares
+(``scipy.optimize.least_squares``, trust region) runs twice: first with nominal channel scales,
+then with each channel weighted by its own residual scatter, so none dominates by its units.
+
+How sure: the covariance is ``s^2 (J^T J)^-1`` at the optimum (``s^2`` the weighted residuals'
+variance per degree of freedom), from an SVD; standard errors and the correlation matrix come
+from it. A direction of parameter space the data do not constrain (a singular value below
+:data:`IDENTIFIABLE_RCOND` of the largest) makes every parameter along it *unidentifiable*: it is
+named, its standard error is infinite, and its value is the base model's or the fit's arbitrary
+one — not a measurement. The channels' scatter after the fit is the noise the model does not
+explain (control noise, tracker noise, process noise): :attr:`CalibrationFit.noise`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from sim_core.controls import LegOffsets
+from sim_core.params import ModelParams
+from sim_core.touchdown_model import CHANNEL_UNITS, CHANNELS, Pairs, TouchdownSeries, predict_pairs
+from sim_core.validation import ParameterError
+
+# The fitted vector, in order: its names in the JSON, and the units the fit works in.
+PARAMETERS = ("alpha", "c_zeta", "c_psi", "psi0_offset_deg.left", "psi0_offset_deg.right",
+              "zeta0_offset.left", "zeta0_offset.right")  # fmt: skip
+TYPICAL_SCALE = np.array([10.0, 0.3, 0.3, 0.5, 0.5, 0.005, 0.005])  # steps of a comparable effect
+NOMINAL_SCATTER = np.array([0.02, 0.02, 0.005])  # first-pass channel scales: xdot, ydot, rise
+FAILED_RESIDUAL = 10.0  # a pair whose predicted jump fails, in channel scales (bounded, so the fit moves on)
+IDENTIFIABLE_RCOND = 1e-6
+CONFOUNDED = 0.95  # |correlation| above which two parameters are reported as hard to tell apart
+MIN_PAIRS = 10
+LOWER = np.array([1.0, 0.0, 0.0, -10.0, -10.0, -0.1, -0.1])
+UPPER = np.array([1000.0, 20.0, 20.0, 10.0, 10.0, 0.1, 0.1])
+
+
+@dataclass(frozen=True)
+class CalibrationFit:
+    """A fitted model with its uncertainty.
+
+    Attributes:
+        model: the base model with the fitted ``alpha``, ``c_zeta``, ``c_psi``.
+        offsets: the fitted leg offsets.
+        stderr: standard error per name of :data:`PARAMETERS` (inf: not identifiable).
+        correlation: (7, 7) correlation matrix in :data:`PARAMETERS` order (NaN rows: unidentifiable).
+        unidentifiable: names the data do not constrain at all (a singular direction).
+        confounded: pairs ``(a, b, correlation)`` with ``|correlation| >`` :data:`CONFOUNDED`: the data
+            pin down a combination of the two better than either (e.g. the legs' zeta0 offsets,
+            whose sum sets the energy) — read their values with their standard errors.
+        touchdowns_used: pairs compared (each a touchdown the model predicted).
+        rms_before, rms_after: RMS one-jump error of the section state [sqrt(g l0)], base vs fitted.
+        channels: per channel ``{"unit", "rms_before", "rms_after"}``.
+        noise: the residual scatter per channel after the fit (the unexplained noise).
+        failed_predictions: pairs whose predicted jump failed with the fitted model.
+    """
+
+    model: ModelParams
+    offsets: LegOffsets
+    stderr: dict[str, float]
+    correlation: np.ndarray
+    unidentifiable: tuple[str, ...]
+    confounded: tuple[tuple[str, str, float], ...]
+    touchdowns_used: int
+    rms_before: float
+    rms_after: float
+    channels: dict[str, dict]
+    noise: dict[str, float]
+    failed_predictions: int
+
+    def to_dict(self) -> dict:
+        """The ``parkour calibrate --json`` contract (NaN and inf become null in JSON)."""
+        se = self.stderr
+        return {
+            "params": {
+                "alpha": self.model.alpha,
+                "c_zeta": self.model.c_zeta,
+                "c_psi": self.model.c_psi,
+                **self.offsets.to_dict(),
+            },
+            "stderr": {
+                "alpha": se["alpha"],
+                "c_zeta": se["c_zeta"],
+                "c_psi": se["c_psi"],
+                "psi0_offset_deg": [se["psi0_offset_deg.left"], se["psi0_offset_deg.right"]],
+                "zeta0_offset": [se["zeta0_offset.left"], se["zeta0_offset.right"]],
+            },
+            "parameters": list(PARAMETERS),
+            "correlation": self.correlation.tolist(),
+            "unidentifiable": list(self.unidentifiable),
+            "confounded": [list(pair) for pair in self.confounded],
+            "touchdowns_used": self.touchdowns_used,
+            "rms_residual_before": self.rms_before,
+            "rms_residual_after": self.rms_after,
+            "residuals": self.channels,
+            "noise": self.noise,
+            "failed_predictions": self.failed_predictions,
+        }
+
+
+def vector_of(model: ModelParams, offsets: LegOffsets) -> np.ndarray:
+    return np.array([model.alpha, model.c_zeta, model.c_psi, *offsets.psi0_offset_deg, *offsets.zeta0_offset])
+
+
+def split(base: ModelParams, vector: np.ndarray) -> tuple[ModelParams, LegOffsets]:
+    model = replace(base, alpha=float(vector[0]), c_zeta=float(vector[1]), c_psi=float(vector[2]))
+    offsets = LegOffsets(psi0_offset_deg=(float(vector[3]), float(vector[4])),
+                         zeta0_offset=(float(vector[5]), float(vector[6])))  # fmt: skip
+    return model, offsets
+
+
+def predict(pairs: Pairs, model: ModelParams, offsets: LegOffsets) -> tuple[np.ndarray, int]:
+    """Predicted ``(xdot, ydot, rise)`` of each pair's second touchdown (NaN rows: failed), and the failures."""
+    out = np.empty((len(pairs), 3))
+    psi0 = np.radians(np.asarray(offsets.psi0_offset_deg, dtype=float))
+    zeta0 = np.asarray(offsets.zeta0_offset, dtype=float)
+    failed = predict_pairs(pairs.before, pairs.after, *model.kernel_args(), psi0, zeta0, out)
+    return out, int(failed)
+
+
+def calibrate(series: list[TouchdownSeries], base: ModelParams, start: LegOffsets | None = None) -> CalibrationFit:
+    """Fit ``alpha``, ``c_zeta``, ``c_psi`` and the leg offsets to ``series``, starting from ``base``.
+
+    Raises :class:`ParameterError` (field ``runs``) with fewer than :data:`MIN_PAIRS` consecutive pairs.
+    """
+    from scipy.optimize import least_squares
+
+    pairs = Pairs.of(series)
+    if len(pairs) < MIN_PAIRS:
+        raise ParameterError(
+            "runs", f"need at least {MIN_PAIRS} consecutive touchdown pairs to calibrate, the runs give {len(pairs)}"
+        )
+    measured = pairs.measured()
+    x0 = np.clip(vector_of(base, start or LegOffsets()), LOWER, UPPER)
+
+    def residuals(vector: np.ndarray, scatter: np.ndarray) -> np.ndarray:
+        predicted, _ = predict(pairs, *split(base, vector))
+        weighted = (predicted - measured) / scatter
+        return np.nan_to_num(weighted, nan=FAILED_RESIDUAL).ravel()
+
+    scatter = NOMINAL_SCATTER
+    before, _ = predict(pairs, *split(base, x0))
+    x = x0
+    for _ in range(2):
+        fit = least_squares(residuals, x, args=(scatter,), bounds=(LOWER, UPPER), x_scale=TYPICAL_SCALE,
+                            diff_step=1e-6, method="trf", xtol=1e-10, ftol=1e-10)  # fmt: skip
+        x = fit.x
+        after, _ = predict(pairs, *split(base, x))
+        scatter = np.maximum(_rms(after - measured, axis=0), 1e-9)
+    after, failed = predict(pairs, *split(base, x))
+    jacobian = fit.jac  # of the weighted residuals, at the optimum
+    stderr, correlation, unidentifiable = _uncertainty(jacobian, fit.fun)
+    model, offsets = split(base, x)
+    channels = {
+        name: {"unit": CHANNEL_UNITS[name], "rms_before": _rms(before[:, i] - measured[:, i]),
+               "rms_after": _rms(after[:, i] - measured[:, i])}
+        for i, name in enumerate(CHANNELS)
+    }  # fmt: skip
+    return CalibrationFit(
+        model=model,
+        offsets=offsets,
+        stderr=dict(zip(PARAMETERS, stderr.tolist(), strict=True)),
+        correlation=correlation,
+        unidentifiable=unidentifiable,
+        confounded=_confounded(correlation),
+        touchdowns_used=len(pairs),
+        rms_before=_rms(before[:, :2] - measured[:, :2]),
+        rms_after=_rms(after[:, :2] - measured[:, :2]),
+        channels=channels,
+        noise={name: float(scatter[i]) for i, name in enumerate(CHANNELS)},
+        failed_predictions=failed,
+    )
+
+
+def _rms(values: np.ndarray, axis=None):
+    """Root mean square over the finite values (a failed prediction has none to give)."""
+    squared = np.where(np.isfinite(values), values, np.nan) ** 2
+    result = np.sqrt(np.nanmean(squared, axis=axis))
+    return result if axis is not None else float(result)
+
+
+def _confounded(correlation: np.ndarray) -> tuple[tuple[str, str, float], ...]:
+    pairs = []
+    for i in range(len(PARAMETERS)):
+        for j in range(i + 1, len(PARAMETERS)):
+            value = correlation[i, j]
+            if math.isfinite(value) and abs(value) > CONFOUNDED:
+                pairs.append((PARAMETERS[i], PARAMETERS[j], round(float(value), 4)))
+    return tuple(pairs)
+
+
+def _uncertainty(jacobian: np.ndarray, weighted: np.ndarray) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
+    """Standard errors, correlation and the unidentifiable parameters from the weighted fit's Jacobian."""
+    m, p = jacobian.shape
+    variance = float(weighted @ weighted) / max(m - p, 1)
+    _, singular, vt = np.linalg.svd(jacobian, full_matrices=False)
+    strong = singular > IDENTIFIABLE_RCOND * singular[0]
+    # Parameters with weight in a direction the data do not constrain cannot be told apart.
+    weak = np.any(np.abs(vt[~strong]) > 0.1, axis=0) if not strong.all() else np.zeros(p, dtype=bool)
+    covariance = (vt[strong].T / singular[strong] ** 2) @ vt[strong] * variance
+    stderr = np.sqrt(np.clip(np.diag(covariance), 0.0, None))
+    stderr[weak] = math.inf
+    with np.errstate(invalid="ignore", divide="ignore"):
+        correlation = covariance / np.outer(stderr, stderr)
+    correlation[weak, :] = np.nan
+    correlation[:, weak] = np.nan
+    return stderr, correlation, tuple(name for name, flag in zip(PARAMETERS, weak, strict=True) if flag)

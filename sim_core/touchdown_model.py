@@ -1,0 +1,173 @@
+"""The model's prediction of tracked touchdowns, jump by jump: what calibration fits (docs/calibration.md).
+
+A tracked run gives, per touchdown, the section state and foot height a detector measured, the
+controls the PC commanded for that touchdown and the body's pitch. The robot does not touch down
+with the commanded controls: its servos add per-leg offsets (:class:`~sim_core.controls.LegOffsets`)
+and its pitch turns the leg (``+pitch`` on the left wall, ``-pitch`` on the right, as
+:mod:`sim_core.noise`). So the leg meets the wall ``a = zeta0 cos psi0`` [l0] from it (realised),
+while the detector finds the crossing of the commanded line ``c`` by extrapolating the flight
+(backend.robot.touchdown): its state and foot height are the ballistic flight's at ``c``, a time
+``(a - c) / |xdot|`` after the real touchdown (nondimensional time, gravity 1). This module maps
+a measured touchdown back to the real one, runs one jump of the Poincaré map
+(:func:`sim_core.stride.jump`) and maps the next real touchdown forward to what the detector
+will report — so model and measurement are compared as the same quantity.
+
+Units: states in ``sqrt(g l0)``, heights in ``l0``, angles in radians; walls as in
+:mod:`sim_core.walls`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim_core._jit import kernel
+from sim_core.failures import OK
+from sim_core.integrate import STATE_SIZE
+from sim_core.stride import jump
+from sim_core.validation import ParameterError
+
+# Columns of the per-pair outputs of :func:`predict_pairs`.
+XDOT, YDOT, RISE = 0, 1, 2
+CHANNELS = ("xdot", "ydot", "rise")
+CHANNEL_UNITS = {"xdot": "sqrt(g l0)", "ydot": "sqrt(g l0)", "rise": "l0"}
+
+
+@dataclass(frozen=True)
+class TouchdownSeries:
+    """One run's detected touchdowns, in order (nondimensional, flipped to the left wall).
+
+    Attributes:
+        state: shape (n, 2), the measured section states ``(xdot, ydot)``.
+        foot_height: shape (n,), the measured foot heights [l0].
+        commanded: shape (n, 2), the commanded ``(psi0 [rad], zeta0 [l0])`` of each touchdown's leg.
+        right_leg: shape (n,), whether the touchdown is on the right wall (its leg the right one).
+        pitch: shape (n,), the body's pitch at the touchdown [rad]; 0 where the tracker gave none.
+        consecutive: shape (n - 1,), whether touchdown ``k + 1`` is the jump after ``k`` (none missed).
+    """
+
+    state: np.ndarray
+    foot_height: np.ndarray
+    commanded: np.ndarray
+    right_leg: np.ndarray
+    pitch: np.ndarray
+    consecutive: np.ndarray
+
+    def __post_init__(self) -> None:
+        n = self.state.shape[0]
+        shapes = {"state": (n, 2), "foot_height": (n,), "commanded": (n, 2), "right_leg": (n,), "pitch": (n,),
+                  "consecutive": (max(n - 1, 0),)}  # fmt: skip
+        for name, shape in shapes.items():
+            if getattr(self, name).shape != shape:
+                raise ParameterError(name, f"must have shape {shape}, got {getattr(self, name).shape}")
+
+    @classmethod
+    def of(cls, *, state, foot_height, commanded, right_leg, pitch=None) -> TouchdownSeries:
+        """A series from sequences; a pair counts as consecutive when its walls alternate."""
+        right = np.asarray(right_leg, dtype=bool)
+        pitches = np.zeros(right.shape) if pitch is None else np.nan_to_num(np.asarray(pitch, dtype=float))
+        return cls(
+            state=np.asarray(state, dtype=float).reshape(-1, 2),
+            foot_height=np.asarray(foot_height, dtype=float),
+            commanded=np.asarray(commanded, dtype=float).reshape(-1, 2),
+            right_leg=right,
+            pitch=pitches,
+            consecutive=right[1:] != right[:-1],
+        )
+
+    @property
+    def pairs(self) -> int:
+        return int(np.count_nonzero(self.consecutive))
+
+
+@dataclass(frozen=True)
+class Pairs:
+    """Consecutive touchdown pairs ``k -> k + 1`` of any number of runs, as the kernel takes them.
+
+    ``before`` and ``after`` hold, per pair, columns ``xdot, ydot, foot_height, psi0_commanded,
+    zeta0_commanded, right_leg (0/1), pitch`` of touchdown ``k`` and ``k + 1``.
+    """
+
+    before: np.ndarray
+    after: np.ndarray
+
+    @classmethod
+    def of(cls, series: list[TouchdownSeries]) -> Pairs:
+        rows = []
+        for run in series:
+            table = np.column_stack([run.state, run.foot_height, run.commanded, run.right_leg, run.pitch])
+            keep = np.flatnonzero(run.consecutive)
+            rows.append((table[keep], table[keep + 1]))
+        if not rows:
+            return cls(np.empty((0, 7)), np.empty((0, 7)))
+        return cls(np.vstack([b for b, _ in rows]), np.vstack([a for _, a in rows]))
+
+    def __len__(self) -> int:
+        return self.before.shape[0]
+
+    def measured(self) -> np.ndarray:
+        """Shape (pairs, 3): the measured next state and the rise [l0] between the two feet."""
+        return np.column_stack([self.after[:, 0], self.after[:, 1], self.after[:, 2] - self.before[:, 2]])
+
+
+@kernel
+def _realised(psi0, zeta0, right_leg, pitch, psi0_offsets, zeta0_offsets):
+    side = 1 if right_leg else 0
+    turned = psi0 + (-pitch if right_leg else pitch) + psi0_offsets[side]
+    return turned, zeta0 + zeta0_offsets[side]
+
+
+@kernel
+def _detection_shift(xdot, psi0, zeta0, psi0_commanded, zeta0_commanded):
+    """Time [sqrt(l0/g)] from the real touchdown to the detector's crossing of the commanded line."""
+    real = zeta0 * math.cos(psi0)
+    commanded = zeta0_commanded * math.cos(psi0_commanded)
+    return (real - commanded) / abs(xdot)
+
+
+@kernel
+def _foot_shift(ydot, shift, psi0, zeta0, psi0_commanded, zeta0_commanded):
+    """Detected minus real foot height [l0]: the flight carried on ``shift``, the commanded leg subtracted."""
+    body = ydot * shift - 0.5 * shift * shift
+    return body - zeta0_commanded * math.sin(psi0_commanded) + zeta0 * math.sin(psi0)
+
+
+@kernel
+def predict_pairs(before, after, alpha, d_hat, c_zeta, c_psi, mu, psi0_offsets, zeta0_offsets, out):
+    """The detected touchdown ``k + 1`` the model predicts from each measured touchdown ``k``.
+
+    Args:
+        before, after: :class:`Pairs` columns; only ``after``'s controls, leg and pitch are read.
+        psi0_offsets [rad], zeta0_offsets [l0]: shape (2,), left and right leg.
+        out: output (pairs, 3): predicted ``xdot, ydot`` and rise [l0]; NaN where the jump failed.
+
+    Returns the number of failed jumps.
+    """
+    no_record = np.empty((0, STATE_SIZE))
+    failed = 0
+    for i in range(before.shape[0]):
+        psi_c, zeta_c, right, pitch = before[i, 3], before[i, 4], before[i, 5] > 0.5, before[i, 6]
+        psi_n, zeta_n, right_n, pitch_n = after[i, 3], after[i, 4], after[i, 5] > 0.5, after[i, 6]
+        psi0, zeta0 = _realised(psi_c, zeta_c, right, pitch, psi0_offsets, zeta0_offsets)
+        next_psi0, next_zeta0 = _realised(psi_n, zeta_n, right_n, pitch_n, psi0_offsets, zeta0_offsets)
+        xdot = before[i, 0]
+        shift = _detection_shift(xdot, psi0, zeta0, psi_c, zeta_c)
+        ydot = before[i, 1] + shift  # back to the real touchdown
+        status, next_xdot, next_ydot, rise, _, _, _ = jump(
+            xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c_psi, mu, no_record
+        )
+        if status != OK or not (next_xdot < 0.0):
+            out[i, :] = math.nan
+            failed += 1
+            continue
+        next_shift = _detection_shift(next_xdot, next_psi0, next_zeta0, psi_n, zeta_n)
+        out[i, XDOT] = next_xdot
+        out[i, YDOT] = next_ydot - next_shift
+        out[i, RISE] = (
+            rise
+            + _foot_shift(next_ydot, next_shift, next_psi0, next_zeta0, psi_n, zeta_n)
+            - _foot_shift(ydot, shift, psi0, zeta0, psi_c, zeta_c)
+        )
+    return failed

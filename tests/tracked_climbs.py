@@ -1,0 +1,101 @@
+"""Tracked climbs without sockets: a robot with known true physics climbs in sim_core's sequencer
+(as the virtual robot does), a 100 Hz tracker sees it with noise, and the PC's touchdown detector
+reads it with the paper's model — the data a calibration test fits, seconds faster than real time.
+:func:`store_tracked_run` files one as a robot run the way a live run is filed (its journal folded)."""
+
+from __future__ import annotations
+
+import datetime
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from backend.robot.touchdown import Touchdown, detect_touchdowns
+from sim_core import ControlSchedule, LegControl, PhysicalParams, gait_of, get_preset
+from sim_core.climb import ClimbSetup, simulate_climb
+from sim_core.controls import LegOffsets
+from sim_core.errors import FixedPointNotFound
+from sim_core.noise import NoiseModel
+from sim_core.noise_rules import NoiseSampler
+from sim_core.presets import START_GUESS
+from sim_core.walls import Wall
+
+PAPER = get_preset("paper")
+FRAME_RATE = 100.0  # [Hz]
+# Gaits the test runs climb (psi0_deg, zeta0) left and right: varied, so the fit can tell parameters apart.
+VARIED_LEGS = (((30.0, 0.90), (30.0, 0.90)), ((30.0, 0.87), (30.0, 0.90)), ((33.0, 0.92), (28.0, 0.88)),
+               ((27.0, 0.89), (32.0, 0.91)))  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Truth:
+    """What the robot really is: the physics and the legs' servo offsets."""
+
+    robot: PhysicalParams
+    offsets: LegOffsets
+
+    @classmethod
+    def of(cls, *, alpha: float, c_zeta: float, c_psi: float, psi0_offset_deg, zeta0_offset) -> Truth:
+        model = replace(PAPER.to_model(), alpha=alpha, c_zeta=c_zeta, c_psi=c_psi)
+        robot = PhysicalParams.from_model(model, mass=PAPER.mass, leg_length=PAPER.leg_length, gravity=PAPER.gravity)
+        return cls(robot, LegOffsets(psi0_offset_deg=tuple(psi0_offset_deg), zeta0_offset=tuple(zeta0_offset)))
+
+
+@dataclass(frozen=True)
+class TrackedClimb:
+    frames: dict[str, np.ndarray]  # time [s], x, y [m], pitch [rad]: the tracker's
+    touchdowns: list[Touchdown]  # as the PC detects them, with the paper's model
+    controls: list[tuple[float, float]]  # commanded (psi0_deg, zeta0) of each detected touchdown
+
+
+def tracked_climb(truth: Truth, legs, *, jumps: int, noise: NoiseModel, rng, tracker_noise=0.001) -> TrackedClimb:
+    """A climb of up to ``jumps`` jumps commanded ``legs`` ((psi0_deg, zeta0) left, right)."""
+    commanded = {Wall.LEFT: LegControl.from_degrees(*legs[0]), Wall.RIGHT: LegControl.from_degrees(*legs[1])}
+    setup = ClimbSetup(truth.robot, sample_rate=FRAME_RATE * truth.robot.scales.time)
+    try:
+        schedule = ControlSchedule.of(commanded[Wall.LEFT], commanded[Wall.RIGHT])
+        state = gait_of(truth.robot.to_model(), schedule, guess=START_GUESS).state
+    except FixedPointNotFound:
+        state = np.array(START_GUESS)
+    done = simulate_climb(
+        setup,
+        lambda wall: truth.offsets.applied(commanded[wall], right_leg=wall == Wall.RIGHT),
+        state,
+        jumps,
+        NoiseSampler(noise, rng),
+    )
+    time = np.concatenate([jump.samples.time for jump in done])
+    x = np.concatenate([jump.samples.x for jump in done]) + rng.normal(0.0, tracker_noise, time.size)
+    y = np.concatenate([jump.samples.y for jump in done]) + rng.normal(0.0, tracker_noise, time.size)
+    pitch = np.concatenate([np.full(len(jump.samples), jump.start.pitch) for jump in done])
+
+    def leg_for(k: int) -> LegControl:  # detected touchdown k is the climb's k + 1
+        return commanded[Wall.RIGHT if k % 2 == 0 else Wall.LEFT]
+
+    found = detect_touchdowns(time, x, y, PAPER, leg_for)
+    controls = [(commanded[td.wall].psi0_deg, commanded[td.wall].zeta0) for td in found]
+    return TrackedClimb({"time": time, "x": x, "y": y, "pitch": pitch}, found, controls)
+
+
+def store_tracked_run(session, climb: TrackedClimb, legs) -> int:
+    """``climb`` filed as a finished robot run (opened, one journal entry, folded); its id."""
+    from backend.robot.tracker import Calibration
+    from backend.schemas import LegIn, RobotRunCreate
+    from backend.services.robot_records import fold_journal, open_robot_run
+    from backend.store.models import RunJournal
+
+    request = RobotRunCreate(controls=[LegIn(psi0_deg=p, zeta0=z) for p, z in legs], jumps=len(climb.touchdowns) + 1)
+    run_id = open_robot_run(session, request, PAPER, Calibration())
+    data = {
+        "frames": {name: column.tolist() for name, column in climb.frames.items()},
+        "touchdowns": [{"touchdown": td.to_dict(), "control": list(c)} for td, c in zip(climb.touchdowns,
+                                                                                         climb.controls, strict=True)],
+        "commands": [{"why": "start"}],
+        "telemetry": [],
+        "transitions": [],
+        "tracker": {"dropped": 0, "loss": 0.0},
+    }  # fmt: skip
+    session.add(RunJournal(run_id=run_id, written_at=datetime.datetime.now(datetime.UTC), data=data))
+    session.commit()
+    fold_journal(session, run_id, status="done", end_reason="jumps done", disarm="confirmed")
+    return run_id
