@@ -10,8 +10,11 @@ import time
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from pydantic import ValidationError
 
 from backend.robot import natnet_source
+from backend.robot.link import LinkState, RobotLink
+from backend.robot.messages import Leg
 from backend.robot.natnet import (
     NatNetError,
     connect_request,
@@ -22,8 +25,15 @@ from backend.robot.natnet import (
     parse_version,
 )
 from backend.robot.natnet_source import NatNetPoseSource
-from backend.robot.tracker import Calibration
+from backend.robot.touchdown import detect_touchdowns
+from backend.robot.tracker import Calibration, UdpPoseSource
+from backend.robot.virtual import VirtualRobot
+from backend.schemas import RobotConnect
+from backend.services.robot import open_tracker
+from sim_core import LegControl, get_preset
 from sim_core.errors import ParameterError
+from sim_core.noise import NO_NOISE
+from sim_core.walls import wall_of
 from tests.backend.robot.natnet_frames import Body, Scene, frame_packet, server_info_packet
 
 VERSIONS = [200, 201, 203, 205, 206, 207, 209, 210, 211, 300, 301, 400, 401]
@@ -33,6 +43,8 @@ BODIES = (
     Body(2, (-0.25, 1.5, 0.02), (0.0, 0.0, math.sin(PITCH / 2), math.cos(PITCH / 2)), error=0.0007),
     Body(3, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0), markers=(), valid=False),
 )
+LEGS = {Leg.LEFT: (30.0, 0.87), Leg.RIGHT: (30.0, 0.9)}
+ROBOT = get_preset("paper")
 SCENE = Scene(frame=4321, timestamp=12.345678, bodies=BODIES)
 
 
@@ -245,3 +257,94 @@ def _free_port() -> int:
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
         probe.bind(("", 0))
         return probe.getsockname()[1]
+
+
+def _climb(tracker, protocol: str, jumps: int = 8):
+    """An open-loop climb of the noiseless virtual robot at 6x real time, its camera on ``protocol``
+    (tracker noise and dropped frames as usual, from the same seed): the touchdowns its tracker saw."""
+    robot = VirtualRobot(
+        tracker_to=tracker.address,
+        noise=NO_NOISE,
+        speed=6.0,
+        seed=1,
+        tracker_protocol=protocol,
+        natnet_version="2.9",
+        natnet_rigid_body_id=3,
+    ).start()
+    link = RobotLink(robot.url)
+    try:
+        link.connect()
+        for leg, (psi0, zeta0) in LEGS.items():
+            link.set_leg(leg, psi0, zeta0)
+        link.arm()
+        link.start()
+        _until(lambda: robot.climber.jumps >= jumps or link.state != LinkState.RUNNING, timeout=30)
+        link.disarm()
+        time.sleep(0.05)
+    finally:
+        link.close()
+        robot.stop()
+        tracker.close()
+    poses = tracker.as_arrays()
+    leg_for = lambda k: LegControl.from_degrees(*LEGS[Leg.of(wall_of(k + 1))])  # noqa: E731
+    return detect_touchdowns(poses["time"], poses["x"], poses["y"], ROBOT, leg_for), tracker.stats, robot.climber
+
+
+def test_a_live_climb_over_natnet_sees_the_touchdowns_pkt1_sees():
+    over_pkt1, pkt1_stats, _ = _climb(UdpPoseSource(), "pkt1")
+    natnet = NatNetPoseSource(
+        3, interface="127.0.0.1", port=0, multicast_group=None, server=("127.0.0.1", 9), version=(2, 9)
+    )
+    over_natnet, stats, climber = _climb(natnet, "natnet")
+    common = min(len(over_pkt1), len(over_natnet))
+    assert common >= 6, (len(over_pkt1), len(over_natnet))
+    # The same seed streams the same poses; NatNet's f32 positions differ from PKT1's f64 by ~1e-7 m,
+    # and a pose lost to real-time jitter (a late frame) moves a fitted touchdown by far less than 1e-3.
+    for ours, theirs in zip(over_natnet[:common], over_pkt1[:common], strict=True):
+        assert ours.wall == theirs.wall
+        assert ours.time == pytest.approx(theirs.time, abs=1e-3)
+        assert ours.state == pytest.approx(theirs.state, abs=1e-3)
+    assert stats.malformed == 0 and stats.ignored == 0
+    assert stats.dropped == pytest.approx(climber.frames_dropped, abs=2), "the robot's dropped frames, seen as gaps"
+    assert abs(stats.loss - pkt1_stats.loss) < 0.02
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "says"),
+    [
+        ("tracker_protocol", "vrpn", "'pkt1' or 'natnet'"),
+        ("natnet_version", "1.5", "from 2.0 to 4.x"),
+        ("natnet_version", "latest", "MAJOR.MINOR"),
+        ("natnet_multicast_group", "10.0.0.1", "multicast address"),
+        ("natnet_multicast_group", "239.255.42", "IPv4 multicast address"),
+        ("natnet_rigid_body_id", -1, "greater than or equal to 0"),
+        ("natnet_command_port", 0, "greater than or equal to 1"),
+    ],
+)
+def test_connect_options_are_checked_naming_the_field(field, value, says):
+    with pytest.raises(ValidationError) as raised:
+        RobotConnect(url="loop://", **{field: value})
+    [error] = raised.value.errors()
+    assert error["loc"] == (field,) and says in error["msg"]
+
+
+def test_connect_opens_the_tracker_it_names():
+    body = RobotConnect(
+        url="loop://",
+        tracker_protocol="natnet",
+        tracker_port=0,
+        natnet_multicast_group=None,
+        natnet_version="2.5",
+        natnet_rigid_body_id=4,
+        natnet_server_host="127.0.0.1",
+    )
+    tracker = open_tracker(body, Calibration(scale=0.001))
+    try:
+        assert isinstance(tracker, NatNetPoseSource) and tracker.version == (2, 5) and tracker.rigid_body_id == 4
+        assert tracker.multicast_group is None and tracker.server == ("127.0.0.1", 1510)
+        assert tracker.calibration.scale == 0.001
+    finally:
+        tracker.close()
+    pkt1 = open_tracker(RobotConnect(url="loop://", tracker_port=0), Calibration())
+    pkt1.close()
+    assert isinstance(pkt1, UdpPoseSource)
