@@ -43,6 +43,15 @@ def robot_sim_command(
             "--noise", help="on: control, pitch and state noise, tracker noise and dropped frames; off: none."
         ),
     ] = Noise.on,
+    tracker_protocol: Annotated[
+        str, typer.Option("--tracker-protocol", help="pkt1 (ParkourLab datagrams) or natnet (the camera software's).")
+    ] = "pkt1",
+    natnet_version: Annotated[
+        str, typer.Option("--natnet-version", help="NatNet version streamed (2.0 to 4.x).")
+    ] = "3.1",
+    natnet_rigid_body_id: Annotated[
+        int, typer.Option("--natnet-rigid-body-id", help="The body's NatNet rigid body id.", min=0)
+    ] = 1,
     *,
     setup: ModelSetup,
 ) -> None:
@@ -62,9 +71,14 @@ def robot_sim_command(
     tracker_host, _, tracker_port = tracker.rpartition(":")
     if not tracker_host or not tracker_port.isdigit():
         raise ParameterError("tracker", f"must be HOST:PORT, got {tracker!r}")
+    natnet = {"natnet_version": natnet_version, "natnet_rigid_body_id": natnet_rigid_body_id}
     robot = VirtualRobot(host, port, tracker_to=(tracker_host, int(tracker_port)), seed=seed,
-                         robot=setup.robot, leg_offsets=offsets, **imperfections).start()  # fmt: skip
-    note(f"virtual robot listening: {robot.url}  tracker to udp://{tracker}  (docs/protocol.md; Ctrl-C stops it)")
+                         tracker_protocol=tracker_protocol, robot=setup.robot, leg_offsets=offsets,
+                         **natnet, **imperfections).start()  # fmt: skip
+    note(
+        f"virtual robot listening: {robot.url}  tracker ({tracker_protocol}) to udp://{tracker}"
+        "  (docs/protocol.md; Ctrl-C stops it)"
+    )
     try:
         while True:
             time.sleep(1.0)

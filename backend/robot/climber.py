@@ -6,7 +6,9 @@ controls plus the imperfections the paper reports: each leg's servo offsets (``l
 truth a calibration should recover) and :mod:`sim_core.noise` (control noise, pitch drift
 offsetting the leg angles, noisy section states), and the body's path is
 streamed as tracker datagrams in real time (or ``speed`` times faster), with position noise and
-dropped frames. Each stance is streamed before the next leg is read, as the real robot positions
+dropped frames, as PKT1 datagrams or, with ``tracker_protocol="natnet"``, as the camera software's
+NatNet frames (:mod:`backend.robot.natnet`: one rigid body, the table plane its x–y plane, the
+pitch its rotation about z). Each stance is streamed before the next leg is read, as the real robot positions
 that leg during the stance. The climb ends when a jump fails (slip, no flight, ...) or the body
 reaches the chute's floor (:data:`sim_core.climb.FLOOR`, where the first foot touches): the
 robot falls and reports it, and :attr:`Climber.end` says why.
@@ -22,11 +24,12 @@ from collections.abc import Callable
 import numpy as np
 
 from backend.robot.messages import Leg
+from backend.robot.natnet import RigidBody, encode_frame, parse_version, quaternion_about_z
 from backend.robot.tracker import Pose, encode_datagram
 from sim_core import ControlSchedule, LegControl, PhysicalParams, climb, gait_of, get_preset
 from sim_core.climb import ClimbSetup, End, Samples
 from sim_core.controls import NO_OFFSETS, LegOffsets
-from sim_core.errors import FixedPointNotFound
+from sim_core.errors import FixedPointNotFound, ParameterError
 from sim_core.noise import NoiseModel
 from sim_core.noise_rules import NoiseSampler
 from sim_core.presets import START_GUESS
@@ -51,6 +54,9 @@ class Climber:
         drop_rate: float = 0.02,
         speed: float = 1.0,
         seed: int = 0,
+        tracker_protocol: str = "pkt1",
+        natnet_version: str = "3.1",
+        natnet_rigid_body_id: int = 1,
     ):
         self.legs, self.running, self.fell = legs, running, fell
         self.tracker_to = tracker_to
@@ -61,6 +67,13 @@ class Climber:
         self.tracker_noise = check_range("tracker_noise", tracker_noise, 0.0, 0.1, low_open=False)
         self.drop_rate = check_range("drop_rate", drop_rate, 0.0, 1.0, low_open=False)
         self.speed = check_range("speed", speed, 0.0, 100.0)
+        if tracker_protocol not in ("pkt1", "natnet"):
+            raise ParameterError("tracker_protocol", f"must be pkt1 or natnet, got {tracker_protocol!r}")
+        self.tracker_protocol = tracker_protocol
+        self.natnet_version = parse_version(natnet_version)
+        self.natnet_rigid_body_id = int(
+            check_range("natnet_rigid_body_id", natnet_rigid_body_id, 0, 2**31, low_open=False)
+        )
         # Two streams: the climb's noise does not depend on how many frames were streamed.
         climb_seed, tracker_seed = np.random.SeedSequence(seed).spawn(2)
         self._climb_rng = np.random.default_rng(climb_seed)
@@ -152,4 +165,11 @@ class Climber:
                 float(y) + self.rng.normal(0, self.tracker_noise),
                 pitch,
             )
-            self._socket.sendto(encode_datagram(self.frames_sent, noisy), self.tracker_to)
+            self._socket.sendto(self._datagram(self.frames_sent, noisy), self.tracker_to)
+
+    def _datagram(self, frame: int, pose: Pose) -> bytes:
+        """What the camera sends for ``pose``: a PKT1 datagram, or a NatNet frame holding the body."""
+        if self.tracker_protocol == "pkt1":
+            return encode_datagram(frame, pose)
+        body = RigidBody(self.natnet_rigid_body_id, (pose.x, pose.y, 0.0), quaternion_about_z(pose.pitch))
+        return encode_frame(frame, pose.time, body, self.natnet_version)

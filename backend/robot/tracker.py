@@ -5,10 +5,11 @@ chute from its centre line, y up — after :class:`Calibration` maps camera coor
 
 Sources (all ``PoseSource``: ``latest()`` and ``poses_since(t)``):
 
-- :class:`UdpPoseSource` — datagrams on a UDP port. The lab's bridge from the camera software
-  (NaturalPoint/OptiTrack NatNet: data port 1511, multicast 239.255.42.99) forwards each frame
-  as one ParkourLab tracker datagram (below); the virtual robot sends the same. Tests use
-  unicast on 127.0.0.1.
+- :class:`UdpPoseSource` — ParkourLab tracker datagrams (below) on a UDP port: the virtual
+  robot's default stream, or any bridge that sends them. Tests use unicast on 127.0.0.1.
+- :class:`backend.robot.natnet_source.NatNetPoseSource` — the camera software's own NatNet stream
+  (NaturalPoint/OptiTrack: multicast 239.255.42.99 on data port 1511, or unicast), one rigid body
+  of it; the virtual robot can stream NatNet too. Chosen at connect (``tracker_protocol``).
 - :func:`recorded_poses` — a recorded run (replay).
 
 Tracker datagram v1 (big-endian, 40 bytes): magic ``b"PKT1"``, frame number u32, time f64,
@@ -84,6 +85,16 @@ class TrackerStats:
     received: int = 0
     dropped: int = 0  # frame-number gaps
     malformed: int = 0
+    ignored: int = 0  # well-formed frames without a pose (NatNet: the rigid body not in it, or not tracked)
+    last_frame: int | None = None
+
+    def frame(self, number: int) -> None:
+        """Count a frame received; a gap in the numbers counts as dropped frames (late ones are not)."""
+        if self.last_frame is not None and number > self.last_frame + 1:
+            self.dropped += number - self.last_frame - 1
+        if self.last_frame is None or number > self.last_frame:
+            self.last_frame = number
+        self.received += 1
 
     @property
     def loss(self) -> float:
@@ -159,7 +170,6 @@ class UdpPoseSource(PoseHistory):
         self.socket.bind((host, port))
         self.socket.settimeout(0.05)
         self.address = self.socket.getsockname()
-        self._last_frame: int | None = None
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._receive, name="tracker-udp", daemon=True)
         self._thread.start()
@@ -182,11 +192,7 @@ class UdpPoseSource(PoseHistory):
             except ValueError:
                 self.stats.malformed += 1
                 continue
-            if self._last_frame is not None and frame > self._last_frame + 1:
-                self.stats.dropped += frame - self._last_frame - 1
-            if self._last_frame is None or frame > self._last_frame:
-                self._last_frame = frame
-            self.stats.received += 1
+            self.stats.frame(frame)
             self.add(pose)
 
 

@@ -49,7 +49,8 @@ class VirtualRobot:
         **climber_options,
     ):
         """``tracker_to``: where to stream the body's tracker datagrams (None: no motion, radio only).
-        ``climber_options`` go to :class:`backend.robot.climber.Climber` (noise, speed, seed ...)."""
+        ``climber_options`` go to :class:`backend.robot.climber.Climber` (noise, speed, seed, the
+        camera's ``tracker_protocol``: PKT1 or NatNet ...)."""
         self.firmware = firmware or Firmware()
         self.server = socket.create_server((host, port))
         self.address = self.server.getsockname()

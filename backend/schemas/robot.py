@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+import ipaddress
+from typing import Annotated, Literal
 
 from pydantic import Field, field_validator
 
+from backend.robot.natnet import COMMAND_PORT, MULTICAST_GROUP, parse_version
 from backend.robot.ports import check_port
 from backend.robot.xbee import ROBOT_ADDRESS
 from backend.schemas.common import LegIn, Psi0Deg, RecordRef, Strict, Tags, Zeta0
@@ -29,7 +31,26 @@ class RobotConnect(Strict):
     ] = f"0x{ROBOT_ADDRESS:016X}"
     baud: Annotated[int, Field(ge=1200, le=1_000_000)] = 57_600
     tracker_host: Annotated[str, Field(max_length=100, pattern=r"^[\w.:-]+$")] = "127.0.0.1"
-    tracker_port: Annotated[int, Field(ge=0, le=65535)] = 9751
+    tracker_port: Annotated[
+        int, Field(ge=0, le=65535, description="the tracker's UDP port here (NatNet multicast: its data port, 1511)")
+    ] = 9751
+    tracker_protocol: Annotated[
+        Literal["pkt1", "natnet"], Field(description="pkt1: ParkourLab datagrams; natnet: the camera software's stream")
+    ] = "pkt1"
+    natnet_rigid_body_id: Annotated[int, Field(ge=0, le=2**31 - 1, description="the body's NatNet streaming id")] = 1
+    natnet_version: Annotated[
+        str, Field(max_length=8, description="the stream's NatNet version (2.0 to 4.x), or auto: the server's answer")
+    ] = "auto"
+    natnet_multicast_group: Annotated[
+        str | None,
+        Field(max_length=15, description="the stream's multicast group; null: unicast (connect to the server)"),
+    ] = MULTICAST_GROUP
+    natnet_server_host: Annotated[
+        str, Field(max_length=100, pattern=r"^[\w.:-]+$", description="the NatNet server")
+    ] = "127.0.0.1"
+    natnet_command_port: Annotated[int, Field(ge=1, le=65535, description="the NatNet server's command port")] = (
+        COMMAND_PORT
+    )
     calibration_origin: Annotated[list[Annotated[float, Field(ge=-1e4, le=1e4)]], Field(min_length=2, max_length=2)] = [
         0.0,
         0.0,
@@ -43,6 +64,27 @@ class RobotConnect(Strict):
     @classmethod
     def _openable(cls, url: str) -> str:
         return check_port(url)
+
+    @field_validator("natnet_version")
+    @classmethod
+    def _known_version(cls, version: str) -> str:
+        if version != "auto":
+            parse_version(version)  # a ParameterError (a ValueError) names the field and the range
+        return version
+
+    @field_validator("natnet_multicast_group")
+    @classmethod
+    def _multicast(cls, group: str | None) -> str | None:
+        if group is not None:
+            try:
+                address = ipaddress.IPv4Address(group)
+            except ValueError:
+                raise ValueError(
+                    f"must be an IPv4 multicast address such as {MULTICAST_GROUP}, got {group!r}"
+                ) from None
+            if not address.is_multicast:
+                raise ValueError(f"must be a multicast address (224.0.0.0 to 239.255.255.255), got {group}")
+        return group
 
 
 class ClosedLoopIn(Strict):

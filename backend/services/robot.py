@@ -19,6 +19,8 @@ import threading
 from backend.robot.limits import ServoLimits
 from backend.robot.link import EstopResult, LinkError, LinkState, RobotLink
 from backend.robot.live_run import LiveRun, RunSnapshot, execute, telemetry_dict
+from backend.robot.natnet import parse_version
+from backend.robot.natnet_source import NatNetPoseSource
 from backend.robot.supervisor import LinkSupervisor
 from backend.robot.tracker import Calibration, UdpPoseSource
 from backend.schemas import RobotConnect, RobotRunCreate
@@ -42,7 +44,7 @@ class RobotService:
         self.sessions = sessions
         self.robot = robot or get_preset("paper")  # the robot's physical parameters
         self.supervisor = LinkSupervisor()  # the link's one owner (backend/robot/supervisor.py)
-        self.tracker: UdpPoseSource | None = None
+        self.tracker: UdpPoseSource | NatNetPoseSource | None = None
         self._run: LiveRun | None = None  # the latest live run (its loop's); read its snapshot
         self._lock = threading.Lock()  # connect, disconnect and starting a run, one at a time
         # The e-stop's own thread: not the request pool that compute can fill, and no lock that a
@@ -70,7 +72,7 @@ class RobotService:
             self._disconnect()
             limits = ServoLimits(tuple(body.psi0_limits_deg), tuple(body.zeta0_limits))
             calibration = Calibration(tuple(body.calibration_origin), body.calibration_angle, body.calibration_scale)
-            self.tracker = UdpPoseSource(body.tracker_host, body.tracker_port, calibration=calibration)
+            self.tracker = open_tracker(body, calibration)
             link = RobotLink(body.url, baud=body.baud, limits=limits, robot_address=int(body.robot_address, 16))
             try:
                 self.supervisor.connect(link)
@@ -123,6 +125,7 @@ class RobotService:
                     "received": tracker.stats.received,
                     "dropped": tracker.stats.dropped,
                     "malformed": tracker.stats.malformed,
+                    "ignored": tracker.stats.ignored,
                     "loss": tracker.stats.loss,
                     "latest": None if pose is None else vars(pose),
                 },
@@ -240,6 +243,21 @@ class RobotService:
             return None
         hover = find_in_place_zeta0(self.robot.to_model(), legs[0].psi0, zeta0_range=(loop.zeta0_min, loop.zeta0_max))
         return loop.target_m, (hover, loop.kp, loop.ki, loop.kd, loop.zeta0_min, loop.zeta0_max)
+
+
+def open_tracker(body: RobotConnect, calibration: Calibration) -> UdpPoseSource | NatNetPoseSource:
+    """The pose source ``body`` asks for: PKT1 datagrams, or the NatNet stream's rigid body."""
+    if body.tracker_protocol == "pkt1":
+        return UdpPoseSource(body.tracker_host, body.tracker_port, calibration=calibration)
+    return NatNetPoseSource(
+        body.natnet_rigid_body_id,
+        interface=body.tracker_host,
+        port=body.tracker_port,
+        multicast_group=body.natnet_multicast_group,
+        server=(body.natnet_server_host, body.natnet_command_port),
+        version=None if body.natnet_version == "auto" else parse_version(body.natnet_version),
+        calibration=calibration,
+    )
 
 
 def _estop_latch(link: RobotLink | None) -> dict:

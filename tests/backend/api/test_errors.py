@@ -110,6 +110,8 @@ STRING_FIELDS = [
     ("/api/v1/runs", RUN | {"tags": ["@"]}, ["body", "tags", 0]),
     ("/api/v1/robot/connect", {"url": "@"}, ["body", "url"]),
     ("/api/v1/robot/connect", CONNECT | {"tracker_host": "@"}, ["body", "tracker_host"]),
+    ("/api/v1/robot/connect", CONNECT | {"natnet_version": "@"}, ["body", "natnet_version"]),
+    ("/api/v1/robot/connect", CONNECT | {"natnet_multicast_group": "@"}, ["body", "natnet_multicast_group"]),
     ("/api/v1/robot/runs", ROBOT_RUN | {"tags": ["@"]}, ["body", "tags", 0]),
 ]
 
