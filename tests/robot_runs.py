@@ -1,5 +1,6 @@
 """A finished robot run in the store, made without a robot or real time: the simulator's climb as
-the tracker's frames, journaled in two entries and folded as the journal writer does.
+the tracker's frames, journaled in two entries (JSON-safe: a missing pitch as null) and folded as
+the journal writer does.
 
 The tracker clock starts at :data:`TRACKER_EPOCH` (a camera's clock is not the run's), a few
 frames have no pitch, and the run has commands, telemetry and link changes stamped in Unix time.
@@ -18,6 +19,7 @@ from backend.schemas import LegIn, RobotRunCreate
 from backend.services import records
 from backend.services.robot_records import fold_journal, open_robot_run
 from backend.store.models import RunJournal
+from experiments.manifest import json_safe
 from sim_core import ControlSchedule, find_fixed_point, get_preset, simulate_trajectory
 
 TRACKER_EPOCH = 1000.0  # [s] the tracker's time of the run's first frame
@@ -62,7 +64,9 @@ def store_robot_run(session) -> int:
             "transitions": [{"time": start + 0.05, "from": "disarmed", "to": "armed", "reason": "arm"}] * (1 - first),
             "tracker": {"dropped": 2 * first, "loss": 0.001 * first},
         }
-        session.add(RunJournal(run_id=run_id, data=entry, written_at=created + datetime.timedelta(seconds=first + 1)))
+        session.add(
+            RunJournal(run_id=run_id, data=json_safe(entry), written_at=created + datetime.timedelta(seconds=first + 1))
+        )
     session.commit()
     fold_journal(session, run_id, status="done", end_reason="jumps done", disarm="disarmed", robot=robot)
     return run_id
