@@ -5,14 +5,15 @@ nondimensional overrides ``--alpha --d-hat --c-zeta --c-psi --mu``; ``--json`` p
 machine-readable form scripts rely on (keep it stable: extend, never break). Errors a user
 can fix print one line and exit with code 2.
 
-``parkour serve`` starts the service with the control panel and the 3D view.
+``parkour serve`` starts the service with the control panel and the 3D view; ``parkour export``
+writes a stored robot or replay run as an MCAP recording.
 """
 
 from __future__ import annotations
 
 import typer
 
-from cli import atlas, basin, bench, calibrate, gaits, mjtf, pid, reproduce, robot, serve, simulate, sweep
+from cli import atlas, basin, bench, calibrate, export, gaits, mjtf, pid, reproduce, robot, serve, simulate, sweep
 
 app = typer.Typer(
     name="parkour",
@@ -22,20 +23,8 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     rich_markup_mode=None,
 )
-COMMANDS = (
-    simulate,
-    gaits,
-    basin,
-    sweep,
-    mjtf,
-    pid,
-    atlas,
-    reproduce,
-    robot,
-    calibrate,
-    bench,
-    serve,
-)  # in the order of --help
+# In the order of --help.
+COMMANDS = (simulate, gaits, basin, sweep, mjtf, pid, atlas, reproduce, robot, calibrate, export, bench, serve)
 for command in COMMANDS:
     app.add_typer(command.app)
 

@@ -19,6 +19,7 @@ import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import Annotated
 
 import typer
@@ -62,6 +63,10 @@ SchedulerOption = Annotated[
     ),
 ]
 SeedOption = Annotated[int, typer.Option("--seed", help="Seed >= 0; the same seed gives the same numbers.")]
+DataDirOption = Annotated[
+    Path | None,
+    typer.Option("--data-dir", help="Where the database and token live; default $PARKOUR_DATA_DIR or ./data."),
+]
 
 
 @dataclass(frozen=True)

@@ -7,13 +7,12 @@ This is where the parts meet: the backend's FastAPI application, with the viser 
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Annotated
 
 import typer
 
 from backend.settings import DEFAULT_HOST, DEFAULT_PORT, WILDCARD_ADDRESSES, Settings
-from cli.options import handles_errors, note
+from cli.options import DataDirOption, handles_errors, note
 
 DEFAULT_VIEW_PORT = 8001
 
@@ -23,10 +22,7 @@ app = typer.Typer(rich_markup_mode=None)
 @app.command("serve")
 @handles_errors
 def serve_command(
-    data_dir: Annotated[
-        Path | None,
-        typer.Option("--data-dir", help="Where the database and token live; default $PARKOUR_DATA_DIR or ./data."),
-    ] = None,
+    data_dir: DataDirOption = None,
     host: Annotated[
         str,
         typer.Option(

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import datetime
 import math
+from collections.abc import Callable
 from dataclasses import asdict
 
 import numpy as np
@@ -160,12 +161,7 @@ def replay_run(session, run_id: int, robot=None) -> Run:
     if source.kind != "robot" or source.trajectory is None:
         raise Conflict(f"run {run_id} is a {source.kind} run without tracker frames; only robot runs can be replayed")
     frames = unpack_trajectory(source.trajectory)
-    recorded = [LegControl.from_degrees(*pair) for pair in source.results.get("touchdown_controls", [])]
-    alternating = [LegControl.from_degrees(*pair) for pair in source.controls]
-
-    def leg_for(k: int) -> LegControl:
-        return recorded[k] if k < len(recorded) else alternating[(k + 1) % 2]
-
+    leg_for = recorded_leg_for(source)
     touchdowns = detect_touchdowns(frames["time"], frames["x"], frames["y"], robot, leg_for)
     analysis = touchdown_results(touchdowns, [leg_for(k) for k in range(len(touchdowns))], robot)
     record = RunRecord(
@@ -188,6 +184,19 @@ def replay_run(session, run_id: int, robot=None) -> Run:
     replay = add_run(session, record, experiment_id=source.experiment_id)
     session.commit()
     return replay
+
+
+def recorded_leg_for(source: Run) -> Callable[[int], LegControl]:
+    """Detected touchdown k's controls in a robot run's replay: the ones the run recorded for it,
+    else the run's two legs alternating as the live run commanded them (detected touchdown k is
+    the climb's touchdown k + 1)."""
+    recorded = [LegControl.from_degrees(*pair) for pair in source.results.get("touchdown_controls", [])]
+    alternating = [LegControl.from_degrees(*pair) for pair in source.controls]
+
+    def leg_for(k: int) -> LegControl:
+        return recorded[k] if k < len(recorded) else alternating[(k + 1) % 2]
+
+    return leg_for
 
 
 def _seconds_between(start: datetime.datetime, end: datetime.datetime) -> float:

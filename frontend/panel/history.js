@@ -21,7 +21,8 @@ function runRow(run) {
   const actions = attributes(element("td", null,
     attributes(element("button", "edit"), { type: "button", class: "edit-run", "data-run": run.id, "aria-label": `edit the tags and notes of run ${run.id}` }), " ",
     attributes(element("button", "3D"), { type: "button", class: "open-3d", "data-run": run.id, "aria-label": `open run ${run.id} in the 3D view` }), " ",
-    attributes(element("a", "share"), { href: `${API}/runs/${run.id}/share.html`, download: "", "aria-label": `share run ${run.id} as a standalone HTML file` })),
+    attributes(element("a", "share"), { href: `${API}/runs/${run.id}/share.html`, download: "", "aria-label": `share run ${run.id} as a standalone HTML file` }),
+    ...recordingLink(run)),
   { class: "actions" });
   const row = element("tr", null, element("td", null, select), element("td", String(run.id)), element("td", run.kind),
     element("td", controls), element("td", `${run.jumps_completed}/${run.jumps}`), element("td", run.climb.toFixed(3)),
@@ -29,6 +30,14 @@ function runRow(run) {
     element("td", new Date(run.created_at).toLocaleString()), actions);
   row.id = `run-${run.id}`;
   return row;
+}
+
+// A robot or replay run that has ended downloads as an MCAP recording (Foxglove, Rerun open it).
+const RECORDED_KINDS = ["robot", "replay"];
+function recordingLink(run) {
+  if (!RECORDED_KINDS.includes(run.kind) || run.status === "running") return [];
+  return [" ", attributes(element("a", "MCAP"), { href: `${API}/runs/${run.id}/export.mcap`, download: "", class: "export-mcap",
+    "aria-label": `download run ${run.id} as an MCAP recording (Foxglove, Rerun)` })];
 }
 
 export async function loadRuns() {

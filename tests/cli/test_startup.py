@@ -11,10 +11,11 @@ import sys
 import pytest
 
 # Loaded only when a command runs: the kernels, the optimiser, the store, the service, the cluster,
-# plotting and the 3D view.
-HEAVY = ("numba", "scipy", "sqlalchemy", "alembic", "dask", "distributed", "matplotlib", "viser", "fastapi", "uvicorn")
+# plotting, the 3D view and the MCAP writer.
+HEAVY = ("numba", "scipy", "sqlalchemy", "alembic", "dask", "distributed", "matplotlib", "viser", "fastapi", "uvicorn",
+         "mcap")  # fmt: skip
 COMMANDS = ("map", "trajectory", "fixed-point", "gaits", "basin", "sweep", "mjtf", "pid", "atlas", "reproduce")
-COMMANDS += ("robot-sim", "bench", "serve")
+COMMANDS += ("robot-sim", "export", "bench", "serve")
 
 
 def _imported_by(*argv: str) -> set[str]:

@@ -14,11 +14,15 @@ from pathlib import Path
 import httpx
 import numpy as np
 import pytest
+from mcap.reader import make_reader
 from PIL import Image
 
 from backend.robot.virtual import VirtualRobot
+from backend.store.database import make_engine, session_factory, sqlite_url
 from sim_core.noise import NO_NOISE
+from tests.backend.api.bodies import RUN
 from tests.helpers import free_port, start_service
+from tests.robot_runs import store_robot_run
 
 pytestmark = pytest.mark.slow  # a browser and a service: ~20 s
 
@@ -30,8 +34,14 @@ sync_api = pytest.importorskip("playwright.sync_api")
 
 
 @pytest.fixture(scope="module")
-def service(tmp_path_factory):
-    data, port = tmp_path_factory.mktemp("panel") / "data", free_port()
+def data_dir(tmp_path_factory):
+    """The service's data directory (its SQLite store)."""
+    return tmp_path_factory.mktemp("panel") / "data"
+
+
+@pytest.fixture(scope="module")
+def service(data_dir):
+    data, port = data_dir, free_port()
     process = start_service(data, port, "--view-port", "0")
     base = f"http://127.0.0.1:{port}"
     yield base, (data / "api_token").read_text().strip()
@@ -481,6 +491,32 @@ def test_a_run_opens_in_3d_and_shares_as_a_file(page, service, tmp_path):
     with page.context.new_page() as offline:  # from disk, no service: what a colleague gets by mail
         offline.goto(path.as_uri())
         assert _canvas_is_drawn(offline.main_frame)
+
+
+def test_a_robot_run_downloads_as_mcap_from_history(page, service, data_dir):
+    base, token = service
+    simulated = page.request.post(f"{base}/api/v1/runs", data=RUN, headers={"Authorization": f"Bearer {token}"})
+    assert simulated.status == 201, simulated.text()
+    engine = make_engine(sqlite_url(data_dir))  # a robot run as a live run stores one, beside the service
+    with session_factory(engine)() as session:
+        run_id = store_robot_run(session)
+    engine.dispose()
+    page.click("nav [data-tab=history]")
+    page.click("#history-form button[type=submit]")
+    page.wait_for_selector(f"#run-{run_id} a.export-mcap")
+    link = f"#run-{run_id} a.export-mcap"
+    assert page.inner_text(link) == "MCAP" and page.get_attribute(link, "download") == ""
+    assert page.get_attribute(link, "href") == f"/api/v1/runs/{run_id}/export.mcap"
+    rows = page.evaluate(
+        "[...document.querySelectorAll('#run-table tbody tr')]"
+        ".map((row) => [row.children[2].textContent, !!row.querySelector('a.export-mcap')])"
+    )
+    assert {kind for kind, linked in rows if linked} <= {"robot", "replay"}
+    assert any(kind == "sim" and not linked for kind, linked in rows), "a simulated run is no recording"
+    recording = page.request.get(f"{base}{page.get_attribute(link, 'href')}")
+    assert recording.ok and recording.headers["content-type"] == "application/octet-stream"
+    summary = make_reader(io.BytesIO(recording.body())).get_summary()
+    assert sum(summary.statistics.channel_message_counts.values()) > 336
 
 
 def test_each_person_has_their_own_3d_view(page, service):

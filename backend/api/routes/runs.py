@@ -2,19 +2,24 @@
 
 from __future__ import annotations
 
+import io
 from typing import Annotated
 
 from fastapi import APIRouter, Query, Request
 from fastapi.concurrency import run_in_threadpool
-from fastapi.responses import StreamingResponse
+from fastapi.responses import Response, StreamingResponse
 from pydantic import Field
 
 from backend import schemas
 from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, QuickCompute, RecordId, RunQuery, request_session
-from backend.services import exports, records, simulation
+from backend.services import exports, mcap_export, records, simulation
 from backend.services.robot_records import replay_run
 
 router = APIRouter(prefix="/api/v1/runs", tags=["runs"])
+
+
+class McapResponse(Response):
+    media_type = "application/octet-stream"  # MCAP has no registered media type
 
 
 @router.post("", status_code=201, dependencies=AUTHORIZED, response_model=schemas.RunDetail)
@@ -103,6 +108,17 @@ def get_trajectory(run_id: RecordId, db: Db):
         raise records.NotFound("trajectory of run", run_id)
     columns = simulation.unpack_trajectory(run.trajectory)
     return {"units": "nondimensional", "columns": {name: values.tolist() for name, values in columns.items()}}
+
+
+@router.get("/{run_id}/export.mcap", response_class=McapResponse)
+def export_mcap(run_id: RecordId, db: Db) -> McapResponse:
+    """A robot or replay run as an MCAP recording, which Foxglove and Rerun open: tracker poses,
+    touchdowns, commands, telemetry, link changes and the model's prediction (docs/service.md).
+    A simulated or still running run is a 409."""
+    stream = io.BytesIO()
+    mcap_export.export_run(db, run_id, stream)
+    disposition = f'attachment; filename="parkourlab-run-{run_id}.mcap"'
+    return McapResponse(stream.getvalue(), headers={"Content-Disposition": disposition})
 
 
 @router.post("/{run_id}/replay", status_code=201, dependencies=AUTHORIZED, response_model=schemas.RunDetail)

@@ -4,8 +4,10 @@ import csv
 import io
 
 import pytest
+from mcap.reader import make_reader
 
 from tests.backend.api.bodies import RUN
+from tests.robot_runs import store_robot_run
 
 
 def test_run_matches_the_simulator_and_stores_its_path(client, auth):
@@ -57,6 +59,25 @@ def test_export_csv_and_json(client, auth):
     as_json = client.get("/api/v1/runs/export", params={"format": "json"}).json()
     assert [row["id"] for row in as_json] == ids and as_json[2]["leg0.zeta0"] == 0.92
     assert client.get("/api/v1/runs/export", params={"format": "xml"}).status_code == 422
+
+
+def test_a_robot_run_downloads_as_mcap(client, auth):
+    with client.app.state.sessions() as session:
+        robot_run = store_robot_run(session)
+    response = client.get(f"/api/v1/runs/{robot_run}/export.mcap")
+    assert response.status_code == 200 and response.headers["content-type"] == "application/octet-stream"
+    assert response.headers["content-disposition"] == f'attachment; filename="parkourlab-run-{robot_run}.mcap"'
+    summary = make_reader(io.BytesIO(response.content)).get_summary()
+    counts = {summary.channels[i].topic: n for i, n in summary.statistics.channel_message_counts.items()}
+    assert counts["/tracker/pose"] == 336 and counts["/touchdowns"] == 5 and counts["/model/prediction"] == 5
+    replay = client.post(f"/api/v1/runs/{robot_run}/replay", headers=auth).json()
+    assert client.get(f"/api/v1/runs/{replay['id']}/export.mcap").status_code == 200
+    missing = client.get("/api/v1/runs/999/export.mcap")
+    assert (missing.status_code, missing.json()) == (404, {"detail": "run 999 does not exist"})
+    simulated = client.post("/api/v1/runs", json=RUN, headers=auth).json()
+    refused = client.get(f"/api/v1/runs/{simulated['id']}/export.mcap")
+    assert refused.status_code == 409 and "only robot and replay runs are recordings" in refused.json()["detail"]
+    assert client.get("/api/v1/runs/0/export.mcap").status_code == 422
 
 
 def test_compare_shows_only_what_differs(client, auth):

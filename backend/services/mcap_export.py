@@ -1,0 +1,237 @@
+"""A robot or replay run as an MCAP recording (https://mcap.dev), which Foxglove and Rerun open.
+
+Channels (topics, schemas and units: :mod:`backend.services.mcap_schemas`), JSON messages:
+
+- ``/tracker/pose`` and ``/tracker/pose_in_frame`` (Foxglove's ``foxglove.PoseInFrame``): one
+  message per tracker frame;
+- ``/touchdowns``: one per detected touchdown, with the controls it was made with;
+- ``/commands``, ``/telemetry``, ``/robot/link``: what the PC sent, what the robot reported, the
+  link's state changes;
+- ``/model/prediction``: the model's prediction of each touchdown from the first (none with fewer
+  than two touchdowns).
+
+Timestamps (log time = publish time, UTC nanoseconds since the Unix epoch): a tracker-clock time
+``t`` (frames, touchdowns, predictions) is placed at the run's start (``created_at``) plus ``t``
+minus the first frame's time, so the first frame is at the start; commands, telemetry and link
+changes carry Unix times of their own and are placed at them. The two clocks then agree to the
+few milliseconds between the run's start and its first frame. Messages are written in log-time
+order, zstd-compressed in chunks, with a summary (message counts per channel).
+
+A replay run has no frames, commands or telemetry of its own: its recording is its source run's
+(frames, commands, telemetry, link, and times from the source's start) with the replay's own
+touchdowns and prediction. The run's metadata — id, kind, model, controls, code version,
+calibration, how it ended — is a Metadata record named ``parkourlab.run`` (text as it is, any
+other value as JSON text).
+Simulated runs are not recordings (nondimensional, no clock) and are refused with a Conflict.
+"""
+
+from __future__ import annotations
+
+import datetime
+import json
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import BinaryIO
+
+from sqlalchemy.orm import Session
+
+from backend.services.mcap_schemas import CHANNELS
+from backend.services.records import Conflict, get_run
+from backend.services.robot_records import recorded_leg_for
+from backend.services.simulation import unpack_trajectory
+from backend.store.models import Run
+from experiments.manifest import json_safe
+
+EXPORTED_KINDS = ("robot", "replay")
+METADATA_NAME = "parkourlab.run"
+POSE_FRAME = "chute"
+NS_PER_S = 1_000_000_000
+
+
+@dataclass(frozen=True)
+class Recording:
+    """What a run's MCAP holds before it is written: each topic's messages as (log time [ns], JSON
+    dict), in the order they happened, and the run's metadata (:func:`_metadata`)."""
+
+    run_id: int
+    messages: dict[str, list[tuple[int, dict]]]
+    metadata: dict[str, str]
+
+    def counts(self) -> dict[str, int]:
+        return {topic: len(messages) for topic, messages in self.messages.items()}
+
+
+def export_run(session: Session, run_id: int, stream: BinaryIO) -> dict[str, int]:
+    """Write run ``run_id``'s recording to ``stream`` (binary, seekable or not); returns the
+    message count per topic. NotFound for a missing run, Conflict for one that is no recording."""
+    recording = recording_of(session, run_id)
+    write_recording(recording, stream)
+    return recording.counts()
+
+
+def recording_of(session: Session, run_id: int) -> Recording:
+    """The recording of a robot run that has ended, or of a replay whose source run is stored."""
+    run = get_run(session, run_id)
+    if run.kind not in EXPORTED_KINDS:
+        raise Conflict(f"run {run_id} is a {run.kind} run: only robot and replay runs are recordings (MCAP);"
+                       f" its path is at /api/v1/runs/{run_id}/trajectory")  # fmt: skip
+    if run.status == "running":
+        raise Conflict(f"run {run_id} is still running; export it once it has ended")
+    source = run
+    if run.kind == "replay":
+        source_id = run.results.get("source_run_id")
+        source = session.get(Run, source_id) if isinstance(source_id, int) else None
+        if source is None:
+            raise Conflict(f"replay run {run_id}'s source run {source_id} is gone: its frames were not kept")
+    frames = unpack_trajectory(source.trajectory) if source.trajectory is not None else None
+    first_frame_time = float(frames["time"][0]) if frames is not None and frames["time"].size else 0.0
+    start_ns = _utc_ns(source.created_at)
+
+    def at(tracker_time: float) -> int:
+        return start_ns + round((tracker_time - first_frame_time) * NS_PER_S)
+
+    results = run.results
+    touchdowns = results.get("touchdowns", [])
+    if run.kind == "robot":
+        controls = [{"psi0_deg": psi0, "zeta0": zeta0} for psi0, zeta0 in results.get("touchdown_controls", [])]
+    else:
+        leg_for = recorded_leg_for(source)
+        controls = [{"psi0_deg": leg.psi0_deg, "zeta0": leg.zeta0} for leg in map(leg_for, range(len(touchdowns)))]
+    rises = results.get("rises", [])
+    poses = [(at(frame["tracker_time"]), frame) for frame in _poses(frames)]
+    messages = {
+        "/tracker/pose": poses,
+        "/tracker/pose_in_frame": [(time, _pose_in_frame(time, pose)) for time, pose in poses],
+        "/touchdowns": [
+            (at(td["time"]), _touchdown(td, controls[k] if k < len(controls) else None, rises))
+            for k, td in enumerate(touchdowns)
+        ],
+        "/commands": _unix_timed(source.results.get("commands", [])),
+        "/telemetry": _unix_timed(source.results.get("telemetry", [])),
+        "/model/prediction": [
+            (at(touchdowns[k]["time"]), message)
+            for k, message in enumerate(_predictions(results.get("prediction"), touchdowns, rises))
+        ],
+        "/robot/link": _unix_timed(source.results.get("transitions", [])),
+    }
+    return Recording(run.id, messages, _metadata(run, source))
+
+
+def write_recording(recording: Recording, stream: BinaryIO) -> None:
+    """The recording as MCAP on ``stream``: a schema and channel per topic (even one without
+    messages), the metadata record, then every message in log-time order."""
+    from mcap.writer import Writer  # the exports load it, not the service's start
+
+    writer = Writer(stream)
+    writer.start(profile="", library="parkourlab")
+    channel_ids = {}
+    for topic, schema in CHANNELS.items():
+        schema_id = writer.register_schema(schema["title"], "jsonschema", json.dumps(schema).encode())
+        channel_ids[topic] = writer.register_channel(topic, "json", schema_id)
+    writer.add_metadata(METADATA_NAME, recording.metadata)
+    timed = sorted(
+        ((time, topic, sequence, message) for topic in CHANNELS
+         for sequence, (time, message) in enumerate(recording.messages[topic])),
+        key=lambda item: item[0],
+    )  # fmt: skip
+    for time, topic, sequence, message in timed:
+        data = json.dumps(json_safe(message), allow_nan=False, separators=(",", ":")).encode()
+        writer.add_message(channel_ids[topic], log_time=time, data=data, publish_time=time, sequence=sequence)
+    writer.finish()
+
+
+def _poses(frames: dict | None) -> Iterator[dict]:
+    if frames is None:
+        return
+    times, xs, ys = frames["time"].tolist(), frames["x"].tolist(), frames["y"].tolist()
+    pitches = frames["pitch"].tolist() if "pitch" in frames else [math.nan] * len(times)
+    for t, x, y, pitch in zip(times, xs, ys, pitches, strict=True):
+        yield {"tracker_time": t, "x": x, "y": y, "pitch": pitch if math.isfinite(pitch) else None}
+
+
+def _pose_in_frame(time_ns: int, pose: dict) -> dict:
+    """A tracker pose as ``foxglove.PoseInFrame`` in frame ``chute`` (x across, z up): a
+    counter-clockwise pitch seen with x right and up up is a turn about -y."""
+    half = 0.5 * (pose["pitch"] or 0.0)
+    return {
+        "timestamp": {"sec": time_ns // NS_PER_S, "nsec": time_ns % NS_PER_S},
+        "frame_id": POSE_FRAME,
+        "pose": {
+            "position": {"x": pose["x"], "y": 0.0, "z": pose["y"]},
+            "orientation": {"x": 0.0, "y": -math.sin(half), "z": 0.0, "w": math.cos(half)},
+        },
+    }
+
+
+def _touchdown(stored: dict, control: dict | None, rises: list) -> dict:
+    k = stored["index"]
+    return {
+        "index": k,
+        "tracker_time": stored["time"],
+        "wall": stored["wall"],
+        "state": stored["state"],
+        "body_height": stored["body_height"],
+        "foot_height": stored["foot_height"],
+        "poses_fitted": stored["poses_fitted"],
+        "control": control,
+        "rise": rises[k - 1] if 0 < k <= len(rises) else None,
+    }
+
+
+def _predictions(prediction: dict | None, touchdowns: list[dict], rises: list) -> list[dict]:
+    """One message per predicted touchdown k (the measured touchdown k beside it)."""
+    if prediction is None:
+        return []
+    predicted_rises = prediction["rises"]
+    return [
+        {
+            "index": k,
+            "state": state,
+            "measured_state": touchdowns[k]["state"],
+            "rise": predicted_rises[k - 1] if 0 < k <= len(predicted_rises) else None,
+            "measured_rise": rises[k - 1] if 0 < k <= len(rises) else None,
+        }
+        for k, state in enumerate(prediction["states"][: len(touchdowns)])
+    ]
+
+
+def _unix_timed(records: list[dict]) -> list[tuple[int, dict]]:
+    """Records stamped with their own Unix ``time`` [s], in the order they were recorded."""
+    return [(round(record["time"] * NS_PER_S), record) for record in records]
+
+
+def _metadata(run: Run, source: Run) -> dict[str, str]:
+    results = source.results
+    values = {
+        "run_id": run.id,
+        "kind": run.kind,
+        "status": run.status,
+        "created_at": _utc(run.created_at).isoformat(),
+        "recorded_at": _utc(source.created_at).isoformat(),
+        "source_run_id": source.id if source is not run else None,
+        "code_version": run.code_version,
+        "model": run.model,
+        "controls": run.controls,
+        "jumps": run.jumps,
+        "tags": list(run.tags),
+        "calibration": results.get("calibration"),
+        "closed_loop": results.get("closed_loop"),
+        "end_reason": results.get("end_reason"),
+        "disarm": results.get("disarm"),
+        "tracker": results.get("tracker"),
+        "time_convention": "log time = UTC ns; tracker times at recorded_at + (t - first frame's t); "
+        "commands, telemetry, link at their own Unix time",
+    }
+    return {name: value if isinstance(value, str) else json.dumps(json_safe(value)) for name, value in values.items()}
+
+
+def _utc(moment: datetime.datetime) -> datetime.datetime:
+    """A stored time as aware UTC (SQLite gives it back naive, in UTC)."""
+    return moment if moment.tzinfo is not None else moment.replace(tzinfo=datetime.UTC)
+
+
+def _utc_ns(moment: datetime.datetime) -> int:
+    aware = _utc(moment)
+    epoch = datetime.datetime(1970, 1, 1, tzinfo=datetime.UTC)
+    return (aware - epoch) // datetime.timedelta(microseconds=1) * 1000

@@ -1,0 +1,54 @@
+"""``parkour export``: a stored robot or replay run as an MCAP recording, which Foxglove and Rerun
+open (the format: docs/service.md, "Recordings"; the writer: backend/services/mcap_export.py)."""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from cli.options import DataDirOption, JsonOption, handles_errors, note, print_json
+from sim_core.errors import ParameterError
+
+app = typer.Typer(rich_markup_mode=None)
+
+
+@app.command("export")
+@handles_errors
+def export_command(
+    run_id: Annotated[int, typer.Argument(help="The run's id (a robot or replay run).", min=1)],
+    out: Annotated[
+        Path | None, typer.Option("--out", help="The MCAP file to write; default parkourlab-run-RUN_ID.mcap.")
+    ] = None,
+    data_dir: DataDirOption = None,
+    json_output: JsonOption = False,
+) -> None:
+    """Export a robot or replay run as MCAP: tracker poses, touchdowns, commands, telemetry, the model's prediction."""
+    from backend.services import mcap_export, records
+    from backend.settings import Settings
+    from backend.store.database import database_file, make_engine, migrate, session_factory
+
+    settings = Settings.from_environment(data_dir)
+    engine = make_engine(settings.database_url)
+    try:
+        database = database_file(engine)
+        if database is not None and not database.exists():
+            raise ParameterError("data_dir", f"no store in {settings.data_dir} (no {database.name}); give --data-dir")
+        migrate(engine)  # as the service does at its start: nothing to do for a store it has opened
+        stream = io.BytesIO()
+        with session_factory(engine)() as session:
+            try:
+                counts = mcap_export.export_run(session, run_id, stream)
+            except (records.NotFound, records.Conflict) as error:
+                raise ParameterError("run_id", str(error)) from None
+    finally:
+        engine.dispose()
+    path = out or Path(f"parkourlab-run-{run_id}.mcap")
+    path.write_bytes(stream.getvalue())
+    size = path.stat().st_size
+    if json_output:
+        print_json({"path": str(path), "bytes": size, "channels": counts})
+    else:
+        note(f"run {run_id} → {path} ({size} bytes): " + ", ".join(f"{topic} {n}" for topic, n in counts.items()))

@@ -1,0 +1,82 @@
+"""A finished robot run in the store, made without a robot or real time: the simulator's climb as
+the tracker's frames, journaled in two entries (JSON-safe: a missing pitch as null) and folded as
+the journal writer does.
+
+The tracker clock starts at :data:`TRACKER_EPOCH` (a camera's clock is not the run's), a few
+frames have no pitch, and the run has commands, telemetry and link changes stamped in Unix time.
+"""
+
+from __future__ import annotations
+
+import datetime
+import math
+
+import numpy as np
+
+from backend.robot.touchdown import detect_touchdowns
+from backend.robot.tracker import Calibration
+from backend.schemas import LegIn, RobotRunCreate
+from backend.services import records
+from backend.services.robot_records import fold_journal, open_robot_run
+from backend.store.models import RunJournal
+from experiments.manifest import json_safe
+from sim_core import ControlSchedule, find_fixed_point, get_preset, simulate_trajectory
+
+TRACKER_EPOCH = 1000.0  # [s] the tracker's time of the run's first frame
+JUMPS = 6
+LEGS = ((30.0, 0.87), (30.0, 0.9))
+REQUEST = RobotRunCreate(controls=[LegIn(psi0_deg=p, zeta0=z) for p, z in LEGS], jumps=JUMPS - 1, tags=["lab"])
+
+
+def climb_frames(jumps: int = JUMPS) -> dict[str, np.ndarray]:
+    """The paper's period-2 gait climbing ``jumps`` jumps, as 100 Hz tracker frames (SI, wall coordinates)."""
+    robot = get_preset("paper")
+    model = robot.to_model()
+    schedule = ControlSchedule.from_degrees(LEGS)
+    gait = find_fixed_point(model, schedule, 2, (-0.8, -0.15))
+    path = simulate_trajectory(model, schedule, gait.state, jumps, sample_rate=100.0 * robot.scales.time).to_si(robot)
+    pitch = np.full(path.time.size, 0.02)
+    pitch[::7] = math.nan  # frames the markers gave no pitch
+    return {"time": path.time + TRACKER_EPOCH, "x": path.x, "y": path.y, "pitch": pitch}
+
+
+def store_robot_run(session) -> int:
+    """A robot run stored as a live run stores one (opened, journaled, folded ``done``); its id."""
+    robot = get_preset("paper")
+    schedule = ControlSchedule.from_degrees(LEGS)
+    frames = climb_frames()
+    touchdowns = detect_touchdowns(frames["time"], frames["x"], frames["y"], robot, lambda k: schedule[k + 1])
+    run_id = open_robot_run(session, REQUEST, robot, Calibration())
+    created = records.get_run(session, run_id).created_at.replace(tzinfo=datetime.UTC)
+    start = created.timestamp()
+    half = frames["time"].size // 2
+    split = frames["time"][half]
+    for first, (lo, hi) in enumerate(((0, half), (half, frames["time"].size))):
+        entry = {
+            "frames": {name: values[lo:hi].tolist() for name, values in frames.items()},
+            "touchdowns": [
+                {"touchdown": td.to_dict(), "control": [schedule[td.index + 1].psi0_deg, schedule[td.index + 1].zeta0]}
+                for td in touchdowns
+                if (td.time < split) == (first == 0)
+            ],
+            "commands": [_command(start + 0.01 * leg, leg) for leg in (0, 1)] if first == 0 else [_command(start + 2)],
+            "telemetry": [_telemetry(start + 0.1 * (seq + 1), seq) for seq in range(3 * first, 3 * first + 3)],
+            "transitions": [{"time": start + 0.05, "from": "disarmed", "to": "armed", "reason": "arm"}] * (1 - first),
+            "tracker": {"dropped": 2 * first, "loss": 0.001 * first},
+        }
+        session.add(
+            RunJournal(run_id=run_id, data=json_safe(entry), written_at=created + datetime.timedelta(seconds=first + 1))
+        )
+    session.commit()
+    fold_journal(session, run_id, status="done", end_reason="jumps done", disarm="disarmed", robot=robot)
+    return run_id
+
+
+def _command(time: float, leg: int = 0) -> dict:
+    psi0_deg, zeta0 = LEGS[leg]
+    return {"time": time, "leg": ("left", "right")[leg], "psi0_deg": psi0_deg, "zeta0": zeta0, "why": "start"}
+
+
+def _telemetry(time: float, seq: int) -> dict:
+    return {"time": time, "seq": seq, "state": "running", "psi_servo_deg": [30.0, 30.0], "zeta_servo": [0.87, 0.9],
+            "battery_mv": 7400, "faults": 0}  # fmt: skip
