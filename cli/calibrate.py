@@ -3,23 +3,15 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 from typing import Annotated
 
 import typer
 
-from cli.options import EXIT_USAGE, JsonOption, handles_errors, note, print_json
+from cli.options import DataDirOption, JsonOption, handles_errors, note, print_json, store_sessions
 from sim_core.errors import ParameterError
 from sim_core.presets import DEFAULT_PRESET
 
 app = typer.Typer(rich_markup_mode=None)
-
-DataDirOption = Annotated[
-    Path | None,
-    typer.Option(
-        "--data-dir", help="Where the database lives; default $PARKOUR_DATA_DIR or ./data ($DATABASE_URL wins)."
-    ),
-]
 
 
 def parse_run_ids(text: str) -> list[int]:
@@ -54,18 +46,14 @@ def calibrate_command(
     """
     from backend.services.calibrations import calibrate_runs
     from backend.services.records import Conflict, NotFound
-    from backend.settings import Settings
-    from backend.store.database import opened_store
 
     run_ids = parse_run_ids(runs)
     name = name or "calibrated-" + "-".join(map(str, run_ids))[:50]
-    settings = Settings.from_environment(data_dir)
-    with opened_store(settings.database_url) as sessions, sessions() as session:
+    with store_sessions(data_dir) as sessions, sessions() as session:
         try:
             payload = calibrate_runs(session, run_ids, name=name, base=base)
         except (NotFound, Conflict) as error:
-            typer.echo(f"error: {error}", err=True)
-            raise typer.Exit(EXIT_USAGE) from None
+            raise ParameterError("runs", str(error)) from None
     if json_output:
         print_json(payload)
         return

@@ -9,7 +9,7 @@ from typing import Annotated
 
 import typer
 
-from cli.options import DataDirOption, JsonOption, handles_errors, note, print_json
+from cli.options import DataDirOption, JsonOption, handles_errors, note, print_json, store_sessions
 from sim_core.errors import ParameterError
 
 app = typer.Typer(rich_markup_mode=None)
@@ -27,24 +27,13 @@ def export_command(
 ) -> None:
     """Export a robot or replay run as MCAP: tracker poses, touchdowns, commands, telemetry, the model's prediction."""
     from backend.services import mcap_export, records
-    from backend.settings import Settings
-    from backend.store.database import database_file, make_engine, migrate, session_factory
 
-    settings = Settings.from_environment(data_dir)
-    engine = make_engine(settings.database_url)
-    try:
-        database = database_file(engine)
-        if database is not None and not database.exists():
-            raise ParameterError("data_dir", f"no store in {settings.data_dir} (no {database.name}); give --data-dir")
-        migrate(engine)  # as the service does at its start: nothing to do for a store it has opened
-        stream = io.BytesIO()
-        with session_factory(engine)() as session:
-            try:
-                counts = mcap_export.export_run(session, run_id, stream)
-            except (records.NotFound, records.Conflict) as error:
-                raise ParameterError("run_id", str(error)) from None
-    finally:
-        engine.dispose()
+    stream = io.BytesIO()
+    with store_sessions(data_dir) as sessions, sessions() as session:
+        try:
+            counts = mcap_export.export_run(session, run_id, stream)
+        except (records.NotFound, records.Conflict) as error:
+            raise ParameterError("run_id", str(error)) from None
     path = out or Path(f"parkourlab-run-{run_id}.mcap")
     path.write_bytes(stream.getvalue())
     size = path.stat().st_size

@@ -90,18 +90,32 @@ def build_setup(preset: str, **overrides: float | None) -> ModelSetup:
 
 def stored_preset(name: str) -> PhysicalParams:
     """A preset ``parkour calibrate`` stored, from the database of ``$PARKOUR_DATA_DIR`` (default
-    ./data) or ``$DATABASE_URL``; the unknown-preset error if there is none. A missing SQLite file
-    is not created."""
+    ./data) or ``$DATABASE_URL``; the unknown-preset error if there is none (no store is created)."""
     from backend.services.calibrations import preset_params
+
+    try:
+        with store_sessions(None) as sessions, sessions() as session:
+            return preset_params(session, name)[0]
+    except ParameterError as error:
+        if error.field != "data_dir":
+            raise
+        return get_preset(name)  # no store: raises, naming the built-in presets
+
+
+@contextmanager
+def store_sessions(data_dir: Path | None) -> Iterator[Callable]:
+    """Sessions on the store of ``data_dir`` (default ``$PARKOUR_DATA_DIR`` or ./data; ``$DATABASE_URL``
+    wins), migrated as the service's start migrates it. A SQLite store that does not exist is a
+    :class:`ParameterError` naming ``data_dir``: a command that reads never creates an empty one."""
     from backend.settings import Settings
     from backend.store.database import opened_store, sqlite_file
 
-    settings = Settings.from_environment()
+    settings = Settings.from_environment(data_dir)
     database = sqlite_file(settings.database_url)
-    if settings.database_url.startswith("sqlite") and (database is None or not database.exists()):
-        return get_preset(name)  # raises, naming the built-in presets
-    with opened_store(settings.database_url) as sessions, sessions() as session:
-        return preset_params(session, name)[0]
+    if database is not None and not database.exists():
+        raise ParameterError("data_dir", f"no store in {settings.data_dir} (no {database.name}); give --data-dir")
+    with opened_store(settings.database_url) as sessions:
+        yield sessions
 
 
 _MODEL_PARAMETERS = [

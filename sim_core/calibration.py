@@ -6,17 +6,24 @@ servo offsets of psi0 [deg] and zeta0 [l0] (:class:`~sim_core.controls.LegOffset
 
 From what: touchdown-to-touchdown pairs. Each measured touchdown is mapped one jump forward by
 the model (:mod:`sim_core.touchdown_model`) and compared with the next measured one on three
-channels — ``xdot``, ``ydot`` and the rise between the feet. Least squares
-(``scipy.optimize.least_squares``, trust region) runs twice: first with nominal channel scales,
-then with each channel weighted by its own residual scatter, so none dominates by its units.
+channels — ``xdot``, ``ydot`` and the rise between the feet.
 
-How sure: the covariance is ``s^2 (J^T J)^-1`` at the optimum (``s^2`` the weighted residuals'
-variance per degree of freedom), from an SVD; standard errors and the correlation matrix come
-from it. A direction of parameter space the data do not constrain (a singular value below
-:data:`IDENTIFIABLE_RCOND` of the largest) makes every parameter along it *unidentifiable*: it is
-named, its standard error is infinite, and its value is the base model's or the fit's arbitrary
-one — not a measurement. The channels' scatter after the fit is the noise the model does not
-explain (control noise, tracker noise, process noise): :attr:`CalibrationFit.noise`.
+How: least squares (``scipy.optimize.least_squares``, trust region), first with each channel at a
+nominal scale, then (:data:`GLS_PASSES` times) with each pair weighted by its own covariance: the
+noise of its inputs carried through the map's sensitivities plus the tracker's on its outputs,
+at the noise levels most likely at the estimate so far (:mod:`sim_core.calibration_noise`). A jump
+near failing, where the map is steep, so counts for little and does not bias the fit; a plain
+fit of these runs put its parameters 2-3 times further from the truth than its errors said.
+Huber's loss beyond :data:`ROBUST_SCALE` sigmas outweighs what still falls outside (the last
+touchdown before a fall). The noise levels found are reported: :attr:`CalibrationFit.noise`.
+
+How sure: the covariance is a sandwich estimate at the optimum (:func:`_uncertainty`; neighbouring
+pairs share a touchdown), its inner inverse from an SVD; standard errors and the correlation
+matrix come from it. On 14 seeded sets of four noisy 100-jump climbs the errors of the seven
+parameters had standard deviations of 0.9-1.4 standard errors. A direction of parameter space the
+data do not constrain (a singular value below :data:`IDENTIFIABLE_RCOND` of the largest) makes
+every parameter along it *unidentifiable*: named, with an infinite standard error — not a
+measurement. Pairs correlated beyond :data:`CONFOUNDED` are named as hard to tell apart.
 """
 
 from __future__ import annotations
@@ -26,9 +33,10 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from sim_core.calibration_noise import TouchdownNoise, estimate_noise, pair_covariances, whitening
 from sim_core.controls import LegOffsets
 from sim_core.params import ModelParams
-from sim_core.touchdown_model import CHANNEL_UNITS, CHANNELS, Pairs, TouchdownSeries, predict_pairs
+from sim_core.touchdown_model import CHANNEL_UNITS, CHANNELS, Pairs, TouchdownSeries, predict_pairs, sensitivities
 from sim_core.validation import ParameterError
 
 # The fitted vector, in order: its names in the JSON, and the units the fit works in.
@@ -36,6 +44,8 @@ PARAMETERS = ("alpha", "c_zeta", "c_psi", "psi0_offset_deg.left", "psi0_offset_d
               "zeta0_offset.left", "zeta0_offset.right")  # fmt: skip
 TYPICAL_SCALE = np.array([10.0, 0.3, 0.3, 0.5, 0.5, 0.005, 0.005])  # steps of a comparable effect
 NOMINAL_SCATTER = np.array([0.02, 0.02, 0.005])  # first-pass channel scales: xdot, ydot, rise
+GLS_PASSES = 2
+ROBUST_SCALE = 3.0  # Huber loss: residuals beyond 3 channel sigmas count linearly, not squared
 FAILED_RESIDUAL = 10.0  # a pair whose predicted jump fails, in channel scales (bounded, so the fit moves on)
 IDENTIFIABLE_RCOND = 1e-6
 CONFOUNDED = 0.95  # |correlation| above which two parameters are reported as hard to tell apart
@@ -60,7 +70,7 @@ class CalibrationFit:
         touchdowns_used: pairs compared (each a touchdown the model predicted).
         rms_before, rms_after: RMS one-jump error of the section state [sqrt(g l0)], base vs fitted.
         channels: per channel ``{"unit", "rms_before", "rms_after"}``.
-        noise: the residual scatter per channel after the fit (the unexplained noise).
+        noise: the residual scatter per channel after the fit (the unexplained noise; a robust sigma).
         failed_predictions: pairs whose predicted jump failed with the fitted model.
     """
 
@@ -142,20 +152,28 @@ def calibrate(series: list[TouchdownSeries], base: ModelParams, start: LegOffset
     measured = pairs.measured()
     x0 = np.clip(vector_of(base, start or LegOffsets()), LOWER, UPPER)
 
-    def residuals(vector: np.ndarray, scatter: np.ndarray) -> np.ndarray:
+    def residuals(vector: np.ndarray, whiten: np.ndarray) -> np.ndarray:
         predicted, _ = predict(pairs, *split(base, vector))
-        weighted = (predicted - measured) / scatter
-        return np.nan_to_num(weighted, nan=FAILED_RESIDUAL).ravel()
+        whitened = np.einsum("ijk,ik->ij", whiten, predicted - measured)
+        return np.nan_to_num(whitened, nan=FAILED_RESIDUAL).ravel()
 
-    scatter = NOMINAL_SCATTER
+    def fitted(x: np.ndarray, whiten: np.ndarray):
+        return least_squares(residuals, x, args=(whiten,), bounds=(LOWER, UPPER), x_scale=TYPICAL_SCALE,
+                             loss="huber", f_scale=ROBUST_SCALE, diff_step=1e-6, method="trf", xtol=1e-10,
+                             ftol=1e-10)  # fmt: skip
+
     before, _ = predict(pairs, *split(base, x0))
-    x = x0
-    for _ in range(2):
-        fit = least_squares(residuals, x, args=(scatter,), bounds=(LOWER, UPPER), x_scale=TYPICAL_SCALE,
-                            diff_step=1e-6, method="trf", xtol=1e-10, ftol=1e-10)  # fmt: skip
-        x = fit.x
-        after, _ = predict(pairs, *split(base, x))
-        scatter = np.maximum(_rms(after - measured, axis=0), 1e-9)
+    # First each channel by a nominal scale, then (GLS_PASSES times) each pair by its own covariance
+    # under the noise most likely at the estimate so far (sim_core.calibration_noise).
+    fit = fitted(x0, np.broadcast_to(np.diag(1.0 / NOMINAL_SCATTER), (len(pairs), 3, 3)))
+    noise = TouchdownNoise()
+    for _ in range(GLS_PASSES):
+        model, offsets = split(base, fit.x)
+        predicted, _ = predict(pairs, model, offsets)
+        sensitivity = _sensitivities(pairs, model, offsets)
+        noise = estimate_noise(predicted - measured, sensitivity, noise)
+        fit = fitted(fit.x, _whitening(sensitivity, noise))
+    x = fit.x
     after, failed = predict(pairs, *split(base, x))
     jacobian = fit.jac  # of the weighted residuals, at the optimum
     stderr, correlation, unidentifiable = _uncertainty(jacobian, fit.fun)
@@ -176,7 +194,7 @@ def calibrate(series: list[TouchdownSeries], base: ModelParams, start: LegOffset
         rms_before=_rms(before[:, :2] - measured[:, :2]),
         rms_after=_rms(after[:, :2] - measured[:, :2]),
         channels=channels,
-        noise={name: float(scatter[i]) for i, name in enumerate(CHANNELS)},
+        noise=noise.to_dict(),
         failed_predictions=failed,
     )
 
@@ -198,15 +216,42 @@ def _confounded(correlation: np.ndarray) -> tuple[tuple[str, str, float], ...]:
     return tuple(pairs)
 
 
-def _uncertainty(jacobian: np.ndarray, weighted: np.ndarray) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
-    """Standard errors, correlation and the unidentifiable parameters from the weighted fit's Jacobian."""
+def _sensitivities(pairs: Pairs, model: ModelParams, offsets: LegOffsets) -> np.ndarray:
+    psi0 = np.radians(np.asarray(offsets.psi0_offset_deg, dtype=float))
+    return sensitivities(pairs, model.kernel_args(), psi0, np.asarray(offsets.zeta0_offset, dtype=float))
+
+
+def _whitening(sensitivity: np.ndarray, noise: TouchdownNoise) -> np.ndarray:
+    """Each pair's whitening under ``noise``; a pair whose jump fails gets the nominal channel scales."""
+    usable = np.isfinite(sensitivity).all(axis=(1, 2))
+    whiten = np.broadcast_to(np.diag(1.0 / NOMINAL_SCATTER), (sensitivity.shape[0], 3, 3)).copy()
+    whiten[usable] = whitening(pair_covariances(sensitivity[usable], noise))
+    return whiten
+
+
+def _uncertainty(jacobian: np.ndarray, residuals: np.ndarray) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
+    """Standard errors, correlation and the unidentifiable parameters at the optimum.
+
+    ``jacobian`` is least_squares' (rows scaled by the Huber loss's weights), ``residuals`` the
+    weighted residuals, three per pair in pair order. The covariance is the sandwich
+    ``A^-1 B A^-1`` (``A = J^T J``): ``B`` sums the pairs' scores with Newey–West weights over two
+    neighbours, because neighbouring pairs share a touchdown and their errors are not independent,
+    and the errors grow where the map is sensitive. ``s^2 (J^T J)^-1`` would claim more certainty.
+    """
     m, p = jacobian.shape
-    variance = float(weighted @ weighted) / max(m - p, 1)
+    weights = np.minimum(1.0, ROBUST_SCALE / np.maximum(np.abs(residuals), 1e-300))
+    scaled = np.sqrt(weights) * residuals  # as least_squares scaled the Jacobian's rows
     _, singular, vt = np.linalg.svd(jacobian, full_matrices=False)
     strong = singular > IDENTIFIABLE_RCOND * singular[0]
     # Parameters with weight in a direction the data do not constrain cannot be told apart.
     weak = np.any(np.abs(vt[~strong]) > 0.1, axis=0) if not strong.all() else np.zeros(p, dtype=bool)
-    covariance = (vt[strong].T / singular[strong] ** 2) @ vt[strong] * variance
+    inverse = (vt[strong].T / singular[strong] ** 2) @ vt[strong]
+    scores = (jacobian * scaled[:, None]).reshape(-1, len(CHANNELS), p).sum(axis=1)
+    middle = scores.T @ scores
+    for lag, weight in ((1, 2 / 3), (2, 1 / 3)):
+        cross = scores[lag:].T @ scores[:-lag]
+        middle += weight * (cross + cross.T)
+    covariance = inverse @ middle @ inverse * (m / max(m - p, 1))
     stderr = np.sqrt(np.clip(np.diag(covariance), 0.0, None))
     stderr[weak] = math.inf
     with np.errstate(invalid="ignore", divide="ignore"):

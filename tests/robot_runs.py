@@ -46,13 +46,11 @@ def store_robot_run(session) -> int:
     schedule = ControlSchedule.from_degrees(LEGS)
     frames = climb_frames()
     touchdowns = detect_touchdowns(frames["time"], frames["x"], frames["y"], robot, lambda k: schedule[k + 1])
-    run_id = open_robot_run(session, REQUEST, robot, Calibration())
-    created = records.get_run(session, run_id).created_at.replace(tzinfo=datetime.UTC)
-    start = created.timestamp()
     half = frames["time"].size // 2
     split = frames["time"][half]
-    for first, (lo, hi) in enumerate(((0, half), (half, frames["time"].size))):
-        entry = {
+
+    def entries(start: float) -> list[dict]:  # start: the run's creation in Unix time
+        return [{
             "frames": {name: values[lo:hi].tolist() for name, values in frames.items()},
             "touchdowns": [
                 {"touchdown": td.to_dict(), "control": [schedule[td.index + 1].psi0_deg, schedule[td.index + 1].zeta0]}
@@ -63,12 +61,23 @@ def store_robot_run(session) -> int:
             "telemetry": [_telemetry(start + 0.1 * (seq + 1), seq) for seq in range(3 * first, 3 * first + 3)],
             "transitions": [{"time": start + 0.05, "from": "disarmed", "to": "armed", "reason": "arm"}] * (1 - first),
             "tracker": {"dropped": 2 * first, "loss": 0.001 * first},
-        }
-        session.add(
-            RunJournal(run_id=run_id, data=json_safe(entry), written_at=created + datetime.timedelta(seconds=first + 1))
-        )
+        } for first, (lo, hi) in enumerate(((0, half), (half, frames["time"].size)))]  # fmt: skip
+
+    return store_journaled_run(session, REQUEST, entries, disarm="disarmed")
+
+
+def store_journaled_run(session, request: RobotRunCreate, entries, *, disarm: str = "confirmed") -> int:
+    """A robot run opened for ``request``, journaled with the entries ``entries(start)`` gives
+    (``start``: the run's creation, Unix time) a second apart, and folded ``done`` as the journal
+    writer folds one; its id."""
+    robot = get_preset("paper")
+    run_id = open_robot_run(session, request, robot, Calibration())
+    created = records.get_run(session, run_id).created_at.replace(tzinfo=datetime.UTC)
+    for index, entry in enumerate(entries(created.timestamp())):
+        written = created + datetime.timedelta(seconds=index + 1)
+        session.add(RunJournal(run_id=run_id, data=json_safe(entry), written_at=written))
     session.commit()
-    fold_journal(session, run_id, status="done", end_reason="jumps done", disarm="disarmed", robot=robot)
+    fold_journal(session, run_id, status="done", end_reason="jumps done", disarm=disarm, robot=robot)
     return run_id
 
 

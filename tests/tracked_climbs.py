@@ -5,7 +5,6 @@ reads it with the paper's model — the data a calibration test fits, seconds fa
 
 from __future__ import annotations
 
-import datetime
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -52,14 +51,14 @@ def tracked_climb(truth: Truth, legs, *, jumps: int, noise: NoiseModel, rng, tra
     """A climb of up to ``jumps`` jumps commanded ``legs`` ((psi0_deg, zeta0) left, right)."""
     commanded = {Wall.LEFT: LegControl.from_degrees(*legs[0]), Wall.RIGHT: LegControl.from_degrees(*legs[1])}
     setup = ClimbSetup(truth.robot, sample_rate=FRAME_RATE * truth.robot.scales.time)
-    try:
-        schedule = ControlSchedule.of(commanded[Wall.LEFT], commanded[Wall.RIGHT])
-        state = gait_of(truth.robot.to_model(), schedule, guess=START_GUESS).state
+    realised = {wall: truth.offsets.applied(leg, right_leg=wall == Wall.RIGHT) for wall, leg in commanded.items()}
+    try:  # launched as the virtual robot launches (backend/robot/climber.py)
+        state = gait_of(truth.robot.to_model(), ControlSchedule.of(realised[Wall.LEFT]), guess=START_GUESS).state
     except FixedPointNotFound:
         state = np.array(START_GUESS)
     done = simulate_climb(
         setup,
-        lambda wall: truth.offsets.applied(commanded[wall], right_leg=wall == Wall.RIGHT),
+        realised.__getitem__,
         state,
         jumps,
         NoiseSampler(noise, rng),
@@ -67,35 +66,37 @@ def tracked_climb(truth: Truth, legs, *, jumps: int, noise: NoiseModel, rng, tra
     time = np.concatenate([jump.samples.time for jump in done])
     x = np.concatenate([jump.samples.x for jump in done]) + rng.normal(0.0, tracker_noise, time.size)
     y = np.concatenate([jump.samples.y for jump in done]) + rng.normal(0.0, tracker_noise, time.size)
-    pitch = np.concatenate([np.full(len(jump.samples), jump.start.pitch) for jump in done])
+    # Seen as the virtual robot reports it: a stance with its jump's pitch, the flight after the lift-off's step.
+    pitch = np.concatenate([np.where(np.arange(len(jump.samples)) < jump.liftoff, jump.start.pitch, jump.next.pitch)
+                            for jump in done])  # fmt: skip
 
     def leg_for(k: int) -> LegControl:  # detected touchdown k is the climb's k + 1
         return commanded[Wall.RIGHT if k % 2 == 0 else Wall.LEFT]
 
-    found = detect_touchdowns(time, x, y, PAPER, leg_for)
+    found = detect_touchdowns(time, x, y, PAPER, leg_for, pitch)
     controls = [(commanded[td.wall].psi0_deg, commanded[td.wall].zeta0) for td in found]
     return TrackedClimb({"time": time, "x": x, "y": y, "pitch": pitch}, found, controls)
 
 
 def store_tracked_run(session, climb: TrackedClimb, legs) -> int:
     """``climb`` filed as a finished robot run (opened, one journal entry, folded); its id."""
-    from backend.robot.tracker import Calibration
     from backend.schemas import LegIn, RobotRunCreate
-    from backend.services.robot_records import fold_journal, open_robot_run
-    from backend.store.models import RunJournal
+    from tests.robot_runs import store_journaled_run
 
     request = RobotRunCreate(controls=[LegIn(psi0_deg=p, zeta0=z) for p, z in legs], jumps=len(climb.touchdowns) + 1)
-    run_id = open_robot_run(session, request, PAPER, Calibration())
-    data = {
+    entry = {
         "frames": {name: column.tolist() for name, column in climb.frames.items()},
-        "touchdowns": [{"touchdown": td.to_dict(), "control": list(c)} for td, c in zip(climb.touchdowns,
-                                                                                         climb.controls, strict=True)],
-        "commands": [{"why": "start"}],
-        "telemetry": [],
-        "transitions": [],
-        "tracker": {"dropped": 0, "loss": 0.0},
+        "touchdowns": [{"touchdown": td.to_dict(), "control": list(control)}
+                       for td, control in zip(climb.touchdowns, climb.controls, strict=True)],
+        "commands": [], "telemetry": [], "transitions": [], "tracker": {"dropped": 0, "loss": 0.0},
     }  # fmt: skip
-    session.add(RunJournal(run_id=run_id, written_at=datetime.datetime.now(datetime.UTC), data=data))
-    session.commit()
-    fold_journal(session, run_id, status="done", end_reason="jumps done", disarm="confirmed")
-    return run_id
+    return store_journaled_run(session, request, lambda _start: [entry])
+
+
+def store_varied_runs(session, truth: Truth, *, noise: NoiseModel, jumps: int = 40, seed: int = 3) -> list[int]:
+    """One stored robot run per gait of :data:`VARIED_LEGS`, the robot being ``truth``; their ids."""
+    rng = np.random.default_rng(seed)
+    return [
+        store_tracked_run(session, tracked_climb(truth, legs, jumps=jumps, noise=noise, rng=rng), legs)
+        for legs in VARIED_LEGS
+    ]

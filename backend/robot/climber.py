@@ -74,10 +74,9 @@ class Climber:
         self.natnet_rigid_body_id = int(
             check_range("natnet_rigid_body_id", natnet_rigid_body_id, 0, 2**31, low_open=False)
         )
-        # Two streams: the climb's noise does not depend on how many frames were streamed.
-        climb_seed, tracker_seed = np.random.SeedSequence(seed).spawn(2)
-        self._climb_rng = np.random.default_rng(climb_seed)
-        self.rng = np.random.default_rng(tracker_seed)  # tracker noise and dropped frames
+        self.seed = seed
+        self.climbs = 0  # climbs started: climb k draws from its own streams (_seed_climb)
+        self._seed_climb()
         self.end: End | None = None  # why the last climb ended (a failure or the floor)
         self.frames_sent = 0
         self.frames_dropped = 0
@@ -107,8 +106,17 @@ class Climber:
         commanded = LegControl.from_degrees(*self.legs()[Leg.of(wall)])
         return self.leg_offsets.applied(commanded, right_leg=wall == Wall.RIGHT)
 
+    def _seed_climb(self) -> None:
+        # Streams per climb, so the k-th climb of a seeded robot is the same however long the ones
+        # before it ran; and two per climb: its noise does not depend on how many frames were streamed.
+        climb_seed, tracker_seed = np.random.SeedSequence([self.seed, self.climbs]).spawn(2)
+        self._climb_rng = np.random.default_rng(climb_seed)
+        self.rng = np.random.default_rng(tracker_seed)  # tracker noise and dropped frames
+
     def _climb(self) -> None:
         """One climb from launch until stopped, failed or at the floor."""
+        self._seed_climb()
+        self.climbs += 1
         setup = ClimbSetup(self.robot, sample_rate=FRAME_RATE * self.robot.scales.time)
         sampler = NoiseSampler(self.noise, self._climb_rng)
         first = self._commanded(Wall.LEFT)
@@ -126,7 +134,8 @@ class Climber:
             # Read at lift-off: the robot positioned this leg during the stance just streamed.
             next_leg = climb.read_next_leg(start, self._commanded(start.wall.other), sampler)
             jump = climb.jump(setup, start, next_leg)
-            if not self._streamed(jump.flight, jump.end, start.pitch, started):
+            # The pitch stepped at lift-off: the flight is seen with the pitch the next leg reaches at.
+            if not self._streamed(jump.flight, jump.end, next_leg.pitch, started):
                 return
             start = climb.touchdown_after(setup, jump, sampler)
             self.jumps += 1

@@ -196,7 +196,7 @@ def execute(
             if len(poses) > 1:
                 times = np.array([p.time for p in poses])
                 found = detect_touchdowns(times, np.array([p.x for p in poses]), np.array([p.y for p in poses]),
-                                          robot, leg_for)  # fmt: skip
+                                          robot, leg_for, np.array([p.pitch for p in poses]))  # fmt: skip
                 while len(run.touchdown_controls) < len(found):
                     run.touchdown_controls.append(leg_for(len(run.touchdown_controls)))
                 for touchdown in found[len(run.touchdowns) :]:

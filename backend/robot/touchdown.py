@@ -1,8 +1,10 @@
 """Touchdowns from tracker poses: the robot's Poincaré section states and height gains.
 
 The PC knows each touchdown's controls, so it knows where the body is when a foot meets the
-wall: ``zeta0 l0 cos psi0`` from it. A touchdown is the tracked body crossing that line on its
-way to the wall. Between the chute's centre line and that crossing the body is in flight, so
+wall: ``zeta0 l0 cos psi`` from it, the leg's angle ``psi`` being the commanded ``psi0`` turned by the
+body's pitch when the tracker gives one (``+pitch`` on the left wall, ``-pitch`` on the right, the
+convention of docs/model.md §5.1): the leg is fixed to the body. A touchdown is the tracked body
+crossing that line on its way to the wall. Between the chute's centre line and that crossing the body is in flight, so
 those poses follow ``x = a + b t`` and ``y = c + e t - g t^2 / 2`` exactly: a least-squares fit
 through them gives the crossing time and the velocity at touchdown, averaging tracker noise and
 bridging dropped frames. States come out as the simulator's — nondimensional, flipped so every
@@ -51,8 +53,10 @@ def detect_touchdowns(
     y: np.ndarray,
     robot: PhysicalParams,
     leg_for: Callable[[int], LegControl],
+    pitch: np.ndarray | None = None,
 ) -> list[Touchdown]:
-    """Touchdowns in a pose stream (SI, wall coordinates; ``leg_for(k)`` is touchdown k's controls).
+    """Touchdowns in a pose stream (SI, wall coordinates; ``leg_for(k)`` is touchdown k's controls;
+    ``pitch`` [rad] per pose, NaN where the markers gave none, or None).
 
     A crossing whose flight could not be fitted (fewer than ``MIN_FIT_POSES`` flight poses) is
     skipped; the stream may start and end anywhere.
@@ -69,7 +73,8 @@ def detect_touchdowns(
             continue
         wall = Wall.RIGHT if x[i] > 0 else Wall.LEFT
         leg = leg_for(len(touchdowns))
-        line = wall * (half - leg.zeta0 * robot.leg_length * math.cos(leg.psi0))
+        psi = leg.psi0 - wall * _pitch_at(pitch, i)  # the leg turned with the body
+        line = wall * (half - leg.zeta0 * robot.leg_length * math.cos(psi))
         if wall * x[i] < wall * line:
             continue
         fit = slice(flight_start, i)  # flight poses before the line
@@ -91,11 +96,21 @@ def detect_touchdowns(
                 wall=wall,
                 state=state,
                 body_height=body,
-                foot_height=body - leg.zeta0 * robot.leg_length * math.sin(leg.psi0),
+                foot_height=body - leg.zeta0 * robot.leg_length * math.sin(psi),
                 poses_fitted=fit.stop - fit.start,
             )
         )
     return touchdowns
+
+
+def _pitch_at(pitch: np.ndarray | None, i: int) -> float:
+    """The body's pitch at pose ``i``: its own, else the newest finite one before it, else 0."""
+    if pitch is None:
+        return 0.0
+    for j in range(i, max(i - 10, -1), -1):
+        if math.isfinite(pitch[j]):
+            return float(pitch[j])
+    return 0.0
 
 
 def height_gains(touchdowns: list[Touchdown], robot: PhysicalParams) -> np.ndarray:

@@ -10,7 +10,6 @@ the code version. A stored preset is used by name wherever a built-in one is
 
 from __future__ import annotations
 
-import math
 import re
 from collections.abc import Callable
 from dataclasses import asdict
@@ -30,12 +29,11 @@ from sim_core.controls import NO_OFFSETS, LegControl, LegOffsets
 from sim_core.errors import ParameterError
 from sim_core.params import ModelParams, PhysicalParams
 from sim_core.presets import PRESETS, get_preset
-from sim_core.touchdown_model import TouchdownSeries
+from sim_core.touchdown_model import TouchdownSeries, pitch_at
 from sim_core.walls import Wall
 
 CALIBRATED_KINDS = ("robot", "replay")
 PRESET_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$")
-PITCH_WINDOW = 0.03  # [s] tracker frames after a touchdown whose pitch is its pitch (3 frames at 100 Hz)
 MAX_RUNS = 100
 Fitter = Callable[[list[TouchdownSeries], ModelParams], CalibrationFit]
 
@@ -185,17 +183,9 @@ def _touchdown_controls(session: Session, run: Run) -> list:
     return controls or []
 
 
-def _pitch_at(run: Run | None, times: list[float]) -> list[float]:
-    """The median tracked pitch [rad] in :data:`PITCH_WINDOW` after each time; 0 where there is none."""
-    if run is None or run.trajectory is None:
-        return [0.0] * len(times)
-    frames = unpack_trajectory(run.trajectory)
-    if "pitch" not in frames:
-        return [0.0] * len(times)
-    t, pitch = frames["time"], frames["pitch"]
-    result = []
-    for moment in times:
-        window = pitch[(t >= moment) & (t <= moment + PITCH_WINDOW)]
-        window = window[np.isfinite(window)]
-        result.append(float(np.median(window)) if window.size else 0.0)
-    return [p if math.isfinite(p) else 0.0 for p in result]
+def _pitch_at(run: Run | None, times: list[float]) -> np.ndarray:
+    """The tracked pitch [rad] at each touchdown (:func:`sim_core.touchdown_model.pitch_at`); 0 without frames."""
+    frames = None if run is None or run.trajectory is None else unpack_trajectory(run.trajectory)
+    if frames is None or "pitch" not in frames:
+        return np.zeros(len(times))
+    return pitch_at(times, frames["time"], frames["pitch"])

@@ -162,7 +162,7 @@ def replay_run(session, run_id: int, robot=None) -> Run:
         raise Conflict(f"run {run_id} is a {source.kind} run without tracker frames; only robot runs can be replayed")
     frames = unpack_trajectory(source.trajectory)
     leg_for = recorded_leg_for(source)
-    touchdowns = detect_touchdowns(frames["time"], frames["x"], frames["y"], robot, leg_for)
+    touchdowns = detect_touchdowns(frames["time"], frames["x"], frames["y"], robot, leg_for, frames.get("pitch"))
     analysis = touchdown_results(touchdowns, [leg_for(k) for k in range(len(touchdowns))], robot)
     record = RunRecord(
         kind="replay",

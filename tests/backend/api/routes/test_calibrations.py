@@ -1,0 +1,46 @@
+"""Calibrations through the API: fitted in the compute worker, stored as a preset, listed, read,
+deleted; only with the token; bad requests name their field (backend/api/routes/calibrations.py)."""
+
+from sim_core.noise import NoiseModel
+from tests.tracked_climbs import Truth, store_varied_runs
+
+TRUTH = Truth.of(alpha=72.0, c_zeta=1.25, c_psi=0.8, psi0_offset_deg=(0.6, -0.8), zeta0_offset=(0.004, -0.005))
+
+
+def test_a_calibration_is_fitted_stored_listed_and_deleted(client, auth):
+    with client.app.state.sessions() as session:
+        runs = store_varied_runs(session, TRUTH, noise=NoiseModel(pitch_drift_deg=0.2), jumps=30)
+    body = {"runs": runs, "name": "table.v1"}
+    assert client.post("/api/v1/calibrations", json=body).status_code == 401, "a change needs the token"
+    response = client.post("/api/v1/calibrations", json=body, headers=auth)
+    assert response.status_code == 201, response.text
+    fitted = response.json()
+    assert abs(fitted["params"]["alpha"] - 72.0) < 3 * fitted["stderr"]["alpha"]
+    assert fitted["preset"]["runs"] == runs and fitted["rms_residual_after"] < fitted["rms_residual_before"]
+    assert client.get("/api/v1/calibrations/table.v1").json() == fitted
+    assert [item["preset"]["name"] for item in client.get("/api/v1/calibrations").json()["items"]] == ["table.v1"]
+    again = client.post("/api/v1/calibrations", json=body, headers=auth)
+    assert again.status_code == 409 and "exists" in again.json()["detail"]
+    assert client.delete("/api/v1/calibrations/table.v1").status_code == 401
+    assert client.delete("/api/v1/calibrations/table.v1", headers=auth).status_code == 204
+    assert client.get("/api/v1/calibrations/table.v1").status_code == 404
+
+
+def test_bad_calibration_requests_name_what_is_wrong(client, auth):
+    def error(body):
+        response = client.post("/api/v1/calibrations", json=body, headers=auth)
+        return response.status_code, response.json()["detail"]
+
+    status, detail = error({"runs": [], "name": "x"})
+    assert status == 422 and detail[0]["loc"] == ["body", "runs"]
+    status, detail = error({"runs": [1], "name": "no spaces"})
+    assert status == 422 and detail[0]["loc"] == ["body", "name"]
+    assert error({"runs": [1], "name": "paper"})[0] == 422, "a built-in preset's name is taken"
+    assert error({"runs": [999], "name": "x"}) == (404, "run 999 does not exist")
+    run = client.post(
+        "/api/v1/runs", json={"controls": [{"psi0_deg": 30, "zeta0": 0.9}], "start": {"xdot": -0.9, "ydot": -0.2}},
+        headers=auth,
+    ).json()  # fmt: skip
+    status, detail = error({"runs": [run["id"]], "name": "x"})
+    assert status == 409 and "robot and replay runs" in detail
+    assert client.get("/api/v1/calibrations/nothing").status_code == 404
