@@ -36,7 +36,8 @@ import numpy as np
 from sim_core.calibration_noise import TouchdownNoise, estimate_noise, pair_covariances, whitening
 from sim_core.controls import LegOffsets
 from sim_core.params import ModelParams
-from sim_core.touchdown_model import CHANNEL_UNITS, CHANNELS, Pairs, TouchdownSeries, predict_pairs, sensitivities
+from sim_core.touchdown_model import predict_pairs, sensitivities
+from sim_core.touchdown_series import CHANNEL_UNITS, CHANNELS, Pairs, TouchdownSeries
 from sim_core.validation import ParameterError
 
 # The fitted vector, in order: its names in the JSON, and the units the fit works in.
@@ -259,3 +260,16 @@ def _uncertainty(jacobian: np.ndarray, residuals: np.ndarray) -> tuple[np.ndarra
     correlation[weak, :] = np.nan
     correlation[:, weak] = np.nan
     return stderr, correlation, tuple(name for name, flag in zip(PARAMETERS, weak, strict=True) if flag)
+
+
+def one_jump_predictions(series: TouchdownSeries, models: dict[str, tuple[ModelParams, LegOffsets]]) -> dict:
+    """Each touchdown of ``series`` that follows a measured one, predicted from it by each model.
+
+    Returns ``{"index": [k...], "measured": (n, 3), name: (n, 3) ...}`` — columns ``xdot, ydot, rise``
+    of touchdown ``k`` (the rise from touchdown ``k - 1``), NaN where a model's jump fails.
+    """
+    pairs = Pairs.of([series])
+    result = {"index": (np.flatnonzero(series.consecutive) + 1).tolist(), "measured": pairs.measured()}
+    for name, (model, offsets) in models.items():
+        result[name] = predict(pairs, model, offsets)[0]
+    return result

@@ -110,3 +110,6 @@ PageLimit = Annotated[int, Query(ge=1, le=records.MAX_PAGE, description="items p
 Cursor = Annotated[int | None, Query(ge=1, le=schemas.MAX_ID, description="next_cursor of the previous page")]
 RecordId = Annotated[int, FastAPIPath(ge=1, le=schemas.MAX_ID)]
 OptionalRecordId = Annotated[int | None, Query(ge=1, le=schemas.MAX_ID)]
+PresetQuery = Annotated[
+    str | None, Query(min_length=1, max_length=64, pattern=schemas.PRESET_PATTERN, description="a stored calibration")
+]

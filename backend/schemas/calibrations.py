@@ -10,7 +10,8 @@ from pydantic import BaseModel, Field
 
 from backend.schemas.common import MAX_ID, Strict
 
-PresetName = Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$")]
+PRESET_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$"  # a stored preset's name
+PresetName = Annotated[str, Field(min_length=1, max_length=64, pattern=PRESET_PATTERN)]
 Pair = Annotated[list[float], Field(min_length=2, max_length=2)]
 MaybePair = Annotated[list[float | None], Field(min_length=2, max_length=2)]
 
@@ -74,3 +75,28 @@ class CalibrationOut(BaseModel):
 
 class CalibrationList(BaseModel):
     items: list[CalibrationOut]
+
+
+class Channels(BaseModel):
+    xdot: float | None = Field(description="[sqrt(g l0)]")
+    ydot: float | None = Field(description="[sqrt(g l0)]")
+    rise: float | None = Field(description="foot height gained since the touchdown before [l0]")
+
+
+class TouchdownPrediction(BaseModel):
+    index: int = Field(description="the touchdown's number in the run (0-based)")
+    time: float = Field(description="[s], the tracker's clock")
+    wall: str
+    measured: Channels
+    paper: Channels = Field(description="predicted by the base model from the touchdown before")
+    paper_residual: Channels
+    calibrated: Channels | None = None
+    calibrated_residual: Channels | None = None
+
+
+class TouchdownComparison(BaseModel):
+    run_id: int
+    base: str
+    preset: str | None
+    touchdowns: list[TouchdownPrediction]
+    rms: dict[str, Channels] = Field(description="RMS residual per model")

@@ -10,32 +10,37 @@ the code version. A stored preset is used by name wherever a built-in one is
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Callable
 from dataclasses import asdict
+from typing import TYPE_CHECKING
 
 import numpy as np
 from sqlalchemy import select
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
+from backend.schemas.calibrations import PRESET_PATTERN
 from backend.services.records import Conflict, NotFound, fetch
 from backend.services.simulation import current_code_version, unpack_trajectory
 from backend.store.database import lock_for_write
 from backend.store.models import ModelPreset, Run
 from experiments.manifest import json_safe
-from sim_core.calibration import CalibrationFit, calibrate
 from sim_core.controls import NO_OFFSETS, LegControl, LegOffsets
 from sim_core.errors import ParameterError
 from sim_core.params import ModelParams, PhysicalParams
 from sim_core.presets import PRESETS, get_preset
-from sim_core.touchdown_model import TouchdownSeries, pitch_at
+from sim_core.touchdown_series import TouchdownSeries, pitch_at
 from sim_core.walls import Wall
 
+if TYPE_CHECKING:  # the kernels load in compute workers, not in the service (tests/backend/api/test_startup.py)
+    from sim_core.calibration import CalibrationFit
+
 CALIBRATED_KINDS = ("robot", "replay")
-PRESET_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$")
+PRESET_NAME = re.compile(PRESET_PATTERN)
 MAX_RUNS = 100
-Fitter = Callable[[list[TouchdownSeries], ModelParams], CalibrationFit]
+Fitter = Callable[[list[TouchdownSeries], ModelParams], "CalibrationFit"]
 
 
 def check_preset_name(name: str) -> str:
@@ -67,13 +72,27 @@ def touchdown_series(session: Session, run: Run, robot: PhysicalParams) -> Touch
     )
 
 
+def fit_touchdowns(series: list[TouchdownSeries], base: ModelParams) -> CalibrationFit:
+    """:func:`sim_core.calibration.calibrate`, loaded where it runs (a compute worker, a command)."""
+    from sim_core.calibration import calibrate
+
+    return calibrate(series, base)
+
+
+def predict_touchdowns(series: TouchdownSeries, models: dict) -> dict:
+    """:func:`sim_core.calibration.one_jump_predictions`, loaded where it runs."""
+    from sim_core.calibration import one_jump_predictions
+
+    return one_jump_predictions(series, models)
+
+
 def calibrate_runs(
-    session: Session, run_ids: list[int], *, name: str, base: str = "paper", fit: Fitter = calibrate
+    session: Session, run_ids: list[int], *, name: str, base: str = "paper", fit: Fitter = fit_touchdowns
 ) -> dict:
     """Fit the model to ``run_ids`` and store it as preset ``name``; the ``parkour calibrate --json`` payload.
 
-    ``fit`` is :func:`sim_core.calibration.calibrate` or a call of it elsewhere (the service's
-    compute worker): it gets the runs' :class:`TouchdownSeries` and the base model, nothing of the store.
+    ``fit`` is :func:`fit_touchdowns` or a call of it elsewhere (the service's compute worker): it
+    gets the runs' :class:`TouchdownSeries` and the base model, nothing of the store.
     """
     check_preset_name(name)
     if not 1 <= len(run_ids) <= MAX_RUNS:
@@ -189,3 +208,43 @@ def _pitch_at(run: Run | None, times: list[float]) -> np.ndarray:
     if frames is None or "pitch" not in frames:
         return np.zeros(len(times))
     return pitch_at(times, frames["time"], frames["pitch"])
+
+
+def touchdown_predictions(session: Session, run_id: int, *, preset: str | None, predict=None) -> dict:
+    """A robot or replay run's touchdowns as measured, as the base model predicts each from the one
+    before, and (``preset``, a stored calibration) as the calibrated model does, with the residuals
+    and their RMS. ``predict`` is :func:`sim_core.calibration.one_jump_predictions` or a call of it
+    in a compute worker."""
+    run = _calibration_run(session, run_id)
+    stored = None if preset is None else get_stored_preset(session, preset)
+    base_name = stored.base if stored is not None else "paper"
+    base = get_preset(base_name)
+    series = touchdown_series(session, run, base)
+    models = {"paper": (base.to_model(), NO_OFFSETS)}
+    if stored is not None:
+        robot, offsets = preset_params(session, preset)
+        models["calibrated"] = (robot.to_model(), offsets)
+    session.rollback()
+    found = (predict or predict_touchdowns)(series, models)
+    touchdowns = run.results.get("touchdowns") or []
+    rows = []
+    for row, k in enumerate(found["index"]):
+        entry = {"index": k, "time": touchdowns[k]["time"], "wall": Wall(touchdowns[k]["wall"]).code,
+                 "measured": _channels(found["measured"][row])}  # fmt: skip
+        for name in models:
+            predicted = found[name][row]
+            entry[name] = _channels(predicted)
+            entry[f"{name}_residual"] = _channels(predicted - found["measured"][row])
+        rows.append(entry)
+    rms = {name: _rms_by_channel(found[name] - found["measured"]) for name in models}
+    return json_safe({"run_id": run_id, "base": base_name, "preset": preset, "touchdowns": rows, "rms": rms})
+
+
+def _channels(values) -> dict:
+    return dict(zip(("xdot", "ydot", "rise"), (float(v) for v in values), strict=True))
+
+
+def _rms_by_channel(residuals: np.ndarray) -> dict:
+    finite = np.where(np.isfinite(residuals), residuals, np.nan)
+    with np.errstate(invalid="ignore"):
+        return _channels(np.sqrt(np.nanmean(finite**2, axis=0)) if len(finite) else [math.nan] * 3)

@@ -8,7 +8,7 @@ import pytest
 
 from sim_core.calibration import PARAMETERS, calibrate
 from sim_core.noise import NO_NOISE, NoiseModel
-from sim_core.touchdown_model import TouchdownSeries, pitch_at
+from sim_core.touchdown_series import TouchdownSeries, pitch_at
 from sim_core.validation import ParameterError
 from sim_core.walls import Wall
 from tests.tracked_climbs import PAPER, VARIED_LEGS, TrackedClimb, Truth, tracked_climb

@@ -11,7 +11,6 @@ from backend import schemas
 from backend.api.deps import AUTHORIZED, Db, QuickCompute
 from backend.services import calibrations
 from backend.services.compute import ComputePool
-from sim_core.calibration import calibrate
 
 router = APIRouter(prefix="/api/v1/calibrations", tags=["calibrations"])
 PresetPath = Annotated[str, Path(min_length=1, max_length=64, pattern=calibrations.PRESET_NAME.pattern)]
@@ -42,4 +41,4 @@ def delete_calibration(name: PresetPath, db: Db) -> None:
 
 def _fit_in_worker(compute: ComputePool, series, model):
     # Seconds of kernels at most (a few hundred pairs, two fits): the quick worker, not this thread's GIL.
-    return compute.run(calibrate, series, model)
+    return compute.run(calibrations.fit_touchdowns, series, model)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import io
 from typing import Annotated
 
@@ -11,8 +12,18 @@ from fastapi.responses import Response, StreamingResponse
 from pydantic import Field
 
 from backend import schemas
-from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, QuickCompute, RecordId, RunQuery, request_session
-from backend.services import exports, mcap_export, records, simulation
+from backend.api.deps import (
+    AUTHORIZED,
+    Cursor,
+    Db,
+    PageLimit,
+    PresetQuery,
+    QuickCompute,
+    RecordId,
+    RunQuery,
+    request_session,
+)
+from backend.services import calibrations, exports, mcap_export, records, simulation
 from backend.services.robot_records import replay_run
 
 router = APIRouter(prefix="/api/v1/runs", tags=["runs"])
@@ -119,6 +130,15 @@ def export_mcap(run_id: RecordId, db: Db) -> McapResponse:
     mcap_export.export_run(db, run_id, stream)
     disposition = f'attachment; filename="parkourlab-run-{run_id}.mcap"'
     return McapResponse(stream.getvalue(), headers={"Content-Disposition": disposition})
+
+
+@router.get("/{run_id}/touchdowns", response_model=schemas.TouchdownComparison)
+def touchdown_predictions(run_id: RecordId, db: Db, compute: QuickCompute, preset: PresetQuery = None):
+    """A robot or replay run's touchdowns as measured beside the paper's model's one-jump prediction
+    of each and, with ``preset`` (a stored calibration), the calibrated model's, with residuals."""
+    return calibrations.touchdown_predictions(
+        db, run_id, preset=preset, predict=functools.partial(compute.run, calibrations.predict_touchdowns)
+    )
 
 
 @router.post("/{run_id}/replay", status_code=201, dependencies=AUTHORIZED, response_model=schemas.RunDetail)

@@ -1,6 +1,8 @@
 """Calibrations through the API: fitted in the compute worker, stored as a preset, listed, read,
 deleted; only with the token; bad requests name their field (backend/api/routes/calibrations.py)."""
 
+import pytest
+
 from sim_core.noise import NoiseModel
 from tests.tracked_climbs import Truth, store_varied_runs
 
@@ -19,6 +21,20 @@ def test_a_calibration_is_fitted_stored_listed_and_deleted(client, auth):
     assert fitted["preset"]["runs"] == runs and fitted["rms_residual_after"] < fitted["rms_residual_before"]
     assert client.get("/api/v1/calibrations/table.v1").json() == fitted
     assert [item["preset"]["name"] for item in client.get("/api/v1/calibrations").json()["items"]] == ["table.v1"]
+
+    compared = client.get(f"/api/v1/runs/{runs[2]}/touchdowns", params={"preset": "table.v1"}).json()
+    rows, rms = compared["touchdowns"], compared["rms"]
+    assert len(rows) > 20 and {"measured", "paper", "calibrated", "paper_residual", "calibrated_residual"} <= set(
+        rows[0]
+    )
+    assert rows[0]["paper_residual"]["xdot"] == pytest.approx(rows[0]["paper"]["xdot"] - rows[0]["measured"]["xdot"])
+    for channel in ("xdot", "ydot", "rise"):
+        assert rms["calibrated"][channel] < 0.5 * rms["paper"][channel], (channel, rms)
+    plain = client.get(f"/api/v1/runs/{runs[2]}/touchdowns").json()
+    assert plain["preset"] is None and plain["touchdowns"][0]["calibrated"] is None
+    assert client.get(f"/api/v1/runs/{runs[2]}/touchdowns", params={"preset": "nothing"}).status_code == 404
+    assert client.get(f"/api/v1/runs/{runs[2]}/touchdowns", params={"preset": "a b"}).status_code == 422
+
     again = client.post("/api/v1/calibrations", json=body, headers=auth)
     assert again.status_code == 409 and "exists" in again.json()["detail"]
     assert client.delete("/api/v1/calibrations/table.v1").status_code == 401
@@ -43,4 +59,5 @@ def test_bad_calibration_requests_name_what_is_wrong(client, auth):
     ).json()  # fmt: skip
     status, detail = error({"runs": [run["id"]], "name": "x"})
     assert status == 409 and "robot and replay runs" in detail
+    assert client.get(f"/api/v1/runs/{run['id']}/touchdowns").status_code == 409
     assert client.get("/api/v1/calibrations/nothing").status_code == 404
