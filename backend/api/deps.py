@@ -10,14 +10,16 @@ from typing import Annotated
 
 from fastapi import Depends, HTTPException, Query, Request, status
 from fastapi import Path as FastAPIPath
+from fastapi.concurrency import run_in_threadpool
 from sqlalchemy.orm import Session
 
 from backend import schemas
 from backend.api.security import require_token
-from backend.services import jobs, records
+from backend.services import calibrations, jobs, records
 from backend.services.compute import ComputePool
 from backend.services.robot import RobotService
 from backend.store.database import StorageFull, after_storage_full
+from sim_core.presets import PRESETS
 
 VIEW_NOT_STARTED = "the 3D view is not running (it starts with `parkour serve`)"
 
@@ -113,3 +115,16 @@ OptionalRecordId = Annotated[int | None, Query(ge=1, le=schemas.MAX_ID)]
 PresetQuery = Annotated[
     str | None, Query(min_length=1, max_length=64, pattern=schemas.PRESET_PATTERN, description="a stored calibration")
 ]
+
+
+async def preset_resolved(request: Request, body):
+    """``body`` with a stored preset resolved (:func:`backend.services.calibrations.with_preset_resolved`):
+    at once for a built-in one, in a request thread when the store must be read."""
+    if body.model.preset in PRESETS:
+        return body
+
+    def resolve():
+        with request_session(request.app.state.sessions) as session:
+            return calibrations.with_preset_resolved(session, body)
+
+    return await run_in_threadpool(resolve)

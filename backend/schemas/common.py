@@ -37,9 +37,13 @@ class LegIn(Strict):
 
 
 class ModelIn(Strict):
-    """The ``paper`` preset with optional nondimensional overrides (docs/model.md §1)."""
+    """A preset — ``paper``, or a calibration stored by name (docs/calibration.md) — with optional
+    nondimensional overrides (docs/model.md §1)."""
 
-    preset: Literal["paper"] = "paper"
+    preset: str = Field(
+        "paper", min_length=1, max_length=64, pattern=r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$",
+        description="paper, or a stored calibration's name (GET /api/v1/calibrations)",
+    )  # fmt: skip
     alpha: Annotated[float, Field(gt=0.0, le=1e4)] | None = None
     d_hat: Annotated[float, Field(gt=0.0, le=100.0)] | None = None
     c_zeta: Annotated[float, Field(ge=0.0, le=1e3)] | None = None

@@ -163,6 +163,23 @@ def preset_params(session: Session | None, name: str) -> tuple[PhysicalParams, L
     )
 
 
+def with_preset_resolved(session: Session, body):
+    """``body`` (a request with ``model``, a :class:`~backend.schemas.ModelIn`) with a stored preset
+    replaced by what it is: its base preset and the fitted ``alpha``, ``c_zeta``, ``c_psi`` where the
+    request does not override them — numbers a job keeps even if the preset is deleted later. A
+    built-in preset passes through; an unknown name is a :class:`ParameterError` naming ``model.preset``."""
+    model = body.model
+    if model.preset in PRESETS:
+        return body
+    stored = session.scalar(select(ModelPreset).where(ModelPreset.name == model.preset))
+    if stored is None:
+        known = ", ".join([*sorted(PRESETS), *(preset.name for preset in list_presets(session))])
+        raise ParameterError("model.preset", f"unknown preset {model.preset!r}; known presets: {known}")
+    fitted = PhysicalParams(**stored.physical).to_model()
+    fields = {name: getattr(fitted, name) for name in ("alpha", "c_zeta", "c_psi") if getattr(model, name) is None}
+    return body.model_copy(update={"model": model.model_copy(update={"preset": stored.base, **fields})})
+
+
 def _stored(fit: CalibrationFit, *, name: str, base: str, robot: PhysicalParams, run_ids: list[int]) -> ModelPreset:
     fitted = PhysicalParams.from_model(fit.model, mass=robot.mass, leg_length=robot.leg_length, gravity=robot.gravity)
     return ModelPreset(

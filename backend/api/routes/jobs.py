@@ -13,7 +13,7 @@ from fastapi.responses import StreamingResponse
 
 from backend import schemas
 from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, RecordId, Runner
-from backend.services import jobs
+from backend.services import calibrations, jobs
 
 EVENT_POLL_S = 0.25  # progress comes from committed chunks; a quarter second is live enough
 
@@ -22,7 +22,7 @@ router = APIRouter(prefix="/api/v1/jobs", tags=["jobs"])
 
 @router.post("", status_code=202, dependencies=AUTHORIZED, response_model=schemas.JobOut)
 def create_job(body: schemas.JobCreate, db: Db, runner: Runner):
-    job = jobs.create_job(db, body)
+    job = jobs.create_job(db, calibrations.with_preset_resolved(db, body))
     if runner is not None:
         runner.submit(job.id)
     return job_out(job)

@@ -21,6 +21,7 @@ from backend.api.deps import (
     QuickCompute,
     RecordId,
     RunQuery,
+    preset_resolved,
     request_session,
 )
 from backend.services import calibrations, exports, mcap_export, records, simulation
@@ -38,6 +39,7 @@ async def create_run(body: schemas.RunCreate, request: Request, compute: QuickCo
     """Simulate (in the quick compute worker) and store a run. Async: the simulation is awaited, so
     no request thread waits for it; the database work before and after takes one briefly."""
     sessions = request.app.state.sessions
+    body = await preset_resolved(request, body)
 
     def check() -> None:
         with request_session(sessions) as session:

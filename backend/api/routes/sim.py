@@ -7,11 +7,11 @@ worker even encodes the JSON, which the route forwards as it is.
 
 from __future__ import annotations
 
-from fastapi import APIRouter
+from fastapi import APIRouter, Request
 from fastapi.responses import Response
 
 from backend import schemas
-from backend.api.deps import QuickCompute
+from backend.api.deps import QuickCompute, preset_resolved
 from backend.services import simulation
 from backend.services.compute import as_json
 
@@ -19,18 +19,21 @@ router = APIRouter(prefix="/api/v1/sim", tags=["simulate"])
 
 
 @router.post("/map")
-async def sim_map(body: schemas.MapIn, compute: QuickCompute) -> Response:
+async def sim_map(body: schemas.MapIn, request: Request, compute: QuickCompute) -> Response:
+    body = await preset_resolved(request, body)
     return _json(await compute.call(as_json, simulation.map_orbit, body))
 
 
 @router.post("/trajectory")
-async def sim_trajectory(body: schemas.TrajectoryIn, compute: QuickCompute) -> Response:
+async def sim_trajectory(body: schemas.TrajectoryIn, request: Request, compute: QuickCompute) -> Response:
     """The sampled path in wall coordinates (nondimensional), for drawing; not stored."""
+    body = await preset_resolved(request, body)
     return _json(await compute.call(as_json, simulation.trajectory_columns, body))
 
 
 @router.post("/fixed-point")
-async def sim_fixed_point(body: schemas.FixedPointIn, compute: QuickCompute) -> Response:
+async def sim_fixed_point(body: schemas.FixedPointIn, request: Request, compute: QuickCompute) -> Response:
+    body = await preset_resolved(request, body)
     return _json(await compute.call(as_json, simulation.fixed_point, body))
 
 

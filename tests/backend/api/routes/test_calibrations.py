@@ -35,6 +35,18 @@ def test_a_calibration_is_fitted_stored_listed_and_deleted(client, auth):
     assert client.get(f"/api/v1/runs/{runs[2]}/touchdowns", params={"preset": "nothing"}).status_code == 404
     assert client.get(f"/api/v1/runs/{runs[2]}/touchdowns", params={"preset": "a b"}).status_code == 422
 
+    # The preset by name, wherever a model is asked for: resolved to its base and fitted numbers.
+    query = {"controls": [{"psi0_deg": 30, "zeta0": 0.9}], "start": {"xdot": -0.9, "ydot": -0.2}, "jumps": 3}
+    by_name = client.post("/api/v1/sim/map", json=query | {"model": {"preset": "table.v1"}}).json()
+    numbers = {name: fitted["params"][name] for name in ("alpha", "c_zeta", "c_psi")}
+    by_numbers = client.post("/api/v1/sim/map", json=query | {"model": numbers}).json()
+    assert by_name["rises"] == pytest.approx(by_numbers["rises"], rel=1e-9)
+    run = client.post("/api/v1/runs", json=query | {"model": {"preset": "table.v1"}}, headers=auth).json()
+    assert run["model"]["alpha"] == pytest.approx(fitted["params"]["alpha"])
+    unknown = client.post("/api/v1/sim/map", json=query | {"model": {"preset": "nothing"}})
+    assert unknown.status_code == 422 and unknown.json()["detail"][0]["loc"] == ["body", "model.preset"]
+    assert "known presets: paper, table.v1" in unknown.json()["detail"][0]["msg"]
+
     again = client.post("/api/v1/calibrations", json=body, headers=auth)
     assert again.status_code == 409 and "exists" in again.json()["detail"]
     assert client.delete("/api/v1/calibrations/table.v1").status_code == 401
