@@ -77,3 +77,46 @@ def _print_report(payload: dict) -> None:
     if payload["unidentifiable"]:
         note(f"the runs cannot tell these apart: {', '.join(payload['unidentifiable'])} (vary the controls more)")
     note(f"stored as preset {payload['preset']['name']!r}: use --preset {payload['preset']['name']}")
+
+
+@app.command("robustness")
+@handles_errors
+def robustness_command(
+    preset: Annotated[str, typer.Option("--preset", help="A stored calibration (parkour calibrate).")],
+    runs: Annotated[
+        str | None, typer.Option("--runs", help="Robot runs to compare with, ID[,ID...]; default: the preset's.")
+    ] = None,
+    trials: Annotated[int, typer.Option("--trials", help="MJTF trials of the model per gait.", min=1)] = 500,
+    cap: Annotated[int, typer.Option("--cap", help="Jumps a trial may reach at most.", min=1)] = 2000,
+    seed: Annotated[int, typer.Option("--seed", help="Seed >= 0 of the trials.", min=0)] = 0,
+    data_dir: DataDirOption = None,
+    json_output: JsonOption = False,
+) -> None:
+    """The calibrated model's Mean Jumps To Failure beside the robot's, per gait, with 95% intervals.
+
+    The model simulates with the noise the calibration estimated from the runs (docs/calibration.md).
+    """
+    from backend.services.records import Conflict, NotFound
+    from backend.services.robustness import robustness
+
+    run_ids = None if runs is None else parse_run_ids(runs)
+    with store_sessions(data_dir) as sessions, sessions() as session:
+        try:
+            payload = robustness(session, preset, run_ids, trials=trials, cap=cap, seed=seed)
+        except (NotFound, Conflict) as error:
+            raise ParameterError(
+                "preset" if isinstance(error, NotFound) and run_ids is None else "runs", str(error)
+            ) from None
+    if json_output:
+        print_json(payload)
+        return
+    for row in payload["gaits"]:
+        legs = ", ".join(f"{psi0:g}°:{zeta0:g}" for psi0, zeta0 in row["controls"])
+        typer.echo(f"{legs:<22} robot {_mjtf_text(row['robot'])}   model {_mjtf_text(row['model'])}")
+
+
+def _mjtf_text(estimate: dict) -> str:
+    low, high = estimate["ci95"]
+    if estimate["mjtf"] is None:
+        return f"no failure in {estimate['jumps']} jumps (MJTF > {low:.0f})"
+    return f"{estimate['mjtf']:.0f} [{low:.0f}, {high:.0f}] ({estimate['failures']} falls in {estimate['tries']})"

@@ -116,3 +116,13 @@ def pitch_at(times, frame_time: np.ndarray, frame_pitch: np.ndarray) -> np.ndarr
         if window.size:
             result[i] = float(np.median(window))
     return result
+
+
+def pitch_drift_deg(series: list[TouchdownSeries]) -> float:
+    """The standard deviation [deg] of the pitch's change from one touchdown to the next (its
+    random walk's step, docs/model.md §5.1), over consecutive pairs; 0 without tracked pitch."""
+    steps = [np.diff(run.pitch)[run.consecutive] for run in series if run.pitch.size > 1]
+    steps = np.concatenate(steps) if steps else np.empty(0)
+    if steps.size < 2 or not np.any(steps):
+        return 0.0
+    return float(np.degrees(np.std(steps, ddof=1)))

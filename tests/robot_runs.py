@@ -66,7 +66,9 @@ def store_robot_run(session) -> int:
     return store_journaled_run(session, REQUEST, entries, disarm="disarmed")
 
 
-def store_journaled_run(session, request: RobotRunCreate, entries, *, disarm: str = "confirmed") -> int:
+def store_journaled_run(
+    session, request: RobotRunCreate, entries, *, disarm: str = "confirmed", end_reason: str = "jumps done"
+) -> int:
     """A robot run opened for ``request``, journaled with the entries ``entries(start)`` gives
     (``start``: the run's creation, Unix time) a second apart, and folded ``done`` as the journal
     writer folds one; its id."""
@@ -77,7 +79,7 @@ def store_journaled_run(session, request: RobotRunCreate, entries, *, disarm: st
         written = created + datetime.timedelta(seconds=index + 1)
         session.add(RunJournal(run_id=run_id, data=json_safe(entry), written_at=written))
     session.commit()
-    fold_journal(session, run_id, status="done", end_reason="jumps done", disarm=disarm, robot=robot)
+    fold_journal(session, run_id, status="done", end_reason=end_reason, disarm=disarm, robot=robot)
     return run_id
 
 

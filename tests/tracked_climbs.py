@@ -78,8 +78,11 @@ def tracked_climb(truth: Truth, legs, *, jumps: int, noise: NoiseModel, rng, tra
     return TrackedClimb({"time": time, "x": x, "y": y, "pitch": pitch}, found, controls)
 
 
-def store_tracked_run(session, climb: TrackedClimb, legs) -> int:
-    """``climb`` filed as a finished robot run (opened, one journal entry, folded); its id."""
+def store_tracked_run(session, climb: TrackedClimb, legs, *, fell: bool = False) -> int:
+    """``climb`` filed as a finished robot run (opened, one journal entry, folded); its id. ``fell``:
+    it ended as a fall does (the firmware's FELL fault in its telemetry, the robot disarmed)."""
+    from backend.robot.live_run import CLEAN_ENDINGS
+    from backend.robot.messages import Fault
     from backend.schemas import LegIn, RobotRunCreate
     from tests.robot_runs import store_journaled_run
 
@@ -88,9 +91,11 @@ def store_tracked_run(session, climb: TrackedClimb, legs) -> int:
         "frames": {name: column.tolist() for name, column in climb.frames.items()},
         "touchdowns": [{"touchdown": td.to_dict(), "control": list(control)}
                        for td, control in zip(climb.touchdowns, climb.controls, strict=True)],
-        "commands": [], "telemetry": [], "transitions": [], "tracker": {"dropped": 0, "loss": 0.0},
+        "commands": [], "telemetry": [{"seq": 1, "faults": int(Fault.FELL) if fell else 0}], "transitions": [],
+        "tracker": {"dropped": 0, "loss": 0.0},
     }  # fmt: skip
-    return store_journaled_run(session, request, lambda _start: [entry])
+    ending = "robot disarmed (fell or timed out)" if fell else CLEAN_ENDINGS[0]
+    return store_journaled_run(session, request, lambda _start: [entry], end_reason=ending)
 
 
 def store_varied_runs(session, truth: Truth, *, noise: NoiseModel, jumps: int = 40, seed: int = 3) -> list[int]:

@@ -59,3 +59,15 @@ def test_calibrate_reports_in_words_and_refuses_what_it_cannot_fit(data_dir):
     missing = invoke("calibrate", "--data-dir", str(directory / "elsewhere"), "--runs", "1")
     assert missing.exit_code == 2 and "no store in" in missing.output
     assert not (directory / "elsewhere").exists(), "a command that reads creates no store"
+
+
+def test_robustness_puts_the_models_mjtf_beside_the_robots(data_dir):
+    directory, runs = data_dir
+    json_of("calibrate", "--data-dir", str(directory), "--runs", ",".join(map(str, runs)), "--name", "bench")
+    study = json_of("robustness", "--data-dir", str(directory), "--preset", "bench", "--trials", "20", "--cap", "100")
+    assert study["runs"] == runs and len(study["gaits"]) == 4 and study["trials"] == 20
+    assert {"robot", "model", "controls"} <= set(study["gaits"][0])
+    words = invoke("robustness", "--data-dir", str(directory), "--preset", "bench", "--trials", "5", "--cap", "50")
+    assert words.exit_code == 0 and "robot no failure in" in words.stdout and "model" in words.stdout
+    missing = invoke("robustness", "--data-dir", str(directory), "--preset", "nothing")
+    assert missing.exit_code == 2 and "preset: preset nothing does not exist" in missing.output

@@ -1,0 +1,83 @@
+"""The robustness study of a calibration: its model's MJTF beside the robot's jumps to failure
+(:mod:`experiments.robustness`, docs/calibration.md), from the runs it was fitted to or others.
+
+A robot run failed when its telemetry reported the FELL fault (the firmware's "a jump failed"),
+or — without telemetry — when the robot disarmed on its own; a run stopped otherwise (its jumps
+done, a stop, a time limit, a lost link) is censored. Its jumps are those between its first and
+last touchdown. A replay counts as the robot run it was made from, once.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+
+import numpy as np
+from sqlalchemy.orm import Session
+
+from backend.robot.messages import Fault
+from backend.services.calibrations import get_stored_preset, preset_params, touchdown_series
+from backend.services.records import Conflict, fetch
+from backend.store.models import Run
+from sim_core.errors import ParameterError
+from sim_core.presets import get_preset
+
+MAX_TRIALS = 5000
+MAX_CAP = 100_000
+SELF_DISARMED = "robot disarmed (fell or timed out)"  # backend.robot.live_run's ending
+
+
+def robustness(
+    session: Session, preset: str, run_ids: list[int] | None = None, *, trials: int, cap: int, seed: int = 0
+) -> dict:
+    """The study's JSON: the preset, the noise it simulates with, and per gait the robot's MJTF and the model's."""
+    from experiments.robustness import JumpsToFailure, compare, noise_of
+    from sim_core.touchdown_series import pitch_drift_deg
+
+    if not 1 <= trials <= MAX_TRIALS:
+        raise ParameterError("trials", f"must be in [1, {MAX_TRIALS}], got {trials}")
+    if not 1 <= cap <= MAX_CAP:
+        raise ParameterError("cap", f"must be in [1, {MAX_CAP}], got {cap}")
+    stored = get_stored_preset(session, preset)
+    robot, offsets = preset_params(session, preset)
+    base = get_preset(stored.base)
+    tries: dict[tuple, list[tuple[int, bool]]] = defaultdict(list)
+    series, seen = [], set()
+    for run_id in run_ids or stored.runs:
+        run = _robot_run(session, run_id)
+        if run.id in seen:
+            continue
+        seen.add(run.id)
+        series.append(touchdown_series(session, run, base))
+        tries[_legs(run)].append((run.jumps_completed, _fell(run)))
+    drift = pitch_drift_deg(series)
+    noise = noise_of(stored.fit["noise"], drift, offsets)
+    groups = {
+        legs: JumpsToFailure(tuple(j for j, _ in ends), tuple(f for _, f in ends)) for legs, ends in tries.items()
+    }
+    rows = compare(groups, robot.to_model(), offsets, noise, trials=trials, cap=cap, seed=seed)
+    return {"preset": preset, "runs": sorted(seen), "noise": noise.to_dict(), "trials": trials, "cap": cap,
+            "seed": seed, "gaits": rows}  # fmt: skip
+
+
+def _robot_run(session: Session, run_id: int) -> Run:
+    run = fetch(session, Run, run_id, "run")
+    if run.kind == "replay":
+        run = fetch(session, Run, run.results.get("source_run_id"), "run")
+    if run.kind != "robot":
+        raise Conflict(f"run {run_id} is a {run.kind} run; the study compares the robot's runs")
+    if run.status == "running":
+        raise Conflict(f"run {run_id} is still running")
+    return run
+
+
+def _legs(run: Run) -> tuple:
+    """The gait commanded: ((psi0_deg, zeta0) left, right); one pair is both legs'."""
+    pairs = [tuple(float(v) for v in pair) for pair in run.controls]
+    return (pairs[0], pairs[-1])
+
+
+def _fell(run: Run) -> bool:
+    telemetry = run.results.get("telemetry") or []
+    if telemetry:
+        return bool(np.bitwise_or.reduce([int(t.get("faults", 0)) for t in telemetry]) & Fault.FELL)
+    return run.results.get("end_reason") == SELF_DISARMED
