@@ -26,6 +26,7 @@ import viser
 
 from backend.robot.messages import Leg
 from backend.services import records
+from frontend.viewer.ghost_models import BASE, ghost_model, model_choices, realised
 from frontend.viewer.motion import STANCE, TRAIL_STRIDE, Controls, JumpPlan, PathClip, SimulatedClimb, model_jump
 from frontend.viewer.recordings import Recording, load_recording
 from frontend.viewer.scene import ChuteScene
@@ -315,15 +316,22 @@ class LiveMode(_Mode):
     name = "live"
     TRAIL_SECONDS = 3.0
 
-    def __init__(self, client: viser.ClientHandle, scene: ChuteScene, lock, robot_service):
+    def __init__(self, client: viser.ClientHandle, scene: ChuteScene, lock, robot_service, sessions=None):
         super().__init__(client, scene, lock)
         self.robot_service = robot_service
+        self.sessions = sessions
         gui = client.gui
         with gui.add_folder("Live", visible=False) as self.folder:
             self.gui_ghost = gui.add_checkbox(
                 "Model ghost", initial_value=True, hint="the model's jump from each touchdown"
             )
+            self.gui_ghost_model = gui.add_dropdown(
+                "Ghost model", model_choices(sessions), initial_value=BASE,
+                hint="the paper's model, or a calibration fitted to the robot's runs (docs/calibration.md)",
+            )  # fmt: skip
             self.gui_readout = gui.add_markdown("")
+        self.gui_ghost_model.on_update(lambda _event: self.use_ghost_model(self.gui_ghost_model.value))
+        self.ghost_model = ghost_model(sessions, BASE)
         self._ghosts: dict[int, JumpPlan] = {}
         self._marked = 0
         self._run = None
@@ -337,18 +345,28 @@ class LiveMode(_Mode):
         self._run = run
         return [] if run is None else list(run.touchdowns)
 
+    def use_ghost_model(self, name: str) -> None:
+        """Predict the ghost with model ``name`` (:func:`frontend.viewer.ghost_models.model_choices`) from now on."""
+        model = ghost_model(self.sessions, name)
+        with self.lock:
+            self.ghost_model, self._ghosts = model, {}
+
     def _ghost(self, touchdowns, k: int) -> JumpPlan | None:
         if k in self._ghosts:
             return self._ghosts[k]
-        run, robot = self._run, self.robot_service.robot
+        run, (robot, offsets) = self._run, self.ghost_model
         controls = run.touchdown_controls
         if k >= len(controls):
             return None
         touchdown = touchdowns[k]
         # The leg in flight after touchdown k reaches for the other wall: the one commanded now.
         next_leg = run.command_for(Leg.of(touchdown.wall.other)) or controls[k]
+        leg, next_leg = (
+            realised(offsets, controls[k], touchdown.wall),
+            realised(offsets, next_leg, touchdown.wall.other),
+        )
         try:
-            plan = model_jump(robot, touchdown.state, controls[k], next_leg, wall=touchdown.wall,
+            plan = model_jump(robot, touchdown.state, leg, next_leg, wall=touchdown.wall,
                               start_time=touchdown.time, start_height=touchdown.body_height)  # fmt: skip
         except (ValueError, ArithmeticError):
             plan = None

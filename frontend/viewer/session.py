@@ -62,7 +62,7 @@ class ViewerSession:
         self.gui_mode = gui.add_dropdown("Mode", MODES, initial_value="simulate")
         self.modes = {
             "simulate": SimulateMode(client, self.scene, self.lock, robot),
-            "live": LiveMode(client, self.scene, self.lock, context.robot_service),
+            "live": LiveMode(client, self.scene, self.lock, context.robot_service, context.sessions),
             "replay": ReplayMode(client, self.scene, self.lock, context.sessions),
         }
         self.modes["replay"].share = share

@@ -5,6 +5,7 @@ A real viser server on a free port; browsers are headless websocket clients (tes
 viewer/headless.py), and each one's GUI is driven from Python as its callbacks would drive it.
 """
 
+import dataclasses
 import time
 
 import numpy as np
@@ -305,3 +306,45 @@ def test_live_mode_shows_the_robot_to_everyone_who_chooses_it_with_the_model_bes
         assert "Touchdowns this run:** 6" in live.readout(60.0)
     finally:
         client.post("/api/v1/robot/disconnect", headers=auth)
+
+
+def test_the_live_ghost_can_predict_with_a_calibrated_model(service, browsers):
+    """A robot unlike the paper's: the ghost of a calibration of it lands where the robot touches
+    down, the paper's does not; each browser chooses its own."""
+    import socket
+
+    from backend.robot.virtual import VirtualRobot
+    from backend.store.models import ModelPreset
+    from sim_core.noise import NO_NOISE
+    from tests.helpers import free_port
+    from tests.tracked_climbs import Truth
+
+    client, auth, _view = service
+    truth = Truth.of(alpha=72.0, c_zeta=1.25, c_psi=0.8, psi0_offset_deg=(0.6, -0.8), zeta0_offset=(0.004, -0.005))
+    with client.app.state.sessions() as session:
+        session.add(ModelPreset(name="truth", base="paper", physical=dataclasses.asdict(truth.robot),
+                                offsets=truth.offsets.to_dict(), fit={}, runs=[], code_version="test"))  # fmt: skip
+        session.commit()
+    port = free_port(socket.SOCK_DGRAM)
+    robot = VirtualRobot(tracker_to=("127.0.0.1", port), robot=truth.robot, leg_offsets=truth.offsets,
+                         noise=NO_NOISE, tracker_noise=0.0, drop_rate=0.0, speed=4.0).start()  # fmt: skip
+    (_, paper_view), (_, calibrated_view) = browsers(), browsers()
+    try:
+        answer = client.post("/api/v1/robot/connect", json={"url": robot.url, "tracker_port": port}, headers=auth)
+        assert answer.status_code == 200, answer.text
+        paper, calibrated = paper_view.modes["live"], calibrated_view.modes["live"]
+        assert calibrated.gui_ghost_model.options == ("paper", "truth")
+        calibrated.use_ghost_model("truth")
+        paper_view.set_mode("live")
+        calibrated_view.set_mode("live")
+        controls = [{"psi0_deg": 30, "zeta0": 0.87}, {"psi0_deg": 30, "zeta0": 0.9}]
+        assert (
+            client.post("/api/v1/robot/runs", json={"controls": controls, "jumps": 6}, headers=auth).status_code == 202
+        )
+        _wait_for(lambda: not client.get("/api/v1/robot").json()["run"]["active"], timeout=30)
+        _wait_for(lambda: paper._marked >= 6 and calibrated._marked >= 6)
+        assert abs(calibrated.last_error) < 0.002, f"the calibrated ghost's error {calibrated.last_error:+.4f} m"
+        assert abs(paper.last_error) > 3 * abs(calibrated.last_error), (paper.last_error, calibrated.last_error)
+    finally:
+        client.post("/api/v1/robot/disconnect", headers=auth)
+        robot.stop()
