@@ -71,7 +71,7 @@ class CalibrationFit:
         touchdowns_used: pairs compared (each a touchdown the model predicted).
         rms_before, rms_after: RMS one-jump error of the section state [sqrt(g l0)], base vs fitted.
         channels: per channel ``{"unit", "rms_before", "rms_after"}``.
-        noise: the residual scatter per channel after the fit (the unexplained noise; a robust sigma).
+        noise: the noise levels most likely at the fit (:class:`sim_core.calibration_noise.TouchdownNoise`).
         failed_predictions: pairs whose predicted jump failed with the fitted model.
     """
 

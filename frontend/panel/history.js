@@ -13,6 +13,9 @@ function runQuery() {
 }
 
 const shownRuns = new Map();  // id -> the run as last listed: what the editor starts from
+// The runs ticked in the table (compare, 3D's ghost, calibrate), as last listed.
+export const selectedRuns = () => [...document.querySelectorAll("#run-table input:checked")]
+  .map((box) => shownRuns.get(Number(box.value))).filter(Boolean);
 
 function runRow(run) {
   const controls = run.controls.map((c) => `${c[0]}°/${c[1]}`).join(", ");
@@ -32,12 +35,15 @@ function runRow(run) {
   return row;
 }
 
-// A robot or replay run that has ended downloads as an MCAP recording (Foxglove, Rerun open it).
-const RECORDED_KINDS = ["robot", "replay"];
+// A robot or replay run that has ended downloads as an MCAP recording (Foxglove, Rerun open it),
+// and shows its touchdowns beside the model's predictions (touchdowns.js).
+export const RECORDED_KINDS = ["robot", "replay"];
 function recordingLink(run) {
   if (!RECORDED_KINDS.includes(run.kind) || run.status === "running") return [];
   return [" ", attributes(element("a", "MCAP"), { href: `${API}/runs/${run.id}/export.mcap`, download: "", class: "export-mcap",
-    "aria-label": `download run ${run.id} as an MCAP recording (Foxglove, Rerun)` })];
+    "aria-label": `download run ${run.id} as an MCAP recording (Foxglove, Rerun)` }), " ",
+  attributes(element("button", "touchdowns"), { type: "button", class: "show-touchdowns", "data-run": run.id,
+    "aria-label": `run ${run.id}'s touchdowns, measured and predicted` })];
 }
 
 export async function loadRuns() {

@@ -5,12 +5,15 @@
 import { initTabs } from "./tabs.js";
 import { loadJobs } from "./jobs.js";
 import { loadExperiments, loadRuns } from "./history.js";
+import { loadCalibrations } from "./calibration.js";
+import "./touchdowns.js";
 import { drawLive, refreshRobot, syncLive } from "./robot.js";
+import "./connect.js";
 import "./simulate.js";
 import { showView } from "./view.js";
 
 initTabs((name) => {
-  if (name === "history") loadExperiments().then(loadRuns).catch(() => {});
+  if (name === "history") loadExperiments().then(loadRuns).then(loadCalibrations).catch(() => {});
   if (name === "jobs") loadJobs();
   if (name === "robot") { refreshRobot().catch(() => {}); drawLive(); }
   syncLive();  // the live websocket is open while the Robot tab is shown

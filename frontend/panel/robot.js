@@ -1,6 +1,5 @@
 // The Robot tab: connect, arm, live runs (open and closed loop), the live plot and websocket,
 // the emergency stop (no token needed) and the latched e-stop banner.
-import { Fields } from "./fields.js";
 import { API, $, say, call, on } from "./api.js";
 import { filedUnder, LEG_FIELDS, SIM_LOCATIONS, checked } from "./forms.js";
 import { PLOT_CONFIG, layout } from "./plots.js";
@@ -13,8 +12,6 @@ export const plot = { key: undefined, label: "", t: [], y: [], lastTime: null, t
 let pendingTarget;  // the closed-loop target of the run this browser is starting (undefined: none)
 let runWasActive = false;
 let localRuns = 0;
-
-
 
 function describeRun(run) {
   if (!run) return "—";
@@ -158,17 +155,7 @@ export function closeLive() {
 
 document.addEventListener("visibilitychange", syncLive);
 
-on("#connect-form", "submit", async (event) => {
-  event.preventDefault();
-  const numbers = await Fields.readFields(event.target, [{ name: "tracker_port", rule: "RobotConnect.tracker_port" }]);
-  if (!numbers) return;  // an empty or non-numeric port is marked at its field, never sent as 0
-  const form = new FormData(event.target);
-  const body = { url: String(form.get("url")).trim(), robot_address: String(form.get("robot_address")).trim(), ...numbers };
-  const fields = ["url", "robot_address", "tracker_port"];
-  const status = await call("POST", "/robot/connect", body, { form: event.target, locations: Object.fromEntries(fields.map((f) => [f, f])) });
-  showStatus(status);
-  say(`Connected to ${status.robot_address ?? body.robot_address} on ${status.url ?? body.url}.`);
-});
+// The connect form (the link, the tracker and its protocol): connect.js.
 on("#disconnect", "click", async () => { showStatus(await call("POST", "/robot/disconnect")); say("Disconnected."); });
 on("#arm", "click", async () => showStatus(await call("POST", "/robot/arm")));
 on("#disarm", "click", async () => showStatus(await call("POST", "/robot/disarm")));

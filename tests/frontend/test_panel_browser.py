@@ -999,3 +999,146 @@ def _shot_xss(page, name, selector=None):
     folder = Path("/tmp/xss_shots")
     folder.mkdir(exist_ok=True)
     (page.locator(selector) if selector else page).screenshot(path=str(folder / f"{name}.png"))
+
+
+# History → calibration, and predicted against measured (docs/calibration.md) -------------------
+CALIBRATION_TRUTH = dict(alpha=72.0, c_zeta=1.25, c_psi=0.8, psi0_offset_deg=(0.6, -0.8), zeta0_offset=(0.004, -0.005))
+
+
+@pytest.fixture(scope="module")
+def varied_runs(service, data_dir):
+    """Robot runs of a robot unlike the paper's at four gaits, stored beside the service; their ids."""
+    from sim_core.noise import NoiseModel
+    from tests.tracked_climbs import Truth, store_varied_runs
+
+    engine = make_engine(sqlite_url(data_dir))
+    with session_factory(engine)() as session:
+        runs = store_varied_runs(
+            session, Truth.of(**CALIBRATION_TRUTH), noise=NoiseModel(pitch_drift_deg=0.2), jumps=30
+        )
+    engine.dispose()
+    return runs
+
+
+def _show_runs(page, runs):
+    page.click("nav [data-tab=history]")
+    page.select_option("#history-form select[name=kind]", "robot")
+    page.click("#history-form button[type=submit]")
+    _until(page, " && ".join(f"!!document.querySelector('#run-{run}')" for run in runs))
+
+
+def test_history_calibrates_selected_runs_and_lists_the_calibration(page, service, varied_runs):
+    """Tick robot runs, "Calibrate selected…", a name: a bad one is marked at the field (as text),
+    a good one fits and stores; the report shows value ± error with units, rms before → after, the
+    noise; the calibration is listed, offered for the touchdowns, and deleted."""
+    base, token = service
+    httpx.patch(f"{base}/api/v1/runs/{varied_runs[0]}", json={"notes": XSS[1]},
+                headers={"Authorization": f"Bearer {token}"}).raise_for_status()  # fmt: skip
+    _show_runs(page, varied_runs)
+    for run in varied_runs:
+        page.check(f"#run-{run} input[type=checkbox]")
+    page.click("#calibrate")
+    assert page.evaluate("document.querySelector('#calibrate-dialog').open")
+    assert page.inner_text("#calibrate-runs") == f"From runs {', '.join(map(str, varied_runs))}."
+    for bad in (XSS[0], "paper"):
+        page.fill("#calibrate-form input[name=name]", bad)
+        page.click("#calibrate-fit")
+        _until(page, "document.querySelector('#name-error') !== null")
+        assert page.get_attribute("#calibrate-form input[name=name]", "aria-invalid") == "true"
+        _no_script_ran(page, "the calibrate dialog")
+    assert "built-in preset" in page.inner_text("#name-error")
+    _shot(page, "history_calibrate")
+    page.fill("#calibrate-form input[name=name]", "table.v1")
+    page.click("#calibrate-fit")
+    _until(page, "!!document.querySelector('#calibration-params') && !document.querySelector('#calibrate-dialog').open",
+           timeout=60_000)  # fmt: skip
+    cells = (
+        "[...document.querySelectorAll('#calibration-params tr')].map((r) => [...r.children].map((c) => c.textContent))"
+    )
+    rows = page.evaluate(cells)[1:]
+    assert [row[0] for row in rows][:3] == ["alpha", "c_zeta", "c_psi"] and len(rows) == 7
+    assert [row[2] for row in rows] == ["nondimensional"] * 3 + ["deg"] * 2 + ["l0"] * 2
+    alpha, error = (float(part) for part in rows[0][1].split(" ± "))
+    assert abs(alpha - 72.0) < 4 * error, rows[0]
+    report = page.inner_text("#calibration-out")
+    assert (
+        re.search(r"RMS residual [\d.e-]+ → [\d.e-]+ √\(g l0\)", report)
+        and "Noise estimated (σ): touchdown state" in report
+    )
+    assert page.inner_text("#calibration-table tr[data-name='table.v1'] button.show-calibration") == "table.v1"
+    assert "table.v1" in page.evaluate("[...document.querySelectorAll('#touchdown-preset option')].map((o) => o.value)")
+    page.locator("#calibrations-box").scroll_into_view_if_needed()
+    _shot(page, "history_calibration")
+    _no_script_ran(page, "the calibration report")
+    page.once("dialog", _accept)
+    page.click("#calibration-table tr[data-name='table.v1'] button.delete-calibration")
+    _until(page, "!document.querySelector(\"#calibration-table tr[data-name='table.v1']\")")
+    assert page.inner_text("#calibration-out") == ""
+    assert httpx.get(f"{base}/api/v1/calibrations/table.v1").status_code == 404
+
+
+def test_a_robot_runs_touchdowns_are_drawn_against_the_models(page, service, varied_runs):
+    """ "touchdowns" on a robot run: measured against the paper's model, and against a stored
+    calibration once chosen; one channel at a time, residuals below, the RMS of each as text."""
+    base, token = service
+    fitted = httpx.post(f"{base}/api/v1/calibrations", json={"runs": varied_runs, "name": "touch.v1"},
+                        headers={"Authorization": f"Bearer {token}"}, timeout=120)  # fmt: skip
+    assert fitted.status_code == 201, fitted.text
+    _show_runs(page, varied_runs)
+    page.evaluate("async () => (await import('/panel/calibration.js')).loadCalibrations()")
+    page.evaluate("document.querySelector('#touchdown-preset').value = ''")  # the paper's model alone first
+    run = varied_runs[2]
+    page.click(f"#run-{run} button.show-touchdowns")
+    traces = "document.querySelector('#touchdown-plot').data?.map((t) => t.name).join('|') ?? ''"
+    _until(page, f'{traces} === "measured|paper\'s model"')
+    rms = page.inner_text("#touchdowns-rms")
+    assert "paper: xdot" in rms and "calibrated" not in rms, rms
+    page.select_option("#touchdown-preset", "touch.v1")
+    _until(page, f'{traces} === "measured|paper\'s model|calibrated (touch.v1)"')
+    _until(page, "document.querySelector('#touchdowns-rms').textContent.includes('calibrated (touch.v1)')")
+    rms = page.inner_text("#touchdowns-rms")
+    assert "calibrated (touch.v1): xdot" in rms and "rise" in rms, rms
+    page.select_option("#touchdown-channel", "rise")
+    _until(page, "document.querySelector('#touchdown-plot').layout.yaxis.title.text === 'rise [l0]'")
+    residuals = page.evaluate("document.querySelector('#residual-plot').data.map((t) => [t.name, t.y.length])")
+    assert [name for name, _ in residuals] == ["paper's model", "calibrated (touch.v1)"] and residuals[0][1] > 20
+    assert page.evaluate("document.querySelector('#touchdown-plot').data.every((t) => t.y.every((v) => v !== null))")
+    page.locator("#touchdowns-box").scroll_into_view_if_needed()
+    _shot(page, "history_touchdowns")
+    httpx.delete(f"{base}/api/v1/calibrations/touch.v1", headers={"Authorization": f"Bearer {token}"})
+
+
+def test_the_connect_form_offers_natnet_and_marks_its_fields(page):
+    """NatNet's fields show only with NatNet chosen; a bad rigid body id is marked and not sent; an
+    empty multicast group goes as null (unicast); a version the service refuses lands at its field."""
+    sent = []
+    page.on("request", lambda request: "/robot/connect" in request.url and sent.append(request.post_data_json))
+    page.click("nav [data-tab=robot]")
+    assert page.is_hidden("#natnet-fields")
+    page.select_option("#tracker-protocol", "natnet")
+    assert (
+        page.is_visible("#natnet-fields") and page.input_value("input[name=natnet_multicast_group]") == "239.255.42.99"
+    )
+    page.fill("input[name=natnet_rigid_body_id]", "-1")
+    page.click("#connect")
+    _until(page, "document.querySelector('#natnet_rigid_body_id-error') !== null")
+    assert "at least 0" in page.inner_text("#natnet_rigid_body_id-error") and sent == []
+    page.fill("input[name=natnet_rigid_body_id]", "7")
+    page.fill("input[name=natnet_version]", "9.9")
+    page.fill("input[name=natnet_multicast_group]", "")
+    page.click("#connect")
+    _until(page, "document.querySelector('#natnet_version-error') !== null")
+    assert "9.9" in page.inner_text("#natnet_version-error")
+    assert page.get_attribute("input[name=natnet_version]", "aria-invalid") == "true"
+    _shot(page, "robot_natnet")
+    [body] = sent
+    assert (
+        body["tracker_protocol"] == "natnet"
+        and body["natnet_rigid_body_id"] == 7
+        and body["natnet_command_port"] == 1510
+    )
+    assert body["natnet_multicast_group"] is None and body["natnet_server_host"] == "127.0.0.1"
+    page.fill("input[name=natnet_version]", "auto")
+    page.fill("input[name=natnet_multicast_group]", "239.255.42.99")
+    page.select_option("#tracker-protocol", "pkt1")
+    assert page.is_hidden("#natnet-fields") and page.is_hidden("#natnet-help")
