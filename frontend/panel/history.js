@@ -46,10 +46,13 @@ function recordingLink(run) {
     "aria-label": `run ${run.id}'s touchdowns, measured and predicted` })];
 }
 
+let listing = 0;  // the newest listing asked for: an older answer arriving later is not shown
 export async function loadRuns() {
+  const asked = ++listing;
   const params = runQuery();
   const sort = new FormData($("#history-form")).get("sort");
   const page = await call("GET", `/runs?limit=100&sort=${sort}&${params}`);
+  if (asked !== listing) return;  // the tab's first listing answered after the filter's
   $("#export-csv").href = `${API}/runs/export?format=csv&${params}`;
   $("#export-json").href = `${API}/runs/export?format=json&${params}`;
   shownRuns.clear();

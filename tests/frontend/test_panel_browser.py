@@ -302,7 +302,10 @@ def test_tabs_keys_an_empty_result_and_sort_at_once(page, service):
     order lists at once, without pressing Filter."""
     base, token = service
     body = {"controls": [{"psi0_deg": 30, "zeta0": 0.9}], "start": {"xdot": -0.93, "ydot": -0.2}, "jumps": 2}
-    httpx.post(f"{base}/api/v1/runs", json=body, headers={"Authorization": f"Bearer {token}"}).raise_for_status()
+    # The first simulation of the module waits for the quick worker to load the kernels: generous.
+    httpx.post(
+        f"{base}/api/v1/runs", json=body, headers={"Authorization": f"Bearer {token}"}, timeout=60
+    ).raise_for_status()
     page.click("nav [data-tab=simulate]")
     assert page.get_attribute("#tab-simulate", "aria-controls") == "simulate"
     assert page.get_attribute("#simulate", "aria-labelledby") == "tab-simulate"
