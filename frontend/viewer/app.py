@@ -119,12 +119,16 @@ class ClimbView:
             session.replay(pending.run_id, pending.overlay_id, pending.recording, pending.overlay)
 
     def _disconnect(self, client: viser.ClientHandle) -> None:
-        with self._sessions_lock:
-            remaining = dict(self.sessions)
-            session = remaining.pop(client.client_id, None)
-            self.sessions = MappingProxyType(remaining)
+        # Closed before it leaves the mapping, so a session no longer listed is one that draws and
+        # computes nothing (a closed one still listed draws nothing either); the close is outside
+        # the lock, as it waits for the session's gait search to stop.
+        session = self.sessions.get(client.client_id)
         if session is not None:
             session.close()
+        with self._sessions_lock:
+            remaining = dict(self.sessions)
+            remaining.pop(client.client_id, None)
+            self.sessions = MappingProxyType(remaining)
 
     def sessions_of(self, viewer: str) -> list[ViewerSession]:
         """The connected views of the panel called ``viewer`` (usually one)."""
