@@ -37,7 +37,7 @@ from sim_core.calibration_noise import TouchdownNoise, estimate_noise, pair_cova
 from sim_core.controls import LegOffsets
 from sim_core.params import ModelParams
 from sim_core.touchdown_model import predict_pairs, sensitivities
-from sim_core.touchdown_series import CHANNEL_UNITS, CHANNELS, Pairs, TouchdownSeries
+from sim_core.touchdown_series import CHANNEL_UNITS, CHANNELS, Pairs, TouchdownSeries, finite_rms
 from sim_core.validation import ParameterError
 
 # The fitted vector, in order: its names in the JSON, and the units the fit works in.
@@ -180,8 +180,8 @@ def calibrate(series: list[TouchdownSeries], base: ModelParams, start: LegOffset
     stderr, correlation, unidentifiable = _uncertainty(jacobian, fit.fun)
     model, offsets = split(base, x)
     channels = {
-        name: {"unit": CHANNEL_UNITS[name], "rms_before": _rms(before[:, i] - measured[:, i]),
-               "rms_after": _rms(after[:, i] - measured[:, i])}
+        name: {"unit": CHANNEL_UNITS[name], "rms_before": finite_rms(before[:, i] - measured[:, i]),
+               "rms_after": finite_rms(after[:, i] - measured[:, i])}
         for i, name in enumerate(CHANNELS)
     }  # fmt: skip
     return CalibrationFit(
@@ -192,19 +192,12 @@ def calibrate(series: list[TouchdownSeries], base: ModelParams, start: LegOffset
         unidentifiable=unidentifiable,
         confounded=_confounded(correlation),
         touchdowns_used=len(pairs),
-        rms_before=_rms(before[:, :2] - measured[:, :2]),
-        rms_after=_rms(after[:, :2] - measured[:, :2]),
+        rms_before=finite_rms(before[:, :2] - measured[:, :2]),
+        rms_after=finite_rms(after[:, :2] - measured[:, :2]),
         channels=channels,
         noise=noise.to_dict(),
         failed_predictions=failed,
     )
-
-
-def _rms(values: np.ndarray, axis=None):
-    """Root mean square over the finite values (a failed prediction has none to give)."""
-    squared = np.where(np.isfinite(values), values, np.nan) ** 2
-    result = np.sqrt(np.nanmean(squared, axis=axis))
-    return result if axis is not None else float(result)
 
 
 def _confounded(correlation: np.ndarray) -> tuple[tuple[str, str, float], ...]:

@@ -8,6 +8,7 @@ Units: states in ``sqrt(g l0)``, heights in ``l0``, angles in radians; walls as 
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -126,3 +127,13 @@ def pitch_drift_deg(series: list[TouchdownSeries]) -> float:
     if steps.size < 2 or not np.any(steps):
         return 0.0
     return float(np.degrees(np.std(steps, ddof=1)))
+
+
+def finite_rms(values: np.ndarray, axis=None):
+    """Root mean square over the finite values (a failed prediction has none to give); NaN where
+    there are none."""
+    squared = np.where(np.isfinite(values), values, np.nan) ** 2
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a column without a finite value is NaN
+        result = np.sqrt(np.nanmean(squared, axis=axis))
+    return result if axis is not None else float(result)

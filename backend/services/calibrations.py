@@ -10,7 +10,6 @@ the code version. A stored preset is used by name wherever a built-in one is
 
 from __future__ import annotations
 
-import math
 import re
 from collections.abc import Callable
 from dataclasses import asdict
@@ -31,7 +30,7 @@ from sim_core.controls import NO_OFFSETS, LegControl, LegOffsets
 from sim_core.errors import ParameterError
 from sim_core.params import ModelParams, PhysicalParams
 from sim_core.presets import PRESETS, get_preset
-from sim_core.touchdown_series import TouchdownSeries, pitch_at
+from sim_core.touchdown_series import TouchdownSeries, finite_rms, pitch_at
 from sim_core.walls import Wall
 
 if TYPE_CHECKING:  # the kernels load in compute workers, not in the service (tests/backend/api/test_startup.py)
@@ -253,15 +252,9 @@ def touchdown_predictions(session: Session, run_id: int, *, preset: str | None, 
             entry[name] = _channels(predicted)
             entry[f"{name}_residual"] = _channels(predicted - found["measured"][row])
         rows.append(entry)
-    rms = {name: _rms_by_channel(found[name] - found["measured"]) for name in models}
+    rms = {name: _channels(finite_rms(found[name] - found["measured"], axis=0)) for name in models}
     return json_safe({"run_id": run_id, "base": base_name, "preset": preset, "touchdowns": rows, "rms": rms})
 
 
 def _channels(values) -> dict:
     return dict(zip(("xdot", "ydot", "rise"), (float(v) for v in values), strict=True))
-
-
-def _rms_by_channel(residuals: np.ndarray) -> dict:
-    finite = np.where(np.isfinite(residuals), residuals, np.nan)
-    with np.errstate(invalid="ignore"):
-        return _channels(np.sqrt(np.nanmean(finite**2, axis=0)) if len(finite) else [math.nan] * 3)
