@@ -527,3 +527,30 @@ def flap_supervised(seconds: float, monkeypatch, caplog, thread_errors: list, *,
     assert most_threads <= baseline + THREADS_DURING, f"too many threads while flapping: {seen}"
     assert supervisor.link is None and link.state == LinkState.DISCONNECTED
     return seen
+
+
+def climb_open_loop(robot, legs: dict, jumps: int, timeout: float = 30.0):
+    """Connect to the started virtual ``robot`` as the PC does, set ``legs`` ({Leg: (psi0_deg, zeta0)}),
+    arm and start; wait for ``jumps`` jumps or the run's end; disarm; close the link. Returns the
+    link's state when the wait ended (RUNNING: the jumps were done) and the closed link (its last
+    telemetry)."""
+    from backend.robot.link import LinkState, RobotLink
+
+    link = RobotLink(robot.url)
+    try:
+        link.connect()
+        for leg, (psi0, zeta0) in legs.items():
+            link.set_leg(leg, psi0, zeta0)
+        link.arm()
+        link.start()
+        deadline = time.monotonic() + timeout
+        while robot.climber.jumps < jumps and link.state == LinkState.RUNNING:
+            assert time.monotonic() < deadline, "the robot stopped climbing"
+            time.sleep(0.02)
+        state_at_end = link.state
+        if state_at_end == LinkState.RUNNING:
+            link.disarm()
+        time.sleep(0.05)
+        return state_at_end, link
+    finally:
+        link.close()

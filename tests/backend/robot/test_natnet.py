@@ -13,7 +13,6 @@ from hypothesis import strategies as st
 from pydantic import ValidationError
 
 from backend.robot import natnet_source
-from backend.robot.link import LinkState, RobotLink
 from backend.robot.messages import Leg
 from backend.robot.natnet import (
     NatNetError,
@@ -35,6 +34,8 @@ from sim_core.errors import ParameterError
 from sim_core.noise import NO_NOISE
 from sim_core.walls import wall_of
 from tests.backend.robot.natnet_frames import Body, Scene, frame_packet, server_info_packet
+from tests.helpers import free_port
+from tests.robot_rig import climb_open_loop
 
 VERSIONS = [200, 201, 203, 205, 206, 207, 209, 210, 211, 300, 301, 400, 401]
 PITCH = 0.3
@@ -235,7 +236,7 @@ def test_a_configured_version_wins_and_needs_no_answer():
 
 
 def test_multicast_source_joins_the_group():
-    port = _free_port()
+    port = free_port(socket.SOCK_DGRAM)
     try:
         source = NatNetPoseSource(2, interface="127.0.0.1", port=port, server=("127.0.0.1", 9), version=(3, 1))
     except OSError as error:
@@ -253,12 +254,6 @@ def test_multicast_source_joins_the_group():
         source.close()
 
 
-def _free_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
-        probe.bind(("", 0))
-        return probe.getsockname()[1]
-
-
 def _climb(tracker, protocol: str, jumps: int = 8):
     """An open-loop climb of the noiseless virtual robot at 6x real time, its camera on ``protocol``
     (tracker noise and dropped frames as usual, from the same seed): the touchdowns its tracker saw."""
@@ -271,18 +266,9 @@ def _climb(tracker, protocol: str, jumps: int = 8):
         natnet_version="2.9",
         natnet_rigid_body_id=3,
     ).start()
-    link = RobotLink(robot.url)
     try:
-        link.connect()
-        for leg, (psi0, zeta0) in LEGS.items():
-            link.set_leg(leg, psi0, zeta0)
-        link.arm()
-        link.start()
-        _until(lambda: robot.climber.jumps >= jumps or link.state != LinkState.RUNNING, timeout=30)
-        link.disarm()
-        time.sleep(0.05)
+        climb_open_loop(robot, LEGS, jumps)
     finally:
-        link.close()
         robot.stop()
         tracker.close()
     poses = tracker.as_arrays()

@@ -7,7 +7,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from backend.robot.link import LinkState, RobotLink
+from backend.robot.link import LinkState
 from backend.robot.messages import Ack, Command, Fault, Kind, Leg, RobotState, decode, encode
 from backend.robot.touchdown import detect_touchdowns, height_gains
 from backend.robot.tracker import UdpPoseSource
@@ -26,6 +26,7 @@ from sim_core.climb import FLOOR, ClimbEnd
 from sim_core.controls import LegOffsets
 from sim_core.noise import NO_NOISE, NoiseModel
 from sim_core.walls import Wall, wall_of
+from tests.robot_rig import climb_open_loop
 
 LEGS = {Leg.LEFT: (30.0, 0.87), Leg.RIGHT: (30.0, 0.9)}
 ROBOT = get_preset("paper")
@@ -74,24 +75,10 @@ def test_the_radio_answers_transmit_status_as_an_xbee_does():
 def _run(noise, jumps, *, speed=6.0, seed=1, legs=LEGS, **climber_options):
     tracker = UdpPoseSource()
     robot = VirtualRobot(tracker_to=tracker.address, noise=noise, speed=speed, seed=seed, **climber_options).start()
-    link = RobotLink(robot.url)
     try:
-        link.connect()
-        for leg, (psi0, zeta0) in legs.items():
-            link.set_leg(leg, psi0, zeta0)
-        link.arm()
-        link.start()
-        deadline = time.monotonic() + 30
-        while robot.climber.jumps < jumps and link.state == LinkState.RUNNING:
-            assert time.monotonic() < deadline, "the robot stopped climbing"
-            time.sleep(0.02)
-        state_at_end = link.state
-        if state_at_end == LinkState.RUNNING:
-            link.disarm()
-        time.sleep(0.05)
+        state_at_end, link = climb_open_loop(robot, legs, jumps)
         return tracker, robot, link, state_at_end
     finally:
-        link.close()
         robot.stop()
         tracker.close()
 
