@@ -19,6 +19,7 @@ from fastapi import FastAPI
 from fastapi.staticfiles import StaticFiles
 
 from backend.api import errors, security
+from backend.api.deps import Database
 from backend.api.routes import calibrations, experiments, jobs, robot, runs, sim, site, view
 from backend.api.security import api_token
 from backend.services import jobs as job_service
@@ -99,6 +100,7 @@ def create_app(
     app.mount("/panel", StaticFiles(directory=PANEL_DIR, html=True), name="panel")
     app.state.settings = settings
     app.state.sessions = sessions
+    app.state.database = Database(sessions)
     app.state.token = token
     app.state.runner = runner if run_jobs else None
     app.state.robot = robot_service

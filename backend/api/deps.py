@@ -1,17 +1,22 @@
 """What routes ask FastAPI for: a database session, the token check, the service's parts, and the
-shared path and query parameters (ids, pages, the run filters)."""
+shared path and query parameters (ids, pages, the run filters).
+
+Every dependency here that does no blocking work is ``async``: FastAPI runs a plain ``def`` one in
+a request thread, and each such hop costs about 0.8 ms of the service's CPU on this machine
+(``scripts/bench_load.py``), more than most of them compute — and the e-stop's must never wait
+for a request thread that compute or a busy store holds."""
 
 from __future__ import annotations
 
 import contextlib
 import datetime
-from collections.abc import Iterator
-from typing import Annotated
+from collections.abc import Callable, Iterator
+from typing import Annotated, TypeVar
 
 from fastapi import Depends, HTTPException, Query, Request, status
 from fastapi import Path as FastAPIPath
 from fastapi.concurrency import run_in_threadpool
-from sqlalchemy.orm import Session
+from sqlalchemy.orm import Session, sessionmaker
 
 from backend import schemas
 from backend.api.security import require_token
@@ -21,13 +26,14 @@ from backend.services.robot import RobotService
 from backend.store.database import StorageFull, after_storage_full
 from sim_core.presets import PRESETS
 
+T = TypeVar("T")
 VIEW_NOT_STARTED = "the 3D view is not running (it starts with `parkour serve`)"
 
 
 @contextlib.contextmanager
 def request_session(sessions) -> Iterator[Session]:
-    """A session for one request's database work (the ``Db`` dependency's, or an async route's in
-    a thread): on a full disk — answered 507 (errors.py) — the WAL is folded so that a retry can fit."""
+    """A session for one request's database work, in a request thread (:class:`Database`): on a
+    full disk — answered 507 (errors.py) — the WAL is folded so that a retry can fit."""
     with sessions() as session:
         try:
             yield session
@@ -37,12 +43,35 @@ def request_session(sessions) -> Iterator[Session]:
             raise
 
 
-def get_session(request: Request) -> Iterator[Session]:
-    with request_session(request.app.state.sessions) as session:
-        yield session
+class Database:
+    """The routes' way to the store: ``await db(work, *args)`` runs ``work(session, *args)`` in a
+    request thread with a session of its own, opened and closed there (:func:`request_session`),
+    and returns what it returns — the route's whole database work in one thread hop, its answer
+    serialised on the event loop.
+
+    So a connection is held only while a request thread works. The sync ``Db`` dependency this
+    replaces kept its session open from the route until FastAPI had serialised the answer, which
+    for a sync route waits for a request thread too: under 50 clients, 15 requests held the pool's
+    every connection while the 4 threads waited for one, and every request hung for 30 s and
+    failed 500 (``scripts/bench_load.py --clients 50``, reproduced on the code before)."""
+
+    def __init__(self, sessions: sessionmaker[Session]):
+        self.sessions = sessions
+
+    async def __call__(self, work: Callable[..., T], /, *args, **kwargs) -> T:
+        return await run_in_threadpool(self.run, work, *args, **kwargs)
+
+    def run(self, work: Callable[..., T], /, *args, **kwargs) -> T:
+        """``work(session, *args, **kwargs)`` here, in this thread, with a session of its own."""
+        with request_session(self.sessions) as session:
+            return work(session, *args, **kwargs)
 
 
-def run_filter(
+async def database(request: Request) -> Database:
+    return request.app.state.database
+
+
+async def run_filter(
     experiment_id: Annotated[int | None, Query(ge=1, le=schemas.MAX_ID)] = None,
     kind: schemas.RunKind | None = None,
     status_: Annotated[schemas.RunStatus | None, Query(alias="status")] = None,
@@ -72,17 +101,15 @@ def run_filter(
 
 
 async def robot_service(request: Request) -> RobotService:
-    # async: FastAPI runs a plain def dependency in the request thread pool, which compute can fill
-    # — and the e-stop asks for this one.
     return request.app.state.robot
 
 
 async def quick_compute(request: Request) -> ComputePool:
-    """The worker pool for API calls that compute (async: it must not wait for a request thread)."""
+    """The worker pool for API calls that compute."""
     return request.app.state.compute.quick
 
 
-def job_runner(request: Request) -> jobs.JobRunner | None:
+async def job_runner(request: Request) -> jobs.JobRunner | None:
     """The service's job runner, or None when it runs no jobs (``create_app(run_jobs=False)``)."""
     return request.app.state.runner
 
@@ -92,7 +119,7 @@ def view_unavailable_reason(request: Request) -> str:
     return VIEW_NOT_STARTED if starter is None else starter.unavailable_reason
 
 
-def scene_view(request: Request):
+def view_of(request: Request):
     """The 3D view, or a 503 saying why there is none (not started, still starting, failed)."""
     starter = request.app.state.view_starter
     view = None if starter is None else starter.view
@@ -101,7 +128,12 @@ def scene_view(request: Request):
     return view
 
 
-Db = Annotated[Session, Depends(get_session)]
+async def scene_view(request: Request):
+    """The ``SceneView`` dependency: :func:`view_of` the request."""
+    return view_of(request)
+
+
+Db = Annotated[Database, Depends(database)]
 RunQuery = Annotated[records.RunFilter, Depends(run_filter)]
 Robot = Annotated[RobotService, Depends(robot_service)]
 Runner = Annotated[jobs.JobRunner | None, Depends(job_runner)]
@@ -122,9 +154,4 @@ async def preset_resolved(request: Request, body):
     at once for a built-in one, in a request thread when the store must be read."""
     if body.model.preset in PRESETS:
         return body
-
-    def resolve():
-        with request_session(request.app.state.sessions) as session:
-            return calibrations.with_preset_resolved(session, body)
-
-    return await run_in_threadpool(resolve)
+    return await request.app.state.database(calibrations.with_preset_resolved, body)

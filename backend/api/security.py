@@ -111,7 +111,7 @@ def _write_atomically(path: Path, data: bytes) -> None:
         os.close(directory)
 
 
-def require_token(
+async def require_token(
     request: Request, credentials: Annotated[HTTPAuthorizationCredentials | None, Depends(bearer)]
 ) -> None:
     """Mutating calls carry ``Authorization: Bearer <token>``; the token is in the data directory.

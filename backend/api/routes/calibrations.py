@@ -17,26 +17,28 @@ PresetPath = Annotated[str, Path(min_length=1, max_length=64, pattern=calibratio
 
 
 @router.post("", status_code=201, dependencies=AUTHORIZED, response_model=schemas.CalibrationOut)
-def create_calibration(body: schemas.CalibrationCreate, db: Db, compute: QuickCompute):
+async def create_calibration(body: schemas.CalibrationCreate, db: Db, compute: QuickCompute):
     """Fit ``alpha``, ``c_zeta``, ``c_psi`` and the legs' offsets to the runs; stored as preset ``name``."""
-    return calibrations.calibrate_runs(
-        db, body.runs, name=body.name, base=body.preset, fit=functools.partial(_fit_in_worker, compute)
-    )
+    fit = functools.partial(_fit_in_worker, compute)
+    return await db(calibrations.calibrate_runs, body.runs, name=body.name, base=body.preset, fit=fit)
 
 
 @router.get("", response_model=schemas.CalibrationList)
-def list_calibrations(db: Db):
-    return {"items": [calibrations.preset_payload(preset) for preset in calibrations.list_presets(db)]}
+async def list_calibrations(db: Db):
+    def listed(session) -> list[dict]:
+        return [calibrations.preset_payload(preset) for preset in calibrations.list_presets(session)]
+
+    return {"items": await db(listed)}
 
 
 @router.get("/{name}", response_model=schemas.CalibrationOut)
-def get_calibration(name: PresetPath, db: Db):
-    return calibrations.preset_payload(calibrations.get_stored_preset(db, name))
+async def get_calibration(name: PresetPath, db: Db):
+    return await db(lambda session: calibrations.preset_payload(calibrations.get_stored_preset(session, name)))
 
 
 @router.delete("/{name}", status_code=204, dependencies=AUTHORIZED)
-def delete_calibration(name: PresetPath, db: Db) -> None:
-    calibrations.delete_preset(db, name)
+async def delete_calibration(name: PresetPath, db: Db) -> None:
+    await db(calibrations.delete_preset, name)
 
 
 def _fit_in_worker(compute: ComputePool, series, model):

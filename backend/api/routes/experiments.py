@@ -13,32 +13,35 @@ router = APIRouter(prefix="/api/v1/experiments", tags=["experiments"])
 
 
 @router.post("", status_code=201, dependencies=AUTHORIZED, response_model=schemas.ExperimentOut)
-def create_experiment(body: schemas.ExperimentCreate, db: Db):
-    return experiment_out(db, records.create_experiment(db, body))
+async def create_experiment(body: schemas.ExperimentCreate, db: Db):
+    return await db(lambda session: experiment_out(session, records.create_experiment(session, body)))
 
 
 @router.get("", response_model=schemas.ExperimentPage)
-def list_experiments(db: Db, limit: PageLimit = 50, cursor: Cursor = None):
-    rows, next_cursor = records.list_experiments(db, limit=limit, cursor=cursor)
-    return {"items": [experiment_out(db, row) for row in rows], "next_cursor": next_cursor}
+async def list_experiments(db: Db, limit: PageLimit = 50, cursor: Cursor = None):
+    def page(session: Session) -> dict:
+        rows, next_cursor = records.list_experiments(session, limit=limit, cursor=cursor)
+        return {"items": [experiment_out(session, row) for row in rows], "next_cursor": next_cursor}
+
+    return await db(page)
 
 
 @router.get("/{experiment_id}", response_model=schemas.ExperimentOut)
-def get_experiment(experiment_id: RecordId, db: Db):
-    return experiment_out(db, records.get_experiment(db, experiment_id))
+async def get_experiment(experiment_id: RecordId, db: Db):
+    return await db(lambda session: experiment_out(session, records.get_experiment(session, experiment_id)))
 
 
 @router.patch("/{experiment_id}", dependencies=AUTHORIZED, response_model=schemas.ExperimentOut)
-def update_experiment(experiment_id: RecordId, body: schemas.ExperimentUpdate, db: Db):
-    return experiment_out(db, records.update_experiment(db, experiment_id, body))
+async def update_experiment(experiment_id: RecordId, body: schemas.ExperimentUpdate, db: Db):
+    return await db(lambda session: experiment_out(session, records.update_experiment(session, experiment_id, body)))
 
 
 @router.delete("/{experiment_id}", status_code=204, dependencies=AUTHORIZED)
-def delete_experiment(experiment_id: RecordId, db: Db) -> None:
-    records.delete_experiment(db, experiment_id)
+async def delete_experiment(experiment_id: RecordId, db: Db) -> None:
+    await db(records.delete_experiment, experiment_id)
 
 
-def experiment_out(db: Session, experiment) -> dict:
+def experiment_out(session: Session, experiment) -> dict:
     return {
         "id": experiment.id,
         "name": experiment.name,
@@ -47,5 +50,5 @@ def experiment_out(db: Session, experiment) -> dict:
         "tags": experiment.tags,
         "created_at": experiment.created_at,
         "updated_at": experiment.updated_at,
-        "runs": records.run_count(db, experiment.id),
+        "runs": records.run_count(session, experiment.id),
     }

@@ -10,6 +10,7 @@ from typing import Annotated
 from fastapi import APIRouter, Query, Request
 from fastapi.encoders import jsonable_encoder
 from fastapi.responses import StreamingResponse
+from sqlalchemy.orm import Session
 
 from backend import schemas
 from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, RecordId, Runner
@@ -21,39 +22,47 @@ router = APIRouter(prefix="/api/v1/jobs", tags=["jobs"])
 
 
 @router.post("", status_code=202, dependencies=AUTHORIZED, response_model=schemas.JobOut)
-def create_job(body: schemas.JobCreate, db: Db, runner: Runner):
-    job = jobs.create_job(db, calibrations.with_preset_resolved(db, body))
+async def create_job(body: schemas.JobCreate, db: Db, runner: Runner):
+    job = await db(lambda session: job_out(jobs.create_job(session, calibrations.with_preset_resolved(session, body))))
     if runner is not None:
-        runner.submit(job.id)
-    return job_out(job)
+        runner.submit(job["id"])
+    return job
 
 
 @router.get("", response_model=schemas.JobPage)
-def list_jobs(
+async def list_jobs(
     db: Db,
     limit: PageLimit = 50,
     cursor: Cursor = None,
     state: schemas.JobState | None = None,
     experiment_id: Annotated[int | None, Query(ge=1, le=schemas.MAX_ID, description="only this experiment's")] = None,
 ):
-    rows, next_cursor = jobs.list_jobs(db, state=state, limit=limit, cursor=cursor, experiment_id=experiment_id)
-    return {"items": [job_out(row) for row in rows], "next_cursor": next_cursor}
+    def page(session: Session) -> dict:
+        rows, next_cursor = jobs.list_jobs(
+            session, state=state, limit=limit, cursor=cursor, experiment_id=experiment_id
+        )
+        return {"items": [job_out(row) for row in rows], "next_cursor": next_cursor}
+
+    return await db(page)
 
 
 @router.get("/{job_id}", response_model=schemas.JobOut)
-def get_job(job_id: RecordId, db: Db):
-    return job_out(jobs.get_job(db, job_id))
+async def get_job(job_id: RecordId, db: Db):
+    return await db(job_snapshot, job_id)
 
 
 @router.get("/{job_id}/results", response_model=schemas.JobResults)
-def job_results(job_id: RecordId, db: Db):
-    job = jobs.get_job(db, job_id)
-    if job.kind != "mjtf":
-        return {"job": job_out(job), "partial": job.state != "done", "result": job.result}
-    summaries = jobs.level_summaries(db, job)
+async def job_results(job_id: RecordId, db: Db):
+    def read(session: Session) -> tuple:
+        job = jobs.get_job(session, job_id)
+        return job_out(job), job.result, jobs.level_summaries(session, job) if job.kind == "mjtf" else None
+
+    job, result, summaries = await db(read)
+    if summaries is None:
+        return {"job": job, "partial": job["state"] != "done", "result": result}
     return {
-        "job": job_out(job),
-        "partial": job.state != "done",
+        "job": job,
+        "partial": job["state"] != "done",
         "levels": [level for level in summaries if level["trials"]],  # a level with trials has a mean
         "missing_zeta0s": [level["zeta0"] for level in summaries if not level["trials"]],
     }
@@ -69,13 +78,8 @@ async def job_events(
 ):
     """Server-sent events: a ``progress`` event whenever the job's state or count changes; the
     stream ends after the job's final state (done, cancelled, failed) or ``timeout``."""
-    sessions = request.app.state.sessions
-
-    def snapshot() -> dict:
-        with sessions() as db:
-            return job_out(jobs.get_job(db, job_id))
-
-    first = await asyncio.to_thread(snapshot)  # a missing job is a 404 before the stream opens
+    db = request.app.state.database
+    first = await db(job_snapshot, job_id)  # a missing job is a 404 before the stream opens
 
     async def stream():
         job, last, deadline = first, None, time.monotonic() + timeout
@@ -87,14 +91,18 @@ async def job_events(
             if job["state"] in jobs.FINAL or time.monotonic() > deadline or await request.is_disconnected():
                 return
             await asyncio.sleep(EVENT_POLL_S)
-            job = await asyncio.to_thread(snapshot)
+            job = await db(job_snapshot, job_id)
 
     return StreamingResponse(stream(), media_type="text/event-stream", headers={"Cache-Control": "no-cache"})
 
 
 @router.post("/{job_id}/cancel", dependencies=AUTHORIZED, response_model=schemas.JobOut)
-def cancel_job(job_id: RecordId, db: Db):
-    return job_out(jobs.cancel_job(db, job_id))
+async def cancel_job(job_id: RecordId, db: Db):
+    return await db(lambda session: job_out(jobs.cancel_job(session, job_id)))
+
+
+def job_snapshot(session: Session, job_id: int) -> dict:
+    return job_out(jobs.get_job(session, job_id))
 
 
 def job_out(job) -> dict:

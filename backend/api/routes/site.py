@@ -73,8 +73,8 @@ def swagger_init(request: Request) -> Response:
 
 
 @router.get("/api/v1/health", tags=["service"], response_model=schemas.Health)
-def health(db: Db):
-    return {"status": "ok", "database": ping(db), "code_version": simulation.current_code_version()}
+async def health(db: Db):
+    return {"status": "ok", "database": await db(ping), "code_version": simulation.current_code_version()}
 
 
 @router.get("/api/v1/auth", tags=["service"], dependencies=AUTHORIZED, response_model=schemas.TokenAccepted)

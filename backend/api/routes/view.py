@@ -8,7 +8,7 @@ from fastapi import APIRouter, HTTPException, Query, Request
 from fastapi.responses import HTMLResponse
 
 from backend import schemas
-from backend.api.deps import AUTHORIZED, OptionalRecordId, RecordId, SceneView, scene_view, view_unavailable_reason
+from backend.api.deps import AUTHORIZED, OptionalRecordId, RecordId, SceneView, view_of, view_unavailable_reason
 
 router = APIRouter(tags=["view"])
 
@@ -17,7 +17,7 @@ router = APIRouter(tags=["view"])
 def view_info(request: Request, viewer: Annotated[str | None, Query(pattern=schemas.VIEWER_ID_PATTERN)] = None):
     """Where the 3D view is (its own port on this host), and what the panel ``viewer``'s view shows."""
     try:
-        return scene_view(request).info(viewer)
+        return view_of(request).info(viewer)
     except HTTPException:
         starter = request.app.state.view_starter
         starting = starter is not None and starter.starting
