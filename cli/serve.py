@@ -7,6 +7,7 @@ This is where the parts meet: the backend's FastAPI application, with the viser 
 
 from __future__ import annotations
 
+import gc
 from typing import Annotated
 
 import typer
@@ -15,6 +16,7 @@ from backend.settings import DEFAULT_HOST, DEFAULT_PORT, WILDCARD_ADDRESSES, Set
 from cli.options import DataDirOption, handles_errors, note
 
 DEFAULT_VIEW_PORT = 8001
+YOUNG_COLLECTION_THRESHOLD = 20_000  # allocations between young collections (CPython 3.11: 700)
 
 app = typer.Typer(rich_markup_mode=None)
 
@@ -76,4 +78,10 @@ def serve_command(
     # browser never sends to a server (so it is in no access log); the panel keeps it and takes it
     # out of the address bar.
     note(f"sign in to make changes: {base}/panel/#token={token}")
+    # What start-up built lives as long as the service: out of the collector's way (gc.freeze), and
+    # young collections a tenth as often. Under 20 clients this took the service's CPU per request
+    # from 11.5 to 11.0 ms and the reads' p95 from 276 to 239 ms (scripts/bench_load.py, side by side).
+    gc.collect()
+    gc.freeze()
+    gc.set_threshold(YOUNG_COLLECTION_THRESHOLD, 50, 100)
     uvicorn.run(application, host=host, port=port, log_level="info")
