@@ -8,9 +8,8 @@ for a request thread that compute or a busy store holds."""
 
 from __future__ import annotations
 
-import contextlib
 import datetime
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from typing import Annotated, TypeVar
 
 from fastapi import Depends, HTTPException, Query, Request, status
@@ -30,24 +29,11 @@ T = TypeVar("T")
 VIEW_NOT_STARTED = "the 3D view is not running (it starts with `parkour serve`)"
 
 
-@contextlib.contextmanager
-def request_session(sessions) -> Iterator[Session]:
-    """A session for one request's database work, in a request thread (:class:`Database`): on a
-    full disk — answered 507 (errors.py) — the WAL is folded so that a retry can fit."""
-    with sessions() as session:
-        try:
-            yield session
-        except StorageFull:
-            session.rollback()
-            after_storage_full(session.get_bind())
-            raise
-
-
 class Database:
     """The routes' way to the store: ``await db(work, *args)`` runs ``work(session, *args)`` in a
-    request thread with a session of its own, opened and closed there (:func:`request_session`),
-    and returns what it returns — the route's whole database work in one thread hop, its answer
-    serialised on the event loop.
+    request thread with a session of its own, opened and closed there, and returns what it
+    returns — the route's whole database work in one thread hop, its answer serialised on the
+    event loop.
 
     So a connection is held only while a request thread works. The sync ``Db`` dependency this
     replaces kept its session open from the route until FastAPI had serialised the answer, which
@@ -62,9 +48,15 @@ class Database:
         return await run_in_threadpool(self.run, work, *args, **kwargs)
 
     def run(self, work: Callable[..., T], /, *args, **kwargs) -> T:
-        """``work(session, *args, **kwargs)`` here, in this thread, with a session of its own."""
-        with request_session(self.sessions) as session:
-            return work(session, *args, **kwargs)
+        """``work(session, *args, **kwargs)`` here, in this thread, with a session of its own. On a
+        full disk — answered 507 (errors.py) — the WAL is folded so that a retry can fit."""
+        with self.sessions() as session:
+            try:
+                return work(session, *args, **kwargs)
+            except StorageFull:
+                session.rollback()
+                after_storage_full(session.get_bind())
+                raise
 
 
 async def database(request: Request) -> Database:

@@ -84,7 +84,8 @@ def list_experiments(session: Session, *, limit: int, cursor: int | None) -> tup
 def create_run(session: Session, body: RunCreate, compute=None) -> Run:
     """Simulate ``body`` — in ``compute``'s workers (a :class:`~backend.services.compute.ComputePool`),
     or here without one — and store it as a run. (The API awaits the simulation instead of holding a
-    request thread: it calls :func:`check_run_request`, the worker, then :func:`store_run`.)"""
+    request thread: it checks what the request names (:func:`check_run_request`), awaits the worker,
+    then calls :func:`store_run`.)"""
     check_run_request(session, body)
     # Simulated before the lock is taken: it takes a while.
     record = simulate_run(body) if compute is None else compute.run(simulate_run, body)
