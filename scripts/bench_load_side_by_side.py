@@ -1,0 +1,105 @@
+"""The load benchmark as a ratio: this working tree's service against a base revision's, side by side.
+
+This shared 2-core machine changes speed by up to 1.5x within minutes (the same code measured 138
+and then 243 req/s ten minutes apart), so two bench_load.py runs one after the other compare the
+machine, not the code. This script checks ``--base`` out into a temporary git worktree, starts
+both services (``parkour serve``, each on its own copy of one seeded store) and loads them in
+short alternating phases (the order flips each round), so a slow minute hits both alike. It
+prints each side's medians and the per-round ratio of CPU per request (new / base).
+Usage: PYTHONPATH=. python scripts/bench_load_side_by_side.py [--base HEAD] [--clients 20] [--rounds 5] [--seconds 4]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import random
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import httpx
+from bench_load import phase  # scripts/ is on the path when this script runs
+from bench_store import seed
+
+ROOT = Path(__file__).resolve().parents[1]
+START_TIMEOUT_S = 60.0
+
+
+def start(tree: Path, data_dir: Path, port: int) -> subprocess.Popen:
+    """``parkour serve`` from ``tree`` (this project's venv), once its health check answers."""
+    command = [sys.executable, "-m", "cli", "serve", "--data-dir", str(data_dir), "--port", str(port), "--no-view"]
+    env = dict(os.environ, PYTHONPATH=str(tree))
+    process = subprocess.Popen(command, cwd=tree, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + START_TIMEOUT_S
+    while time.monotonic() < deadline:
+        try:
+            if httpx.get(f"http://127.0.0.1:{port}/api/v1/health", timeout=1).status_code == 200:
+                return process
+        except httpx.HTTPError:
+            time.sleep(0.2)
+    process.kill()
+    raise SystemExit(f"the service from {tree} did not start within {START_TIMEOUT_S:g} s")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--base", default="HEAD", help="the revision to compare against (default: the last commit)")
+    parser.add_argument("--runs", type=int, default=20_000)
+    parser.add_argument("--clients", type=int, default=20)
+    parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--seconds", type=float, default=4.0, help="each phase's length")
+    parser.add_argument("--port", type=int, default=8781, help="the base's port; the new one's is the next")
+    args = parser.parse_args()
+    scratch = Path(tempfile.mkdtemp(prefix="parkourlab-sbs-"))
+    base_tree = scratch / "base-tree"
+    subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", "-q", str(base_tree), args.base], check=True)
+    sides = {"base": (base_tree, args.port), "new": (ROOT, args.port + 1)}
+    processes: dict[str, subprocess.Popen] = {}
+    results: dict[str, list[dict]] = {name: [] for name in sides}
+    try:
+        (scratch / "seed").mkdir()
+        seed(f"sqlite:///{scratch / 'seed' / 'parkourlab.sqlite3'}", args.runs, random.Random(0))
+        tokens = {}
+        for name, (tree, port) in sides.items():
+            shutil.copytree(scratch / "seed", scratch / name)
+            processes[name] = start(tree, scratch / name, port)
+            tokens[name] = (scratch / name / "api_token").read_text().strip()
+            phase(f"http://127.0.0.1:{port}", tokens[name], 2, 2.0)  # warm: kernels, database pages
+        for round_ in range(args.rounds):
+            for name in sides if round_ % 2 == 0 else reversed(sides):
+                base_url = f"http://127.0.0.1:{sides[name][1]}"
+                pid = processes[name].pid
+                results[name].append(phase(base_url, tokens[name], args.clients, args.seconds, pid))
+    finally:
+        for process in processes.values():
+            process.terminate()
+            process.wait(30)
+        subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(base_tree)], check=False)
+        shutil.rmtree(scratch, ignore_errors=True)
+    print(f"{args.clients} clients, {args.rounds} rounds of {args.seconds:g} s per side; base = {args.base}")
+    for name, phases in results.items():
+
+        def median(field, phases=phases):
+            return statistics.median(field(entry) for entry in phases)
+
+        errors = [entry["errors"] for entry in phases if entry["errors"]]
+        print(
+            f"{name:>5}: {median(lambda e: e['per_s']):.0f} req/s, "
+            f"{median(lambda e: e['service_cpu_ms_per_request']):.2f} ms CPU/request, "
+            f"reads p95 {median(lambda e: e['read']['p95_ms']):.0f} ms, "
+            f"writes p95 {median(lambda e: e['write']['p95_ms']):.0f} ms, errors {errors or 'none'}"
+        )
+    ratios = [
+        new["service_cpu_ms_per_request"] / base["service_cpu_ms_per_request"]
+        for new, base in zip(results["new"], results["base"], strict=True)
+    ]
+    print("CPU per request, new / base, per round:", ", ".join(f"{ratio:.2f}" for ratio in ratios))
+
+
+if __name__ == "__main__":
+    main()
