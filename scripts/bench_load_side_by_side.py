@@ -12,38 +12,19 @@ Usage: PYTHONPATH=. python scripts/bench_load_side_by_side.py [--base HEAD] [--c
 from __future__ import annotations
 
 import argparse
-import os
 import random
 import shutil
 import statistics
 import subprocess
-import sys
 import tempfile
-import time
 from pathlib import Path
 
-import httpx
 from bench_load import phase  # scripts/ is on the path when this script runs
 from bench_store import seed
 
+from tests.helpers import start_service
+
 ROOT = Path(__file__).resolve().parents[1]
-START_TIMEOUT_S = 60.0
-
-
-def start(tree: Path, data_dir: Path, port: int) -> subprocess.Popen:
-    """``parkour serve`` from ``tree`` (this project's venv), once its health check answers."""
-    command = [sys.executable, "-m", "cli", "serve", "--data-dir", str(data_dir), "--port", str(port), "--no-view"]
-    env = dict(os.environ, PYTHONPATH=str(tree))
-    process = subprocess.Popen(command, cwd=tree, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    deadline = time.monotonic() + START_TIMEOUT_S
-    while time.monotonic() < deadline:
-        try:
-            if httpx.get(f"http://127.0.0.1:{port}/api/v1/health", timeout=1).status_code == 200:
-                return process
-        except httpx.HTTPError:
-            time.sleep(0.2)
-    process.kill()
-    raise SystemExit(f"the service from {tree} did not start within {START_TIMEOUT_S:g} s")
 
 
 def main() -> None:
@@ -67,7 +48,7 @@ def main() -> None:
         tokens = {}
         for name, (tree, port) in sides.items():
             shutil.copytree(scratch / "seed", scratch / name)
-            processes[name] = start(tree, scratch / name, port)
+            processes[name] = start_service(scratch / name, port, "--no-view", tree=tree)
             tokens[name] = (scratch / name / "api_token").read_text().strip()
             phase(f"http://127.0.0.1:{port}", tokens[name], 2, 2.0)  # warm: kernels, database pages
         for round_ in range(args.rounds):

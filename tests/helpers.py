@@ -4,6 +4,7 @@ clients that keep its request thread pool full."""
 from __future__ import annotations
 
 import json
+import os
 import socket
 import subprocess
 import sys
@@ -32,11 +33,14 @@ def free_port(kind: socket.SocketKind = socket.SOCK_STREAM) -> int:
         return probe.getsockname()[1]
 
 
-def start_service(data_dir: Path, port: int, *options: str) -> subprocess.Popen:
+def start_service(data_dir: Path, port: int, *options: str, tree: Path | None = None) -> subprocess.Popen:
     """``parkour serve --data-dir DATA_DIR --port PORT OPTIONS...`` in a subprocess, returned once
-    ``/api/v1/health`` answers; the caller ends it (``terminate``, or ``SIGKILL`` to test a crash)."""
+    ``/api/v1/health`` answers; the caller ends it (``terminate``, or ``SIGKILL`` to test a crash).
+    ``tree``: the service's code from another checkout (a benchmark's base revision), run with this
+    venv."""
     command = [sys.executable, "-m", "cli", "serve", "--data-dir", str(data_dir), "--port", str(port), *options]
-    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    env = None if tree is None else dict(os.environ, PYTHONPATH=str(tree))
+    process = subprocess.Popen(command, cwd=tree, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + SERVICE_START_TIMEOUT
     while time.monotonic() < deadline:
         try:
