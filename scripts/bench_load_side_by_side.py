@@ -27,6 +27,16 @@ from tests.helpers import start_service
 ROOT = Path(__file__).resolve().parents[1]
 
 
+def median_of(phases: list[dict], *keys: str) -> float:
+    """The median over ``phases`` (bench_load.phase summaries) of the value at ``keys``."""
+    values = []
+    for entry in phases:
+        for key in keys:
+            entry = entry[key]
+        values.append(entry)
+    return statistics.median(values)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--base", default="HEAD", help="the revision to compare against (default: the last commit)")
@@ -38,11 +48,13 @@ def main() -> None:
     args = parser.parse_args()
     scratch = Path(tempfile.mkdtemp(prefix="parkourlab-sbs-"))
     base_tree = scratch / "base-tree"
-    subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", "-q", str(base_tree), args.base], check=True)
     sides = {"base": (base_tree, args.port), "new": (ROOT, args.port + 1)}
     processes: dict[str, subprocess.Popen] = {}
     results: dict[str, list[dict]] = {name: [] for name in sides}
     try:
+        git_worktree = ["git", "-C", str(ROOT), "worktree"]
+        if subprocess.run([*git_worktree, "add", "--detach", "-q", str(base_tree), args.base]).returncode:
+            raise SystemExit(f"--base {args.base!r} is no revision git can check out (git said why, above)")
         (scratch / "seed").mkdir()
         seed(f"sqlite:///{scratch / 'seed' / 'parkourlab.sqlite3'}", args.runs, random.Random(0))
         tokens = {}
@@ -53,27 +65,23 @@ def main() -> None:
             phase(f"http://127.0.0.1:{port}", tokens[name], 2, 2.0)  # warm: kernels, database pages
         for round_ in range(args.rounds):
             for name in sides if round_ % 2 == 0 else reversed(sides):
-                base_url = f"http://127.0.0.1:{sides[name][1]}"
-                pid = processes[name].pid
-                results[name].append(phase(base_url, tokens[name], args.clients, args.seconds, pid))
+                url, pid = f"http://127.0.0.1:{sides[name][1]}", processes[name].pid
+                results[name].append(phase(url, tokens[name], args.clients, args.seconds, pid))
     finally:
         for process in processes.values():
             process.terminate()
             process.wait(30)
-        subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(base_tree)], check=False)
+        if base_tree.exists():
+            subprocess.run([*git_worktree, "remove", "--force", str(base_tree)], check=False)
         shutil.rmtree(scratch, ignore_errors=True)
     print(f"{args.clients} clients, {args.rounds} rounds of {args.seconds:g} s per side; base = {args.base}")
     for name, phases in results.items():
-
-        def median(field, phases=phases):
-            return statistics.median(field(entry) for entry in phases)
-
         errors = [entry["errors"] for entry in phases if entry["errors"]]
         print(
-            f"{name:>5}: {median(lambda e: e['per_s']):.0f} req/s, "
-            f"{median(lambda e: e['service_cpu_ms_per_request']):.2f} ms CPU/request, "
-            f"reads p95 {median(lambda e: e['read']['p95_ms']):.0f} ms, "
-            f"writes p95 {median(lambda e: e['write']['p95_ms']):.0f} ms, errors {errors or 'none'}"
+            f"{name:>5}: {median_of(phases, 'per_s'):.0f} req/s, "
+            f"{median_of(phases, 'service_cpu_ms_per_request'):.2f} ms CPU/request, "
+            f"reads p95 {median_of(phases, 'read', 'p95_ms'):.0f} ms, "
+            f"writes p95 {median_of(phases, 'write', 'p95_ms'):.0f} ms, errors {errors or 'none'}"
         )
     ratios = [
         new["service_cpu_ms_per_request"] / base["service_cpu_ms_per_request"]
