@@ -11,7 +11,8 @@ cost little (an httpx client thread cost more CPU per request than the service).
 
 Prints, per phase, throughput and p50/p95/max latency of the reads and the writes, and the
 ratio of each phase's p95 to idle, and the CPU time the service's own process spent per request
-answered (its compute workers not counted): what bounds its throughput. ``--json`` for the
+answered (its worker processes not counted), and the whole machine's CPU per request (the read
+workers that answer the run list's pages, the compute workers, the clients). ``--json`` for the
 numbers alone.
 Usage: PYTHONPATH=. python scripts/bench_load.py [--runs 20000] [--clients 20 50] [--seconds 20] [--job mjtf]
 """
@@ -110,8 +111,16 @@ def cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
+def machine_cpu_seconds() -> float:
+    """The CPU time every core of this machine has spent busy so far (Linux /proc/stat): the
+    service, its read and compute workers, the clients and anything else running."""
+    user, nice, system, _idle, _iowait, irq, softirq, steal = map(int, Path("/proc/stat").read_text().split()[1:9])
+    return (user + nice + system + irq + softirq + steal) / os.sysconf("SC_CLK_TCK")
+
+
 def phase(base: str, token: str, clients: int, seconds: float, service_pid: int | None = None) -> dict:
     cpu_before = cpu_seconds(service_pid) if service_pid else None
+    machine_before = machine_cpu_seconds()
     per_process = [clients // CLIENT_PROCESSES + (k < clients % CLIENT_PROCESSES) for k in range(CLIENT_PROCESSES)]
     context = multiprocessing.get_context("spawn")
     with concurrent.futures.ProcessPoolExecutor(CLIENT_PROCESSES, mp_context=context) as pool:
@@ -123,8 +132,10 @@ def phase(base: str, token: str, clients: int, seconds: float, service_pid: int 
     summary = {"requests": len(requests), "per_s": len(requests) / seconds, "errors": {}}
     # What the clients themselves cost (they share the cores with the service): keep it small.
     summary["client_cpu_ms_per_request"] = 1e3 * sum(cpu for _, cpu in answers) / max(len(requests), 1)
-    if service_pid:  # the service's own CPU per request answered: what bounds its throughput
+    if service_pid:  # the service's own CPU per request answered: what its event loop and GIL carry
         summary["service_cpu_ms_per_request"] = 1e3 * (cpu_seconds(service_pid) - cpu_before) / max(len(requests), 1)
+    # Every process's, the read workers' (which answer the run list's pages) and the clients' too.
+    summary["machine_cpu_ms_per_request"] = 1e3 * (machine_cpu_seconds() - machine_before) / max(len(requests), 1)
     for kind in ("read", "write"):
         times = sorted(latency for name, latency, status in requests if name == kind)
         if times:
@@ -208,8 +219,8 @@ def main() -> None:
         return
     print(f"{args.runs} runs; phases of {args.seconds:g} s; job: {args.job}")
     header = ("clients", "phase", "req/s", "read p50", "p95", "max", "write p50", "p95", "max", "p95 x idle (r/w)",
-              "cpu ms/req")  # fmt: skip
-    widths = (7, 5, 7, 9, 7, 7, 10, 7, 7, 17, 11)
+              "cpu ms/req", "machine")  # fmt: skip
+    widths = (7, 5, 7, 9, 7, 7, 10, 7, 7, 17, 11, 8)
     print(" ".join(f"{name:>{width}}" for name, width in zip(header, widths, strict=True)))
     for entry in results["phases"]:
         for name in ("idle", "job", "export"):
@@ -222,7 +233,8 @@ def main() -> None:
             print(
                 f"{entry['clients']:>7} {name:>5} {row['per_s']:>7.0f} {read['p50_ms']:>9.1f} {read['p95_ms']:>7.1f} "
                 f"{read['max_ms']:>7.0f} {write['p50_ms']:>10.1f} {write['p95_ms']:>7.1f} {write['max_ms']:>7.0f} "
-                f"{ratio:>17} {row['service_cpu_ms_per_request']:>11.1f}  {row['errors'] or ''}"
+                f"{ratio:>17} {row['service_cpu_ms_per_request']:>11.1f} {row['machine_cpu_ms_per_request']:>8.1f}  "
+                f"{row['errors'] or ''}"
             )
         print(f"{'':>7} job: {entry['job']['job_state_at_end']}, {entry['job']['job_completed']} done during the phase")
         if "export" in entry:

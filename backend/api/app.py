@@ -25,6 +25,7 @@ from backend.api.security import api_token
 from backend.services import jobs as job_service
 from backend.services.compute import Compute
 from backend.services.robot import RobotService
+from backend.services.store_reads import StoreReads
 from backend.services.view import ViewContext, ViewFactory, ViewStarter
 from backend.settings import Settings
 from backend.store.database import ensure_reserve, make_engine, migrate, session_factory
@@ -105,6 +106,7 @@ def create_app(
     app.state.runner = runner if run_jobs else None
     app.state.robot = robot_service
     app.state.compute = compute
+    app.state.reads = StoreReads(compute.reads, settings.database_url)
     app.state.view_starter = None
     security.install(app, settings)  # headers, Host/Origin allow-list, token first, body limit
     errors.install(app)

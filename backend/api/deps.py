@@ -22,6 +22,7 @@ from backend.api.security import require_token
 from backend.services import calibrations, jobs, records
 from backend.services.compute import ComputePool
 from backend.services.robot import RobotService
+from backend.services.store_reads import StoreReads
 from backend.store.database import StorageFull, after_storage_full
 from sim_core.presets import PRESETS
 
@@ -101,6 +102,11 @@ async def quick_compute(request: Request) -> ComputePool:
     return request.app.state.compute.quick
 
 
+async def store_reads(request: Request) -> StoreReads:
+    """The reads answered in worker processes (the run list's pages)."""
+    return request.app.state.reads
+
+
 async def job_runner(request: Request) -> jobs.JobRunner | None:
     """The service's job runner, or None when it runs no jobs (``create_app(run_jobs=False)``)."""
     return request.app.state.runner
@@ -130,6 +136,7 @@ RunQuery = Annotated[records.RunFilter, Depends(run_filter)]
 Robot = Annotated[RobotService, Depends(robot_service)]
 Runner = Annotated[jobs.JobRunner | None, Depends(job_runner)]
 QuickCompute = Annotated[ComputePool, Depends(quick_compute)]
+Reads = Annotated[StoreReads, Depends(store_reads)]
 SceneView = Annotated[object, Depends(scene_view)]  # frontend.viewer's view (the backend does not import it)
 AUTHORIZED = [Depends(require_token)]  # every mutating route's dependencies
 PageLimit = Annotated[int, Query(ge=1, le=records.MAX_PAGE, description="items per page")]

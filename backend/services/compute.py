@@ -6,12 +6,14 @@ instead to a :class:`ComputePool`: a small pool of worker processes (``spawn``: 
 interpreter, no inherited threads or locks) that load sim_core once and keep it. The service's
 process only sends arguments and receives results.
 
-Two pools, so a long job never delays a quick call (:class:`Compute`): ``quick`` for the panel's
-``/sim/*`` calls and ``POST /runs``, ``jobs`` for job chunks. Work is bounded: a pool refuses a
-call when ``max_pending`` are already waiting (:class:`ComputeBusy`, a 503 with Retry-After), and
-a call that outlives its ``timeout`` stops its pool's workers, which start afresh for the next
-call (:class:`ComputeTimeout`). A worker that dies (out of memory, a crash) is replaced the same
-way (:class:`ComputeFailed`). ``restart`` is also how a job is cancelled mid-chunk.
+Three pools, so a long job never delays a quick call (:class:`Compute`): ``quick`` for the panel's
+``/sim/*`` calls and ``POST /runs``, ``jobs`` for job chunks, and ``reads`` for the run list's
+pages (``backend/services/store_reads.py``), which are not compute but held the service's GIL as
+long. Work is bounded: a pool refuses a call when ``max_pending`` are already waiting
+(:class:`ComputeBusy`, a 503 with Retry-After), and a call that outlives its ``timeout`` stops its
+pool's workers, which start afresh for the next call (:class:`ComputeTimeout`). A worker that dies
+(out of memory, a crash) is replaced the same way (:class:`ComputeFailed`). ``restart`` is also
+how a job is cancelled mid-chunk.
 """
 
 from __future__ import annotations
@@ -33,6 +35,11 @@ QUICK_TIMEOUT = 60.0  # [s] the longest a quick call may take (they are bounded 
 QUICK_PENDING = 64  # quick calls waiting at most; more get a 503
 JOB_PENDING = 8  # job chunks in flight at most (the runner keeps the worker fed, no more)
 WORKER_NICENESS = 10  # added to the workers' scheduling niceness (os.nice): compute yields to the service
+READ_WORKERS = 2  # the reads pool's processes: on this 2-core machine a third gained nothing (docs/service.md)
+# The readers answer requests, so they sit above compute; below the service's own process, so its
+# event loop (the e-stop) still gets a core first when the readers fill both.
+READ_NICENESS = 4
+READ_PENDING = 256  # page reads waiting at most (one per client in flight: 50 clients need 50)
 
 
 class ComputeBusy(RuntimeError):
@@ -50,12 +57,12 @@ class ComputeFailed(RuntimeError):
 _progress = None  # in a worker: the queue report() puts progress on (set as the worker starts)
 
 
-def _init_worker(progress) -> None:
+def _init_worker(progress, niceness: int) -> None:
     global _progress
     _progress = progress
-    # Below the service in the OS's eyes: with every core computing, the service's own process —
-    # HTTP, the live view, the e-stop — still gets the CPU first.
-    os.nice(WORKER_NICENESS)
+    # Below the service in the OS's eyes: with every core busy, the service's own process — HTTP,
+    # the live view, the e-stop — still gets the CPU first.
+    os.nice(niceness)
 
 
 def as_json(function: Callable, *args) -> bytes:
@@ -84,10 +91,20 @@ class ComputePool:
     """``workers`` processes running one call each at a time; :meth:`run` from a thread,
     :meth:`call` from the event loop. Thread-safe; the executor is replaced only under its lock."""
 
-    def __init__(self, name: str, workers: int = 1, *, max_pending: int = QUICK_PENDING):
+    def __init__(
+        self,
+        name: str,
+        workers: int = 1,
+        *,
+        max_pending: int = QUICK_PENDING,
+        niceness: int = WORKER_NICENESS,
+        warm_up: Callable[[], None] = _warm,
+    ):
         self.name = name
         self.workers = workers
         self.max_pending = max_pending
+        self.niceness = niceness  # added to the workers' (os.nice)
+        self.warm_up = warm_up  # what warm() runs in each worker
         self.restarts = 0  # times the workers were stopped and started afresh
         self._context = multiprocessing.get_context("spawn")
         self._lock = threading.Lock()  # guards _executor and _pending
@@ -156,7 +173,7 @@ class ComputePool:
     def warm(self) -> None:
         """Start the workers now and load the kernels in each (in the background)."""
         for _ in range(self.workers):
-            self.submit(_warm)
+            self.submit(self.warm_up)
 
     def restart(self, why: str) -> None:
         """Stop the workers at once (their calls fail with ComputeFailed); the next call starts new ones."""
@@ -180,7 +197,7 @@ class ComputePool:
         # A fresh progress queue with each start: a worker stopped mid-put may leave the old one locked.
         self._progress = self._context.Queue()
         return concurrent.futures.ProcessPoolExecutor(
-            self.workers, mp_context=self._context, initializer=_init_worker, initargs=(self._progress,)
+            self.workers, mp_context=self._context, initializer=_init_worker, initargs=(self._progress, self.niceness)
         )
 
     def _finished(self, _future) -> None:
@@ -198,17 +215,28 @@ def _stop(executor: concurrent.futures.ProcessPoolExecutor) -> None:
         process.join(5)
 
 
+def _warm_reads() -> None:
+    """A read worker's first task: load the store and the schemas a first page needs."""
+    import backend.services.store_reads  # noqa: F401
+
+
 class Compute:
-    """The service's two pools: ``quick`` for API calls, ``jobs`` for job chunks."""
+    """The service's pools: ``quick`` for API calls, ``jobs`` for job chunks, ``reads`` for the
+    run list's pages."""
 
     def __init__(self, quick: ComputePool | None = None, jobs: ComputePool | None = None):
         self.quick = quick or ComputePool("quick", max_pending=QUICK_PENDING)
         self.jobs = jobs or ComputePool("jobs", max_pending=JOB_PENDING)
+        self.reads = ComputePool(
+            "reads", READ_WORKERS, max_pending=READ_PENDING, niceness=READ_NICENESS, warm_up=_warm_reads
+        )
 
     def warm(self) -> None:
         self.quick.warm()
         self.jobs.warm()
+        self.reads.warm()
 
     def close(self) -> None:
         self.quick.close()
         self.jobs.close()
+        self.reads.close()

@@ -10,11 +10,12 @@ of 50 costs a fraction of a millisecond of SQL and no JSON it does not return.
 from __future__ import annotations
 
 import datetime
+import functools
 import json
 from collections.abc import Iterator
 from dataclasses import asdict, dataclass
 
-from sqlalchemy import Select, Text, cast, func, select
+from sqlalchemy import Integer, Select, Text, bindparam, cast, func, select
 from sqlalchemy.orm import Session
 
 from backend.store.models import Run, RunTag
@@ -67,25 +68,29 @@ class RunFilter:
     created_before: datetime.datetime | None = None
 
 
+# Each filter criterion as the condition it puts on a query, given its value (a literal, or a
+# bindparam in a cached page statement). Every criterion has an index.
+_CONDITIONS = {
+    "experiment_id": lambda v: Run.experiment_id == v,
+    "kind": lambda v: Run.kind == v,
+    "status": lambda v: Run.status == v,
+    "failure_code": lambda v: Run.failure_code == v,
+    "zeta0_min": lambda v: Run.zeta0 >= v,
+    "zeta0_max": lambda v: Run.zeta0 <= v,
+    "psi0_min": lambda v: Run.psi0_deg >= v,
+    "psi0_max": lambda v: Run.psi0_deg <= v,
+    "created_after": lambda v: Run.created_at >= v,
+    "created_before": lambda v: Run.created_at < v,
+    "tag": lambda v: Run.id.in_(select(RunTag.run_id).where(RunTag.tag == v)),
+}
+
+
 def filtered(query: Select, where: RunFilter) -> Select:
-    """``query`` restricted to the runs ``where`` selects (every criterion has an index)."""
-    conditions = [
-        (where.experiment_id, lambda v: Run.experiment_id == v),
-        (where.kind, lambda v: Run.kind == v),
-        (where.status, lambda v: Run.status == v),
-        (where.failure_code, lambda v: Run.failure_code == v),
-        (where.zeta0_min, lambda v: Run.zeta0 >= v),
-        (where.zeta0_max, lambda v: Run.zeta0 <= v),
-        (where.psi0_min, lambda v: Run.psi0_deg >= v),
-        (where.psi0_max, lambda v: Run.psi0_deg <= v),
-        (where.created_after, lambda v: Run.created_at >= v),
-        (where.created_before, lambda v: Run.created_at < v),
-    ]
-    for value, condition in conditions:
+    """``query`` restricted to the runs ``where`` selects."""
+    for name, condition in _CONDITIONS.items():
+        value = getattr(where, name)
         if value is not None:
             query = query.where(condition(value))
-    if where.tag is not None:
-        query = query.where(Run.id.in_(select(RunTag.run_id).where(RunTag.tag == where.tag)))
     return query
 
 
@@ -95,33 +100,48 @@ def listed_page(
     """A page of listed runs (dicts of :data:`LISTED` and ``tags``) and what fetches the next:
     sorted by id (newest first by default) a keyset ``cursor`` (the last id of this page); by
     another column (``-climb``: best first) the next ``offset``. None at the end."""
-    name = sort.lstrip("-")
     if sort not in SORTS:
         raise ValueError(f"sort must be one of {', '.join(SORTS)}, got {sort!r}")
-    descending = sort.startswith("-")
-    column = getattr(Run, name)
-    order = [column.desc() if descending else column.asc(), Run.id.desc() if descending else Run.id.asc()]
-    # The page's ids first, then their rows, each with its tags in one column: a filter an index
-    # cannot order (a zeta0 range sorted by id) sorts only ids, once, not thousands of whole rows;
-    # and a page is 51 rows stepped, not one per tag (each step hands the GIL to another thread).
-    ids = filtered(select(Run.id).order_by(*order).limit(limit + 1), where)
-    if name == "id":
-        if cursor is not None:
-            ids = ids.where(Run.id < cursor if descending else Run.id > cursor)
-    else:
-        ids = ids.offset(offset)
-    query = select(*LISTED, _TAG_LIST).where(Run.id.in_(ids)).order_by(*order)
-    rows = [dict(row) for row in session.connection().execute(query).mappings()]  # plain Core rows
+    by_id = sort.lstrip("-") == "id"
+    criteria = tuple(name for name in _CONDITIONS if getattr(where, name) is not None)
+    keyset = by_id and cursor is not None
+    values = {name: getattr(where, name) for name in criteria} | {"page_rows": limit + 1}
+    values |= {"cursor": cursor} if keyset else {} if by_id else {"page_offset": offset}
+    query = _page_statement(sort, criteria, keyset)
+    rows = [dict(row) for row in session.connection().execute(query, values).mappings()]  # plain Core rows
     decoded = decode_json_texts([[row[name] for name in LISTED_JSON] for row in rows])
-    for row, values in zip(rows, decoded, strict=True):
-        row.update(zip(LISTED_JSON, values, strict=True))
+    for row, json_values in zip(rows, decoded, strict=True):
+        row.update(zip(LISTED_JSON, json_values, strict=True))
         tag_list = row.pop("tag_list")
         row["tags"] = sorted(tag_list.split(TAG_SEPARATOR)) if tag_list else []
     more = len(rows) > limit
     rows = rows[:limit]
-    if name == "id":
+    if by_id:
         return rows, rows[-1]["id"] if more else None
     return rows, offset + limit if more else None
+
+
+@functools.lru_cache(maxsize=512)
+def _page_statement(sort: str, criteria: tuple[str, ...], keyset: bool) -> Select:
+    """The page query for a sort, a set of filter criteria and whether a keyset cursor applies,
+    with every value a bindparam: built once per shape, so a page pays neither building the
+    statement nor its cache key (a fifth of a page's CPU, scripts/bench_load.py), only its values.
+
+    The page's ids first, then their rows, each with its tags in one column: a filter an index
+    cannot order (a zeta0 range sorted by id) sorts only ids, once, not thousands of whole rows;
+    and a page is 51 rows stepped, not one per tag (each step hands the GIL to another thread)."""
+    name = sort.lstrip("-")
+    descending = sort.startswith("-")
+    column = getattr(Run, name)
+    order = [column.desc() if descending else column.asc(), Run.id.desc() if descending else Run.id.asc()]
+    ids = select(Run.id).order_by(*order).limit(bindparam("page_rows", type_=Integer))
+    for criterion in criteria:
+        ids = ids.where(_CONDITIONS[criterion](bindparam(criterion)))  # typed as its column
+    if keyset:
+        ids = ids.where(Run.id < bindparam("cursor") if descending else Run.id > bindparam("cursor"))
+    elif name != "id":
+        ids = ids.offset(bindparam("page_offset", type_=Integer))
+    return select(*LISTED, _TAG_LIST).where(Run.id.in_(ids)).order_by(*order)
 
 
 def decode_json_texts(rows: list[list[str]]) -> list[list]:

@@ -19,6 +19,7 @@ from backend.api.deps import (
     PageLimit,
     PresetQuery,
     QuickCompute,
+    Reads,
     RecordId,
     RunQuery,
     preset_resolved,
@@ -46,7 +47,7 @@ async def create_run(body: schemas.RunCreate, request: Request, db: Db, compute:
 
 @router.get("", response_model=schemas.RunPage)
 async def list_runs(
-    db: Db,
+    reads: Reads,
     where: RunQuery,
     limit: PageLimit = 50,
     cursor: Cursor = None,
@@ -54,9 +55,10 @@ async def list_runs(
     offset: Annotated[int, Query(ge=0, le=10_000_000, description="for sorts other than id")] = 0,
 ):
     """Runs matching the filters. Sorted by id, ``next_cursor`` pages by keyset; sorted by another
-    field, pass ``next_cursor`` back as ``offset``."""
-    rows, next_cursor = await db(records.list_runs, where, limit=limit, cursor=cursor, sort=sort, offset=offset)
-    return {"items": rows, "next_cursor": next_cursor}
+    field, pass ``next_cursor`` back as ``offset``. Read and encoded in a worker process
+    (services/store_reads.py): the service's own process only forwards the page."""
+    page = await reads.runs_page(where, limit=limit, cursor=cursor, sort=sort, offset=offset)
+    return Response(page, media_type="application/json")
 
 
 @router.get("/export", response_class=StreamingResponse)

@@ -7,7 +7,15 @@ import time
 
 import pytest
 
-from backend.services.compute import ComputeBusy, ComputeFailed, ComputePool, ComputeTimeout, report
+from backend.services.compute import (
+    READ_NICENESS,
+    WORKER_NICENESS,
+    ComputeBusy,
+    ComputeFailed,
+    ComputePool,
+    ComputeTimeout,
+    report,
+)
 from sim_core.errors import ParameterError
 
 WAIT_S = 60.0  # [s] a worker's start and a call, generously
@@ -20,6 +28,10 @@ def _pid() -> int:
 def _sleep(seconds: float) -> float:
     time.sleep(seconds)
     return seconds
+
+
+def _niceness() -> int:
+    return os.nice(0)
 
 
 def _die() -> None:
@@ -86,3 +98,13 @@ def test_a_closed_pool_starts_afresh_when_called_again(pool):
     before = pool.run(_pid, timeout=WAIT_S)
     pool.close()
     assert pool.run(_pid, timeout=WAIT_S) != before
+
+
+def test_a_pool_sets_its_workers_niceness():
+    compute, reads = ComputePool("niced"), ComputePool("readers", niceness=READ_NICENESS)
+    try:
+        assert compute.run(_niceness, timeout=WAIT_S) == os.nice(0) + WORKER_NICENESS
+        assert reads.run(_niceness, timeout=WAIT_S) == os.nice(0) + READ_NICENESS < os.nice(0) + WORKER_NICENESS
+    finally:
+        compute.close()
+        reads.close()

@@ -298,12 +298,16 @@ def test_live_mode_shows_the_robot_to_everyone_who_chooses_it_with_the_model_bes
             client.post("/api/v1/robot/runs", json={"controls": controls, "jumps": 6}, headers=auth).status_code == 202
         )
         _wait_for(lambda: not client.get("/api/v1/robot").json()["run"]["active"], timeout=30)
-        _wait_for(lambda: live._marked >= 6 and also.modes["live"]._marked >= 6)
+        # A loaded machine's control loop may see a touchdown or more past the sixth before it ends the
+        # run: the views show what the run recorded, however many that was.
+        recorded = client.get("/api/v1/robot").json()["run"]["touchdowns"]
+        assert recorded >= 6
+        _wait_for(lambda: live._marked == recorded and also.modes["live"]._marked == recorded)
         assert watching.scene.ghost.visible, "the model's jump from the last touchdown is drawn"
         assert simulating.mode.name == "simulate" and simulating.modes["live"]._marked == 0, "choosing is each one's"
         # Without noise the robot is the model: the ghost lands where the robot touched down.
         assert abs(live.last_error) < 0.01, f"model's touchdown height error {live.last_error:+.4f} m"
-        assert "Touchdowns this run:** 6" in live.readout(60.0)
+        assert f"Touchdowns this run:** {recorded} " in live.readout(60.0)
     finally:
         client.post("/api/v1/robot/disconnect", headers=auth)
 

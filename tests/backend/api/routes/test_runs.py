@@ -24,6 +24,16 @@ def test_run_matches_the_simulator_and_stores_its_path(client, auth):
     )
 
 
+def test_a_stored_run_reads_the_same_in_its_answer_its_record_and_the_list(client, auth):
+    with_path = client.post("/api/v1/runs", json=RUN | {"trajectory_rate": 40.0, "tags": ["x"]}, headers=auth).json()
+    without = client.post("/api/v1/runs", json=RUN, headers=auth).json()
+    assert with_path["has_trajectory"] and not without["has_trajectory"]
+    listed = {run["id"]: run for run in client.get("/api/v1/runs").json()["items"]}  # read in a worker process
+    for run in (with_path, without):
+        assert client.get(f"/api/v1/runs/{run['id']}").json() == run
+        assert listed[run["id"]] == {key: value for key, value in run.items() if key != "results"}
+
+
 def test_run_lists_filter_and_page(client, auth):
     for zeta0, tag in [(0.86, "low"), (0.88, "low"), (0.9, "mid"), (0.92, "high"), (0.94, "high")]:
         body = RUN | {"controls": [{"psi0_deg": 30, "zeta0": zeta0}], "tags": [tag]}

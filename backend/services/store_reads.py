@@ -1,0 +1,64 @@
+"""The run list's pages, read and encoded in worker processes, not the service's own.
+
+The service is one process: it owns the robot link, the job runner and the 3D view, and its
+event loop answers the e-stop. Every page of ``GET /api/v1/runs`` it read itself cost it about
+4 ms of its GIL (the SQL's Python side, the rows, validating and encoding the JSON), and under 20
+clients that queue, not the cores, set the latency: p95 136 ms with a third of the machine idle
+(``scripts/bench_load.py``, docs/service.md). So a page is read where no request of the service
+waits for its GIL: in the compute module's ``reads`` pool, whose workers each keep an engine on
+the store and hand back the page's finished JSON, which the route forwards as it is.
+
+A worker reads through its own connection, so it sees what was committed before the request
+came (a run just stored is listed); the page is the same JSON the route would encode itself
+(:data:`PAGE` is its response model).
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+
+from pydantic import TypeAdapter
+from sqlalchemy.orm import Session, sessionmaker
+
+from backend.schemas import RunPage
+from backend.services.compute import ComputePool
+from backend.services.records import RunFilter, list_runs
+from backend.store.database import make_engine, session_factory
+
+PAGE = TypeAdapter(RunPage)
+STORES_KEPT = 4  # engines a worker keeps open (one in service; tests open one per temporary store)
+_stores: OrderedDict[str, sessionmaker[Session]] = OrderedDict()  # in a worker: by database URL, newest last
+
+
+class StoreReads:
+    """Awaitable reads of the store at ``database_url``, each in a worker of ``pool``."""
+
+    def __init__(self, pool: ComputePool, database_url: str):
+        self.pool = pool
+        self.database_url = database_url
+
+    async def runs_page(self, where: RunFilter, *, limit: int, cursor: int | None, sort: str, offset: int) -> bytes:
+        """A page of the runs ``where`` selects as the API's ``RunPage`` JSON (see
+        :func:`backend.services.records.list_runs` for the sort, cursor and offset)."""
+        return await self.pool.call(runs_page_json, self.database_url, where, limit, cursor, sort, offset)
+
+
+def runs_page_json(
+    database_url: str, where: RunFilter, limit: int, cursor: int | None, sort: str, offset: int
+) -> bytes:
+    """In a worker: the page, encoded (:meth:`StoreReads.runs_page`)."""
+    with _sessions(database_url)() as session:
+        rows, next_cursor = list_runs(session, where, limit=limit, cursor=cursor, sort=sort, offset=offset)
+    return PAGE.dump_json(PAGE.validate_python({"items": rows, "next_cursor": next_cursor}))
+
+
+def _sessions(database_url: str) -> sessionmaker[Session]:
+    """This worker's sessions on ``database_url``, its engine made once and kept while in use."""
+    if database_url in _stores:
+        _stores.move_to_end(database_url)
+        return _stores[database_url]
+    _stores[database_url] = session_factory(make_engine(database_url))
+    while len(_stores) > STORES_KEPT:
+        _url, oldest = _stores.popitem(last=False)
+        oldest.kw["bind"].dispose()
+    return _stores[database_url]

@@ -1,0 +1,48 @@
+"""The run list's pages read in worker processes (backend/services/store_reads.py): the same page
+the records service lists, as the API's JSON, seeing what was just stored; a worker keeps few engines."""
+
+import asyncio
+import json
+
+from backend.schemas import RunPage
+from backend.services import records, store_reads
+from backend.services.compute import ComputePool
+from backend.services.records import RunFilter
+from backend.store.database import make_engine, migrate, sqlite_url
+
+
+def test_a_page_read_in_a_worker_is_the_records_page_as_the_api_encodes_it(tmp_path, sessions, make_run):
+    for zeta0 in (0.86, 0.88, 0.9):
+        make_run(zeta0=zeta0, tags=["b", "a"])
+    url = sqlite_url(tmp_path)
+    pool = ComputePool("reads-test", max_pending=4, niceness=0)
+    try:
+        reads = store_reads.StoreReads(pool, url)
+        where = RunFilter(zeta0_min=0.87)
+        page = asyncio.run(reads.runs_page(where, limit=1, cursor=None, sort="-id", offset=0))
+        with sessions() as session:
+            rows, next_cursor = records.list_runs(session, where, limit=1, cursor=None)
+            expected = RunPage.model_validate({"items": rows, "next_cursor": next_cursor}).model_dump(mode="json")
+        assert json.loads(page) == expected and expected["next_cursor"] is not None
+        assert expected["items"][0]["tags"] == ["a", "b"]
+        make_run(zeta0=0.95)  # stored after the worker opened its connection: the next page sees it
+        newest = json.loads(asyncio.run(reads.runs_page(where, limit=1, cursor=None, sort="-id", offset=0)))
+        assert newest["items"][0]["controls"][0][1] == 0.95
+    finally:
+        pool.close()
+
+
+def test_a_worker_keeps_a_few_stores_open_and_lets_the_oldest_go(tmp_path, monkeypatch):
+    monkeypatch.setattr(store_reads, "_stores", type(store_reads._stores)())
+    urls = []
+    for k in range(store_reads.STORES_KEPT + 2):
+        (tmp_path / f"store{k}").mkdir()
+        engine = make_engine(sqlite_url(tmp_path / f"store{k}"))
+        migrate(engine)
+        engine.dispose()
+        urls.append(sqlite_url(tmp_path / f"store{k}"))
+        page = json.loads(store_reads.runs_page_json(urls[-1], RunFilter(), 10, None, "-id", 0))
+        assert page == {"items": [], "next_cursor": None}
+    assert list(store_reads._stores) == urls[-store_reads.STORES_KEPT :]
+    store_reads.runs_page_json(urls[-store_reads.STORES_KEPT], RunFilter(), 10, None, "-id", 0)
+    assert list(store_reads._stores)[-1] == urls[-store_reads.STORES_KEPT], "the store just read is kept longest"
