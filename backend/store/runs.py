@@ -106,7 +106,10 @@ def listed_page(
     criteria = tuple(name for name in _CONDITIONS if getattr(where, name) is not None)
     keyset = by_id and cursor is not None
     values = {name: getattr(where, name) for name in criteria} | {"page_rows": limit + 1}
-    values |= {"cursor": cursor} if keyset else {} if by_id else {"page_offset": offset}
+    if keyset:
+        values["cursor"] = cursor
+    elif not by_id:
+        values["page_offset"] = offset
     query = _page_statement(sort, criteria, keyset)
     rows = [dict(row) for row in session.connection().execute(query, values).mappings()]  # plain Core rows
     decoded = decode_json_texts([[row[name] for name in LISTED_JSON] for row in rows])
@@ -125,7 +128,7 @@ def listed_page(
 def _page_statement(sort: str, criteria: tuple[str, ...], keyset: bool) -> Select:
     """The page query for a sort, a set of filter criteria and whether a keyset cursor applies,
     with every value a bindparam: built once per shape, so a page pays neither building the
-    statement nor its cache key (a fifth of a page's CPU, scripts/bench_load.py), only its values.
+    statement nor its cache key, only its values (a zeta0-range page of 50 at 20,000 runs: 2.1 → 1.4 ms).
 
     The page's ids first, then their rows, each with its tags in one column: a filter an index
     cannot order (a zeta0 range sorted by id) sorts only ids, once, not thousands of whole rows;
