@@ -26,6 +26,7 @@ import multiprocessing
 import os
 import queue as queue_module
 import threading
+import time
 from collections.abc import Callable
 from concurrent.futures.process import BrokenProcessPool
 
@@ -39,6 +40,7 @@ READ_WORKERS = 2  # the reads pool's processes: on this 2-core machine a third g
 # The readers answer requests, so they sit above compute; below the service's own process, so its
 # event loop (the e-stop) still gets a core first when the readers fill both.
 READ_NICENESS = 4
+PARENT_CHECK_S = 1.0  # [s] how often a worker checks that the service that started it is alive
 READ_PENDING = 256  # page reads waiting at most (one per client in flight: 50 clients need 50)
 
 
@@ -63,6 +65,17 @@ def _init_worker(progress, niceness: int) -> None:
     # Below the service in the OS's eyes: with every core busy, the service's own process — HTTP,
     # the live view, the e-stop — still gets the CPU first.
     os.nice(niceness)
+    threading.Thread(target=_exit_with_parent, args=(os.getppid(),), name="exit-with-parent", daemon=True).start()
+
+
+def _exit_with_parent(parent: int) -> None:
+    """In a worker: end this process once its parent is gone. A service killed outright (kill -9,
+    out of memory) stops no workers, and a worker waits on its task queue forever (it holds the
+    queue's writing end itself): each crash left its workers, a read worker's store connection
+    among them, until the machine restarted."""
+    while os.getppid() == parent:
+        time.sleep(PARENT_CHECK_S)
+    os._exit(0)
 
 
 def as_json(function: Callable, *args) -> bytes:

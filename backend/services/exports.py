@@ -15,12 +15,13 @@ import functools
 import io
 import json
 from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass
 
 from sqlalchemy import Text, cast
 from sqlalchemy.orm import Session
 
 from backend.store.models import Run
-from backend.store.runs import RunFilter, decode_json_texts, exported_rows, widest_schedule
+from backend.store.runs import RunFilter, decode_json_texts, exported_batch, newest_id, widest_schedule
 from experiments.manifest import json_safe
 from sim_core.params import ModelParams
 
@@ -51,7 +52,7 @@ def record_values(run, model: dict, controls: Sequence, start_state: Sequence, t
     decoded JSON columns."""
     values = [run.id, run.experiment_id, run.kind, run.status, run.created_at.isoformat(), run.duration_s,
               run.code_version, " ".join(tags), run.notes, run.jumps, run.jumps_completed, run.failure_code, run.climb,
-              start_state[0], start_state[1], *[model.get(name) for name in MODEL_FIELDS]]  # fmt: skip
+              start_state[0], start_state[1], *map(model.get, MODEL_FIELDS)]  # fmt: skip
     for leg in range(legs):
         values += controls[leg] if leg < len(controls) else (None, None)
     return values
@@ -68,50 +69,81 @@ def _record(run, model: dict, controls: Sequence, start_state: Sequence, tags: I
     return dict(zip(record_fields(len(controls)), values, strict=True))
 
 
+@dataclass(frozen=True)
+class ExportPlan:
+    """What every part of one export shares, fixed at its start: the format, the CSV's legs (as
+    many as the widest run: its columns come before the first row), and the largest id it covers
+    (runs stored after it began are not in it; None: no run matches)."""
+
+    format: str
+    legs: int
+    last_id: int | None
+
+
+def plan_export(session: Session, where: RunFilter, format_: str) -> ExportPlan:
+    last_id = newest_id(session, where)
+    legs = widest_schedule(session, where, last_id) if format_ == "csv" and last_id is not None else 0
+    return ExportPlan(format_, legs, last_id)
+
+
+def export_head(plan: ExportPlan) -> str:
+    return "".join(csv_text([[list(record_fields(plan.legs))]], ())) if plan.format == "csv" else "["
+
+
+def export_tail(plan: ExportPlan) -> str:
+    return "" if plan.format == "csv" else "]"
+
+
+def export_part(session: Session, where: RunFilter, plan: ExportPlan, after_id: int) -> tuple[str, int | None]:
+    """The next batch of the export: the matching runs with ids past ``after_id`` (0 at the start)
+    up to the plan's last, as text that follows what came before, and the last id in it; ``("",
+    None)`` at the end. Each part reads in its own short transaction, so an export can be read a
+    part at a time anywhere (services/store_reads.py: in a read worker, a call each)."""
+    if plan.last_id is None or after_id >= plan.last_id:
+        return "", None
+    batch, tags = exported_batch(session, where, EXPORTED, after_id, plan.last_id)
+    if not batch:
+        return "", None
+    decoded = decode_json_texts([[getattr(row, name) for name in JSON_COLUMNS] for row in batch])
+    runs = [(row, *columns, tags.get(row.id, ())) for row, columns in zip(batch, decoded, strict=True)]
+    if plan.format == "csv":
+        text = "".join(csv_text([[record_values(*run, plan.legs) for run in runs]], TEXT_COLUMNS))
+    else:
+        text = ("" if after_id == 0 else ",") + json_text([_record(*run) for run in runs])
+    return text, batch[-1].id
+
+
 def export(sessions, where: RunFilter, format_: str) -> Iterator[str]:
-    """Every matching run, oldest first, as CSV or JSON text in chunks, read in batches in a
-    session of its own (the response streams after the request's session has closed). The CSV's
-    columns are known before the first row: every model field and as many legs as the widest run;
-    a JSON record has its own run's legs."""
+    """Every matching run, oldest first, as CSV or JSON text in parts, each part read in a session
+    of its own (the response streams after the request's session has closed). The CSV's columns
+    are known before the first row: every model field and as many legs as the widest run; a JSON
+    record has its own run's legs."""
     with sessions() as session:
-        if format_ == "csv":
-            legs = widest_schedule(session, where)
-            yield from csv_text(_values(session, where, legs), record_fields(legs))
-        else:
-            yield from json_text(_records(session, where))
+        plan = plan_export(session, where, format_)
+    yield export_head(plan)
+    after_id: int | None = 0
+    while True:
+        with sessions() as session:
+            text, after_id = export_part(session, where, plan, after_id)
+        if after_id is None:
+            break
+        yield text
+    yield export_tail(plan)
 
 
-def _decoded_batches(session: Session, where: RunFilter):
-    """Batches of (row, model, controls, start_state, tags) — a batch's JSON decoded in one call."""
-    for batch, tags in exported_rows(session, where, EXPORTED):
-        decoded = decode_json_texts([[getattr(row, name) for name in JSON_COLUMNS] for row in batch])
-        yield [(row, *columns, tags.get(row.id, ())) for row, columns in zip(batch, decoded, strict=True)]
-
-
-def _values(session: Session, where: RunFilter, legs: int) -> Iterator[list[list]]:
-    for batch in _decoded_batches(session, where):
-        yield [record_values(row, model, controls, start, tags, legs) for row, model, controls, start, tags in batch]
-
-
-def _records(session: Session, where: RunFilter) -> Iterator[list[dict]]:
-    for batch in _decoded_batches(session, where):
-        yield [_record(row, model, controls, start, tags) for row, model, controls, start, tags in batch]
-
-
-def csv_text(batches: Iterable[list[list]], fields: Sequence[str], text_columns=TEXT_COLUMNS) -> Iterator[str]:
-    """Batches of rows (values in ``fields`` order) as CSV text in chunks. Text that a spreadsheet
+def csv_text(batches: Iterable[list[list]], text_columns=TEXT_COLUMNS) -> Iterator[str]:
+    """Batches of rows of values as CSV text in chunks of about :data:`CHUNK_CHARS`. Text that a spreadsheet
     would run as a formula (starting with = + - @, a tab or a return) in a ``text_columns`` cell is
     written with a leading apostrophe, as OWASP advises; numbers are written as they are."""
     buffer = io.StringIO()
     writer = csv.writer(buffer)
-    writer.writerow(fields)
-    for rows in batches:
-        for row in rows:
+    for batch in batches:
+        for row in batch:
             for column in text_columns:
                 value = row[column]
                 if value and value[0] in FORMULA_START:
                     row[column] = "'" + value
-        writer.writerows(rows)
+        writer.writerows(batch)
         if buffer.tell() > CHUNK_CHARS:
             yield buffer.getvalue()
             buffer.seek(0)
@@ -119,17 +151,11 @@ def csv_text(batches: Iterable[list[list]], fields: Sequence[str], text_columns=
     yield buffer.getvalue()
 
 
-def json_text(batches: Iterable[list[dict]]) -> Iterator[str]:
-    """Batches of records as one strict JSON array, a batch at a time (NaN and infinities as null)."""
-    yield "["
-    first = True
-    for records in batches:
-        if not records:
-            continue
-        try:
-            text = json.dumps(records, allow_nan=False)
-        except ValueError:  # a NaN or an infinity somewhere in the batch: JSON has neither
-            text = json.dumps(json_safe(records))
-        yield ("" if first else ",") + text[1:-1]
-        first = False
-    yield "]"
+def json_text(records: list[dict]) -> str:
+    """Records as the members of a strict JSON array, without its brackets (NaN and infinities as
+    null); no records, no text."""
+    try:
+        text = json.dumps(records, allow_nan=False)
+    except ValueError:  # a NaN or an infinity somewhere in the batch: JSON has neither
+        text = json.dumps(json_safe(records))
+    return text[1:-1]

@@ -1,4 +1,4 @@
-"""The run list's pages, read and encoded in worker processes, not the service's own.
+"""The run list's pages and exports, read and encoded in worker processes, not the service's own.
 
 The service is one process: it owns the robot link, the job runner and the 3D view, and its
 event loop answers the e-stop. Every page of ``GET /api/v1/runs`` it read itself cost it about
@@ -6,7 +6,9 @@ event loop answers the e-stop. Every page of ``GET /api/v1/runs`` it read itself
 clients that queue, not the cores, set the latency: p95 136 ms with a third of the machine idle
 (``scripts/bench_load.py``, docs/service.md). So a page is read where no request of the service
 waits for its GIL: in the compute module's ``reads`` pool, whose workers each keep an engine on
-the store and hand back the page's finished JSON, which the route forwards as it is.
+the store and hand back the page's finished JSON, which the route forwards as it is. An export
+goes the same way a batch of 1000 runs per call (``exports.export_part``), so it streams without
+holding the service's GIL, and two exports, or pages and an export, take turns between batches.
 
 A worker reads through its own connection, so it sees what was committed before the request
 came (a run just stored is listed); the page is the same JSON the route would encode itself
@@ -15,13 +17,16 @@ came (a run just stored is listed); the page is the same JSON the route would en
 
 from __future__ import annotations
 
+import asyncio
 from collections import OrderedDict
+from collections.abc import AsyncIterator
 
 from pydantic import TypeAdapter
 from sqlalchemy.orm import Session, sessionmaker
 
 from backend.schemas import RunPage
 from backend.services.compute import ComputePool
+from backend.services.exports import ExportPlan, export_head, export_part, export_tail, plan_export
 from backend.services.records import RunFilter, list_runs
 from backend.store.database import make_engine, session_factory
 
@@ -40,16 +45,45 @@ class StoreReads:
     async def runs_page(self, where: RunFilter, *, limit: int, cursor: int | None, sort: str, offset: int) -> bytes:
         """A page of the runs ``where`` selects as the API's ``RunPage`` JSON (see
         :func:`backend.services.records.list_runs` for the sort, cursor and offset)."""
-        return await self.pool.call(runs_page_json, self.database_url, where, limit, cursor, sort, offset)
+        return await self._read(runs_page_json, where, limit, cursor, sort, offset)
+
+    async def export_plan(self, where: RunFilter, format_: str) -> ExportPlan:
+        """An export's plan (``exports.plan_export``): asked before its response starts, so a busy
+        pool or a failing store is a status, not a cut-off download."""
+        return await self._read(plan_export, where, format_)
+
+    async def export_text(self, where: RunFilter, plan: ExportPlan) -> AsyncIterator[str]:
+        """The export ``plan`` describes, as text: its head, a batch per worker call, its tail
+        (``exports.export``, the same parts read in this process). The next batch is read while
+        this one is sent, so neither the worker nor the connection waits for the other."""
+        yield export_head(plan)
+        following = asyncio.ensure_future(self._read(export_part, where, plan, 0))
+        try:
+            while True:
+                text, after_id = await following
+                if after_id is None:
+                    break
+                following = asyncio.ensure_future(self._read(export_part, where, plan, after_id))
+                yield text
+        finally:
+            following.cancel()  # the client went away: no more batches (one under way finishes unread)
+        yield export_tail(plan)
+
+    async def _read(self, work, *args):
+        """``work(session, *args)`` in a worker, with a session on the store."""
+        return await self.pool.call(_in_session, work, self.database_url, *args)
 
 
-def runs_page_json(
-    database_url: str, where: RunFilter, limit: int, cursor: int | None, sort: str, offset: int
-) -> bytes:
-    """In a worker: the page, encoded (:meth:`StoreReads.runs_page`)."""
-    with _sessions(database_url)() as session:
-        rows, next_cursor = list_runs(session, where, limit=limit, cursor=cursor, sort=sort, offset=offset)
+def runs_page_json(session: Session, where: RunFilter, limit: int, cursor: int | None, sort: str, offset: int) -> bytes:
+    """The page, encoded (:meth:`StoreReads.runs_page`)."""
+    rows, next_cursor = list_runs(session, where, limit=limit, cursor=cursor, sort=sort, offset=offset)
     return PAGE.dump_json(PAGE.validate_python({"items": rows, "next_cursor": next_cursor}))
+
+
+def _in_session(work, database_url: str, *args):
+    """In a worker: ``work(session, *args)`` in a session on ``database_url``."""
+    with _sessions(database_url)() as session:
+        return work(session, *args)
 
 
 def _sessions(database_url: str) -> sessionmaker[Session]:

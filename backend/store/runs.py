@@ -12,7 +12,6 @@ from __future__ import annotations
 import datetime
 import functools
 import json
-from collections.abc import Iterator
 from dataclasses import asdict, dataclass
 
 from sqlalchemy import Integer, Select, Text, bindparam, cast, func, select
@@ -162,15 +161,26 @@ def _tags_where(session: Session, condition) -> dict[int, list[str]]:
     return tags
 
 
-def exported_rows(session: Session, where: RunFilter, columns) -> Iterator[tuple[list, dict[int, list[str]]]]:
-    """Every matching run's ``columns`` (``Run.id`` first), oldest first, in batches of
-    :data:`EXPORT_BATCH` rows with their tags: what an export streams, never all in memory. Plain
-    Core rows (no ORM loading); a batch's tags are read by its id range, not a thousand parameters."""
-    query = filtered(select(*columns).order_by(Run.id), where).execution_options(yield_per=EXPORT_BATCH)
-    for batch in session.connection().execute(query).partitions():
-        yield batch, _tags_where(session, RunTag.run_id.between(batch[0][0], batch[-1][0]))
+def exported_batch(session: Session, where: RunFilter, columns, after_id: int, last_id: int) -> tuple[list, dict]:
+    """The next :data:`EXPORT_BATCH` matching runs' ``columns`` (``Run.id`` first) with ids in
+    (``after_id``, ``last_id``], oldest first, and their tags by run: one part of an export, never
+    all of it in memory. Plain Core rows (no ORM loading); the batch's tags are read by its id
+    range, not a thousand parameters."""
+    query = filtered(select(*columns).where(Run.id > after_id, Run.id <= last_id), where)
+    batch = session.connection().execute(query.order_by(Run.id).limit(EXPORT_BATCH)).all()
+    tags = _tags_where(session, RunTag.run_id.between(batch[0][0], batch[-1][0])) if batch else {}
+    return batch, tags
 
 
-def widest_schedule(session: Session, where: RunFilter) -> int:
-    """The most legs any matching run's schedule has (0 when none match)."""
-    return session.scalar(filtered(select(func.max(func.json_array_length(Run.controls))), where)) or 0
+def newest_id(session: Session, where: RunFilter) -> int | None:
+    """The largest id of a matching run (None when none match)."""
+    return session.scalar(filtered(select(func.max(Run.id)), where))
+
+
+def widest_schedule(session: Session, where: RunFilter, last_id: int | None = None) -> int:
+    """The most legs any matching run's schedule has, of those with ids up to ``last_id`` if given
+    (0 when none match)."""
+    query = filtered(select(func.max(func.json_array_length(Run.controls))), where)
+    if last_id is not None:
+        query = query.where(Run.id <= last_id)
+    return session.scalar(query) or 0

@@ -24,7 +24,7 @@ from backend.api.deps import (
     RunQuery,
     preset_resolved,
 )
-from backend.services import calibrations, exports, mcap_export, records, simulation
+from backend.services import calibrations, mcap_export, records, simulation
 from backend.services.robot_records import replay_run
 
 router = APIRouter(prefix="/api/v1/runs", tags=["runs"])
@@ -63,10 +63,12 @@ async def list_runs(
 
 @router.get("/export", response_class=StreamingResponse)
 async def export_runs(
-    request: Request, where: RunQuery, format_: Annotated[str, Query(alias="format", pattern="^(csv|json)$")] = "csv"
+    reads: Reads, where: RunQuery, format_: Annotated[str, Query(alias="format", pattern="^(csv|json)$")] = "csv"
 ):
-    """Every run matching the filters, streamed, with tags, timings and parameters (not the path)."""
-    body = exports.export(request.app.state.sessions, where, format_)
+    """Every run matching the filters when the export began, streamed, with tags, timings and
+    parameters (not the path); read and encoded in a worker process a batch at a time."""
+    plan = await reads.export_plan(where, format_)
+    body = reads.export_text(where, plan)
     media = "text/csv" if format_ == "csv" else "application/json"
     disposition = {"Content-Disposition": f'attachment; filename="runs.{format_}"'}
     return StreamingResponse(body, media_type=media, headers=disposition)

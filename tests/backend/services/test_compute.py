@@ -3,11 +3,16 @@ dead or stopped worker is replaced."""
 
 import asyncio
 import os
+import signal
+import subprocess
+import sys
 import time
+from pathlib import Path
 
 import pytest
 
 from backend.services.compute import (
+    PARENT_CHECK_S,
     READ_NICENESS,
     WORKER_NICENESS,
     ComputeBusy,
@@ -108,3 +113,39 @@ def test_a_pool_sets_its_workers_niceness():
     finally:
         compute.close()
         reads.close()
+
+
+def _gone(pid: int) -> bool:
+    """Whether process ``pid`` has ended (a zombie its new parent has not reaped yet counts)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()[0] == "Z"
+    except FileNotFoundError:
+        return True
+
+
+def test_workers_end_when_the_service_is_killed_outright():
+    owner = subprocess.Popen(
+        [sys.executable, "-c", ORPHANING_SERVICE], stdout=subprocess.PIPE, text=True, cwd=Path(__file__).parents[3]
+    )
+    try:
+        worker = int(owner.stdout.readline())
+        assert not _gone(worker)
+    finally:
+        owner.kill()
+        owner.wait()
+    deadline = time.monotonic() + 10 * PARENT_CHECK_S
+    while not _gone(worker):
+        if time.monotonic() > deadline:
+            os.kill(worker, signal.SIGKILL)
+            pytest.fail("a worker outlived its killed service")
+        time.sleep(0.1)
+
+
+# A service in miniature: a pool with a worker started, then killed with SIGKILL by the test.
+ORPHANING_SERVICE = """
+import os, time
+from backend.services.compute import ComputePool
+pool = ComputePool("orphaned")
+print(pool.run(os.getpid, timeout=60), flush=True)
+time.sleep(600)
+"""

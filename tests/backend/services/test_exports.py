@@ -10,6 +10,7 @@ import pytest
 from backend.schemas import LegIn
 from backend.services import exports, records
 from backend.services.records import RunFilter
+from backend.store import runs as store_runs
 from experiments.manifest import json_safe
 from sim_core.presets import get_preset
 
@@ -55,13 +56,36 @@ def test_csv_export_parses_back(sessions, stored_runs):
     assert parsed[-1]["failure_code"] == "slip" and parsed[0]["failure_code"] == ""
 
 
-def test_csv_export_streams_in_pieces():
-    batches = [[[i, "x" * 100] for i in range(start, start + 1000)] for start in (0, 1000)]
-    pieces = list(exports.csv_text(iter(batches), ["id", "text"], text_columns=(1,)))
-    assert len(pieces) > 2, "a large export is written in pieces, not one string"
+def test_csv_text_comes_in_pieces():
+    batches = [[["id", "text"]]] + [[[i, "x" * 100] for i in range(start, start + 1000)] for start in (0, 1000)]
+    pieces = list(exports.csv_text(iter(batches), text_columns=(1,)))
+    assert len(pieces) > 2, "a large batch is written in pieces, not one string"
     parsed = list(csv.DictReader(io.StringIO("".join(pieces))))
     assert len(parsed) == 2000 and parsed[-1] == {"id": "1999", "text": "x" * 100}
-    assert "".join(exports.csv_text(iter([]), ["id"])) == "id\r\n", "no runs: the header alone"
+
+
+def test_an_export_with_no_runs_is_the_header_alone_or_an_empty_array(sessions):
+    fields = ",".join(exports.record_fields(0))
+    assert "".join(exports.export(sessions, RunFilter(), "csv")) == fields + "\r\n"
+    assert "".join(exports.export(sessions, RunFilter(), "json")) == "[]"
+
+
+def test_an_export_is_read_a_batch_at_a_time_and_ends_at_the_runs_it_began_with(
+    sessions, session, make_run, monkeypatch
+):
+    """Each part a batch in a session of its own: a run stored during the export is not in it (its
+    CSV columns were fixed by the runs there at the start), whatever the batch size."""
+    monkeypatch.setattr(store_runs, "EXPORT_BATCH", 2)
+    ids = [make_run(zeta0=0.86 + 0.01 * k).id for k in range(5)]
+    chunks = exports.export(sessions, RunFilter(), "json")
+    head, first = next(chunks), next(chunks)
+    assert head == "[" and [row["id"] for row in json.loads(f"[{first}]")] == ids[:2]
+    two_legs = [LegIn(psi0_deg=30.0, zeta0=0.87), LegIn(psi0_deg=30.0, zeta0=0.9)]
+    make_run(controls=two_legs)  # stored while the export streams
+    rest = "".join(chunks)
+    assert [row["id"] for row in json.loads(head + first + rest)] == ids
+    parts = list(exports.export(sessions, RunFilter(zeta0_max=0.95), "csv"))
+    assert len(parts) == 1 + 3 + 1, "the header, three batches of at most two runs, the (empty) tail"
 
 
 def test_csv_export_keeps_every_runs_legs(sessions, make_run):
@@ -81,8 +105,7 @@ def test_csv_cells_a_spreadsheet_would_run_are_escaped(sessions, make_run, sessi
 
 
 def test_json_export_is_strict_json():
-    batches = [[{"id": 1, "climb": math.nan, "mu": math.inf}], [], [{"id": 2, "climb": 1.5, "mu": 2.0}]]
-    text = "".join(exports.json_text(iter(batches)))
-    assert json.loads(text) == [{"id": 1, "climb": None, "mu": None}, {"id": 2, "climb": 1.5, "mu": 2.0}]
+    text = "[" + exports.json_text([{"id": 1, "climb": math.nan, "mu": math.inf}, {"id": 2, "climb": 1.5}]) + "]"
+    assert json.loads(text) == [{"id": 1, "climb": None, "mu": None}, {"id": 2, "climb": 1.5}]
     assert json.loads(text, parse_constant=pytest.fail) is not None, "no NaN or Infinity literals"
-    assert "".join(exports.json_text(iter([]))) == "[]"
+    assert exports.json_text([]) == ""

@@ -41,8 +41,10 @@ def test_a_worker_keeps_a_few_stores_open_and_lets_the_oldest_go(tmp_path, monke
         migrate(engine)
         engine.dispose()
         urls.append(sqlite_url(tmp_path / f"store{k}"))
-        page = json.loads(store_reads.runs_page_json(urls[-1], RunFilter(), 10, None, "-id", 0))
+        page = json.loads(
+            store_reads._in_session(store_reads.runs_page_json, urls[-1], RunFilter(), 10, None, "-id", 0)
+        )
         assert page == {"items": [], "next_cursor": None}
     assert list(store_reads._stores) == urls[-store_reads.STORES_KEPT :]
-    store_reads.runs_page_json(urls[-store_reads.STORES_KEPT], RunFilter(), 10, None, "-id", 0)
+    store_reads._in_session(store_reads.runs_page_json, urls[-store_reads.STORES_KEPT], RunFilter(), 10, None, "-id", 0)
     assert list(store_reads._stores)[-1] == urls[-store_reads.STORES_KEPT], "the store just read is kept longest"
