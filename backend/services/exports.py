@@ -21,7 +21,7 @@ from sqlalchemy import Text, cast
 from sqlalchemy.orm import Session
 
 from backend.store.models import Run
-from backend.store.runs import RunFilter, decode_json_texts, exported_batch, newest_id, widest_schedule
+from backend.store.runs import RunFilter, decode_json_texts, export_part_ends, exported_batch, widest_schedule
 from experiments.manifest import json_safe
 from sim_core.params import ModelParams
 
@@ -72,18 +72,20 @@ def _record(run, model: dict, controls: Sequence, start_state: Sequence, tags: I
 @dataclass(frozen=True)
 class ExportPlan:
     """What every part of one export shares, fixed at its start: the format, the CSV's legs (as
-    many as the widest run: its columns come before the first row), and the largest id it covers
-    (runs stored after it began are not in it; None: no run matches)."""
+    many as the widest run: its columns come before the first row), and where each part ends:
+    part k holds the matching runs with ids in (``ends[k - 1]``, ``ends[k]``] (from 0), at most
+    :data:`backend.store.runs.EXPORT_BATCH` of them. Runs stored after the export began are not
+    in it; one deleted meanwhile is left out of a part not read yet."""
 
     format: str
     legs: int
-    last_id: int | None
+    ends: tuple[int, ...]
 
 
 def plan_export(session: Session, where: RunFilter, format_: str) -> ExportPlan:
-    last_id = newest_id(session, where)
-    legs = widest_schedule(session, where, last_id) if format_ == "csv" and last_id is not None else 0
-    return ExportPlan(format_, legs, last_id)
+    ends = tuple(export_part_ends(session, where))
+    legs = widest_schedule(session, where, ends[-1]) if format_ == "csv" and ends else 0
+    return ExportPlan(format_, legs, ends)
 
 
 def export_head(plan: ExportPlan) -> str:
@@ -94,23 +96,24 @@ def export_tail(plan: ExportPlan) -> str:
     return "" if plan.format == "csv" else "]"
 
 
-def export_part(session: Session, where: RunFilter, plan: ExportPlan, after_id: int) -> tuple[str, int | None]:
-    """The next batch of the export: the matching runs with ids past ``after_id`` (0 at the start)
-    up to the plan's last, as text that follows what came before, and the last id in it; ``("",
-    None)`` at the end. Each part reads in its own short transaction, so an export can be read a
-    part at a time anywhere (services/store_reads.py: in a read worker, a call each)."""
-    if plan.last_id is None or after_id >= plan.last_id:
-        return "", None
-    batch, tags = exported_batch(session, where, EXPORTED, after_id, plan.last_id)
-    if not batch:
-        return "", None
+def export_part(session: Session, where: RunFilter, plan: ExportPlan, part: int) -> str:
+    """Part ``part`` of the export as text: CSV rows, or JSON records without the array's brackets
+    and commas around them (:func:`joined` puts them in). The parts depend on nothing but the
+    plan, so they can be read anywhere, in any order, a short transaction each
+    (services/store_reads.py: in the read workers, two at a time)."""
+    after_id = plan.ends[part - 1] if part else 0
+    batch, tags = exported_batch(session, where, EXPORTED, after_id, plan.ends[part])
     decoded = decode_json_texts([[getattr(row, name) for name in JSON_COLUMNS] for row in batch])
     runs = [(row, *columns, tags.get(row.id, ())) for row, columns in zip(batch, decoded, strict=True)]
     if plan.format == "csv":
-        text = "".join(csv_text([[record_values(*run, plan.legs) for run in runs]], TEXT_COLUMNS))
-    else:
-        text = ("" if after_id == 0 else ",") + json_text([_record(*run) for run in runs])
-    return text, batch[-1].id
+        return "".join(csv_text([[record_values(*run, plan.legs) for run in runs]], TEXT_COLUMNS))
+    return json_text([_record(*run) for run in runs])
+
+
+def joined(plan: ExportPlan, text: str, follows: bool) -> str:
+    """A part's ``text`` as it goes into the export: after another part's records (``follows``)
+    a JSON part's come after a comma."""
+    return "," + text if plan.format == "json" and follows and text else text
 
 
 def export(sessions, where: RunFilter, format_: str) -> Iterator[str]:
@@ -121,13 +124,12 @@ def export(sessions, where: RunFilter, format_: str) -> Iterator[str]:
     with sessions() as session:
         plan = plan_export(session, where, format_)
     yield export_head(plan)
-    after_id: int | None = 0
-    while True:
+    follows = False
+    for part in range(len(plan.ends)):
         with sessions() as session:
-            text, after_id = export_part(session, where, plan, after_id)
-        if after_id is None:
-            break
-        yield text
+            text = export_part(session, where, plan, part)
+        yield joined(plan, text, follows)
+        follows = follows or bool(text)
     yield export_tail(plan)
 
 

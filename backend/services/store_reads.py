@@ -7,8 +7,8 @@ clients that queue, not the cores, set the latency: p95 136 ms with a third of t
 (``scripts/bench_load.py``, docs/service.md). So a page is read where no request of the service
 waits for its GIL: in the compute module's ``reads`` pool, whose workers each keep an engine on
 the store and hand back the page's finished JSON, which the route forwards as it is. An export
-goes the same way a batch of 1000 runs per call (``exports.export_part``), so it streams without
-holding the service's GIL, and two exports, or pages and an export, take turns between batches.
+goes the same way, a part of 1000 runs per call (``exports.export_part``), so it streams without
+holding the service's GIL, and exports and pages take turns at the workers between parts.
 
 A worker reads through its own connection, so it sees what was committed before the request
 came (a run just stored is listed); the page is the same JSON the route would encode itself
@@ -18,7 +18,7 @@ came (a run just stored is listed); the page is the same JSON the route would en
 from __future__ import annotations
 
 import asyncio
-from collections import OrderedDict
+from collections import OrderedDict, deque
 from collections.abc import AsyncIterator
 
 from pydantic import TypeAdapter
@@ -26,7 +26,7 @@ from sqlalchemy.orm import Session, sessionmaker
 
 from backend.schemas import RunPage
 from backend.services.compute import ComputePool
-from backend.services.exports import ExportPlan, export_head, export_part, export_tail, plan_export
+from backend.services.exports import ExportPlan, export_head, export_part, export_tail, joined, plan_export
 from backend.services.records import RunFilter, list_runs
 from backend.store.database import make_engine, session_factory
 
@@ -53,20 +53,31 @@ class StoreReads:
         return await self._read(plan_export, where, format_)
 
     async def export_text(self, where: RunFilter, plan: ExportPlan) -> AsyncIterator[str]:
-        """The export ``plan`` describes, as text: its head, a batch per worker call, its tail
-        (``exports.export``, the same parts read in this process). The next batch is read while
-        this one is sent, so neither the worker nor the connection waits for the other."""
+        """The export ``plan`` describes, as text: its head, a part per worker call, its tail
+        (``exports.export``: the same parts read in this process). As many parts are read at
+        once as the pool has workers, so the connection and the workers wait for each other
+        least; they come out in order."""
         yield export_head(plan)
-        following = asyncio.ensure_future(self._read(export_part, where, plan, 0))
+        parts = iter(range(len(plan.ends)))
+        reading: deque[asyncio.Future] = deque()
+
+        def read_next() -> None:
+            part = next(parts, None)
+            if part is not None:
+                reading.append(asyncio.ensure_future(self._read(export_part, where, plan, part)))
+
+        for _ in range(self.pool.workers):
+            read_next()
+        follows = False
         try:
-            while True:
-                text, after_id = await following
-                if after_id is None:
-                    break
-                following = asyncio.ensure_future(self._read(export_part, where, plan, after_id))
-                yield text
+            while reading:
+                text = await reading.popleft()
+                read_next()
+                yield joined(plan, text, follows)
+                follows = follows or bool(text)
         finally:
-            following.cancel()  # the client went away: no more batches (one under way finishes unread)
+            for pending in reading:  # the client went away: no more parts (one under way finishes unread)
+                pending.cancel()
         yield export_tail(plan)
 
     async def _read(self, work, *args):

@@ -162,19 +162,24 @@ def _tags_where(session: Session, condition) -> dict[int, list[str]]:
 
 
 def exported_batch(session: Session, where: RunFilter, columns, after_id: int, last_id: int) -> tuple[list, dict]:
-    """The next :data:`EXPORT_BATCH` matching runs' ``columns`` (``Run.id`` first) with ids in
-    (``after_id``, ``last_id``], oldest first, and their tags by run: one part of an export, never
+    """The matching runs' ``columns`` (``Run.id`` first) with ids in (``after_id``, ``last_id``],
+    oldest first, and their tags by run: one part of an export (:func:`export_part_ends`), never
     all of it in memory. Plain Core rows (no ORM loading); the batch's tags are read by its id
     range, not a thousand parameters."""
     query = filtered(select(*columns).where(Run.id > after_id, Run.id <= last_id), where)
-    batch = session.connection().execute(query.order_by(Run.id).limit(EXPORT_BATCH)).all()
+    batch = session.connection().execute(query.order_by(Run.id)).all()
     tags = _tags_where(session, RunTag.run_id.between(batch[0][0], batch[-1][0])) if batch else {}
     return batch, tags
 
 
-def newest_id(session: Session, where: RunFilter) -> int | None:
-    """The largest id of a matching run (None when none match)."""
-    return session.scalar(filtered(select(func.max(Run.id)), where))
+def export_part_ends(session: Session, where: RunFilter) -> list[int]:
+    """Where each part of an export of the matching runs ends: the id of every
+    :data:`EXPORT_BATCH`-th of them, oldest first, and the newest's (empty when none match). One
+    pass over the matching ids; the parts' own reads then need nothing from each other."""
+    numbered = filtered(select(Run.id, func.row_number().over(order_by=Run.id).label("n")), where).subquery()
+    ends = list(session.scalars(select(numbered.c.id).where(numbered.c.n % EXPORT_BATCH == 0).order_by(numbered.c.id)))
+    newest = session.scalar(filtered(select(func.max(Run.id)), where))
+    return ends if newest is None or (ends and ends[-1] == newest) else [*ends, newest]
 
 
 def widest_schedule(session: Session, where: RunFilter, last_id: int | None = None) -> int:

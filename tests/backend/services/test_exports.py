@@ -70,11 +70,10 @@ def test_an_export_with_no_runs_is_the_header_alone_or_an_empty_array(sessions):
     assert "".join(exports.export(sessions, RunFilter(), "json")) == "[]"
 
 
-def test_an_export_is_read_a_batch_at_a_time_and_ends_at_the_runs_it_began_with(
-    sessions, session, make_run, monkeypatch
-):
+def test_an_export_reads_a_part_at_a_time_and_ends_at_the_runs_it_began_with(sessions, make_run, monkeypatch):
     """Each part a batch in a session of its own: a run stored during the export is not in it (its
-    CSV columns were fixed by the runs there at the start), whatever the batch size."""
+    CSV columns were fixed by the runs there at the start), one deleted before its part is read is
+    left out, and the JSON stays one array whatever parts came out empty."""
     monkeypatch.setattr(store_runs, "EXPORT_BATCH", 2)
     ids = [make_run(zeta0=0.86 + 0.01 * k).id for k in range(5)]
     chunks = exports.export(sessions, RunFilter(), "json")
@@ -82,10 +81,22 @@ def test_an_export_is_read_a_batch_at_a_time_and_ends_at_the_runs_it_began_with(
     assert head == "[" and [row["id"] for row in json.loads(f"[{first}]")] == ids[:2]
     two_legs = [LegIn(psi0_deg=30.0, zeta0=0.87), LegIn(psi0_deg=30.0, zeta0=0.9)]
     make_run(controls=two_legs)  # stored while the export streams
-    rest = "".join(chunks)
-    assert [row["id"] for row in json.loads(head + first + rest)] == ids
+    with sessions() as session:
+        for run_id in ids[2:4]:  # the whole second part
+            records.delete_run(session, run_id)
+    assert [row["id"] for row in json.loads(head + first + "".join(chunks))] == [*ids[:2], ids[4]]
     parts = list(exports.export(sessions, RunFilter(zeta0_max=0.95), "csv"))
-    assert len(parts) == 1 + 3 + 1, "the header, three batches of at most two runs, the (empty) tail"
+    assert len(parts) == 1 + 2 + 1, "the header, two parts of at most two runs, the (empty) tail"
+    assert len(list(csv.reader(io.StringIO("".join(parts))))) == 1 + 4
+
+
+def test_the_parts_of_an_export_end_at_every_batch_and_at_the_newest_run(session, make_run, monkeypatch):
+    monkeypatch.setattr(store_runs, "EXPORT_BATCH", 2)
+    ids = [make_run(zeta0=zeta0).id for zeta0 in (0.86, 0.88, 0.9, 0.92, 0.94)]
+    assert store_runs.export_part_ends(session, RunFilter()) == [ids[1], ids[3], ids[4]]
+    assert store_runs.export_part_ends(session, RunFilter(zeta0_max=0.9)) == [ids[1], ids[2]]
+    assert store_runs.export_part_ends(session, RunFilter(zeta0_min=0.89, zeta0_max=0.93)) == [ids[3]]
+    assert store_runs.export_part_ends(session, RunFilter(tag="nobody")) == []
 
 
 def test_csv_export_keeps_every_runs_legs(sessions, make_run):

@@ -5,9 +5,10 @@ import asyncio
 import json
 
 from backend.schemas import RunPage
-from backend.services import records, store_reads
+from backend.services import exports, records, store_reads
 from backend.services.compute import ComputePool
 from backend.services.records import RunFilter
+from backend.store import runs as store_runs
 from backend.store.database import make_engine, migrate, sqlite_url
 
 
@@ -48,3 +49,24 @@ def test_a_worker_keeps_a_few_stores_open_and_lets_the_oldest_go(tmp_path, monke
     assert list(store_reads._stores) == urls[-store_reads.STORES_KEPT :]
     store_reads._in_session(store_reads.runs_page_json, urls[-store_reads.STORES_KEPT], RunFilter(), 10, None, "-id", 0)
     assert list(store_reads._stores)[-1] == urls[-store_reads.STORES_KEPT], "the store just read is kept longest"
+
+
+def test_an_export_read_in_workers_is_the_export_read_here(tmp_path, sessions, make_run, monkeypatch):
+    """Parts read two at a time in the workers come out in order: the same text, chunk for chunk."""
+    monkeypatch.setattr(store_runs, "EXPORT_BATCH", 2)  # here, where the plan is made: nine parts
+    for k in range(17):
+        make_run(zeta0=0.86 + 0.005 * k, tags=[f"t{k % 3}"])
+    pool = ComputePool("reads-test", 2, max_pending=8, niceness=0)
+    try:
+        reads = store_reads.StoreReads(pool, sqlite_url(tmp_path))
+        for format_ in ("json", "csv"):
+            with sessions() as session:
+                plan = exports.plan_export(session, RunFilter(), format_)
+            assert len(plan.ends) == 9
+
+            async def read_all(plan=plan):
+                return [chunk async for chunk in reads.export_text(RunFilter(), plan)]
+
+            assert asyncio.run(read_all()) == list(exports.export(sessions, RunFilter(), format_))
+    finally:
+        pool.close()
