@@ -1,6 +1,7 @@
 """``parkour calibrate``: stored robot runs fitted and kept as a preset that other commands take by
 name (cli/calibrate.py, cli/options.py)."""
 
+import numpy as np
 import pytest
 
 from backend.store.database import make_engine, migrate, session_factory, sqlite_url
@@ -39,7 +40,11 @@ def test_calibrate_prints_the_fit_and_other_commands_use_it_by_name(data_dir):
     calibrated, paper = json_of(*args, "--preset", "bench"), json_of(*args)
     assert calibrated["states"] != paper["states"], "the calibrated model is the one simulated"
     overridden = json_of(*args, "--preset", "bench", "--alpha", str(fitted["params"]["alpha"]))
-    assert overridden == calibrated
+    # The preset keeps physical parameters, so its alpha comes back from the stiffness to within a
+    # rounding: whether the last bit survives depends on the fitted value (a CI run saw 1e-15).
+    assert overridden.keys() == calibrated.keys() and overridden["failure"] == calibrated["failure"]
+    for key in ("states", "rises"):
+        assert np.allclose(overridden[key], calibrated[key], rtol=1e-12, atol=0), key
 
     unknown = invoke(*args, "--preset", "nothing")
     assert unknown.exit_code == 2 and "known presets: paper, bench" in unknown.output
