@@ -103,7 +103,7 @@ async def quick_compute(request: Request) -> ComputePool:
 
 
 async def store_reads(request: Request) -> StoreReads:
-    """The reads answered in worker processes (the run list's pages)."""
+    """The reads answered in worker processes (the run list's pages, exports)."""
     return request.app.state.reads
 
 

@@ -8,8 +8,8 @@ process only sends arguments and receives results.
 
 Three pools, so a long job never delays a quick call (:class:`Compute`): ``quick`` for the panel's
 ``/sim/*`` calls and ``POST /runs``, ``jobs`` for job chunks, and ``reads`` for the run list's
-pages (``backend/services/store_reads.py``), which are not compute but held the service's GIL as
-long. Work is bounded: a pool refuses a call when ``max_pending`` are already waiting
+pages and exports (``backend/services/store_reads.py``), which are not compute but held the
+service's GIL as long. Work is bounded: a pool refuses a call when ``max_pending`` are already waiting
 (:class:`ComputeBusy`, a 503 with Retry-After), and a call that outlives its ``timeout`` stops its
 pool's workers, which start afresh for the next call (:class:`ComputeTimeout`). A worker that dies
 (out of memory, a crash) is replaced the same way (:class:`ComputeFailed`). ``restart`` is also
@@ -36,11 +36,11 @@ QUICK_TIMEOUT = 60.0  # [s] the longest a quick call may take (they are bounded 
 QUICK_PENDING = 64  # quick calls waiting at most; more get a 503
 JOB_PENDING = 8  # job chunks in flight at most (the runner keeps the worker fed, no more)
 WORKER_NICENESS = 10  # added to the workers' scheduling niceness (os.nice): compute yields to the service
+PARENT_CHECK_S = 1.0  # [s] how often a worker checks that the service that started it is alive
 READ_WORKERS = 2  # the reads pool's processes: on this 2-core machine a third gained nothing (docs/service.md)
 # The readers answer requests, so they sit above compute; below the service's own process, so its
 # event loop (the e-stop) still gets a core first when the readers fill both.
 READ_NICENESS = 4
-PARENT_CHECK_S = 1.0  # [s] how often a worker checks that the service that started it is alive
 READ_PENDING = 256  # page reads waiting at most (one per client in flight: 50 clients need 50)
 
 
@@ -235,7 +235,7 @@ def _warm_reads() -> None:
 
 class Compute:
     """The service's pools: ``quick`` for API calls, ``jobs`` for job chunks, ``reads`` for the
-    run list's pages."""
+    run list's pages and exports."""
 
     def __init__(self, quick: ComputePool | None = None, jobs: ComputePool | None = None):
         self.quick = quick or ComputePool("quick", max_pending=QUICK_PENDING)

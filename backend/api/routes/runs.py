@@ -66,7 +66,7 @@ async def export_runs(
     reads: Reads, where: RunQuery, format_: Annotated[str, Query(alias="format", pattern="^(csv|json)$")] = "csv"
 ):
     """Every run matching the filters when the export began, streamed, with tags, timings and
-    parameters (not the path); read and encoded in a worker process a batch at a time."""
+    parameters (not the path); read and encoded by the read workers, a part of 1000 runs at a time."""
     plan = await reads.export_plan(where, format_)
     body = reads.export_text(where, plan)
     media = "text/csv" if format_ == "csv" else "application/json"
