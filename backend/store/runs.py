@@ -176,16 +176,16 @@ def export_part_ends(session: Session, where: RunFilter) -> list[int]:
     """Where each part of an export of the matching runs ends: the id of every
     :data:`EXPORT_BATCH`-th of them, oldest first, and the newest's (empty when none match). One
     pass over the matching ids; the parts' own reads then need nothing from each other."""
-    numbered = filtered(select(Run.id, func.row_number().over(order_by=Run.id).label("n")), where).subquery()
-    ends = list(session.scalars(select(numbered.c.id).where(numbered.c.n % EXPORT_BATCH == 0).order_by(numbered.c.id)))
-    newest = session.scalar(filtered(select(func.max(Run.id)), where))
-    return ends if newest is None or (ends and ends[-1] == newest) else [*ends, newest]
+    numbered = filtered(
+        select(Run.id, func.row_number().over(order_by=Run.id).label("n"), func.max(Run.id).over().label("newest")),
+        where,
+    ).subquery()
+    ends = (numbered.c.n % EXPORT_BATCH == 0) | (numbered.c.id == numbered.c.newest)
+    return list(session.scalars(select(numbered.c.id).where(ends).order_by(numbered.c.id)))
 
 
-def widest_schedule(session: Session, where: RunFilter, last_id: int | None = None) -> int:
-    """The most legs any matching run's schedule has, of those with ids up to ``last_id`` if given
-    (0 when none match)."""
-    query = filtered(select(func.max(func.json_array_length(Run.controls))), where)
-    if last_id is not None:
-        query = query.where(Run.id <= last_id)
+def widest_schedule(session: Session, where: RunFilter, last_id: int) -> int:
+    """The most legs any matching run's schedule has, of those with ids up to ``last_id`` (0 when
+    none match)."""
+    query = filtered(select(func.max(func.json_array_length(Run.controls))).where(Run.id <= last_id), where)
     return session.scalar(query) or 0
