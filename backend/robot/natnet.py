@@ -33,13 +33,22 @@ A message is ``u16 id, u16 byte count`` then that many bytes. A frame of data is
   from 3.0 ``f32`` residual;
 - force plates (2.9+) and devices (2.11+): count, then each ``u32 id, u32 channels``, each channel
   ``u32 n, n × f32``;
-- suffix: ``u32`` timecode, ``u32`` sub-timecode, timestamp [s] (``f32``, ``f64`` from 2.7), from 3.0
-  three ``u64`` high-resolution stamps, from 4.1 the ``u32, u32`` precision timestamp (the SDK's
-  samples disagree whether 4.0 has it: both are accepted there), ``u16`` parameters.
+- suffix: before 3.0 ``f32`` software latency [ms], then ``u32`` timecode, ``u32`` sub-timecode,
+  timestamp [s] (``f32``, ``f64`` from 2.7), from 3.0 three ``u64`` high-resolution stamps, from 4.1
+  the ``u32, u32`` precision timestamp (the SDK's samples disagree whether 4.0 has it: both are
+  accepted there), ``u16`` parameters;
+- then, optionally, the ``u32`` end-of-data tag that PacketClient.cpp reads after the parameters
+  (the SDK never checks its value; NatNetClient.py stops before it, so a frame without it is
+  accepted as well).
+
+The software latency is read from 2.x streams as the 2.x and 3.x SDKs' samples (PacketClient.cpp,
+NatNetClient.py: "removed in version 3.0") and field readers of real 2.x servers do; the 4.x
+samples no longer read it because they no longer talk to such servers.
 
 From 4.1 each block's count is followed by a ``u32`` byte size of the block's elements; it is
-checked against what was read. A frame must fill its message exactly; anything else (truncated,
-oversized, a count that cannot fit, a non-finite timestamp) raises :class:`NatNetError`.
+checked against what was read. A frame must fill its message exactly, but for the end-of-data tag;
+anything else (truncated, oversized, a count that cannot fit, a non-finite timestamp) raises
+:class:`NatNetError`.
 """
 
 from __future__ import annotations
@@ -58,6 +67,7 @@ COMMAND_PORT = 1510  # the server's, for requests
 DATA_PORT = 1511  # where a multicast stream goes
 MULTICAST_GROUP = "239.255.42.99"
 OLDEST, NEWEST = (2, 0), (4, 1)  # the frame layouts known; a later 4.x is read as 4.1
+END_TAG_SIZE = 4  # [bytes] the optional end-of-data tag after a frame's parameters
 
 Version = tuple[int, int]  # (major, minor)
 
@@ -71,14 +81,27 @@ class NatNetError(ValueError):
     """A packet that is not a well-formed NatNet message for the version it is read with."""
 
 
+def is_known(version: Version) -> bool:
+    """Whether frames of NatNet ``version`` can be read: 2.0 to 4.x (a 4.x after 4.1 as 4.1)."""
+    return OLDEST <= version < (NEWEST[0] + 1, 0)
+
+
+def format_version(version: Version) -> str:
+    """``(major, minor)`` as ``"M.m"``."""
+    return f"{version[0]}.{version[1]}"
+
+
+KNOWN_VERSIONS = f"{format_version(OLDEST)} to {NEWEST[0]}.x"  # for messages
+
+
 def parse_version(text: str, field: str = "natnet_version") -> Version:
     """``"M.m"`` (e.g. ``"2.9"``, ``"4.1"``) as ``(major, minor)``, within the layouts known."""
     major, dot, minor = text.strip().partition(".")
     if not (dot and major.isdigit() and minor.isdigit()):
         raise ParameterError(field, f"must be MAJOR.MINOR such as 2.9 or 4.1, got {text!r}")
     version = (int(major), int(minor))
-    if not OLDEST <= version < (NEWEST[0] + 1, 0):
-        raise ParameterError(field, f"must be from {OLDEST[0]}.{OLDEST[1]} to {NEWEST[0]}.x, got {text!r}")
+    if not is_known(version):
+        raise ParameterError(field, f"must be from {KNOWN_VERSIONS}, got {text!r}")
     return version
 
 
@@ -248,15 +271,21 @@ def _channels(reader: _Reader, what: str) -> None:
 
 
 def _suffix(reader: _Reader, version: Version) -> float:
+    if version < (3, 0):
+        reader.skip(4, "software latency")
     reader.skip(8, "timecode")
     timestamp = reader.take(_F64 if version >= (2, 7) else _F32, "timestamp")[0]
     if version >= (3, 0):
         reader.skip(24, "high-resolution timestamps")
-    if version >= (4, 1) or (version >= (4, 0) and reader.left == 10):
+    # 4.0: the precision timestamp is there when 8 bytes more than the parameters (and tag) are left.
+    if version >= (4, 1) or (version >= (4, 0) and reader.left in (10, 10 + END_TAG_SIZE)):
         reader.skip(8, "precision timestamp")
     reader.skip(2, "frame parameters")
-    if reader.left:
-        raise NatNetError(f"{reader.left} bytes after the frame's suffix (a NatNet {version[0]}.{version[1]} frame?)")
+    if reader.left not in (0, END_TAG_SIZE):
+        raise NatNetError(
+            f"{reader.left} bytes after the frame's suffix (a NatNet {format_version(version)} frame?); "
+            f"only a {END_TAG_SIZE}-byte end-of-data tag may follow"
+        )
     if not math.isfinite(timestamp):
         raise NatNetError(f"timestamp {timestamp} is not finite")
     return timestamp
@@ -292,7 +321,7 @@ def keep_alive() -> bytes:
 
 def encode_frame(number: int, timestamp: float, body: RigidBody, version: Version) -> bytes:
     """A frame of data holding one rigid body and nothing else, as a server of ``version`` sends it
-    (the virtual robot's camera)."""
+    (the virtual robot's camera): zero latency and timecode, and a zero end-of-data tag."""
     sized = version >= (4, 1)
 
     def block(count: int, elements: bytes) -> bytes:
@@ -308,12 +337,14 @@ def encode_frame(number: int, timestamp: float, body: RigidBody, version: Versio
     empty_blocks = 2 + (version >= (2, 1)) + (version >= (4, 1)) + (version >= (2, 3))
     empty_blocks += (version >= (2, 9)) + (version >= (2, 11))
     out = _U32.pack(number & 0xFFFFFFFF) + block(0, b"") * 2 + block(1, rigid) + block(0, b"") * (empty_blocks - 2)
+    if version < (3, 0):
+        out += _F32.pack(0.0)  # software latency
     out += _U32.pack(0) * 2 + (_F64 if version >= (2, 7) else _F32).pack(timestamp)
     if version >= (3, 0):
         out += bytes(24)
     if version >= (4, 1):
         out += bytes(8)
-    out += _U16.pack(0)
+    out += _U16.pack(0) + _U32.pack(0)  # parameters, end-of-data tag
     return _HEADER.pack(NAT_FRAMEOFDATA, len(out)) + out
 
 

@@ -15,6 +15,12 @@ goes to the server each second until it answers; its answer (``NAT_SERVERINFO``)
 stream's NatNet version, which is used unless a version was configured (the V100 rig's old
 software: configure it when its server does not answer). Frames that arrive while the version is
 still unknown, or that lack the rigid body or say it is untracked, are counted as ``ignored``.
+
+A ``NAT_SERVERINFO`` is taken only from the configured server's address and command port, and
+only while its answer is awaited (after a connect request, before the first answer): any other
+(a second answer, a stray one, one from another host or port) is counted in
+``server_info_refused`` and changes nothing. An answer naming a version this reader does not know
+sets ``error`` and leaves the version unknown, so no frame is decoded on a guess.
 """
 
 from __future__ import annotations
@@ -30,6 +36,7 @@ import time
 from backend.robot.natnet import (
     COMMAND_PORT,
     DATA_PORT,
+    KNOWN_VERSIONS,
     MULTICAST_GROUP,
     NAT_FRAMEOFDATA,
     NAT_SERVERINFO,
@@ -38,6 +45,8 @@ from backend.robot.natnet import (
     connect_request,
     decode_frame,
     decode_server_info,
+    format_version,
+    is_known,
     keep_alive,
     message_id,
 )
@@ -56,7 +65,12 @@ class NatNetPoseSource(PoseHistory):
     group is joined on ``interface`` (``0.0.0.0``: the system's choice). ``server`` is the NatNet
     server's command address. ``version`` ``(major, minor)`` is the stream's NatNet version, None
     to take the server's word for it.
+
+    For records and the robot's status: ``protocol`` ``"natnet"``, ``version`` the stream's version
+    as ``"M.m"`` (None while unknown), ``error`` why no frame can be read (None: nothing wrong known).
     """
+
+    protocol = "natnet"
 
     def __init__(
         self,
@@ -74,8 +88,11 @@ class NatNetPoseSource(PoseHistory):
         self.rigid_body_id = rigid_body_id
         self.server = server
         self.configured_version = version
-        self.version = version  # the one frames are read with (None: not known yet)
-        self.server_info = None
+        self.stream_version = version  # the one frames are read with (None: not known yet)
+        self.server_info = None  # the server's answer to a connect request, once it came
+        self.server_info_refused = 0  # NAT_SERVERINFO messages not taken (see the module docstring)
+        self.error: str | None = None
+        self._server_ip: str | None = None  # the server's host, resolved when the first request goes
         self.stats = TrackerStats()
         self.multicast_group = multicast_group
         self.command = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
@@ -94,6 +111,11 @@ class NatNetPoseSource(PoseHistory):
         self._thread = threading.Thread(target=self._receive, name="tracker-natnet", daemon=True)
         self._thread.start()
 
+    @property
+    def version(self) -> str | None:
+        """The stream's NatNet version as ``"M.m"``, None while it is not known."""
+        return None if self.stream_version is None else format_version(self.stream_version)
+
     def close(self) -> None:
         self._stop.set()
         self._thread.join(2)
@@ -103,8 +125,10 @@ class NatNetPoseSource(PoseHistory):
 
     def _request(self, data: bytes) -> None:
         try:
-            self.command.sendto(data, self.server)
-        except OSError as error:  # no route yet, or the server's port refused an earlier request
+            if self._server_ip is None:
+                self._server_ip = socket.gethostbyname(self.server[0])
+            self.command.sendto(data, (self._server_ip, self.server[1]))
+        except OSError as error:  # no name or route yet, or the server's port refused an earlier request
             log.debug("NatNet request to %s: %s", self.server, error)
 
     def _receive(self) -> None:
@@ -120,17 +144,17 @@ class NatNetPoseSource(PoseHistory):
             try:
                 ready, _, _ = select.select(sockets, [], [], 0.05)
                 for ready_socket in ready:
-                    self._handle(ready_socket.recv(RECEIVE_BUFFER))
+                    self._handle(*ready_socket.recvfrom(RECEIVE_BUFFER))
             except ConnectionRefusedError:  # an ICMP answer to a request: nothing listens there yet
                 continue
             except (OSError, ValueError):  # closed
                 return
 
-    def _handle(self, data: bytes) -> None:
+    def _handle(self, data: bytes, sender: tuple[str, int]) -> None:
         try:
             ident = message_id(data)
             if ident == NAT_SERVERINFO:
-                self._learn(data)
+                self._learn(data, sender)
             elif ident == NAT_FRAMEOFDATA:
                 self._frame(data)
             # Other messages (model definitions, responses, strings) carry no pose.
@@ -138,25 +162,37 @@ class NatNetPoseSource(PoseHistory):
             self.stats.malformed += 1
             log.debug("NatNet packet of %d bytes: %s", len(data), error)
 
-    def _learn(self, data: bytes) -> None:
+    def _learn(self, data: bytes, sender: tuple[str, int]) -> None:
+        awaited = self.server_info is None and self._server_ip is not None  # a connect request went out
+        if not awaited or sender[:2] != (self._server_ip, self.server[1]):
+            self.server_info_refused += 1
+            log.debug("NatNet server info from %s not taken (awaited: %s)", sender, awaited)
+            return
         info = decode_server_info(data)
         self.server_info = info
         streamed = info.natnet_version[:2]
-        if self.configured_version is None:
-            self.version = streamed
-        elif streamed != self.configured_version:
-            log.warning(
-                "NatNet server %s streams %d.%d; reading it as the configured %d.%d",
-                info.application,
-                *streamed,
-                *self.configured_version,
+        if self.configured_version is not None:
+            if streamed != self.configured_version:
+                log.warning(
+                    "NatNet server %s streams %s; reading it as the configured %s",
+                    info.application,
+                    format_version(streamed),
+                    format_version(self.configured_version),
+                )
+        elif is_known(streamed):
+            self.stream_version = streamed
+        else:
+            self.error = (
+                f"NatNet server {info.application} reports version {format_version(streamed)}; "
+                f"this reader knows {KNOWN_VERSIONS}"
             )
+            log.warning("%s", self.error)
 
     def _frame(self, data: bytes) -> None:
-        if self.version is None:
+        if self.stream_version is None:
             self.stats.ignored += 1
             return
-        frame = decode_frame(data, self.version)
+        frame = decode_frame(data, self.stream_version)
         body = frame.rigid_body(self.rigid_body_id)
         if body is not None and not all(math.isfinite(v) for v in (*body.position, *body.orientation)):
             raise NatNetError(f"rigid body {body.id} has a non-finite pose")

@@ -14,7 +14,9 @@ Sources (all ``PoseSource``: ``latest()`` and ``poses_since(t)``):
 
 Tracker datagram v1 (big-endian, 40 bytes): magic ``b"PKT1"``, frame number u32, time f64,
 x f64, y f64, pitch f64 (NaN when the markers do not give it). Gaps in frame numbers are
-counted as dropped frames; malformed datagrams are counted and ignored.
+counted as dropped frames, a jump or a restart of the numbering as a restart (:class:`TrackerStats`);
+malformed datagrams are counted and ignored. :meth:`TrackerStats.snapshot` and
+:meth:`TrackerCounts.since` give the figures of one run.
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ import socket
 import struct
 import threading
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -80,27 +82,75 @@ def decode_datagram(data: bytes) -> tuple[int, Pose]:
     return frame, Pose(t, x, y, pitch)
 
 
-@dataclass
-class TrackerStats:
-    received: int = 0
-    dropped: int = 0  # frame-number gaps
-    malformed: int = 0
-    ignored: int = 0  # well-formed frames without a pose (NatNet: the rigid body not in it, or not tracked)
-    last_frame: int | None = None
+FRAME_JUMP = 1000  # frames: ~3 s at 360 Hz, 10 s at 100 Hz; a longer forward gap is a jump, not loss
+LATE_FRAMES = 16  # frames: a number this far behind the newest is a late (reordered) datagram, not a restart
 
-    def frame(self, number: int) -> None:
-        """Count a frame received; a gap in the numbers counts as dropped frames (late ones are not)."""
-        if self.last_frame is not None and number > self.last_frame + 1:
-            self.dropped += number - self.last_frame - 1
-        if self.last_frame is None or number > self.last_frame:
-            self.last_frame = number
-        self.received += 1
+
+@dataclass(frozen=True)
+class TrackerCounts:
+    """Tracker figures at one moment, or over a stretch (:meth:`since`): frames ``received``,
+    ``dropped`` (gaps in the frame numbers), ``malformed`` packets, well-formed frames ``ignored``
+    (no pose in them), and ``restarts`` of the numbering (it went back, or jumped ahead further than
+    :data:`FRAME_JUMP`)."""
+
+    received: int = 0
+    dropped: int = 0
+    malformed: int = 0
+    ignored: int = 0
+    restarts: int = 0
 
     @property
     def loss(self) -> float:
         """Fraction of frames lost (dropped / expected)."""
         expected = self.received + self.dropped
         return self.dropped / expected if expected else 0.0
+
+    def since(self, earlier: TrackerCounts) -> TrackerCounts:
+        """The counts from ``earlier`` (a snapshot of the same stats) to these, e.g. over one run."""
+        return TrackerCounts(*(getattr(self, f.name) - getattr(earlier, f.name) for f in fields(self)))
+
+
+@dataclass
+class TrackerStats:
+    """A source's running counts (see :class:`TrackerCounts`), updated by its receiving thread.
+
+    Frame numbers: a gap of up to :data:`FRAME_JUMP` counts as dropped frames. A longer jump ahead,
+    or a number more than :data:`LATE_FRAMES` behind the newest (the camera software restarted, or
+    its 32-bit numbers wrapped), counts as a restart: the new numbering is followed from there, and
+    the frames between are not counted lost. A number just behind the newest is a late datagram."""
+
+    received: int = 0
+    dropped: int = 0  # frame-number gaps
+    malformed: int = 0
+    ignored: int = 0  # well-formed frames without a pose (NatNet: the rigid body not in it, or not tracked)
+    restarts: int = 0  # the numbering went back, or jumped ahead by more than FRAME_JUMP
+    last_frame: int | None = None
+
+    def frame(self, number: int) -> None:
+        """Count a frame received, and the frames lost before it (late ones are not counted twice)."""
+        last = self.last_frame
+        if last is None:
+            self.last_frame = number
+        elif number > last:
+            if number - last - 1 > FRAME_JUMP:
+                self.restarts += 1
+            else:
+                self.dropped += number - last - 1
+            self.last_frame = number
+        elif number < last - LATE_FRAMES:
+            self.restarts += 1
+            self.last_frame = number
+        self.received += 1
+
+    @property
+    def loss(self) -> float:
+        """Fraction of frames lost (dropped / expected)."""
+        return self.snapshot().loss
+
+    def snapshot(self) -> TrackerCounts:
+        """The counts now. Cheap; read while the receiving thread counts, so one field may be a frame
+        ahead of another, never more."""
+        return TrackerCounts(self.received, self.dropped, self.malformed, self.ignored, self.restarts)
 
 
 class PoseHistory:
@@ -161,7 +211,14 @@ class PoseHistory:
 
 
 class UdpPoseSource(PoseHistory):
-    """Receives tracker datagrams on ``host:port`` in a background thread."""
+    """Receives tracker datagrams on ``host:port`` in a background thread.
+
+    For records: ``protocol`` ``"pkt1"``, ``version`` ``"1"`` (the datagram's), ``error`` always None
+    (a PKT1 stream has nothing to disagree about)."""
+
+    protocol = "pkt1"
+    version = "1"
+    error: str | None = None
 
     def __init__(self, host: str = "127.0.0.1", port: int = 0, *, calibration: Calibration | None = None, **kwargs):
         super().__init__(calibration or Calibration(), **kwargs)

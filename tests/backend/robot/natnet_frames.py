@@ -4,6 +4,8 @@ checked against another reading of the layout, not against itself.
 
 Versions are numbers ``100 * major + minor`` here (2.9 is 209, 4.1 is 401). A scene holds something
 in every block the version has, so a decoder that misplaces one block misreads everything after it.
+The suffix follows PacketClient.cpp: a 2.x frame's software latency before the timecode, and (when
+``end_tag`` is given) the 4-byte end-of-data tag after the frame parameters.
 """
 
 from __future__ import annotations
@@ -66,8 +68,9 @@ def _channels(things, v: int) -> bytes:
     return _section(v, len(things), content)
 
 
-def frame_packet(scene: Scene, v: int) -> bytes:
-    """The NAT_FRAMEOFDATA message of ``scene`` as a server of version ``v`` sends it."""
+def frame_packet(scene: Scene, v: int, end_tag: int | None = None) -> bytes:
+    """The NAT_FRAMEOFDATA message of ``scene`` as a server of version ``v`` sends it, ending with the
+    end-of-data tag ``end_tag`` (a u32) unless it is None."""
     p = struct.pack("<i", scene.frame)
     sets = b"".join(
         name.encode() + b"\0" + struct.pack("<i", n) + struct.pack("<fff", 1, 2, 3) * n for name, n in scene.marker_sets
@@ -101,6 +104,8 @@ def frame_packet(scene: Scene, v: int) -> bytes:
         p += _channels(scene.force_plates, v)
     if v >= 211:
         p += _channels(scene.devices, v)
+    if v < 300:
+        p += struct.pack("<f", 4.5)  # software latency [ms]
     p += struct.pack("<II", 0x01020304, 5)  # timecode, sub-timecode
     p += struct.pack("<d" if v >= 207 else "<f", scene.timestamp)
     if v >= 300:
@@ -108,6 +113,8 @@ def frame_packet(scene: Scene, v: int) -> bytes:
     if v >= 401:
         p += struct.pack("<II", 3600, 12345)
     p += struct.pack("<h", 0)
+    if end_tag is not None:
+        p += struct.pack("<I", end_tag)
     return struct.pack("<hH", 7, len(p)) + p
 
 

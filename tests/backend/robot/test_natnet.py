@@ -88,33 +88,70 @@ def test_the_production_encoder_agrees_with_the_published_layout(v):
         force_plates=(),
         devices=(),
     )
-    theirs = frame_packet(alone, v)
-    # The suffix's timecode and stamps differ (the robot's camera has none): compare up to them.
-    suffix = 8 + (8 if v >= 207 else 4) + (24 if v >= 300 else 0) + (8 if v >= 401 else 0) + 2
+    theirs = frame_packet(alone, v, end_tag=0)
+    # The suffix's latency, timecode and stamps differ (the robot's camera has none): compare up to them.
+    latency = 4 if v < 300 else 0
+    suffix = latency + 8 + (8 if v >= 207 else 4) + (24 if v >= 300 else 0) + (8 if v >= 401 else 0) + 2 + 4
     assert ours[4:-suffix] == theirs[4:-suffix] and len(ours) == len(theirs)
+    assert ours[-6:] == theirs[-6:] == bytes(6), "zero parameters and a zero end-of-data tag"
     assert decode_frame(ours, _version(v)).timestamp == pytest.approx(1.25)
 
 
-def test_every_truncation_of_every_version_is_refused():
-    cases = 0
+END_TAGS = (0, 0xFFFFFFFF)  # the SDK reads the tag and never checks its value
+FRAMES_PER_VERSION = 100
+
+
+@pytest.mark.parametrize("v", VERSIONS)
+def test_frames_ending_with_the_end_of_data_tag_decode_as_without_it(v):
+    """PacketClient.cpp reads a u32 end-of-data tag after the frame parameters: Motive's frames carry it."""
+    decoded = 0
+    for k in range(FRAMES_PER_VERSION):
+        scene = Scene(4321 + k, 12.345678 + k / 100, BODIES)
+        plain = decode_frame(frame_packet(scene, v), _version(v))
+        for tag in END_TAGS:
+            tagged = decode_frame(frame_packet(scene, v, end_tag=tag), _version(v))
+            assert tagged == plain, f"frame {scene.frame}, tag {tag:#x}"
+            decoded += 1
+    assert decoded == FRAMES_PER_VERSION * len(END_TAGS)
+
+
+@pytest.mark.parametrize("extra", [1, 2, 3, 5, 6, 7, 9])
+def test_bytes_after_the_frame_other_than_the_tag_are_refused(extra):
     for v, packet in _packets():
-        for n in range(len(packet)):
-            cut = packet[:n]
-            with pytest.raises(NatNetError):
-                decode_frame(cut, _version(v))
-            if n >= 4:  # the header fixed to match: the frame's own structure must catch it
+        longer = packet + bytes(extra)
+        with pytest.raises(NatNetError, match="end-of-data tag"):
+            decode_frame(struct.pack("<HH", 7, len(longer) - 4) + longer[4:], _version(v))
+
+
+def test_every_truncation_of_every_version_is_refused():
+    """Every cut of a frame is refused, tagged or not, but the one that takes off exactly the tag."""
+    cases = 0
+    for v in VERSIONS:
+        for packet in (frame_packet(SCENE, v), frame_packet(SCENE, v, end_tag=0)):
+            for n in range(len(packet)):
+                cut = packet[:n]
                 with pytest.raises(NatNetError):
-                    decode_frame(struct.pack("<HH", 7, n - 4) + cut[4:], _version(v))
-            cases += 2
-    assert cases > 5000
+                    decode_frame(cut, _version(v))
+                if n >= 4 and cut[4:] != frame_packet(SCENE, v)[4:]:
+                    # The header fixed to match: the frame's own structure must catch it.
+                    with pytest.raises(NatNetError):
+                        decode_frame(struct.pack("<HH", 7, n - 4) + cut[4:], _version(v))
+                cases += 2
+    assert cases > 10000
 
 
 def test_a_frame_read_with_the_wrong_version_is_refused():
-    for _v, packet in _packets():
-        for other in VERSIONS:
-            if frame_packet(SCENE, other) != packet:
-                with pytest.raises(NatNetError):
-                    decode_frame(packet, _version(other))
+    """All pairs but 2.6 and 2.7: their frames differ only in the timestamp's size (f32, f64), by 4 bytes,
+    as much as the optional end-of-data tag, so a configured version must name the stream's exactly."""
+    alike = {(206, 207), (207, 206)}
+    for v in VERSIONS:
+        for tag in (None, *END_TAGS):
+            packet = frame_packet(SCENE, v, end_tag=tag)
+            for other in VERSIONS:
+                same_layout = frame_packet(SCENE, other) == frame_packet(SCENE, v)
+                if not same_layout and (v, other) not in alike:
+                    with pytest.raises(NatNetError):
+                        decode_frame(packet, _version(other))
 
 
 def test_a_4_1_block_size_that_does_not_match_is_refused():
@@ -202,9 +239,10 @@ def test_unicast_source_connects_learns_the_version_and_counts(monkeypatch):
         server.sendto(frame_packet(_scene(1), 209), client)  # before the version is known: ignored
         _until(lambda: source.stats.ignored == 1)
         server.sendto(server_info_packet("Motive", (1, 10, 0, 0), (2, 9, 0, 0)), client)
-        _until(lambda: source.version == (2, 9))
-        for frame in (2, 3, 6):  # 4 and 5 lost
-            server.sendto(frame_packet(_scene(frame), 209), client)
+        _until(lambda: source.version == "2.9")
+        assert (source.protocol, source.error, source.server_info_refused) == ("natnet", None, 0)
+        for frame in (2, 3, 6):  # 4 and 5 lost; ended with the end-of-data tag, as Motive sends them
+            server.sendto(frame_packet(_scene(frame), 209, end_tag=0), client)
         server.sendto(frame_packet(_scene(7, BODIES[:1]), 209), client)  # body 2 not seen
         server.sendto(frame_packet(_scene(8), 209)[:-3], client)  # truncated
         server.sendto(b"\x07\x00", client)
@@ -219,6 +257,82 @@ def test_unicast_source_connects_learns_the_version_and_counts(monkeypatch):
     finally:
         source.close()
         server.close()
+
+
+@contextlib.contextmanager
+def _fake_server(monkeypatch, rigid_body_id=2):
+    """A unicast source and the NatNet server it asks (a socket on 127.0.0.1), once its first connect
+    request has arrived there: ``(source, server, client address)``."""
+    monkeypatch.setattr(natnet_source, "REQUEST_EVERY", 0.1)
+    server = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    server.bind(("127.0.0.1", 0))
+    server.settimeout(3.0)
+    source = NatNetPoseSource(
+        rigid_body_id, interface="127.0.0.1", port=0, multicast_group=None, server=server.getsockname()
+    )
+    try:
+        _request, client = server.recvfrom(1024)
+        yield source, server, client
+    finally:
+        source.close()
+        server.close()
+
+
+def _info(version: tuple[int, int]) -> bytes:
+    return server_info_packet("Motive", (3, 1, 0, 0), (*version, 0, 0))
+
+
+def test_server_info_is_taken_only_from_the_server_and_only_once(monkeypatch):
+    stranger = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    stranger.bind(("127.0.0.1", 0))  # the server's host, another port
+    with _fake_server(monkeypatch) as (source, server, client):
+        try:
+            stranger.sendto(_info((2, 0)), client)
+            _until(lambda: source.server_info_refused == 1)
+            assert source.version is None and source.server_info is None, "a stranger's answer is not taken"
+            server.sendto(_info((4, 1)), client)
+            _until(lambda: source.version == "4.1")
+            server.sendto(_info((2, 0)), client)  # a stray second answer from the server itself
+            _until(lambda: source.server_info_refused == 2)
+            assert source.version == "4.1" and source.error is None
+            for frame in range(1, 101):
+                server.sendto(frame_packet(_scene(frame), 401, end_tag=0), client)
+            _until(lambda: source.stats.received == 100)
+            assert (source.stats.malformed, source.stats.ignored, source.stats.dropped) == (0, 0, 0)
+        finally:
+            stranger.close()
+
+
+def test_server_info_before_any_request_is_not_taken(monkeypatch):
+    """The server's name does not resolve, so no connect request goes out: nothing is awaited."""
+
+    def unresolvable(host):
+        raise socket.gaierror(f"{host}: no such host")
+
+    monkeypatch.setattr(natnet_source.socket, "gethostbyname", unresolvable)
+    server = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    server.bind(("127.0.0.1", 0))
+    source = NatNetPoseSource(2, interface="127.0.0.1", port=0, multicast_group=None, server=server.getsockname())
+    try:
+        server.sendto(_info((4, 1)), source.address)
+        _until(lambda: source.server_info_refused == 1)
+        assert source.version is None and source.server_info is None
+    finally:
+        source.close()
+        server.close()
+
+
+@pytest.mark.parametrize(("reported", "says"), [((200, 7), "200.7"), ((1, 9), "1.9"), ((5, 0), "5.0")])
+def test_a_version_this_reader_does_not_know_is_an_error_not_a_guess(monkeypatch, reported, says):
+    with _fake_server(monkeypatch) as (source, server, client):
+        server.sendto(_info(reported), client)
+        _until(lambda: source.error is not None)
+        assert source.error == f"NatNet server Motive reports version {says}; this reader knows 2.0 to 4.x"
+        assert source.version is None
+        server.sendto(frame_packet(_scene(1), 401, end_tag=0), client)
+        _until(lambda: source.stats.ignored == 1)
+        assert (source.stats.received, source.stats.malformed) == (0, 0), "no frame read with a guessed layout"
+        assert source.server_info.natnet_version[:2] == reported, "answered: no more connect requests"
 
 
 def test_a_configured_version_wins_and_needs_no_answer():
@@ -326,7 +440,7 @@ def test_connect_opens_the_tracker_it_names():
     )
     tracker = open_tracker(body, Calibration(scale=0.001))
     try:
-        assert isinstance(tracker, NatNetPoseSource) and tracker.version == (2, 5) and tracker.rigid_body_id == 4
+        assert isinstance(tracker, NatNetPoseSource) and tracker.version == "2.5" and tracker.rigid_body_id == 4
         assert tracker.multicast_group is None and tracker.server == ("127.0.0.1", 1510)
         assert tracker.calibration.scale == 0.001
     finally:

@@ -8,7 +8,18 @@ import numpy as np
 import pytest
 
 from backend.robot.touchdown import detect_touchdowns, height_gains
-from backend.robot.tracker import Calibration, Pose, UdpPoseSource, decode_datagram, encode_datagram, recorded_poses
+from backend.robot.tracker import (
+    FRAME_JUMP,
+    LATE_FRAMES,
+    Calibration,
+    Pose,
+    TrackerCounts,
+    TrackerStats,
+    UdpPoseSource,
+    decode_datagram,
+    encode_datagram,
+    recorded_poses,
+)
 from sim_core import ControlSchedule, find_fixed_point, get_preset, simulate_trajectory
 
 
@@ -74,6 +85,7 @@ def test_udp_source_counts_drops_and_goes_stale():
             time.sleep(0.01)
         assert (source.stats.received, source.stats.dropped, source.stats.malformed) == (4, 2, 1)
         assert source.stats.loss == pytest.approx(2 / 6)
+        assert (source.protocol, source.version, source.error) == ("pkt1", "1", None)
         latest = source.latest()
         assert latest is not None and latest.x == pytest.approx(0.25), "calibrated to wall coordinates"
         assert source.latest(time.monotonic() + 1.0) is None, "stale: nothing arrived for a second"
@@ -99,3 +111,48 @@ def test_indices_count_every_pose_received_when_old_ones_are_let_go(monkeypatch)
     assert history.count() == 12, "a live run's index keeps counting past the history kept"
     assert [pose.time for pose in history.poses_from(9)] == [9.0, 10.0, 11.0]
     assert [pose.time for pose in history.poses_from(0)] == [7.0, 8.0, 9.0, 10.0, 11.0], "from the oldest kept"
+
+
+def _counted(numbers) -> TrackerStats:
+    stats = TrackerStats()
+    for number in numbers:
+        stats.frame(number)
+    return stats
+
+
+def test_a_huge_jump_in_frame_numbers_is_a_restart_not_loss():
+    stats = _counted([*range(1, 51), 2_000_000_000, 2_000_000_001, 2_000_000_003])
+    assert (stats.received, stats.dropped, stats.restarts) == (53, 1, 1), "the gap after the jump still counts"
+    assert stats.loss == pytest.approx(1 / 54)
+
+
+def test_the_longest_gap_counted_as_loss():
+    assert _counted([10, 11 + FRAME_JUMP]).snapshot() == TrackerCounts(received=2, dropped=FRAME_JUMP)
+    assert _counted([10, 12 + FRAME_JUMP]).snapshot() == TrackerCounts(received=2, restarts=1)
+
+
+def test_numbers_going_back_are_a_restart_and_gaps_count_again_after_it():
+    """The camera software restarted: its numbering begins again, and its gaps are losses again."""
+    stats = _counted([*range(5000, 5100), 1, 2, 5, 6])
+    assert (stats.received, stats.dropped, stats.restarts) == (104, 2, 1)
+    assert stats.last_frame == 6
+
+
+def test_a_late_frame_is_not_a_restart():
+    stats = _counted([1, 2, 4, 3, 5, 5 - LATE_FRAMES, 6])
+    assert (stats.received, stats.dropped, stats.restarts) == (7, 1, 0)
+
+
+def test_counts_over_a_run_are_the_difference_of_two_snapshots():
+    stats = _counted([101, 102, 105])
+    stats.malformed, stats.ignored = 3, 1
+    before = stats.snapshot()
+    for number in (106, 109, 110, 1):  # 107 and 108 lost, then a restart
+        stats.frame(number)
+    stats.malformed += 2
+    run = stats.snapshot().since(before)
+    assert run == TrackerCounts(received=4, dropped=2, malformed=2, ignored=0, restarts=1)
+    assert run.loss == pytest.approx(2 / 6)
+    assert before == TrackerCounts(received=3, dropped=2, malformed=3, ignored=1), "a snapshot does not move"
+    assert stats.loss == stats.snapshot().loss == pytest.approx(4 / 11)
+    assert TrackerCounts().loss == 0.0
