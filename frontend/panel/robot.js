@@ -1,6 +1,7 @@
-// The Robot tab: connect, arm, live runs (open and closed loop), the live plot and websocket,
-// the emergency stop (no token needed) and the latched e-stop banner.
+// The Robot tab: connect, arm, live runs (open and closed loop) and who runs one, the live plot
+// and websocket, the emergency stop (no token needed). The latched e-stop's banner: events.js.
 import { API, $, say, call, on } from "./api.js";
+import { onRobotEvent, statusSeen } from "./events.js";
 import { filedUnder, LEG_FIELDS, SIM_LOCATIONS, checked } from "./forms.js";
 import { PLOT_CONFIG, layout } from "./plots.js";
 import { definitions } from "./dom.js";
@@ -13,12 +14,16 @@ let pendingTarget;  // the closed-loop target of the run this browser is startin
 let runWasActive = false;
 let localRuns = 0;
 
+const clock = (epochSeconds) => new Date(epochSeconds * 1000).toLocaleTimeString();
+// Who started a run, when the service says (``started_by``: absent from an older one, or null).
+const startedBy = (run) => (typeof run.started_by === "string" && run.started_by ? ` by ${run.started_by}` : "");
+
 function describeRun(run) {
   if (!run) return "—";
   const parts = [`${run.id !== undefined && run.id !== null ? `run ${run.id}: ` : ""}${run.active ? "running" : run.end_reason ?? "ended"}`,
     `${run.touchdowns} touchdowns`];
   if (run.jumps !== undefined) parts.push(`jumps ${run.jumps}`);  // as the service counts them
-  if (typeof run.started === "number") parts.push(`started ${new Date(run.started * 1000).toLocaleTimeString()}`);
+  if (typeof run.started === "number") parts.push(`started ${clock(run.started)}${startedBy(run)}`);
   if (run.max_seconds !== undefined) parts.push(`time limit ${run.max_seconds} s`);
   if (!run.active && run.disarm) parts.push(`disarm: ${run.disarm}`);
   if (run.stored_run_id !== undefined && run.stored_run_id !== null) parts.push(`stored as run ${run.stored_run_id}`);
@@ -43,27 +48,23 @@ export function showStatus(status) {
   ]));
   const counters = status.counters ? Object.entries(status.counters) : [];
   $("#robot-counters").replaceChildren(...(counters.length ? definitions(counters) : definitions([["—", "not connected"]])));
-  showLatch(status);
+  statusSeen(status);  // the e-stop banner
+  showRunOwner(status.run);
   followRun(status);
 }
 
-// A latched e-stop: a banner on every tab until a status says it is released. An older service
-// sends no ``estop``: then the state says it.
-// Off the Robot tab no live messages come: while latched, a look every few seconds keeps the
-// banner true (a reset from another browser takes it away).
-let latchCheck = null;
-
-function showLatch(status) {
-  const estop = status.estop || { latched: status.state === "estopped", reason: null };
-  $("#estop-banner").hidden = !estop.latched;
-  $("#estop-reason").textContent = estop.latched && estop.reason ? `Reason: ${estop.reason}` : "";
-  if (estop.latched && latchCheck === null) {
-    latchCheck = setTimeout(() => {
-      latchCheck = null;
-      if (!liveSocket.socket && !$("#estop-banner").hidden) refreshRobot().catch(() => {});
-    }, 3000);
-  }
+// Who runs the robot: while a live run goes, which run, since when and who started it, with its
+// Stop (on the Robot tab; the run's summary comes with every status and every robot event).
+function showRunOwner(run) {
+  const box = $("#run-owner");
+  box.hidden = !(run && run.active);
+  if (box.hidden) return;
+  const name = run.id !== undefined && run.id !== null ? `Live run ${run.id}` : "A live run";
+  const since = typeof run.started === "number" ? ` since ${clock(run.started)}` : "";
+  const who = startedBy(run);
+  $("#run-owner-text").textContent = `${name} is running${since}${who ? `, started${who}` : ""}.`;
 }
+onRobotEvent((summary) => showRunOwner(summary.run));
 
 // The live height plot shows one run: a new run (a new id) starts it afresh. An older service
 // sends neither id nor start time: a run seen becoming active is then a new one.
@@ -197,7 +198,9 @@ on("#robot-run-form", "submit", async (event) => {
   }
   say(`Run started: ${body.jumps} jumps at most, ${body.max_seconds} s at most${body.closed_loop ? `, holding ${body.closed_loop.target_m} m` : ""}.`);
 });
-on("#stop-run", "click", async () => showStatus(await call("POST", "/robot/runs/stop")));
+const stopRun = async () => showStatus(await call("POST", "/robot/runs/stop"));
+on("#stop-run", "click", stopRun);
+on("#run-owner-stop", "click", stopRun);
 
 // The e-stop needs no token (the service allows stopping to anyone; call() sends one only when
 // pasted) and always answers within 200 ms; it says whether the robot confirmed the stop.

@@ -835,6 +835,7 @@ def test_the_status_fields_of_the_new_service_are_shown_as_text(page):
         page.click("nav [data-tab=robot]")
     _until(page, "document.querySelector('#live-state').textContent === 'live updates: on'")
     page.evaluate("async () => (await import('/panel/robot.js')).closeLive()")  # only the statuses below
+    page.evaluate(STOP_EVENTS)  # the robot's events would move the banner alone while they flow
     status = {
         "state": "estopped",
         "url": "socket://127.0.0.1:1",
@@ -859,7 +860,165 @@ def test_the_status_fields_of_the_new_service_are_shown_as_text(page):
     assert page.evaluate(LIVE_PLOT_SHOWS) == ["id 42", 1], "a new run id: the plot starts afresh"
     page.evaluate(feed, {**status, "estop": {"latched": False, "reason": None}, "state": "disarmed"})
     assert page.is_hidden("#estop-banner")
+    page.evaluate(FOLLOW_EVENTS)
     page.click("nav [data-tab=simulate]")  # back to the service's own statuses on the next visit
+
+
+# Every open panel learns of a latched e-stop (issue 24) -------------------------------------------
+# How a panel follows the robot (events.js): "live" (the event stream), "polling", "connecting", "off".
+EVENTS_STATE = "async () => (await import('/panel/events.js')).robotEventsState()"
+STOP_EVENTS = "async () => (await import('/panel/events.js')).stopRobotEvents()"
+FOLLOW_EVENTS = "async () => (await import('/panel/events.js')).followRobotEvents()"
+SHOWN_WITHIN_MS = 5_000  # a generous guard against a hang; "within a second" is measured and reported
+
+
+def _events_are(panel, state: str, timeout: float = 15.0) -> None:
+    """Wait until the panel follows the robot as ``state`` says (``_until`` takes an expression,
+    and the panel's module is reached by an async import)."""
+    deadline = time.monotonic() + timeout
+    while (now := panel.evaluate(EVENTS_STATE)) != state:
+        assert time.monotonic() < deadline, f"the panel's robot events are {now!r}, not {state!r}"
+        time.sleep(0.05)
+
+
+# When the banner was first shown, in the page's own clock (ms since its navigation began).
+BANNER_CLOCK = """window.__bannerShownAt = null;
+new MutationObserver(() => {
+  const banner = document.getElementById('estop-banner');
+  if (banner && !banner.hidden && window.__bannerShownAt === null) window.__bannerShownAt = performance.now();
+}).observe(document, { subtree: true, attributes: true, attributeFilter: ['hidden'] });"""
+LOADED_AT = "performance.getEntriesByType('navigation')[0].domContentLoadedEventStart"
+
+
+def _other_browser(page):
+    """A colleague's browser: no token, its own connections to the service."""
+    context = page.context.browser.new_context(viewport={"width": 1360, "height": 900})
+    context.add_init_script(CSP_LISTENER)
+    context.add_init_script(BANNER_CLOCK)
+    return context
+
+
+def test_a_latched_estop_reaches_every_open_panel(page, service, robot):
+    """One panel on History, pressed nowhere near the Robot tab, and one opened after the press:
+    both show the banner with its reason, from the event stream; a reset takes it away on both."""
+    base, _token = service
+    context = _other_browser(page)
+    try:
+        history = context.new_page()
+        history.goto(f"{base}/")
+        history.click("nav [data-tab=history]")
+        _events_are(history, "live")
+        assert history.is_hidden("#estop-banner")
+        page.click("#estop")
+        pressed = time.monotonic()
+        history.locator("#estop-banner").wait_for(state="visible", timeout=SHOWN_WITHIN_MS)
+        on_history = time.monotonic() - pressed
+        reason = httpx.get(f"{base}/api/v1/robot").json()["estop"]["reason"]
+        assert reason and history.inner_text("#estop-reason") == f"Reason: {reason}"
+        assert history.evaluate(EVENTS_STATE) == "live", "the stream brought it, not the fallback"
+        late = context.new_page()
+        opened = time.monotonic()
+        late.goto(f"{base}/")
+        late.locator("#estop-banner").wait_for(state="visible", timeout=SHOWN_WITHIN_MS)
+        on_opening = time.monotonic() - opened
+        assert late.inner_text("#estop-reason") == f"Reason: {reason}" and late.is_visible("#simulate")
+        loaded, shown = late.evaluate(LOADED_AT), late.evaluate("window.__bannerShownAt")
+        print(f"banner shown: {1000 * on_history:.0f} ms after the press on History; on a new panel "
+              f"{1000 * on_opening:.0f} ms after it started loading, {shown - loaded:.0f} ms after its "
+              f"scripts ran (DOMContentLoaded at {loaded:.0f} ms)")  # fmt: skip
+        _shot(history, "estop_on_history")
+        page.click("#estop-banner-reset")  # needs the token: the first panel has it
+        for panel in (history, late, page):
+            panel.locator("#estop-banner").wait_for(state="hidden", timeout=SHOWN_WITHIN_MS)
+        _until(page, f"{ROBOT_STATE} === 'disarmed'")
+        for panel in (history, late):
+            assert panel.evaluate("window.__csp_violations") == [], "the stream is allowed by the CSP"
+    finally:
+        context.close()
+
+
+def test_without_the_stream_a_panel_polls_and_tries_the_stream_again(page, service, robot):
+    """The stream refused (a 503, as past the bound): the panel looks at GET /robot every 2 s, so
+    the banner still comes; once the stream answers again, the panel follows it."""
+    base, _token = service
+    context = _other_browser(page)
+    refused = lambda route: route.fulfill(status=503, json={"detail": "too many robot event streams"})  # noqa: E731
+    try:
+        context.route("**/api/v1/robot/events", refused)
+        other = context.new_page()
+        other.goto(f"{base}/")
+        _events_are(other, "polling")
+        page.click("#estop")
+        other.locator("#estop-banner").wait_for(state="visible", timeout=SHOWN_WITHIN_MS)
+        assert other.evaluate(EVENTS_STATE) == "polling"
+        context.unroute("**/api/v1/robot/events", refused)
+        _events_are(other, "live")  # tried again (2 s, then 5 s, ... after each refusal)
+        page.click("#estop-banner-reset")
+        other.locator("#estop-banner").wait_for(state="hidden", timeout=SHOWN_WITHIN_MS)
+        _until(page, f"{ROBOT_STATE} === 'disarmed'")
+    finally:
+        context.close()
+
+
+def test_the_robot_tab_says_who_runs_the_robot_and_offers_stop(page, service, robot):
+    """A run started in one panel: another (no token) sees which run, since when and who started it;
+    its Stop asks for the token; the first panel's Stop ends the run, and the line goes on both."""
+    base, _token = service
+    context = _other_browser(page)
+    page.on("dialog", _accept)
+    try:
+        other = context.new_page()
+        other.goto(f"{base}/")
+        other.click("nav [data-tab=robot]")
+        assert other.is_hidden("#run-owner")
+        page.click("nav [data-tab=robot]")
+        page.fill("#robot-run-form input[name=jumps]", "200")
+        page.uncheck("#closed-loop")
+        page.click("#live-run")
+        other.locator("#run-owner").wait_for(state="visible", timeout=SHOWN_WITHIN_MS)
+        run = httpx.get(f"{base}/api/v1/robot").json()["run"]
+        since = other.evaluate("(t) => new Date(t * 1000).toLocaleTimeString()", run["started"])
+        said = other.inner_text("#run-owner-text")
+        assert said.startswith(f"Live run {run['id']} is running since {since}"), said
+        if run.get("started_by"):
+            assert said.endswith(f", started by {run['started_by']}."), said
+        _shot(other, "robot_run_owner")
+        other.click("#run-owner-stop")
+        other.locator(".message.error").wait_for(timeout=SHOWN_WITHIN_MS)
+        assert "needs the API token" in other.inner_text(".message.error")
+        assert httpx.get(f"{base}/api/v1/robot").json()["run"]["active"], "no token: the run goes on"
+        page.click("#run-owner-stop")
+        for panel in (page, other):
+            panel.locator("#run-owner").wait_for(state="hidden", timeout=SHOWN_WITHIN_MS * 3)
+        assert not httpx.get(f"{base}/api/v1/robot").json()["run"]["active"]
+        _until(page, f"{ROBOT_STATE} === 'disarmed'", timeout=15_000)
+    finally:
+        page.remove_listener("dialog", _accept)
+        context.close()
+
+
+def test_who_runs_the_robot_is_shown_as_text_with_or_without_a_name(page):
+    page.click("nav [data-tab=robot]")
+    page.evaluate("async () => (await import('/panel/robot.js')).closeLive()")  # only the statuses below
+    page.evaluate(STOP_EVENTS)
+    feed = "async (status) => (await import('/panel/robot.js')).showStatus(status)"
+    run = {"id": 7, "active": True, "started": 1.0e9, "touchdowns": 0, "jumps": 0, "max_seconds": 60.0}
+    since = page.evaluate("(t) => new Date(t * 1000).toLocaleTimeString()", run["started"])
+    try:
+        for started_by, said in (
+            (MARKUP_NOTE, f"Live run 7 is running since {since}, started by {MARKUP_NOTE}."),
+            (None, f"Live run 7 is running since {since}."),
+            ("absent", f"Live run 7 is running since {since}."),
+        ):
+            shown = run if started_by == "absent" else {**run, "started_by": started_by}
+            page.evaluate(feed, {"state": "running", "estop": {"latched": False, "reason": None}, "run": shown})
+            assert page.inner_text("#run-owner-text") == said
+        assert page.query_selector("#run-owner img") is None and page.evaluate("window.__xss") is None
+        page.evaluate(feed, {"state": "disarmed", "run": {**run, "active": False, "end_reason": "stopped"}})
+        assert page.is_hidden("#run-owner")
+    finally:
+        page.evaluate(FOLLOW_EVENTS)
+        page.click("nav [data-tab=simulate]")  # back to the service's own statuses on the next visit
 
 
 # Stored script stays text (issue 14) ---------------------------------------------------------
