@@ -169,14 +169,18 @@ class PtyRobot:
         time.sleep(2 * TICK)  # a read under way ends
         flags = fcntl.fcntl(self._slave, fcntl.F_GETFL)
         fcntl.fcntl(self._slave, fcntl.F_SETFL, flags | os.O_NONBLOCK)
-        filled, settled = 0, 0
-        while settled < JAM_SETTLE:  # the kernel moves buffered bytes on to the line discipline's buffer
-            before = filled
-            with contextlib.suppress(BlockingIOError):
-                while True:
-                    filled += os.write(self._slave, b"\0" * JAM_CHUNK)
-            settled = settled + 1 if filled == before else 0
-            time.sleep(0.01)
+        filled = 0
+        # Big chunks first, then ever smaller ones: the pty may refuse a chunk while it still has
+        # room for a frame, and then the PC's frames would go through.
+        for chunk in (JAM_CHUNK, 64, 1):
+            settled = 0
+            while settled < JAM_SETTLE:  # the kernel moves buffered bytes on to the line discipline's buffer
+                before = filled
+                with contextlib.suppress(BlockingIOError):
+                    while True:
+                        filled += os.write(self._slave, b"\0" * chunk)
+                settled = settled + 1 if filled == before else 0
+                time.sleep(0.01)
         return filled
 
     def unjam(self) -> None:

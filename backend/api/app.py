@@ -41,6 +41,7 @@ ROUTERS = (site, experiments, runs, calibrations, jobs, robot, view, sim)
 # pages/s, p95 199 ms (scripts/bench_load.py). Nothing a sync route does waits long: a request
 # that would (a simulation, a job's compute) awaits a worker instead.
 REQUEST_THREADS = 4
+LATCH_FILE = "estop-latch.json"  # in the data directory: a held e-stop survives a restart
 
 
 def create_app(
@@ -65,7 +66,7 @@ def create_app(
     owns_compute = compute is None
     compute = compute or Compute()
     runner = job_service.JobRunner(sessions, compute.jobs, dask_address=settings.dask_address)
-    robot_service = RobotService(sessions)
+    robot_service = RobotService(sessions, latch_path=settings.data_dir / LATCH_FILE)
 
     @contextlib.asynccontextmanager
     async def lifespan(app: FastAPI):

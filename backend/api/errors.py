@@ -20,7 +20,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 
 from backend.api import security
-from backend.robot.link import LinkError
+from backend.robot.link import EstopLatched, LinkError
 from backend.services import records
 from backend.services.compute import ComputeBusy, ComputeFailed, ComputeTimeout
 from backend.services.robot import RobotUnavailable
@@ -36,6 +36,7 @@ STATUS_OF: dict[type[Exception], tuple[int, str]] = {
     records.NotFound: (status.HTTP_404_NOT_FOUND, "{}"),
     records.Conflict: (status.HTTP_409_CONFLICT, "{}"),
     RobotUnavailable: (status.HTTP_409_CONFLICT, "{}"),
+    EstopLatched: (status.HTTP_409_CONFLICT, "{}"),  # before LinkError, its base: the latch is no outage
     LinkError: (status.HTTP_503_SERVICE_UNAVAILABLE, "robot link: {}"),
     FixedPointNotFound: (status.HTTP_422_UNPROCESSABLE_CONTENT, "{}"),
     ComputeBusy: (status.HTTP_503_SERVICE_UNAVAILABLE, "busy: {}"),

@@ -15,6 +15,11 @@ takes no lock that a command, a blocked write or a reconnect holds for longer th
 write, and gives up after its ``timeout`` with an honest :class:`EstopResult`; the heartbeat
 thread then sends that ESTOP instead of heartbeats until the robot acknowledges it.
 
+The e-stop latch is the service's (:class:`backend.robot.latch.EstopLatch`), handed to each link:
+it outlives a link that is lost, reconnected or replaced. While it holds, every connection sends
+the ESTOP first, in place of heartbeats, until the robot acknowledges it, and ARM and START are
+refused (:class:`EstopLatched`); only an acknowledged RESET releases it.
+
 Every Transmit Request carries a frame id (1..255), so the PC's radio answers each with a
 Transmit Status: delivered or not, after how many retries (``counters``). Those come from the
 local radio, not the robot: they are neither foreign frames nor a sign of the robot's life.
@@ -28,6 +33,7 @@ from collections.abc import Callable
 
 import serial
 
+from backend.robot.latch import EstopLatch
 from backend.robot.limits import ServoLimits
 from backend.robot.link_types import FROM_ROBOT, SAFE, EstopResult, LinkError, LinkState, Transition
 from backend.robot.messages import Ack, Command, Kind, Leg, ProtocolError, Result, SetLeg, Telemetry, decode, encode
@@ -44,13 +50,19 @@ from backend.robot.xbee import (
     tx_request,
 )
 
-HEARTBEAT_PERIOD = 0.2  # [s]
+# [s] between the PC's heartbeats: half the protocol's 0.2 s, so a late one (a loaded machine) still
+# keeps the rule; the robot's watchdog allows 1 s.
+HEARTBEAT_PERIOD = 0.1
 HEARTBEAT_TIMEOUT = 1.0  # [s]
 COMMAND_TIMEOUT = 0.5  # [s] for an acknowledgement
 WRITE_TIMEOUT = 0.1  # [s] the longest any write may block its caller (pyserial's write_timeout)
 ESTOP_TIMEOUT = 0.15  # [s] an e-stop's whole budget, blocked writes included: the API answers within 200 ms
 ESTOP_REPEAT = 0.02  # [s] between e-stop repeats until acknowledged
 READ_TIMEOUT = 0.02  # [s]
+
+
+class EstopLatched(LinkError):
+    """ARM or START while the e-stop latch holds: refused until a RESET is acknowledged."""
 
 
 class RobotLink:
@@ -62,6 +74,7 @@ class RobotLink:
         limits: ServoLimits | None = None,
         heartbeat_timeout: float = HEARTBEAT_TIMEOUT,
         robot_address: int = ROBOT_ADDRESS,
+        latch: EstopLatch | None = None,
     ):
         self.url = url
         self.baud = baud
@@ -90,19 +103,21 @@ class RobotLink:
         self._stop = threading.Event()
         self._threads: list[threading.Thread] = []
         self.send_heartbeats = True  # tests turn this off to starve the robot
-        # An unacknowledged e-stop stops the heartbeats, so the robot's own watchdog disarms it
-        # even if the line is only lossy; a reset or a new connection resumes them.
-        self._starved = False
-        # That e-stop, which the heartbeat thread repeats until it is acknowledged (None: none).
+        self.latch = latch or EstopLatch()  # the service's: it outlives this link
+        # The latched ESTOP that the heartbeat thread sends in place of heartbeats until the robot
+        # acknowledges it (None: none), so the robot's own watchdog disarms it even on a lossy line.
         self._pending_estop: Command | None = None
 
     # Connection -----------------------------------------------------------------------------
     def connect(self, timeout: float = 3.0) -> LinkState:
-        """Open the port and wait for the robot's first telemetry."""
+        """Open the port and wait for the robot's first telemetry. A held e-stop latch is sent
+        first, in place of heartbeats, until the robot acknowledges it on this connection."""
         self.telemetry = None
         self.parser = FrameParser()
         self._forget_estop()
-        self._starved = False
+        if self.latch.held:
+            self.latch.unconfirmed()  # the robot may have restarted, or never heard it
+            self._pending_estop = Command(self._next_seq(), Kind.ESTOP)
         try:
             check_port(self.url)
             self._port = serial.serial_for_url(
@@ -147,12 +162,12 @@ class RobotLink:
 
     # Commands -------------------------------------------------------------------------------
     def arm(self) -> None:
-        self._refuse_if_starved("arm")
+        self._refuse_if_latched("arm")
         self._command(Command(self._next_seq(), Kind.ARM), expect=LinkState.ARMED)
 
     def start(self) -> None:
         """Armed robot: launch and keep jumping with the legs' current controls."""
-        self._refuse_if_starved("start")
+        self._refuse_if_latched("start")
         self._command(Command(self._next_seq(), Kind.START), expect=LinkState.RUNNING)
 
     def disarm(self) -> None:
@@ -182,8 +197,9 @@ class RobotLink:
         return FROM_ROBOT[self.telemetry.state]
 
     def reset(self) -> None:
-        """Clear an e-stop (to disarmed). Repeats of an unacknowledged ESTOP stop before the RESET
-        is sent (none may follow it), and resume if the RESET is not confirmed."""
+        """Clear an e-stop (to disarmed) and release the latch once the robot confirms it. Repeats of
+        an unacknowledged ESTOP stop before the RESET is sent (none may follow it), and resume if the
+        RESET is not confirmed."""
         with self._write_lock:  # not between the heartbeat thread's pick of a repeat and its write
             pending = self._forget_estop()
         try:
@@ -193,12 +209,7 @@ class RobotLink:
                 if self._pending_estop is None:
                     self._pending_estop = pending
             raise
-        self._starved = False
-
-    @property
-    def estop_latched(self) -> bool:
-        """An e-stop was not acknowledged: heartbeats are stopped and arm/start refused until a reset."""
-        return self._starved
+        self.latch.release()
 
     def set_leg(self, leg: Leg, psi0_deg: float, zeta0: float) -> None:
         """Send a leg's controls for its next touchdown; outside the servo limits, refuse to send."""
@@ -212,7 +223,7 @@ class RobotLink:
         raises: a blocked or closed port only ends the attempt sooner. Not acknowledged, the
         heartbeats stop, so the robot's own watchdog disarms it within its heartbeat timeout, and
         the heartbeat thread repeats this ESTOP every HEARTBEAT_PERIOD until it is acknowledged
-        (then the link is e-stopped), a reset, or a new connection."""
+        (then the link is e-stopped) or a reset. Either way the latch holds until a reset."""
         started = time.monotonic()
         deadline = started + timeout
         write_by = deadline - WRITE_TIMEOUT  # a write started by then ends, even blocked, by the deadline
@@ -220,7 +231,7 @@ class RobotLink:
         event, _box = self._expect(message.seq)
         reason = None
         self._forget_estop()  # this e-stop supersedes one still repeated in the background
-        self._starved = True  # the line is the e-stop's; heartbeats resume only if acknowledged
+        self.latch.engage()  # the line is the e-stop's; heartbeats resume only once acknowledged
         tries = 0
         try:
             while not event.is_set() and time.monotonic() < deadline:
@@ -239,7 +250,7 @@ class RobotLink:
             self._acks.pop(message.seq, None)
         latency = time.monotonic() - started
         if event.is_set():
-            self._starved = False
+            self.latch.acknowledged()
             self._move(LinkState.ESTOPPED, "e-stop acknowledged")
             return EstopResult(True, latency)
         self.estops_unacknowledged += 1
@@ -277,10 +288,11 @@ class RobotLink:
         }
 
     # Internals ------------------------------------------------------------------------------
-    def _refuse_if_starved(self, name: str) -> None:
-        # As the firmware latches an e-stop, the link latches one it could not confirm.
-        if self._starved:
-            raise LinkError(f"an e-stop was not acknowledged; reset before you {name}")
+    def _refuse_if_latched(self, name: str) -> None:
+        # As the firmware latches an e-stop, the PC latches it too: a robot that restarted, or never
+        # heard the ESTOP, would otherwise arm.
+        if self.latch.held:
+            raise EstopLatched(f"the e-stop latch holds ({self.latch.state.reason()}); reset before you {name}")
 
     def _command(self, message, expect: LinkState | None = None) -> Ack:
         """Send, wait for the acknowledgement, and (``expect``) for the telemetry showing its effect."""
@@ -387,12 +399,18 @@ class RobotLink:
         # An unacknowledged ESTOP goes instead of the heartbeat, so a line that clears still
         # delivers the stop. Any frame feeds the firmware's watchdog, ESTOP too; that keeps no
         # robot going: ESTOP latches it e-stopped, which only RESET leaves.
-        while not self._stop.wait(HEARTBEAT_PERIOD):
+        # Each is due a period after the previous one was due, not after it was written: a late
+        # wake-up shortens the next wait instead of pushing every later heartbeat back.
+        due = time.monotonic()
+        while not self._stop.wait(max(0.0, due - time.monotonic())):
+            due += HEARTBEAT_PERIOD
+            if due <= time.monotonic():  # more than a period late: start the cadence afresh
+                due = time.monotonic() + HEARTBEAT_PERIOD
             with self._write_lock:  # picked and written at once: reset() forgets the repeat under it
                 message = self._pending_estop
                 if message is not None:
                     self.estop_repeats += 1
-                elif self.send_heartbeats and not self._starved:
+                elif self.send_heartbeats and not self.latch.state.pending:
                     message = Command(self._next_seq(), Kind.HEARTBEAT)
                 else:
                     continue
@@ -415,7 +433,7 @@ class RobotLink:
             if self._pending_estop is None or self._pending_estop.seq != seq:
                 return  # reset, superseded or reconnected meanwhile
             self._pending_estop = None
-            self._starved = False
+        self.latch.acknowledged()
         self._move(LinkState.ESTOPPED, "e-stop acknowledged (repeated)")
 
     def _lost(self, reason: str) -> None:

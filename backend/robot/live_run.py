@@ -63,6 +63,7 @@ class RunSnapshot:
     commands: int = 0  # sent so far
     end_reason: str | None = None
     disarm: str | None = None  # how the ending left the robot: "disarmed", "estopped" or why unconfirmed
+    started_by: str | None = None  # who started it, as other panels are told
 
     def command_for(self, leg: Leg) -> LegControl | None:
         return dict(self.commanded).get(leg)
@@ -72,6 +73,7 @@ class RunSnapshot:
             "id": self.run_id,
             "active": self.active,
             "started": self.started,
+            "started_by": self.started_by,
             "touchdowns": len(self.touchdowns),
             "jumps": self.jumps,
             "max_seconds": self.max_seconds,
@@ -94,6 +96,7 @@ class LiveRun:
     run_id: int | None = None
     started: float = field(default_factory=time.time)
     first_pose: int = 0  # the tracker's index of the run's first frame
+    started_by: str | None = None  # who started it (the operator's name, or the client's address)
     touchdowns: list[Touchdown] = field(default_factory=list)
     touchdown_controls: list[LegControl] = field(default_factory=list)
     commanded: dict[Leg, LegControl] = field(default_factory=dict)
@@ -107,7 +110,9 @@ class LiveRun:
     _stop_requests: queue.SimpleQueue[str] = field(default_factory=queue.SimpleQueue)
 
     def __post_init__(self) -> None:
-        self.snapshot = RunSnapshot(self.run_id, self.started, self.jumps, self.max_seconds, self.target_m)
+        self.snapshot = RunSnapshot(
+            self.run_id, self.started, self.jumps, self.max_seconds, self.target_m, started_by=self.started_by
+        )
 
     def stop(self, reason: str = "stopped") -> None:
         """Any thread: ask the loop to end; it sends nothing more once it has seen this (the first

@@ -12,6 +12,9 @@ robot's first telemetry, plus closing what is left), and requests that arrive du
 to end. Nobody else may call the link's ``connect``, ``reconnect`` or ``close``; reading the link and
 sending it commands (arm, set_leg, the e-stop) needs no request: those are the link's own, bounded.
 
+A connect by hand that fails never drops a working link: one on another port stays open until the
+new link answers; one on the same port (which two links cannot share) gives way and is reopened.
+
 Every ending the supervisor sees disarms: before it closes a live link (a disconnect, a connect to
 another, shutdown), and when a lost link comes back, it sends DISARM and waits for telemetry to
 confirm it (:meth:`RobotLink.make_safe`), whatever the link believed the robot's state to be.
@@ -22,6 +25,7 @@ from __future__ import annotations
 import concurrent.futures
 import functools
 import logging
+import os
 import queue
 import threading
 import time
@@ -152,15 +156,7 @@ class LinkSupervisor:
 
     def _handle(self, request: Request | None) -> None:
         if isinstance(request, Connect):
-            self._close_link()
-            request.link.on_lost.append(functools.partial(self.lost, request.link))
-            try:
-                state = request.link.connect(request.timeout)
-            except LinkError as error:
-                request.answer.set_exception(error)
-                return
-            self.link, self._wanted, self._next_try = request.link, True, 0.0
-            request.answer.set_result(state)
+            self._connect(request)
         elif isinstance(request, Disconnect):
             self._close_link()
             request.answer.set_result(None)
@@ -170,6 +166,28 @@ class LinkSupervisor:
         # since, or queued before a reconnect that worked, changes nothing.
         if self._should_retry() and time.monotonic() >= self._next_try:
             self._retry()
+
+    def _connect(self, request: Connect) -> None:
+        """Open ``request.link`` in place of the current link. A connect that fails leaves the
+        current link as it was: on another port it is closed only once the new one answers; on the
+        same port (one reader per port) it gives way first and, if the new one fails, is reopened
+        at once by the retry that follows, as a lost link would be."""
+        old, wanted = self.link, self._wanted
+        shares_port = old is not None and same_port(old.url, request.link.url)
+        if shares_port:
+            self._close_link()
+        request.link.on_lost.append(functools.partial(self.lost, request.link))
+        try:
+            state = request.link.connect(request.timeout)
+        except LinkError as error:
+            if shares_port and wanted:
+                self.link, self._wanted, self._next_try = old, True, 0.0
+            request.answer.set_exception(error)
+            return
+        if not shares_port:
+            self._close_link()
+        self.link, self._wanted, self._next_try = request.link, True, 0.0
+        request.answer.set_result(state)
 
     def _should_retry(self) -> bool:
         return self._wanted and self.link is not None and self.link.state == LinkState.DISCONNECTED
@@ -197,6 +215,14 @@ class LinkSupervisor:
                 _make_safe(link, "closing the link")  # disconnect, another connect, shutdown
             link.close()
             self.link = None
+
+
+def same_port(url: str, other: str) -> bool:
+    """Whether two link URLs open the same port (a device's symlinks, such as /dev/serial/by-id/…,
+    resolved): two links on one port would each read part of the other's frames."""
+    if "://" in url or "://" in other:
+        return url == other
+    return os.path.realpath(url) == os.path.realpath(other)
 
 
 def _make_safe(link: RobotLink, why: str) -> None:

@@ -105,3 +105,7 @@ class RobotRunCreate(Strict):
     max_seconds: Annotated[float, Field(gt=0.0, le=3600.0)] = 60.0
     closed_loop: ClosedLoopIn | None = None
     tags: Tags = []
+    operator: Annotated[
+        str | None,
+        Field(min_length=1, max_length=80, description="who runs it, as every panel is told (default: the client)"),
+    ] = None

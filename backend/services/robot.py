@@ -14,8 +14,12 @@ from __future__ import annotations
 
 import asyncio
 import concurrent.futures
+import errno
+import logging
 import threading
+from pathlib import Path
 
+from backend.robot.latch import EstopLatch
 from backend.robot.limits import ServoLimits
 from backend.robot.link import EstopResult, LinkError, LinkState, RobotLink
 from backend.robot.live_run import LiveRun, RunSnapshot, execute, telemetry_dict
@@ -29,8 +33,10 @@ from backend.services.robot_journal import JournalWriter
 from backend.services.robot_records import open_robot_run, recover_interrupted
 from experiments.manifest import json_safe
 from sim_core.controls import LegControl
+from sim_core.errors import ParameterError
 from sim_core.presets import get_preset
 
+log = logging.getLogger("parkourlab.robot")
 ESTOP_ANSWER = 0.17  # [s] the longest an e-stop request waits for its answer (the link gives up at 0.15 s)
 STOP_WAIT = 10.0  # [s] the longest a stop or a disconnect waits for the run to end and be stored
 
@@ -40,11 +46,16 @@ class RobotUnavailable(RuntimeError):
 
 
 class RobotService:
-    def __init__(self, sessions, robot=None):
+    """``latch_path``: where the e-stop latch is kept (the data directory's ``estop-latch.json`` in
+    the service), so a restart finds it held; None keeps it in memory."""
+
+    def __init__(self, sessions, robot=None, *, latch_path: Path | None = None):
         self.sessions = sessions
         self.robot = robot or get_preset("paper")  # the robot's physical parameters
         self.supervisor = LinkSupervisor()  # the link's one owner (backend/robot/supervisor.py)
+        self.latch = EstopLatch(latch_path)  # outlives every link: held until a RESET is acknowledged
         self.tracker: UdpPoseSource | NatNetPoseSource | None = None
+        self._tracker_request: RobotConnect | None = None  # what the tracker was opened with
         self._run: LiveRun | None = None  # the latest live run (its loop's); read its snapshot
         self._lock = threading.Lock()  # connect, disconnect and starting a run, one at a time
         # The e-stop's own thread: not the request pool that compute can fill, and no lock that a
@@ -68,41 +79,89 @@ class RobotService:
         return recover_interrupted(self.sessions, self.robot)
 
     def connect(self, body: RobotConnect) -> dict:
+        """Open the link and tracker ``body`` names in place of the current ones. Refused while a
+        live run goes on (409 naming it); one that fails leaves the working link and tracker as
+        they were (the supervisor keeps a link on another port open until the new one answers)."""
         with self._lock:
-            self._disconnect()
+            self._refuse_during_run("connect")
             limits = ServoLimits(tuple(body.psi0_limits_deg), tuple(body.zeta0_limits))
-            calibration = Calibration(tuple(body.calibration_origin), body.calibration_angle, body.calibration_scale)
-            self.tracker = open_tracker(body, calibration)
-            link = RobotLink(body.url, baud=body.baud, limits=limits, robot_address=int(body.robot_address, 16))
+            tracker = self._replace_tracker(body)
+            link = RobotLink(
+                body.url, baud=body.baud, limits=limits, robot_address=int(body.robot_address, 16), latch=self.latch
+            )
             try:
                 self.supervisor.connect(link)
             except LinkError:
-                self.tracker.close()
-                self.tracker = None
+                tracker.close()
+                if self.tracker is None:
+                    self._restore_tracker()  # it gave way to this one's port
                 raise
+            if self.tracker is not None:
+                self.tracker.close()
+            self.tracker, self._tracker_request = tracker, body
         return self.status()
 
     def disconnect(self) -> dict:
+        """Close the link (no more reconnects) and the tracker; refused while a live run goes on."""
         with self._lock:
+            self._refuse_during_run("disconnect")
             self._disconnect()
         return self.status()
 
     def close(self) -> None:
-        """Service shutdown: disconnect, end the link's supervisor, and let the e-stop thread go."""
-        self.disconnect()
+        """Service shutdown: end a live run, close the link, end its supervisor, let the e-stop thread go."""
+        with self._lock:
+            run = self._run
+            if run is not None and not run.done.is_set():
+                run.stop("service shutdown")
+                run.done.wait(STOP_WAIT)
+            self._disconnect()
         self.supervisor.close()
         self._estop_executor.shutdown(wait=False)
 
     def _disconnect(self) -> None:
-        """End a live run, close the link (no more reconnects) and the tracker."""
-        run = self._run
-        if run is not None and not run.done.is_set():
-            run.stop("disconnected")
-            run.done.wait(STOP_WAIT)
+        """Close the link (no more reconnects) and the tracker."""
         self.supervisor.disconnect()
         if self.tracker is not None:
             self.tracker.close()
             self.tracker = None
+        self._tracker_request = None
+
+    def _refuse_during_run(self, what: str) -> None:
+        """One operator per run: a link change while a live run goes on is a 409 naming the run (the
+        e-stop, a disarm and stopping the run stay allowed)."""
+        run = self.run_snapshot()
+        if run is not None and run.active:
+            who = f" by {run.started_by}" if run.started_by else ""
+            raise RobotUnavailable(f"live run {run.run_id} (started{who}) is in progress: stop it before you {what}")
+
+    def _replace_tracker(self, body: RobotConnect) -> UdpPoseSource | NatNetPoseSource:
+        """The tracker ``body`` asks for, opened beside the current one; if its port is taken, the
+        current one gives way (it may hold that port) and is closed. A port another program holds
+        is a 409 naming it; an address this machine cannot bind, a 422 naming the field."""
+        try:
+            return open_tracker(body)
+        except OSError as error:
+            if error.errno != errno.EADDRINUSE or self.tracker is None:
+                raise _tracker_error(body, error) from None
+        self.tracker.close()
+        self.tracker = None
+        try:
+            return open_tracker(body)
+        except OSError as error:
+            self._restore_tracker()
+            raise _tracker_error(body, error) from None
+
+    def _restore_tracker(self) -> None:
+        """Open the tracker the working link had again, after it gave way to a connect that failed."""
+        if self._tracker_request is None:
+            return
+        try:
+            self.tracker = open_tracker(self._tracker_request)
+        except OSError as error:
+            log.error("could not reopen the tracker at %s:%s: %s", self._tracker_request.tracker_host,
+                      self._tracker_request.tracker_port, error)  # fmt: skip
+            self._tracker_request = None
 
     def status(self) -> dict:
         """The robot as it is now, from immutable parts only (cheap: the live view sends it 20 times
@@ -115,7 +174,7 @@ class RobotService:
                 "url": None if link is None else link.url,
                 "robot_address": None if link is None else f"0x{link.robot_address:016X}",
                 "counters": None if link is None else {**link.counters(), "reconnects": self.supervisor.reconnects},
-                "estop": _estop_latch(link),
+                "estop": _estop_latch(self.latch, link),
                 "last_delivery_failure": None if link is None else link.last_delivery_failure,
                 "telemetry": None if link is None or link.telemetry is None else telemetry_dict(link.telemetry),
                 "tracker": None
@@ -151,6 +210,7 @@ class RobotService:
         return self.link
 
     def arm(self) -> dict:
+        self._refuse_during_run("arm")
         self._connected().arm()
         return self.status()
 
@@ -159,6 +219,7 @@ class RobotService:
         return self.status()
 
     def reset(self) -> dict:
+        self._refuse_during_run("reset")
         self._connected().reset()
         return self.status()
 
@@ -194,12 +255,14 @@ class RobotService:
         return {"acknowledged": False, "latency_ms": ESTOP_ANSWER * 1000.0, "reason": reason, **self.status()}
 
     # Live runs -------------------------------------------------------------------------------
-    def start_run(self, body: RobotRunCreate) -> RunSnapshot:
-        """Store the run (status running), then start its control loop and journal writer."""
+    def start_run(self, body: RobotRunCreate, started_by: str | None = None) -> RunSnapshot:
+        """Store the run (status running), then start its control loop and journal writer.
+        ``started_by``: who asked, as other panels are told (the operator's name or the client)."""
         link = self._connected()
         with self._lock:
-            if self._run is not None and not self._run.done.is_set():
-                raise RobotUnavailable("a live run is in progress; stop it first")
+            self._refuse_during_run("start another")
+            if self.latch.held:
+                raise RobotUnavailable(f"the e-stop latch holds ({self.latch.state.reason()}): reset before you start")
             if link.state not in (LinkState.DISARMED, LinkState.ARMED):
                 raise RobotUnavailable(f"the robot is {link.state.value}; it must be disarmed or armed to start")
             legs = [LegControl.from_degrees(leg.psi0_deg, leg.zeta0) for leg in body.controls]
@@ -208,9 +271,11 @@ class RobotService:
             tracker = self.tracker
             controller = self._controller(body, legs)
             with self.sessions() as session:
-                run_id = open_robot_run(session, body, self.robot, tracker.calibration)
+                run_id = open_robot_run(session, body, self.robot, tracker.calibration, started_by=started_by)
             target_m = None if body.closed_loop is None else body.closed_loop.target_m
-            run = LiveRun(body.jumps, body.max_seconds, target_m, run_id=run_id, first_pose=tracker.count())
+            run = LiveRun(
+                body.jumps, body.max_seconds, target_m, run_id=run_id, first_pose=tracker.count(), started_by=started_by
+            )
             journal = JournalWriter(self.sessions, run, tracker, link, self.robot).start()
             self._run = run
         threading.Thread(target=execute, args=(run, link, tracker, self.robot, legs, controller, journal.finish),
@@ -245,8 +310,10 @@ class RobotService:
         return loop.target_m, (hover, loop.kp, loop.ki, loop.kd, loop.zeta0_min, loop.zeta0_max)
 
 
-def open_tracker(body: RobotConnect, calibration: Calibration) -> UdpPoseSource | NatNetPoseSource:
-    """The pose source ``body`` asks for: PKT1 datagrams, or the NatNet stream's rigid body."""
+def open_tracker(body: RobotConnect) -> UdpPoseSource | NatNetPoseSource:
+    """The pose source ``body`` asks for: PKT1 datagrams, or the NatNet stream's rigid body, with
+    its camera calibration. Raises OSError if its socket cannot be bound."""
+    calibration = Calibration(tuple(body.calibration_origin), body.calibration_angle, body.calibration_scale)
     if body.tracker_protocol == "pkt1":
         return UdpPoseSource(body.tracker_host, body.tracker_port, calibration=calibration)
     return NatNetPoseSource(
@@ -260,14 +327,22 @@ def open_tracker(body: RobotConnect, calibration: Calibration) -> UdpPoseSource 
     )
 
 
-def _estop_latch(link: RobotLink | None) -> dict:
-    """Whether an e-stop holds the robot until a reset: acknowledged (the robot reports estopped),
-    or not acknowledged (the link has stopped its heartbeats and refuses to arm or start)."""
-    if link is None:
-        return {"latched": False, "reason": None}
-    if link.state == LinkState.ESTOPPED:
-        return {"latched": True, "reason": "the robot acknowledged an emergency stop"}
-    if link.estop_latched:
-        return {"latched": True, "reason": "an emergency stop was not acknowledged: heartbeats stopped, the "
-                                           "robot's watchdog disarms it"}  # fmt: skip
-    return {"latched": False, "reason": None}
+def _tracker_error(body: RobotConnect, error: OSError) -> Exception:
+    """A tracker socket that could not be bound, in the operator's terms."""
+    where = f"{body.tracker_host}:{body.tracker_port}"
+    if error.errno == errno.EADDRINUSE:
+        return RobotUnavailable(f"tracker_port {body.tracker_port}: {where} is in use by another program")
+    if error.errno in (errno.EACCES, errno.EPERM):
+        return ParameterError("tracker_port", f"this service may not bind {where} ({error.strerror})")
+    return ParameterError("tracker_host", f"cannot listen on {where}: {error.strerror or error}")
+
+
+def _estop_latch(latch: EstopLatch, link: RobotLink | None) -> dict:
+    """The e-stop latch for the status: held until a RESET is acknowledged (``acknowledged``: the
+    robot has confirmed the ESTOP on this connection; until then it goes in place of heartbeats).
+    A robot that reports itself e-stopped is latched on its side whatever the PC's latch says."""
+    state = latch.state
+    if not state.held and link is not None and link.state == LinkState.ESTOPPED:
+        return {"latched": True, "acknowledged": True, "since": None,
+                "reason": "the robot reports itself e-stopped; it holds until a reset"}  # fmt: skip
+    return {"latched": state.held, "acknowledged": state.acknowledged, "since": state.since, "reason": state.reason()}

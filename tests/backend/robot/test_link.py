@@ -7,7 +7,7 @@ import time
 import pytest
 
 from backend.robot.firmware import Firmware
-from backend.robot.link import HEARTBEAT_PERIOD, WRITE_TIMEOUT, LinkError, LinkState, RobotLink
+from backend.robot.link import HEARTBEAT_PERIOD, WRITE_TIMEOUT, EstopLatched, LinkError, LinkState, RobotLink
 from backend.robot.messages import Fault, Kind, Leg, RobotState
 from backend.robot.virtual import VirtualRobot
 from sim_core import ParameterError
@@ -64,10 +64,11 @@ def test_estop_latches_until_reset_and_is_fast(robot, link):
     result = link.estop()
     assert result.acknowledged and result.reason is None
     assert link.state == LinkState.ESTOPPED and robot.firmware.state.name == "ESTOPPED"
-    with pytest.raises(LinkError, match="refused"):
+    with pytest.raises(EstopLatched, match="reset before you arm"):
         link.arm()
     link.reset()
     _wait_for(lambda: link.state == LinkState.DISARMED)
+    assert not link.latch.held, "an acknowledged RESET releases the latch"
 
 
 def test_robot_disarms_when_heartbeats_stop(robot):
@@ -213,8 +214,8 @@ def test_a_lost_estop_gets_through_when_the_air_clears(lossy):
     counters = link.counters()
     assert counters["estops_unacknowledged"] == 1 and counters["retries"] >= 2
     assert counters["delivery_failures"] >= 2 and link.last_delivery_failure == "network ACK failure (0x21)"
-    with pytest.raises(LinkError, match="refused"):
-        link.arm()  # the robot's own latch now, no longer the link's
+    with pytest.raises(EstopLatched, match="the robot acknowledged it"):
+        link.arm()  # the robot's latch now, and the PC's until a reset
     link.reset()
     assert link.state == LinkState.DISARMED
 
@@ -252,15 +253,21 @@ def test_a_failed_reset_keeps_repeating_the_estop(lossy):
     assert rig.state == RobotState.ESTOPPED
 
 
-def test_a_new_connection_ends_the_repeats(lossy):
+def test_a_new_connection_sends_the_latched_estop_first(lossy):
     rig, link = lossy
     link.close()
     link.connect()
-    before = len(rig.heard)
+    before, heard_before = len(rig.sent), len(rig.heard)
+    time.sleep(3 * HEARTBEAT_PERIOD)
+    assert set(_kinds(rig.sent[before:])) == {Kind.ESTOP}, "still lost on the air: the ESTOP, never a heartbeat"
+    with pytest.raises(EstopLatched):
+        link.arm()
     rig.delivery_status = 0x00
-    _wait_for(lambda: _kinds(rig.heard[before:]).count(Kind.HEARTBEAT) >= 2)  # sent only if no e-stop pends
-    assert Kind.ESTOP not in _kinds(rig.heard)
-    assert rig.state == RobotState.ARMED and link.state == LinkState.ARMED
+    _wait_for(lambda: link.state == LinkState.ESTOPPED)
+    heard = _kinds(rig.heard[heard_before:])
+    assert heard[0] == Kind.ESTOP and Kind.HEARTBEAT not in heard[: heard.index(Kind.ESTOP)]
+    _wait_for(lambda: _kinds(rig.heard).count(Kind.HEARTBEAT) >= 2)  # acknowledged: heartbeats resume
+    assert rig.state == RobotState.ESTOPPED and link.latch.held and link.latch.state.acknowledged
 
 
 def test_every_frame_has_a_nonzero_frame_id_in_sequence(answering):

@@ -437,14 +437,15 @@ def test_connect_opens_the_tracker_it_names():
         natnet_version="2.5",
         natnet_rigid_body_id=4,
         natnet_server_host="127.0.0.1",
+        calibration_scale=0.001,
     )
-    tracker = open_tracker(body, Calibration(scale=0.001))
+    tracker = open_tracker(body)
     try:
         assert isinstance(tracker, NatNetPoseSource) and tracker.version == "2.5" and tracker.rigid_body_id == 4
         assert tracker.multicast_group is None and tracker.server == ("127.0.0.1", 1510)
         assert tracker.calibration.scale == 0.001
     finally:
         tracker.close()
-    pkt1 = open_tracker(RobotConnect(url="loop://", tracker_port=0), Calibration())
+    pkt1 = open_tracker(RobotConnect(url="loop://", tracker_port=0))
     pkt1.close()
     assert isinstance(pkt1, UdpPoseSource)

@@ -1,0 +1,52 @@
+"""The e-stop latch: held from the press until a RESET is acknowledged, kept across restarts."""
+
+import json
+
+from backend.robot.latch import EstopLatch, LatchState
+
+
+def test_a_press_holds_until_released_whatever_the_connections_do():
+    latch = EstopLatch()
+    assert latch.state == LatchState() and not latch.held
+    latch.engage()
+    assert latch.state.pending and latch.state.since is not None
+    latch.acknowledged()
+    assert latch.held and not latch.state.pending, "acknowledged: held, no longer sent"
+    latch.unconfirmed()  # a new connection: the robot must confirm it again
+    assert latch.state.pending
+    latch.release()
+    assert latch.state == LatchState()
+
+
+def test_acknowledging_or_reconnecting_a_released_latch_changes_nothing():
+    latch = EstopLatch()
+    latch.acknowledged()
+    latch.unconfirmed()
+    assert latch.state == LatchState()
+
+
+def test_a_held_latch_survives_a_restart_and_a_release_too(tmp_path):
+    path = tmp_path / "estop-latch.json"
+    EstopLatch(path).engage()
+    restarted = EstopLatch(path)
+    assert restarted.held and restarted.state.pending, "a restart finds it held, to be confirmed by the robot"
+    restarted.release()
+    assert not EstopLatch(path).held
+    assert not (tmp_path / "estop-latch.json.tmp").exists(), "written whole, then renamed"
+
+
+def test_a_latch_file_that_cannot_be_read_holds(tmp_path):
+    path = tmp_path / "estop-latch.json"
+    for text in ("{", json.dumps({"held": "no"}), json.dumps([1]), json.dumps({"since": 3.0})):
+        path.write_text(text)
+        latch = EstopLatch(path)
+        assert latch.held and "until a reset" in latch.state.reason(), text
+
+
+def test_the_reason_says_whether_the_robot_confirmed_it():
+    latch = EstopLatch()
+    assert latch.state.reason() is None
+    latch.engage()
+    assert "not yet acknowledged" in latch.state.reason()
+    latch.acknowledged()
+    assert "the robot acknowledged it" in latch.state.reason()
