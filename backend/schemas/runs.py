@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import datetime
 import enum
-from typing import Annotated
+from typing import Annotated, Literal
 
 from pydantic import BaseModel, Field, model_validator
 
@@ -138,7 +138,10 @@ class RunAggregate(BaseModel):
 
 
 class RunTrajectory(BaseModel):
-    """A run's sampled path, column by column (time, phase, x, y, xdot, ydot …)."""
+    """A run's sampled path, column by column. A simulated run's (time, x, y, foot_x, foot_y, psi,
+    zeta, phase, jump) is ``nondimensional``; a robot or replay run's is the tracker's frames
+    (time, x, y, pitch) in ``SI`` units. ``column_units`` names each column's unit."""
 
-    units: str
+    units: Literal["nondimensional", "SI"]
+    column_units: dict[str, str]
     columns: dict[str, list[float | int]]

@@ -185,7 +185,11 @@ class RobotService:
                     "dropped": tracker.stats.dropped,
                     "malformed": tracker.stats.malformed,
                     "ignored": tracker.stats.ignored,
+                    "restarts": tracker.stats.restarts,
                     "loss": tracker.stats.loss,
+                    "protocol": tracker.protocol,
+                    "version": tracker.version,
+                    "error": tracker.error,
                     "latest": None if pose is None else vars(pose),
                 },
                 "run": None if run is None else run.to_status(),
@@ -271,7 +275,10 @@ class RobotService:
             tracker = self.tracker
             controller = self._controller(body, legs)
             with self.sessions() as session:
-                run_id = open_robot_run(session, body, self.robot, tracker.calibration, started_by=started_by)
+                where = {"url": link.url, "robot_address": f"0x{link.robot_address:016X}"}
+                run_id = open_robot_run(
+                    session, body, self.robot, tracker.calibration, started_by=started_by, link=where
+                )
             target_m = None if body.closed_loop is None else body.closed_loop.target_m
             run = LiveRun(
                 body.jumps, body.max_seconds, target_m, run_id=run_id, first_pose=tracker.count(), started_by=started_by

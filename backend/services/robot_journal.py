@@ -14,6 +14,7 @@ from __future__ import annotations
 import logging
 import threading
 import time
+from dataclasses import asdict
 
 from sqlalchemy.exc import SQLAlchemyError
 
@@ -43,6 +44,7 @@ class JournalWriter:
         self.entries = 0  # written so far
         self.failures = 0  # writes that failed (their data went out with a later entry)
         self._next_pose = run.first_pose
+        self._tracker_at_start = tracker.stats.snapshot()  # the run's figures are the counts since
         self._transitions_seen = len(link.transitions)
         self._unwritten: list[dict] = []  # entries a failed write left, oldest first (this thread's)
         self._finished = threading.Event()
@@ -80,7 +82,7 @@ class JournalWriter:
         self._next_pose += len(poses)
         transitions = self.link.transitions[self._transitions_seen :]
         self._transitions_seen += len(transitions)
-        stats = self.tracker.stats
+        counts = self.tracker.stats.snapshot().since(self._tracker_at_start)
         return json_safe(
             {
                 "frames": {name: [getattr(pose, name) for pose in poses] for name in FRAME_COLUMNS},
@@ -88,7 +90,13 @@ class JournalWriter:
                 "commands": [r.value for r in records if r.kind == "command"],
                 "telemetry": [r.value for r in records if r.kind == "telemetry"],
                 "transitions": [transition.to_dict() for transition in transitions],
-                "tracker": {"dropped": stats.dropped, "loss": stats.loss},
+                "tracker": {
+                    **asdict(counts),
+                    "loss": counts.loss,
+                    "protocol": self.tracker.protocol,
+                    "version": self.tracker.version,  # NatNet's is known once the server answers
+                    "address": list(self.tracker.address),
+                },
             }
         )
 

@@ -35,10 +35,12 @@ FRAME_COLUMNS = ("time", "x", "y", "pitch")
 INTERRUPTED = "interrupted: the service stopped during the run; kept to its last journal entry"
 
 
-def open_robot_run(session, request, robot, calibration, *, started_by: str | None = None) -> int:
+def open_robot_run(
+    session, request, robot, calibration, *, started_by: str | None = None, link: dict | None = None
+) -> int:
     """Store a live run as it starts (status ``running``); returns its id. ``request`` is the
     :class:`~backend.schemas.RobotRunCreate`, ``robot`` the physical parameters, ``started_by`` who
-    started it."""
+    started it, ``link`` the radio link it runs on (``url``, ``robot_address``)."""
     model = robot.to_model()
     if request.experiment_id is not None:  # before anything moves: a 404, and the robot stays as it is
         locked(session, Experiment, request.experiment_id, "experiment")
@@ -54,6 +56,7 @@ def open_robot_run(session, request, robot, calibration, *, started_by: str | No
             {
                 "end_reason": None,
                 "started_by": started_by,
+                "link": link,
                 "calibration": asdict(calibration),
                 "closed_loop": None if request.closed_loop is None else request.closed_loop.model_dump(),
             }

@@ -115,13 +115,21 @@ async def get_trajectory(run_id: RecordId, db: Db) -> Response:
     return Response(await db(trajectory_json, run_id), media_type="application/json")
 
 
+# A simulated run's path is nondimensional (docs/model.md §1); a robot or replay run's is the tracker's frames.
+SIMULATED_UNITS = {"time": "sqrt(l0/g)", "x": "l0", "y": "l0", "foot_x": "l0", "foot_y": "l0", "psi": "rad",
+                   "zeta": "l0", "phase": "0 stance, 1 flight", "jump": "index"}  # fmt: skip
+RECORDED_UNITS = {"time": "s", "x": "m", "y": "m", "pitch": "rad"}
+
+
 def trajectory_json(session: Session, run_id: int) -> bytes:
     run = records.get_run(session, run_id)
     if run.trajectory is None:
         raise records.NotFound("trajectory of run", run_id)
     columns = simulation.unpack_trajectory(run.trajectory)
     listed = {name: values.tolist() for name, values in columns.items()}
-    return schemas.RunTrajectory(units="nondimensional", columns=listed).model_dump_json().encode()
+    units, table = ("nondimensional", SIMULATED_UNITS) if run.kind == "sim" else ("SI", RECORDED_UNITS)
+    column_units = {name: table.get(name, "") for name in listed}
+    return schemas.RunTrajectory(units=units, column_units=column_units, columns=listed).model_dump_json().encode()
 
 
 @router.get("/{run_id}/export.mcap", response_class=McapResponse)

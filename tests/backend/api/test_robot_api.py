@@ -170,8 +170,17 @@ def test_open_loop_live_run_is_stored_with_the_model_beside_it(client, auth, con
     )
     assert [c["why"] for c in results["commands"]] == ["start", "start"]
     assert results["calibration"] == {"origin": [0.0, 0.0], "angle": 0.0, "scale": 1.0}
-    frames = client.get(f"/api/v1/runs/{run['id']}/trajectory").json()["columns"]
-    assert len(frames["time"]) > 100, "raw tracker frames are kept"
+    trajectory = client.get(f"/api/v1/runs/{run['id']}/trajectory").json()
+    assert len(trajectory["columns"]["time"]) > 100, "raw tracker frames are kept"
+    assert trajectory["units"] == "SI" and trajectory["column_units"] == {
+        "time": "s",
+        "x": "m",
+        "y": "m",
+        "pitch": "rad",
+    }
+    tracker = results["tracker"]
+    assert tracker["received"] == tracker["frames"] and (tracker["protocol"], tracker["version"]) == ("pkt1", "1")
+    assert results["link"]["url"] == connected.url and results["started_by"] == "a client at testclient"
 
 
 def test_a_live_run_is_filed_under_its_experiment_and_a_missing_one_moves_nothing(client, auth, connected):

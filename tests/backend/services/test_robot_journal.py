@@ -84,3 +84,24 @@ def test_a_failed_journal_write_loses_nothing(sessions, session):
     stored = records.get_run(session, run_id)
     assert [td["index"] for td in stored.results["touchdowns"]] == [0, 1, 2]
     assert stored.results["tracker"]["frames"] == 3 and stored.status == "done"
+
+
+def test_a_runs_tracker_figures_are_its_own_not_the_connections(sessions, session):
+    robot = get_preset("paper")
+    tracker = UdpPoseSource()
+    for number in (1, 2, 5, 6):  # before the run: 2 frames lost on this connection
+        tracker.stats.frame(number)
+    with sessions() as opening:
+        run_id = open_robot_run(opening, RobotRunCreate(controls=LEGS), robot, Calibration())
+    run = LiveRun(jumps=20, max_seconds=60.0, run_id=run_id)
+    writer = JournalWriter(sessions, run, tracker, _Link(), robot, period=3600.0)
+    for number in (7, 8, 10, 11, 12):  # during it: frame 9 lost
+        tracker.stats.frame(number)
+    tracker.stats.malformed += 1
+    run.end_reason, run.disarm = "stopped", "disarmed"
+    writer.start().finish(run)
+    tracker.close()
+    figures = records.get_run(session, run_id).results["tracker"]
+    assert (figures["received"], figures["dropped"], figures["malformed"], figures["restarts"]) == (5, 1, 1, 0)
+    assert figures["loss"] == 1 / 6 and (figures["protocol"], figures["version"]) == ("pkt1", "1")
+    assert figures["address"] == list(tracker.address) and tracker.stats.dropped == 3, "the connection's own"

@@ -16,8 +16,10 @@ def test_run_matches_the_simulator_and_stores_its_path(client, auth):
     direct = client.post("/api/v1/sim/map", json={k: RUN[k] for k in ("controls", "start", "jumps")}).json()
     assert run["results"]["states"] == direct["states"] and run["jumps_completed"] == 4
     assert run["climb"] == pytest.approx(sum(direct["rises"])) and run["tags"] == ["a", "b"]
-    path = client.get(f"/api/v1/runs/{run['id']}/trajectory").json()["columns"]
+    trajectory = client.get(f"/api/v1/runs/{run['id']}/trajectory").json()
+    path = trajectory["columns"]
     assert len(path["time"]) == len(path["y"]) > 100
+    assert trajectory["units"] == "nondimensional" and trajectory["column_units"]["time"] == "sqrt(l0/g)"
     assert (
         run["created_at"].endswith("Z")
         and client.get(f"/api/v1/runs/{run['id']}").json()["created_at"] == run["created_at"]
