@@ -8,14 +8,26 @@ From what: touchdown-to-touchdown pairs. Each measured touchdown is mapped one j
 the model (:mod:`sim_core.touchdown_model`) and compared with the next measured one on three
 channels — ``xdot``, ``ydot`` and the rise between the feet.
 
+From what not: a run that fell (:attr:`TouchdownSeries.fell`) is cut before its fall: the pair into
+the touchdown its failing jump began at (:data:`~sim_core.touchdown_series.FALL_PAIRS`) carries no
+steady-state information — a jump on the edge of failing, often a long slow flight no
+linearisation holds — and on a real robot the detector may find crossings while it falls. What is
+cut is reported: :attr:`CalibrationFit.cut_at_fall`.
+
 How: least squares (``scipy.optimize.least_squares``, trust region), first with each channel at a
 nominal scale, then (:data:`GLS_PASSES` times) with each pair weighted by its own covariance: the
 noise of its inputs carried through the map's sensitivities plus the tracker's on its outputs,
 at the noise levels most likely at the estimate so far (:mod:`sim_core.calibration_noise`). A jump
 near failing, where the map is steep, so counts for little and does not bias the fit; a plain
 fit of these runs put its parameters 2-3 times further from the truth than its errors said.
-Huber's loss beyond :data:`ROBUST_SCALE` sigmas outweighs what still falls outside (the last
-touchdown before a fall). The noise levels found are reported: :attr:`CalibrationFit.noise`.
+
+Robust: the whitened residuals (unit variance where the noise is right) go through Huber's loss
+beyond :data:`ROBUST_SCALE` sigmas, so a pair the model cannot explain pulls no harder than a
+3-sigma one. The noise is estimated from the pairs it explains only (:func:`_inlier_noise`): a
+median-absolute-deviation screen first, then pairs whose Mahalanobis distance under the noise
+found is below :data:`OUTLIER_SIGMAS`, until the set settles — so one wild pair cannot inflate one
+sigma and let the others collapse. The pairs beyond it at the optimum are reported by run and
+touchdown: :attr:`CalibrationFit.outliers`.
 
 How sure: the covariance is a sandwich estimate at the optimum (:func:`_uncertainty`; neighbouring
 pairs share a touchdown), its inner inverse from an SVD; standard errors and the correlation
@@ -47,12 +59,37 @@ TYPICAL_SCALE = np.array([10.0, 0.3, 0.3, 0.5, 0.5, 0.005, 0.005])  # steps of a
 NOMINAL_SCATTER = np.array([0.02, 0.02, 0.005])  # first-pass channel scales: xdot, ydot, rise
 GLS_PASSES = 2
 ROBUST_SCALE = 3.0  # Huber loss: residuals beyond 3 channel sigmas count linearly, not squared
+# A pair whose Mahalanobis distance under the estimated noise is beyond this is an outlier: left out
+# of the noise estimate, reported. sqrt of chi-square(3 channels)'s 99.9 % point: 1 honest pair in 1000.
+OUTLIER_SIGMAS = 4.03
+SCREEN_MADS = 5.0  # first noise estimate: pairs within 5 scaled MADs of the median on every channel
+MAD_TO_SIGMA = 1.4826  # a Gaussian's sigma per median absolute deviation
+INLIER_PASSES = 4
 FAILED_RESIDUAL = 10.0  # a pair whose predicted jump fails, in channel scales (bounded, so the fit moves on)
 IDENTIFIABLE_RCOND = 1e-6
 CONFOUNDED = 0.95  # |correlation| above which two parameters are reported as hard to tell apart
 MIN_PAIRS = 10
 LOWER = np.array([1.0, 0.0, 0.0, -10.0, -10.0, -0.1, -0.1])
 UPPER = np.array([1000.0, 20.0, 20.0, 10.0, 10.0, 0.1, 0.1])
+
+
+@dataclass(frozen=True)
+class Outlier:
+    """A touchdown pair the fit does not explain.
+
+    Attributes:
+        series: the run's position in the series given to :func:`calibrate`.
+        touchdown: index ``k + 1`` in that run of the touchdown predicted from touchdown ``k``.
+        residual: the pair's Mahalanobis distance [sigmas] under its covariance at the fit (3
+            channels); inf where the fitted model's jump fails.
+    """
+
+    series: int
+    touchdown: int
+    residual: float
+
+    def to_dict(self) -> dict:
+        return {"series": self.series, "touchdown": self.touchdown, "residual": self.residual}
 
 
 @dataclass(frozen=True)
@@ -73,6 +110,10 @@ class CalibrationFit:
         channels: per channel ``{"unit", "rms_before", "rms_after"}``.
         noise: the noise levels most likely at the fit (:class:`sim_core.calibration_noise.TouchdownNoise`).
         failed_predictions: pairs whose predicted jump failed with the fitted model.
+        outliers: the pairs the fitted model and noise do not explain (:class:`Outlier`), in run order.
+        cut_at_fall: ``(series, touchdown)`` per run that fell: the position of the run in the
+            series given and the first of its touchdowns not predicted (docs/calibration.md, "Falls").
+        noise_pairs: the pairs the noise was estimated from (the compared ones less the outliers).
     """
 
     model: ModelParams
@@ -87,6 +128,9 @@ class CalibrationFit:
     channels: dict[str, dict]
     noise: dict[str, float]
     failed_predictions: int
+    outliers: tuple[Outlier, ...] = ()
+    cut_at_fall: tuple[tuple[int, int], ...] = ()
+    noise_pairs: int = 0
 
     def to_dict(self) -> dict:
         """The ``parkour calibrate --json`` contract (NaN and inf become null in JSON)."""
@@ -115,6 +159,9 @@ class CalibrationFit:
             "residuals": self.channels,
             "noise": self.noise,
             "failed_predictions": self.failed_predictions,
+            "outliers": [outlier.to_dict() for outlier in self.outliers],
+            "cut_at_fall": [{"series": series, "touchdown": touchdown} for series, touchdown in self.cut_at_fall],
+            "noise_pairs": self.noise_pairs,
         }
 
 
@@ -145,7 +192,7 @@ def calibrate(series: list[TouchdownSeries], base: ModelParams, start: LegOffset
     """
     from scipy.optimize import least_squares
 
-    pairs = Pairs.of(series)
+    pairs = Pairs.of(series, steady=True)
     if len(pairs) < MIN_PAIRS:
         raise ParameterError(
             "runs", f"need at least {MIN_PAIRS} consecutive touchdown pairs to calibrate, the runs give {len(pairs)}"
@@ -153,37 +200,39 @@ def calibrate(series: list[TouchdownSeries], base: ModelParams, start: LegOffset
     measured = pairs.measured()
     x0 = np.clip(vector_of(base, start or LegOffsets()), LOWER, UPPER)
 
-    def residuals(vector: np.ndarray, whiten: np.ndarray) -> np.ndarray:
+    def residuals(vector: np.ndarray, whiten: np.ndarray, kept: np.ndarray) -> np.ndarray:
         predicted, _ = predict(pairs, *split(base, vector))
         whitened = np.einsum("ijk,ik->ij", whiten, predicted - measured)
-        return np.nan_to_num(whitened, nan=FAILED_RESIDUAL).ravel()
+        return (np.nan_to_num(whitened, nan=FAILED_RESIDUAL) * kept[:, None]).ravel()
 
-    def fitted(x: np.ndarray, whiten: np.ndarray):
-        return least_squares(residuals, x, args=(whiten,), bounds=(LOWER, UPPER), x_scale=TYPICAL_SCALE,
+    def fitted(x: np.ndarray, whiten: np.ndarray, kept: np.ndarray):
+        return least_squares(residuals, x, args=(whiten, kept), bounds=(LOWER, UPPER), x_scale=TYPICAL_SCALE,
                              loss="huber", f_scale=ROBUST_SCALE, diff_step=1e-6, method="trf", xtol=1e-10,
                              ftol=1e-10)  # fmt: skip
 
     before, _ = predict(pairs, *split(base, x0))
     # First each channel by a nominal scale, then (GLS_PASSES times) each pair by its own covariance
-    # under the noise most likely at the estimate so far (sim_core.calibration_noise).
-    fit = fitted(x0, np.broadcast_to(np.diag(1.0 / NOMINAL_SCATTER), (len(pairs), 3, 3)))
+    # under the noise most likely, from the pairs it explains, at the estimate so far.
+    inliers = np.ones(len(pairs), dtype=bool)
+    fit = fitted(x0, np.broadcast_to(np.diag(1.0 / NOMINAL_SCATTER), (len(pairs), 3, 3)), inliers)
     noise = TouchdownNoise()
     for _ in range(GLS_PASSES):
         model, offsets = split(base, fit.x)
         predicted, _ = predict(pairs, model, offsets)
         sensitivity = _sensitivities(pairs, model, offsets)
-        noise = estimate_noise(predicted - measured, sensitivity, noise)
-        fit = fitted(fit.x, _whitening(sensitivity, noise))
-    x = fit.x
-    after, failed = predict(pairs, *split(base, x))
-    jacobian = fit.jac  # of the weighted residuals, at the optimum
-    stderr, correlation, unidentifiable = _uncertainty(jacobian, fit.fun)
-    model, offsets = split(base, x)
+        noise, inliers = _inlier_noise(predicted - measured, sensitivity, noise)
+        fit = fitted(fit.x, _whitening(sensitivity, noise), inliers)
+    model, offsets = split(base, fit.x)
+    after, failed = predict(pairs, model, offsets)
+    distance = _distances(after - measured, _sensitivities(pairs, model, offsets), noise)
+    rows = np.repeat(inliers, len(CHANNELS))  # the pairs the last pass fitted
+    stderr, correlation, unidentifiable = _uncertainty(fit.jac[rows], fit.fun[rows])  # of the weighted residuals
     channels = {
         name: {"unit": CHANNEL_UNITS[name], "rms_before": finite_rms(before[:, i] - measured[:, i]),
                "rms_after": finite_rms(after[:, i] - measured[:, i])}
         for i, name in enumerate(CHANNELS)
     }  # fmt: skip
+    outlying = np.flatnonzero(~(distance < OUTLIER_SIGMAS))
     return CalibrationFit(
         model=model,
         offsets=offsets,
@@ -197,7 +246,53 @@ def calibrate(series: list[TouchdownSeries], base: ModelParams, start: LegOffset
         channels=channels,
         noise=noise.to_dict(),
         failed_predictions=failed,
+        outliers=tuple(Outlier(int(pairs.origin[i, 0]), int(pairs.origin[i, 1]), float(distance[i])) for i in outlying),
+        cut_at_fall=_cut_at_fall(series),
+        noise_pairs=int(np.count_nonzero(inliers)),
     )
+
+
+def _cut_at_fall(series: list[TouchdownSeries]) -> tuple[tuple[int, int], ...]:
+    """``(position, first touchdown not predicted)`` of each run that fell and lost pairs to it."""
+    cut = []
+    for position, run in enumerate(series):
+        dropped = np.flatnonzero(run.consecutive & ~run.steady)
+        if dropped.size:
+            cut.append((position, int(dropped[0]) + 1))
+    return tuple(cut)
+
+
+def _inlier_noise(residuals: np.ndarray, sensitivity: np.ndarray, start: TouchdownNoise):
+    """The noise most likely from the pairs it explains, and which those are (shape (pairs,)).
+
+    A median-absolute-deviation screen of the residuals picks the first pairs; then, until the set
+    settles (at most :data:`INLIER_PASSES` times), the noise is estimated from the set and the set
+    becomes the pairs within :data:`OUTLIER_SIGMAS` of it. A pair near failing, with a large
+    residual its own covariance explains, comes back in; a pair nothing explains stays out.
+    """
+    usable = np.isfinite(residuals).all(axis=1) & np.isfinite(sensitivity).all(axis=(1, 2))
+    centre = np.median(residuals[usable], axis=0)
+    spread = MAD_TO_SIGMA * np.median(np.abs(residuals[usable] - centre), axis=0)
+    with np.errstate(invalid="ignore"):
+        inliers = usable & np.all(np.abs(residuals - centre) <= SCREEN_MADS * spread, axis=1)
+    noise = start
+    for _ in range(INLIER_PASSES):
+        noise = estimate_noise(residuals[inliers], sensitivity[inliers], noise)
+        settled = _distances(residuals, sensitivity, noise) < OUTLIER_SIGMAS
+        if np.array_equal(settled, inliers):
+            break
+        inliers = settled
+    return noise, inliers
+
+
+def _distances(residuals: np.ndarray, sensitivity: np.ndarray, noise: TouchdownNoise) -> np.ndarray:
+    """Shape (pairs,): each pair's Mahalanobis distance [sigmas] under ``noise``; inf where its jump fails."""
+    usable = np.isfinite(residuals).all(axis=1) & np.isfinite(sensitivity).all(axis=(1, 2))
+    distance = np.full(residuals.shape[0], math.inf)
+    r = residuals[usable]
+    solved = np.linalg.solve(pair_covariances(sensitivity[usable], noise), r[:, :, None])[:, :, 0]
+    distance[usable] = np.sqrt(np.einsum("ij,ij->i", r, solved))
+    return distance
 
 
 def _confounded(correlation: np.ndarray) -> tuple[tuple[str, str, float], ...]:

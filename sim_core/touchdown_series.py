@@ -20,6 +20,10 @@ from sim_core.validation import ParameterError
 PITCH_WINDOW = (-0.05, 0.0)
 
 COLUMNS = 9  # of Pairs.before and .after
+# Pairs left out at the end of a run that fell: the jump into the touchdown its failing jump began at
+# (a jump on the edge of failing, often a long slow flight the map cannot linearise) and, on a real
+# robot, anything the detector found while the robot fell (docs/calibration.md, "Falls").
+FALL_PAIRS = 1
 PSI0_ERROR, ZETA0_ERROR = 7, 8
 # The channels a pair compares: the next touchdown's section state and the rise to it.
 CHANNELS = ("xdot", "ydot", "rise")
@@ -37,6 +41,8 @@ class TouchdownSeries:
         right_leg: shape (n,), whether the touchdown is on the right wall (its leg the right one).
         pitch: shape (n,), the body's pitch at the touchdown [rad]; 0 where the tracker gave none.
         consecutive: shape (n - 1,), whether touchdown ``k + 1`` is the jump after ``k`` (none missed).
+        fell: whether the run ended in a fall (the robot's FELL fault): the jump from its last
+            touchdown failed.
     """
 
     state: np.ndarray
@@ -45,6 +51,7 @@ class TouchdownSeries:
     right_leg: np.ndarray
     pitch: np.ndarray
     consecutive: np.ndarray
+    fell: bool = False
 
     def __post_init__(self) -> None:
         n = self.state.shape[0]
@@ -55,7 +62,7 @@ class TouchdownSeries:
                 raise ParameterError(name, f"must have shape {shape}, got {getattr(self, name).shape}")
 
     @classmethod
-    def of(cls, *, state, foot_height, commanded, right_leg, pitch=None) -> TouchdownSeries:
+    def of(cls, *, state, foot_height, commanded, right_leg, pitch=None, fell: bool = False) -> TouchdownSeries:
         """A series from sequences; a pair counts as consecutive when its walls alternate."""
         right = np.asarray(right_leg, dtype=bool)
         pitches = np.zeros(right.shape) if pitch is None else np.nan_to_num(np.asarray(pitch, dtype=float))
@@ -66,11 +73,20 @@ class TouchdownSeries:
             right_leg=right,
             pitch=pitches,
             consecutive=right[1:] != right[:-1],
+            fell=bool(fell),
         )
 
     @property
     def pairs(self) -> int:
         return int(np.count_nonzero(self.consecutive))
+
+    @property
+    def steady(self) -> np.ndarray:
+        """Shape (n - 1,): the consecutive pairs less, in a run that fell, its last :data:`FALL_PAIRS`."""
+        keep = self.consecutive.copy()
+        if self.fell:
+            keep[max(keep.size - FALL_PAIRS, 0) :] = False
+        return keep
 
 
 @dataclass(frozen=True)
@@ -81,22 +97,26 @@ class Pairs:
     zeta0_commanded, right_leg (0/1), pitch, psi0_error, zeta0_error`` of touchdown ``k`` and
     ``k + 1``; the errors (0 as measured) are what the leg realised beyond the commanded, offset and
     pitch — the per-jump control noise — and let :func:`sensitivities` ask what it would change.
+    ``origin`` (pairs, 2) says where each pair is from: the series' position in the list and
+    ``k + 1``, the index of the touchdown it predicts.
     """
 
     before: np.ndarray
     after: np.ndarray
+    origin: np.ndarray
 
     @classmethod
-    def of(cls, series: list[TouchdownSeries]) -> Pairs:
+    def of(cls, series: list[TouchdownSeries], *, steady: bool = False) -> Pairs:
+        """The consecutive pairs of ``series``; ``steady``: less those of a fall (:attr:`TouchdownSeries.steady`)."""
         rows = []
-        for run in series:
+        for position, run in enumerate(series):
             errors = np.zeros((run.right_leg.size, 2))
             table = np.column_stack([run.state, run.foot_height, run.commanded, run.right_leg, run.pitch, errors])
-            keep = np.flatnonzero(run.consecutive)
-            rows.append((table[keep], table[keep + 1]))
+            keep = np.flatnonzero(run.steady if steady else run.consecutive)
+            rows.append((table[keep], table[keep + 1], np.column_stack([np.full(keep.size, position), keep + 1])))
         if not rows:
-            return cls(np.empty((0, COLUMNS)), np.empty((0, COLUMNS)))
-        return cls(np.vstack([b for b, _ in rows]), np.vstack([a for _, a in rows]))
+            return cls(np.empty((0, COLUMNS)), np.empty((0, COLUMNS)), np.empty((0, 2), dtype=int))
+        return cls(*(np.vstack([row[part] for row in rows]) for part in range(3)))
 
     def __len__(self) -> int:
         return self.before.shape[0]

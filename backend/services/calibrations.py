@@ -20,6 +20,7 @@ from sqlalchemy import select
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
+from backend.robot.messages import Fault
 from backend.schemas.calibrations import PRESET_PATTERN
 from backend.services.records import Conflict, NotFound, fetch
 from backend.services.simulation import current_code_version, unpack_trajectory
@@ -37,6 +38,7 @@ if TYPE_CHECKING:  # the kernels load in compute workers, not in the service (te
     from sim_core.calibration import CalibrationFit
 
 CALIBRATED_KINDS = ("robot", "replay")
+SELF_DISARMED = "robot disarmed (fell or timed out)"  # backend.robot.live_run's ending
 PRESET_NAME = re.compile(PRESET_PATTERN)
 MAX_RUNS = 100
 Fitter = Callable[[list[TouchdownSeries], ModelParams], "CalibrationFit"]
@@ -61,14 +63,24 @@ def touchdown_series(session: Session, run: Run, robot: PhysicalParams) -> Touch
             f"run {run.id} does not say which controls {len(touchdowns) - len(controls)} of its touchdowns had"
         )
     legs = [LegControl.from_degrees(*pair) for pair in controls[: len(touchdowns)]]
-    pitch = _pitch_at(_tracked(session, run), [td["time"] for td in touchdowns])
+    tracked = _tracked(session, run)
     return TouchdownSeries.of(
         state=[td["state"] for td in touchdowns],
         foot_height=[td["foot_height"] / robot.leg_length for td in touchdowns],
         commanded=[(leg.psi0, leg.zeta0) for leg in legs],
         right_leg=[td["wall"] == Wall.RIGHT for td in touchdowns],
-        pitch=pitch,
+        pitch=_pitch_at(tracked, [td["time"] for td in touchdowns]),
+        fell=tracked is not None and run_fell(tracked),
     )
+
+
+def run_fell(run: Run) -> bool:
+    """Whether a robot run ended in a fall: its telemetry reported the firmware's FELL fault, or,
+    without telemetry, it ended as a robot that disarmed itself does."""
+    telemetry = run.results.get("telemetry") or []
+    if telemetry:
+        return bool(np.bitwise_or.reduce([int(t.get("faults", 0)) for t in telemetry]) & Fault.FELL)
+    return run.results.get("end_reason") == SELF_DISARMED
 
 
 def fit_touchdowns(series: list[TouchdownSeries], base: ModelParams) -> CalibrationFit:
@@ -186,10 +198,18 @@ def _stored(fit: CalibrationFit, *, name: str, base: str, robot: PhysicalParams,
         base=base,
         physical=json_safe(asdict(fitted)),
         offsets=fit.offsets.to_dict(),
-        fit=json_safe(fit.to_dict()),
+        fit=json_safe(_with_run_ids(fit.to_dict(), run_ids)),
         runs=list(run_ids),
         code_version=current_code_version(),
     )
+
+
+def _with_run_ids(report: dict, run_ids: list[int]) -> dict:
+    """The fit's report with each outlier and each cut at a fall naming its run (``run_id``) beside
+    its position in the runs (``series``)."""
+    for key in ("outliers", "cut_at_fall"):
+        report[key] = [{**entry, "run_id": run_ids[entry["series"]]} for entry in report.get(key, [])]
+    return report
 
 
 def _calibration_run(session: Session, run_id: int) -> Run:

@@ -1,14 +1,16 @@
 """Calibration recovers a robot's true physics and servo offsets from its tracked touchdowns, says
-how sure it is, and names what the data cannot tell apart."""
+how sure it is, and names what the data cannot tell apart; a run that fell or a wild touchdown
+does not ruin it (issue 24)."""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from sim_core.calibration import PARAMETERS, calibrate
+from sim_core.calibration import OUTLIER_SIGMAS, PARAMETERS, calibrate
 from sim_core.noise import NO_NOISE, NoiseModel
-from sim_core.touchdown_series import TouchdownSeries, pitch_at
+from sim_core.touchdown_series import Pairs, TouchdownSeries, pitch_at
 from sim_core.validation import ParameterError
 from sim_core.walls import Wall
 from tests.tracked_climbs import PAPER, VARIED_LEGS, TrackedClimb, Truth, tracked_climb
@@ -20,29 +22,35 @@ TOLERANCE = {"alpha": 0.02, "c_zeta": 0.10, "c_psi": 0.10}
 OFFSET_TOLERANCE = {"psi0_offset_deg": 0.3, "zeta0_offset": 0.003}
 
 
-def series_of(climb: TrackedClimb) -> TouchdownSeries:
+def series_of(climb: TrackedClimb, *, fell: bool = False) -> TouchdownSeries:
     return TouchdownSeries.of(
         state=[td.state for td in climb.touchdowns],
         foot_height=[td.foot_height / PAPER.leg_length for td in climb.touchdowns],
         commanded=[(math.radians(p), z) for p, z in climb.controls],
         right_leg=[td.wall == Wall.RIGHT for td in climb.touchdowns],
         pitch=pitch_at([td.time for td in climb.touchdowns], climb.frames["time"], climb.frames["pitch"]),
+        fell=fell,
     )
 
 
 def climbs(truth: Truth, noise: NoiseModel, *, legs=VARIED_LEGS, jumps=60, seed=3) -> list[TouchdownSeries]:
+    """Tracked climbs of ``legs``; one that ended before ``jumps`` fell (a finished climb detects at
+    least ``jumps - 1`` touchdowns: the first, from the floor, has no flight before it)."""
     rng = np.random.default_rng(seed)
-    return [series_of(tracked_climb(truth, pair, jumps=jumps, noise=noise, rng=rng)) for pair in legs]
+    found = [tracked_climb(truth, pair, jumps=jumps, noise=noise, rng=rng) for pair in legs]
+    return [series_of(climb, fell=len(climb.touchdowns) < jumps - 1) for climb in found]
 
 
-def assert_recovered(fit, truth: Truth, *, tolerances: bool = True) -> None:
-    """Every value within 3 of its standard errors of the truth, and (``tolerances``) within the issue's tolerances."""
+def assert_recovered(fit, truth: Truth, *, tolerances: bool = True, damping: bool = True) -> None:
+    """Every value within 3 of its standard errors of the truth, and (``tolerances``) within the issue's
+    tolerances (``damping``: the damping's 10 % too, issue 16's; issue 24 asks for the 3 errors only)."""
     values = fit.to_dict()
     true = {"alpha": truth.robot.to_model().alpha, "c_zeta": truth.robot.to_model().c_zeta,
             "c_psi": truth.robot.to_model().c_psi}  # fmt: skip
     for name, relative in TOLERANCE.items():
         found, error = values["params"][name], values["stderr"][name]
-        assert not tolerances or abs(found - true[name]) < relative * true[name], f"{name}: {found:.4g} vs {true[name]}"
+        checked = tolerances and (damping or name == "alpha")
+        assert not checked or abs(found - true[name]) < relative * true[name], f"{name}: {found:.4g} vs {true[name]}"
         assert abs(found - true[name]) < 3 * error, f"{name}: {found:.4g} ± {error:.2g} vs {true[name]:.4g}"
     for name, tolerance in OFFSET_TOLERANCE.items():
         for side, truth_value in enumerate(getattr(truth.offsets, name)):
@@ -99,3 +107,82 @@ def test_too_few_touchdowns_is_an_error_naming_the_runs():
     with pytest.raises(ParameterError) as error:
         calibrate(few, PAPER.to_model())
     assert error.value.field == "runs" and "at least 10" in str(error.value)
+
+
+# Robots whose runs fall (default noise: 0.5 deg and 0.003 per jump, 0.5 deg of pitch drift): issue
+# 24's finding, the robot above, a soft and a stiff one; each fitted from the first two seeds whose
+# four climbs include one that fell.
+FALLING = {
+    "finding": Truth.of(alpha=84.0, c_zeta=0.6, c_psi=0.2, psi0_offset_deg=(-1.0, 0.5), zeta0_offset=(-0.006, 0.002)),
+    "soft": Truth.of(alpha=62.0, c_zeta=0.9, c_psi=0.45, psi0_offset_deg=(0.8, 1.2), zeta0_offset=(0.005, 0.003)),
+    "stiff": Truth.of(alpha=100.0, c_zeta=0.45, c_psi=0.35, psi0_offset_deg=(-0.4, -1.1), zeta0_offset=(-0.002, 0.0)),
+}
+FALLING_JUMPS = 60
+
+
+def with_fall(truth: Truth, nth: int) -> list[TouchdownSeries]:
+    """The climbs of the ``nth`` seed (from 0) whose four climbs include one that fell."""
+    seed, found = -1, 0
+    while found <= nth:
+        seed += 1
+        series = climbs(truth, NoiseModel(), jumps=FALLING_JUMPS, seed=seed)
+        found += any(run.fell for run in series)
+    return series
+
+
+@pytest.mark.parametrize("nth", [0, 1])
+@pytest.mark.parametrize("name", sorted(FALLING))
+def test_recovers_the_truth_with_a_run_that_fell(name, nth):
+    series = with_fall(FALLING[name], nth)
+    fit = calibrate(series, PAPER.to_model())
+    assert_recovered(fit, FALLING[name], damping=False)
+    fallen = [i for i, run in enumerate(series) if run.fell]
+    assert [position for position, _ in fit.cut_at_fall] == fallen
+    assert fit.touchdowns_used == sum(run.pairs for run in series) - len(fallen)
+    assert fit.noise["zeta0"] == pytest.approx(0.003, rel=0.25), "the robot's control noise, estimated"
+
+
+def wild_touchdown(run: TouchdownSeries) -> TouchdownSeries:
+    """``run`` with a touchdown after its last, as the detector found one while a virtual robot fell
+    (measured: the body crossing the leg's line on its way down, 0.45 m under the last foot)."""
+    flipped = not run.right_leg[-1]
+    return TouchdownSeries.of(
+        state=np.vstack([run.state, [-0.28, -2.34]]),
+        foot_height=np.append(run.foot_height, run.foot_height[-1] - 1.2),
+        commanded=np.vstack([run.commanded, run.commanded[-2]]),
+        right_leg=np.append(run.right_leg, flipped),
+        pitch=np.append(run.pitch, run.pitch[-1]),
+        fell=run.fell,
+    )
+
+
+def test_a_run_that_fell_is_cut_before_its_fall_and_a_wild_touchdown_is_an_outlier():
+    clean = [replace(run, fell=False) for run in climbs(TRUTH, NoiseModel(pitch_drift_deg=0.2), jumps=40)]
+    wild = [*clean[:2], wild_touchdown(clean[2]), clean[3]]
+    last = len(wild[2].state) - 1
+    # Told it fell, the fit leaves out the pair into the fall: the same fit as without that touchdown.
+    fell = [*wild[:2], replace(wild[2], fell=True), wild[3]]
+    assert len(Pairs.of(fell, steady=True)) == len(Pairs.of(fell)) - 1
+    cut, plain = calibrate(fell, PAPER.to_model()), calibrate(clean, PAPER.to_model())
+    assert cut.cut_at_fall == ((2, last),) and cut.touchdowns_used == plain.touchdowns_used
+    assert cut.to_dict()["params"] == plain.to_dict()["params"]
+    assert cut.to_dict()["cut_at_fall"] == [{"series": 2, "touchdown": last}]
+    # Not told, the robust fit reports it by run and touchdown, and neither the parameters nor the
+    # noise follow it: the noise comes from the pairs it explains.
+    fit = calibrate(wild, PAPER.to_model())
+    [outlier] = [o for o in fit.outliers if (o.series, o.touchdown) == (2, last)]
+    assert outlier.residual > 10 * OUTLIER_SIGMAS
+    assert {(o.series, o.touchdown) for o in fit.outliers} == {(o.series, o.touchdown) for o in plain.outliers} | {
+        (2, last)
+    }
+    assert {"series": 2, "touchdown": last, "residual": outlier.residual} in fit.to_dict()["outliers"]
+    assert fit.noise_pairs == plain.noise_pairs
+    for name, value in fit.to_dict()["params"].items():
+        assert np.allclose(
+            value, plain.to_dict()["params"][name], rtol=0, atol=0.1 * np.max(plain.to_dict()["stderr"][name])
+        ), name
+    for name in PARAMETERS:
+        assert abs(fit.stderr[name] - plain.stderr[name]) < 0.1 * plain.stderr[name], name
+    for name, sigma in plain.noise.items():
+        assert fit.noise[name] == pytest.approx(sigma, rel=0.05), name
+    assert fit.noise["psi0_deg"] == pytest.approx(0.5, rel=0.3)

@@ -3,6 +3,7 @@ used by name; wrong runs and names refused with what to do."""
 
 import socket
 
+import numpy as np
 import pytest
 
 from backend.services import calibrations, records
@@ -25,7 +26,9 @@ def robot_runs(session) -> list[int]:
 def test_a_calibration_is_stored_as_a_preset_with_its_provenance(session, robot_runs):
     payload = calibrations.calibrate_runs(session, robot_runs, name="table-2026-12")
     assert set(payload) >= {"params", "stderr", "correlation", "touchdowns_used", "rms_residual_before",
-                            "rms_residual_after", "unidentifiable", "confounded", "noise", "preset"}  # fmt: skip
+                            "rms_residual_after", "unidentifiable", "confounded", "noise", "preset", "outliers",
+                            "cut_at_fall", "noise_pairs"}  # fmt: skip
+    assert payload["cut_at_fall"] == [], "none of these runs fell"
     assert abs(payload["params"]["alpha"] - 72.0) < 3 * payload["stderr"]["alpha"]
     assert payload["rms_residual_after"] < 0.3 * payload["rms_residual_before"]
     assert len(payload["correlation"]) == 7 and payload["touchdowns_used"] > 100
@@ -39,6 +42,24 @@ def test_a_calibration_is_stored_as_a_preset_with_its_provenance(session, robot_
     assert list(offsets.psi0_offset_deg) == payload["params"]["psi0_offset_deg"]
     assert calibrations.preset_payload(calibrations.get_stored_preset(session, "table-2026-12")) == payload
     assert calibrations.preset_params(session, "paper") == (PAPER, calibrations.NO_OFFSETS)
+
+
+def test_a_run_that_fell_is_cut_before_its_fall_and_named_in_the_report(session, robot_runs):
+    from tests.tracked_climbs import VARIED_LEGS, store_tracked_run, tracked_climb
+
+    legs = VARIED_LEGS[1]
+    climb = tracked_climb(TRUTH, legs, jumps=30, noise=NoiseModel(pitch_drift_deg=0.2), rng=np.random.default_rng(7))
+    fallen = store_tracked_run(session, climb, legs, fell=True)
+    assert calibrations.run_fell(records.get_run(session, fallen))
+    assert not calibrations.run_fell(records.get_run(session, robot_runs[0]))
+    replay = replay_run(session, fallen).id  # a replay fell as its robot run did
+    assert calibrations.touchdown_series(session, records.get_run(session, replay), PAPER).fell
+    runs = [*robot_runs[:3], replay]
+    payload = calibrations.calibrate_runs(session, runs, name="with-a-fall")
+    assert payload["cut_at_fall"] == [{"series": 3, "touchdown": len(climb.touchdowns) - 1, "run_id": replay}]
+    assert all(outlier["run_id"] == runs[outlier["series"]] for outlier in payload["outliers"])
+    assert payload["noise_pairs"] == payload["touchdowns_used"] - len(payload["outliers"])
+    assert abs(payload["params"]["alpha"] - 72.0) < 3 * payload["stderr"]["alpha"]
 
 
 def test_a_replay_calibrates_like_its_robot_run(session, robot_runs):
@@ -109,7 +130,6 @@ def test_calibration_recovers_the_virtual_robots_truth(session, service):
     finally:
         service.disconnect()
         robot.stop()
-    import numpy as np
 
     from backend.services.simulation import unpack_trajectory
 
