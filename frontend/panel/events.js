@@ -102,3 +102,4 @@ function stopPolling() {
 }
 
 document.addEventListener("visibilitychange", followRobotEvents);
+followRobotEvents();  // at once: index.html loads this module first, before Plotly

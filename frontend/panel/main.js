@@ -2,9 +2,9 @@
 // served by the service as they are (no build step). Every failing call shows the API's own
 // message, at its field where it has one. This module only wires the tabs to what they load;
 // each tab's module registers its own handlers when it is loaded. Every tab follows the robot's
-// events (events.js: a latched e-stop shows on all of them).
+// events (events.js: a latched e-stop shows on all of them); index.html loads that module first,
+// and it starts itself, so the banner does not wait for Plotly and the other tabs' modules.
 import { initTabs } from "./tabs.js";
-import { followRobotEvents } from "./events.js";
 import { loadJobs } from "./jobs.js";
 import { loadExperiments, loadRuns } from "./history.js";
 import { loadCalibrations } from "./calibration.js";
@@ -21,4 +21,3 @@ initTabs((name) => {
   syncLive();  // the live websocket is open while the Robot tab is shown
   if (name === "view3d") showView();
 });
-followRobotEvents();

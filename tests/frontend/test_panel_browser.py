@@ -869,7 +869,8 @@ def test_the_status_fields_of_the_new_service_are_shown_as_text(page):
 EVENTS_STATE = "async () => (await import('/panel/events.js')).robotEventsState()"
 STOP_EVENTS = "async () => (await import('/panel/events.js')).stopRobotEvents()"
 FOLLOW_EVENTS = "async () => (await import('/panel/events.js')).followRobotEvents()"
-SHOWN_WITHIN_MS = 5_000  # a generous guard against a hang; "within a second" is measured and reported
+SHOWN_WITHIN_MS = 10_000  # a generous guard against a hang; "within a second" is measured and reported
+RUN_STARTS_WITHIN_MS = 30_000  # a run's start is stored first: on a busy machine that can take a while
 
 
 def _events_are(panel, state: str, timeout: float = 15.0) -> None:
@@ -920,12 +921,12 @@ def test_a_latched_estop_reaches_every_open_panel(page, service, robot):
         opened = time.monotonic()
         late.goto(f"{base}/")
         late.locator("#estop-banner").wait_for(state="visible", timeout=SHOWN_WITHIN_MS)
-        on_opening = time.monotonic() - opened
+        on_opening = time.monotonic() - opened  # the page answers no one while Plotly loads
         assert late.inner_text("#estop-reason") == f"Reason: {reason}" and late.is_visible("#simulate")
         loaded, shown = late.evaluate(LOADED_AT), late.evaluate("window.__bannerShownAt")
         print(f"banner shown: {1000 * on_history:.0f} ms after the press on History; on a new panel "
-              f"{1000 * on_opening:.0f} ms after it started loading, {shown - loaded:.0f} ms after its "
-              f"scripts ran (DOMContentLoaded at {loaded:.0f} ms)")  # fmt: skip
+              f"{shown:.0f} ms after it began loading, by its own clock (DOMContentLoaded, once Plotly "
+              f"has run: {loaded:.0f} ms; seen from here after {1000 * on_opening:.0f} ms)")  # fmt: skip
         _shot(history, "estop_on_history")
         page.click("#estop-banner-reset")  # needs the token: the first panel has it
         for panel in (history, late, page):
@@ -975,7 +976,7 @@ def test_the_robot_tab_says_who_runs_the_robot_and_offers_stop(page, service, ro
         page.fill("#robot-run-form input[name=jumps]", "200")
         page.uncheck("#closed-loop")
         page.click("#live-run")
-        other.locator("#run-owner").wait_for(state="visible", timeout=SHOWN_WITHIN_MS)
+        other.locator("#run-owner").wait_for(state="visible", timeout=RUN_STARTS_WITHIN_MS)
         run = httpx.get(f"{base}/api/v1/robot").json()["run"]
         since = other.evaluate("(t) => new Date(t * 1000).toLocaleTimeString()", run["started"])
         said = other.inner_text("#run-owner-text")
@@ -989,7 +990,7 @@ def test_the_robot_tab_says_who_runs_the_robot_and_offers_stop(page, service, ro
         assert httpx.get(f"{base}/api/v1/robot").json()["run"]["active"], "no token: the run goes on"
         page.click("#run-owner-stop")
         for panel in (page, other):
-            panel.locator("#run-owner").wait_for(state="hidden", timeout=SHOWN_WITHIN_MS * 3)
+            panel.locator("#run-owner").wait_for(state="hidden", timeout=RUN_STARTS_WITHIN_MS)
         assert not httpx.get(f"{base}/api/v1/robot").json()["run"]["active"]
         _until(page, f"{ROBOT_STATE} === 'disarmed'", timeout=15_000)
     finally:
