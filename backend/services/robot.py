@@ -118,6 +118,7 @@ class RobotService:
             self._disconnect()
         self.supervisor.close()
         self._estop_executor.shutdown(wait=False)
+        self.latch.flush()  # the latch as it is now is what the next start reads
 
     def _disconnect(self) -> None:
         """Close the link (no more reconnects) and the tracker."""

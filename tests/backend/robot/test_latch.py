@@ -27,10 +27,13 @@ def test_acknowledging_or_reconnecting_a_released_latch_changes_nothing():
 
 def test_a_held_latch_survives_a_restart_and_a_release_too(tmp_path):
     path = tmp_path / "estop-latch.json"
-    EstopLatch(path).engage()
+    latch = EstopLatch(path)
+    latch.engage()
+    latch.flush()
     restarted = EstopLatch(path)
     assert restarted.held and restarted.state.pending, "a restart finds it held, to be confirmed by the robot"
     restarted.release()
+    restarted.flush()
     assert not EstopLatch(path).held
     assert not (tmp_path / "estop-latch.json.tmp").exists(), "written whole, then renamed"
 
@@ -50,3 +53,14 @@ def test_the_reason_says_whether_the_robot_confirmed_it():
     assert "not yet acknowledged" in latch.state.reason()
     latch.acknowledged()
     assert "the robot acknowledged it" in latch.state.reason()
+
+
+def test_changes_reach_the_file_in_their_order(tmp_path):
+    path = tmp_path / "estop-latch.json"
+    latch = EstopLatch(path)
+    for _ in range(20):
+        latch.engage()
+        latch.release()
+    latch.engage()
+    latch.flush()
+    assert json.loads(path.read_text())["held"] is True

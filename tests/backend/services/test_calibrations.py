@@ -131,24 +131,6 @@ def test_calibration_recovers_the_virtual_robots_truth(session, service):
         service.disconnect()
         robot.stop()
 
-    from backend.services.simulation import unpack_trajectory
-
-    for run_id in runs:
-        run = records.get_run(session, run_id)
-        frames = unpack_trajectory(run.trajectory)
-        print(
-            "DEBUG",
-            run_id,
-            run.results["end_reason"],
-            len(run.results["touchdowns"]),
-            np.nanmin(frames["pitch"]),
-            np.nanmax(frames["pitch"]),
-            run.results["touchdown_controls"][:3],
-            [td["wall"] for td in run.results["touchdowns"][:3]],
-        )
-    for i, subset in enumerate((runs[:3], runs[1:], [replay_run(session, r).id for r in runs])):
-        f = calibrations.calibrate_runs(session, subset, name=f"dbg{i}")
-        print("DEBUG", i, f["params"], f["stderr"]["alpha"], f["rms_residual_after"])
     fit = calibrations.calibrate_runs(session, runs, name="virtual")
     # Measured (seed 5, docs/calibration.md): alpha 72.07 ± 0.52, c_zeta 1.234 ± 0.040, c_psi 0.789 ±
     # 0.019, psi0 offsets 0.64 / -0.67 ± 0.09 deg, zeta0 offsets 0.0047 / -0.0041 ± 0.0008, from about
