@@ -29,7 +29,7 @@ from backend.services import records
 from frontend.viewer.ghost_models import BASE, ghost_model, model_choices, realised
 from frontend.viewer.motion import STANCE, TRAIL_STRIDE, Controls, JumpPlan, PathClip, SimulatedClimb, model_jump
 from frontend.viewer.recordings import Recording, load_recording
-from frontend.viewer.scene import ChuteScene
+from frontend.viewer.scene import TOUCHDOWN_MARKERS, ChuteScene
 from sim_core import ControlSchedule, FixedPoint, LegControl, PhysicalParams
 from sim_core.errors import NoGaitFound
 from sim_core.fixed_points import gait_of
@@ -314,7 +314,6 @@ class LiveMode(_Mode):
     """The robot as the tracker sees it, and the model's prediction of the jump under way."""
 
     name = "live"
-    TRAIL_SECONDS = 3.0
 
     def __init__(self, client: viser.ClientHandle, scene: ChuteScene, lock, robot_service, sessions=None):
         super().__init__(client, scene, lock)
@@ -336,20 +335,74 @@ class LiveMode(_Mode):
         self._marked = 0
         self._run = None
         self.last_error: float | None = None
+        # The robot's trail is streamed (ChuteScene.live_trail) from the tracker's frames by their
+        # index (PoseHistory.count), not their time: the camera's clock need not restart at a
+        # run, and the virtual robot's does. The run's first frame this view knows, and the next
+        # frame to draw (None: draw the run's again, from the first).
+        self._tracker = None
+        self._trail_from, self._trail_next = 0, None
+        self._ghost_drawn: tuple[int, int] = (-1, 0)  # the ghost's jump, and its trail's points drawn
 
-    def _touchdowns(self):
+    def activate(self) -> None:
+        super().activate()
+        # Choosing a mode clears the scene: this run's markers and trail are drawn again.
+        self._marked, self._ghost_drawn, self._trail_next = 0, (-1, 0), None
+
+    def _touchdowns(self, tracker):
+        """The latest run's touchdowns; a new run (or tracker) starts the scene's history afresh."""
         run = self.robot_service.run_snapshot() if self.robot_service is not None else None
+        if tracker is not self._tracker:  # connected (again): frames are counted afresh
+            self._tracker, self._trail_next = tracker, None
+            self._trail_from = 0 if tracker is None else tracker.count()
+            self.scene.live_trail.clear()
         if (run is None) != (self._run is None) or (run is not None and run.started != self._run.started):
             self._ghosts, self._marked, self.last_error = {}, 0, None  # a new run
+            self._ghost_drawn = (-1, 0)
             self.scene.clear_history()
+            # The frames not drawn yet are the run's (or from the moment before it: the view looks
+            # each frame); after a time in another mode its first is not known: from now on.
+            if self._trail_next is not None:
+                self._trail_from = self._trail_next
+            elif tracker is not None:
+                self._trail_from = tracker.count()
+        if self._trail_next is None:
+            self._trail_next = self._trail_from
         self._run = run
         return [] if run is None else list(run.touchdowns)
+
+    def _extend_trail(self, tracker) -> None:
+        """Draw the robot's frames that arrived since the last frame (the trail keeps the newest)."""
+        end = tracker.count()
+        # Frames arriving between count() and poses_from() are drawn at the next frame.
+        fresh = tracker.poses_from(self._trail_next)[: end - self._trail_next]
+        self._trail_next = end
+        if fresh:
+            self.scene.live_trail.extend(np.array([(p.x, p.y) for p in fresh]))
+
+    def _show_ghost(self, ghost: JumpPlan | None, k: int, t: float) -> None:
+        """The model's jump from touchdown ``k`` at time ``t`` [s]: its body, and its trail since
+        the touchdown streamed (ChuteScene.live_ghost_trail), afresh at each jump."""
+        if ghost is None:
+            self.scene.show_ghost(None)
+            if self._ghost_drawn != (-1, 0):
+                self.scene.live_ghost_trail.clear()
+                self._ghost_drawn = (-1, 0)
+            return
+        self.scene.show_ghost(ghost.clip.pose_at(t))
+        jump, drawn = self._ghost_drawn
+        if jump != k:
+            self.scene.live_ghost_trail.clear()
+            drawn = 0
+        trail = ghost.clip.body_until(t)[::TRAIL_STRIDE]
+        self.scene.live_ghost_trail.extend(trail[drawn:])
+        self._ghost_drawn = (k, max(drawn, len(trail)))
 
     def use_ghost_model(self, name: str) -> None:
         """Predict the ghost with model ``name`` (:func:`frontend.viewer.ghost_models.model_choices`) from now on."""
         model = ghost_model(self.sessions, name)
         with self.lock:
             self.ghost_model, self._ghosts = model, {}
+            self._ghost_drawn = (-1, 0)  # the jump under way's trail is drawn again, by this model
 
     def _ghost(self, touchdowns, k: int) -> JumpPlan | None:
         if k in self._ghosts:
@@ -376,25 +429,24 @@ class LiveMode(_Mode):
     def frame(self, dt: float) -> None:
         service = self.robot_service
         tracker = None if service is None else service.tracker
-        pose = None if tracker is None else tracker.latest()
-        touchdowns = self._touchdowns()
-        for touchdown in touchdowns[self._marked :]:
+        touchdowns = self._touchdowns(tracker)
+        # After a mode change, only the markers the ring keeps are drawn again.
+        for touchdown in touchdowns[max(self._marked, len(touchdowns) - TOUCHDOWN_MARKERS) :]:
             self.scene.add_touchdown(touchdown.wall, touchdown.foot_height)
             previous = self._ghosts.get(touchdown.index - 1)
             if previous is not None and previous.failure is None:
                 self.last_error = touchdown.body_height - previous.next_height
         self._marked = len(touchdowns)
+        if tracker is None:
+            return
+        self._extend_trail(tracker)
+        pose = tracker.latest()
         if pose is None:
             return
-        recent = tracker.poses_since(pose.time - self.TRAIL_SECONDS)
-        trail = np.array([[p.x, p.y] for p in recent]).reshape(-1, 2)
         body = PathClip.from_body([pose.time], [pose.x], [pose.y]).pose_at(pose.time)
-        self.scene.show(body, None, trail, follow=True)
-        ghost = self._ghost(touchdowns, len(touchdowns) - 1) if touchdowns and self.gui_ghost.value else None
-        if ghost is None:
-            self.scene.show_ghost(None)
-        else:
-            self.scene.show_ghost(ghost.clip.pose_at(pose.time), ghost.clip.body_until(pose.time)[::TRAIL_STRIDE])
+        self.scene.show(body, None, None, follow=True)
+        k = len(touchdowns) - 1
+        self._show_ghost(self._ghost(touchdowns, k) if touchdowns and self.gui_ghost.value else None, k, pose.time)
 
     def readout(self, updates_per_s: float) -> str:
         service = self.robot_service

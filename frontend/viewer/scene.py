@@ -30,6 +30,10 @@ DEPTH = 0.35  # [m] how deep the walls are drawn (the model is planar)
 BODY_RADIUS = 0.022  # [m]
 LEG_THICKNESS = 0.012  # [m]
 TRAIL_JUMPS = 30  # past jumps whose trail stays drawn
+# Live mode's trails are streamed (StreamedTrail): pieces of PIECE_POINTS points, each sent once.
+PIECE_POINTS = 25  # a piece's points (the next piece starts at its last): 0.24 s of the tracker's 100 Hz
+LIVE_TRAIL_PIECES = 40  # finished pieces of the robot's path kept: 960 tracker frames, 9.6 s at 100 Hz
+GHOST_TRAIL_PIECES = 16  # finished pieces of the live ghost's jump kept: 1.1 s of the model's path
 TOUCHDOWN_MARKERS = 60
 HEADROOM = 1.5  # [m] walls and ruler reach this far above the highest point shown
 FOLLOW_MARGIN = 0.6  # [m] with follow on, the body stays this high: where the default camera looks
@@ -125,6 +129,9 @@ class ChuteScene:
         self.ghost_jump_trails = NodeRing(
             "/chute/ghost/jump_", TRAIL_JUMPS, self._trail_maker(GHOST_TRAIL_COLOR, 0.003)
         )
+        # Live mode's: its nodes are made when first drawn (none in simulate, replay or a shared file).
+        self.live_trail = StreamedTrail(scene, "/chute/trail/live/", LIVE_TRAIL_PIECES, TRAIL_COLOR, 0.003)
+        self.live_ghost_trail = StreamedTrail(scene, "/chute/ghost/live/", GHOST_TRAIL_PIECES, GHOST_TRAIL_COLOR, 0.003)
         self.reach(1.0)
 
     # Static parts -------------------------------------------------------------------------------
@@ -178,9 +185,10 @@ class ChuteScene:
         self._ruler_labels += len(growth.labels)
 
     # Per frame ----------------------------------------------------------------------------------
-    def show(self, pose: Pose, idle_leg: LegControl | None, trail: np.ndarray, *, follow: bool) -> None:
+    def show(self, pose: Pose, idle_leg: LegControl | None, trail: np.ndarray | None, *, follow: bool) -> None:
         """Move the robot to ``pose``; ``idle_leg`` is the controls of the leg not drawn by the pose
-        (None: legs unknown, as for tracker data); ``trail`` (n, 2) the body's path this jump."""
+        (None: legs unknown, as for tracker data); ``trail`` (n, 2) the body's path this jump (None:
+        drawn otherwise, as live mode streams it into :attr:`live_trail`)."""
         robot = self.robot
         body = (pose.x, pose.y)
         self.body.position = tuple(to_scene(*body))
@@ -195,7 +203,7 @@ class ChuteScene:
         for wall, leg in self.legs.items():
             leg.visible = legs_known and (wall == pose.leg_wall or idle_leg is not None)
         self.foot.visible = legs_known and pose.phase == STANCE
-        if len(trail) >= 2:
+        if trail is not None and len(trail) >= 2:
             self.trail.points = polyline_segments(trail)
         self.reach(pose.y)
         if follow:
@@ -247,6 +255,8 @@ class ChuteScene:
         """Hide trails and touchdown markers (a reset or a new run)."""
         for ring in (self.touchdown_markers, self.jump_trails, self.ghost_jump_trails):
             ring.clear()
+        self.live_trail.clear()
+        self.live_ghost_trail.clear()
         self.trail.points = np.zeros((1, 2, 3))
         self.offset = 0.0
         self.root.position = (0.0, 0.0, 0.0)
@@ -281,3 +291,53 @@ class NodeRing:
         for node in self.nodes:
             node.visible = False
         self.count = 0
+
+
+class StreamedTrail:
+    """A path drawn as it grows, each point sent to the browser about once (live mode: the
+    robot's tracked path, the ghost's jump under way).
+
+    viser sends a node's whole ``points`` each time they change, so a trail drawn as one node is
+    sent whole every frame, and grows. Here the path is cut into pieces of :data:`PIECE_POINTS`
+    points, each starting at the last point of the one before (the line is unbroken). The piece
+    under way is node ``prefix + "now"``, sent again as it grows (at most PIECE_POINTS - 1
+    segments); a finished piece is shown by a node of a :class:`NodeRing` (``prefix + "piece_k"``)
+    and not sent again: the last ``pieces`` finished pieces stay drawn, the oldest node reused
+    for the newest. Nodes are made when first needed. :meth:`clear` starts afresh.
+    """
+
+    def __init__(self, scene: viser.SceneApi, prefix: str, pieces: int, color, thickness: float):
+        self.scene, self.prefix, self.color, self.thickness = scene, prefix, color, thickness
+        self.finished = NodeRing(f"{prefix}piece_", pieces, self._make)
+        self.now: viser.LineSegmentsHandle | None = None
+        self.piece = np.empty((0, 2))  # the piece under way's points (n, 2) [m]
+
+    def _make(self, name: str) -> viser.LineSegmentsHandle:
+        points = np.zeros((1, 2, 3))
+        return self.scene.add_line_segments(
+            name, points=points, colors=self.color, thickness=self.thickness, visible=False
+        )
+
+    def extend(self, points: np.ndarray) -> None:
+        """Add ``points`` (n, 2) [m, model plane] to the path's end."""
+        if len(points) == 0:
+            return
+        path = np.concatenate([self.piece, np.asarray(points, dtype=float).reshape(-1, 2)])
+        step = PIECE_POINTS - 1
+        done = (len(path) - 1) // step  # pieces finished by these points
+        # Only the last ``size`` of them would stay drawn.
+        for k in range(max(done - self.finished.size, 0), done):
+            self.finished.show_next(points=polyline_segments(path[k * step : (k + 1) * step + 1]))
+        self.piece = path[done * step :]
+        if self.now is None:
+            self.now = self._make(f"{self.prefix}now")
+            self.now.visible = True
+        # One point left: a segment of no length (the next point makes it a line).
+        self.now.points = polyline_segments(self.piece if len(self.piece) >= 2 else self.piece[[0, 0]])
+
+    def clear(self) -> None:
+        """Nothing drawn; the next point starts a new path."""
+        self.finished.clear()
+        self.piece = np.empty((0, 2))
+        if self.now is not None:
+            self.now.points = np.zeros((1, 2, 3))

@@ -2,9 +2,10 @@
 
 It connects as viser's web client does (its subprotocol, the page's Origin, the panel's
 ``/viewer/ID`` path when it has one), sends one camera message (viser counts a client as
-connected from its first), and then receives on a thread of its own, keeping the time each
-websocket message arrived: one message is one update of the view (a frame's changes, sent
-together).
+connected from its first), and then receives on a thread of its own, keeping the time and size
+of each websocket message: one message is one update of the view (a frame's changes, sent
+together). It reads the GUI's labels from the updates (:func:`decode`), so it can change a
+control as a person would (:meth:`HeadlessViewer.set_gui`: the Mode dropdown, say).
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import time
 
 import msgspec
 import viser
+import zstandard
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
@@ -29,6 +31,15 @@ CAMERA = {
     "look_at": (0.0, 0.0, 0.6),
     "up_direction": (0.0, 0.0, 1.0),
 }
+
+
+def decode(update: bytes) -> list[dict]:
+    """The messages in one update as viser's web client reads them (viser/infra/_infra.py: the
+    lengths of the msgpack part and of its zstd, the zstd, then the arrays, each 8-byte aligned);
+    an array stays a placeholder ``{"__binary_index": i, "dtype": ...}`` (not needed here)."""
+    size, compressed = int.from_bytes(update[:8], "little"), int.from_bytes(update[8:16], "little")
+    inner = zstandard.ZstdDecompressor().decompress(update[16 : 16 + compressed], max_output_size=size)
+    return msgspec.msgpack.decode(inner)["messages"]
 
 
 class HeadlessViewer:
@@ -48,7 +59,9 @@ class HeadlessViewer:
         )
         self.socket.send(msgspec.msgpack.encode(CAMERA))
         self.arrivals: list[float] = []  # time.monotonic() of each message
+        self.sizes: list[int] = []  # [bytes] of each message
         self.bytes = 0
+        self.gui: dict[str, str] = {}  # label -> uuid of each GUI control made so far
         self._thread = threading.Thread(target=self._receive, name="headless-viewer", daemon=True)
         self._thread.start()
 
@@ -56,9 +69,27 @@ class HeadlessViewer:
         try:
             for message in self.socket:
                 self.arrivals.append(time.monotonic())
+                self.sizes.append(len(message))
                 self.bytes += len(message)
+                self._read_gui(message)
         except ConnectionClosed:
             pass
+
+    def _read_gui(self, update: bytes) -> None:
+        for message in decode(update):
+            if message["type"].startswith("Gui") and "label" in message.get("props", {}):
+                self.gui[message["props"]["label"]] = message["uuid"]
+
+    def set_gui(self, label: str, value, timeout: float = 10.0) -> None:
+        """Set the control labelled ``label`` to ``value`` as the browser does when a person
+        changes it (viser's ``GuiUpdateMessage``); waits up to ``timeout`` [s] for the control."""
+        deadline = time.monotonic() + timeout
+        while label not in self.gui:
+            if time.monotonic() > deadline:
+                raise TimeoutError(f"no GUI control labelled {label!r} arrived")
+            time.sleep(0.02)
+        update = {"type": "GuiUpdateMessage", "uuid": self.gui[label], "updates": {"value": value}}
+        self.socket.send(msgspec.msgpack.encode(update))
 
     def updates_per_s(self, since: float, until: float | None = None) -> float:
         """Messages per second that arrived between ``since`` and ``until`` (now) [time.monotonic()]."""

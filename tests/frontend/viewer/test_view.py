@@ -304,6 +304,8 @@ def test_live_mode_shows_the_robot_to_everyone_who_chooses_it_with_the_model_bes
         assert recorded >= 6
         _wait_for(lambda: live._marked == recorded and also.modes["live"]._marked == recorded)
         assert watching.scene.ghost.visible, "the model's jump from the last touchdown is drawn"
+        ghost_trail = watching.scene.live_ghost_trail
+        assert ghost_trail.finished.count or len(ghost_trail.piece) >= 2, "and its trail since the touchdown"
         assert simulating.mode.name == "simulate" and simulating.modes["live"]._marked == 0, "choosing is each one's"
         # Without noise the robot is the model: the ghost lands where the robot touched down.
         assert abs(live.last_error) < 0.01, f"model's touchdown height error {live.last_error:+.4f} m"

@@ -1,0 +1,196 @@
+"""Live mode's trail: bounded, sent a piece at a time (``StreamedTrail``), and drawn afresh at
+each run's start.
+
+:class:`LiveMode` draws frame by frame (60 a second) on a private viser server's scene while its
+tracker is fed as the virtual robot feeds it: 100 frames a second, the clock starting again at
+each run. What the browser gets is what viser's serializer records, decoded as the browser
+decodes it (tests/frontend/viewer/test_share.py); byte counts are of the arrays sent.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import threading
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+import viser
+
+from backend.robot.live_run import RunSnapshot
+from backend.robot.touchdown import Touchdown
+from backend.robot.tracker import Calibration, Pose, PoseHistory
+from frontend.viewer.geometry import polyline_segments
+from frontend.viewer.modes import LiveMode
+from frontend.viewer.scene import LIVE_TRAIL_PIECES, PIECE_POINTS, ChuteScene, StreamedTrail
+from sim_core import get_preset
+from sim_core.walls import Wall
+from tests.frontend.viewer.test_share import SceneTree, decode_recording
+
+ROBOT = get_preset("paper")
+TRACKER_RATE = 100.0  # [Hz] the virtual robot's tracker frames
+FRAME_RATE = 60.0  # [Hz] the view's frames
+SEGMENT_BYTES = 2 * 3 * 4  # a segment's two points, float32
+# A frame sends at most the piece under way and one finished piece.
+FRAME_TRAIL_BYTES = 2 * (PIECE_POINTS - 1) * SEGMENT_BYTES
+TRAIL_SEGMENTS = LIVE_TRAIL_PIECES * (PIECE_POINTS - 1)  # a full trail: its finished pieces
+
+
+def climb(t: np.ndarray, start_height: float) -> np.ndarray:
+    """[m] a body zigzagging between the walls as it climbs, (n, 2)."""
+    return np.column_stack([0.1 * np.sin(2 * np.pi * t), start_height + 0.05 * t])
+
+
+@dataclass
+class Robot:
+    """The robot service as live mode reads it: its tracker and its latest run."""
+
+    tracker: PoseHistory
+    run: RunSnapshot | None = None
+
+    def run_snapshot(self) -> RunSnapshot | None:
+        return self.run
+
+
+class Live:
+    """Live mode on a viser server's scene, recorded frame by frame."""
+
+    def __init__(self, server: viser.ViserServer):
+        self.robot = Robot(PoseHistory(Calibration()))
+        self.mode = LiveMode(server, ChuteScene(server.scene, ROBOT), threading.RLock(), self.robot)
+        self.serializer = server.get_scene_serializer()
+        self.frames = 0  # frames drawn so far
+        self.ends: list[int] = []  # frames drawn by the end of each run
+        self.frame()  # the robot connected, no run yet: the view is watching when the first starts
+
+    def frame(self) -> None:
+        self.mode.frame(1 / FRAME_RATE)
+        self.serializer.insert_sleep(1 / FRAME_RATE)
+        self.frames += 1
+
+    def run(self, seconds: float, start_height: float) -> np.ndarray:
+        """A run of ``seconds``: its poses (n, 2) [m], fed at the tracker's rate while drawing."""
+        self.robot.run = RunSnapshot(run_id=len(self.ends) + 1, started=time.time(), jumps=100, max_seconds=60.0)
+        times = np.arange(0.0, seconds, 1 / TRACKER_RATE)  # the robot's clock: from 0 each run
+        path = climb(times, start_height)
+        fed = 0
+        for k in range(int(seconds * FRAME_RATE)):
+            while fed < times.size and times[fed] <= k / FRAME_RATE:
+                self.robot.tracker.add(Pose(float(times[fed]), *map(float, path[fed])))
+                fed += 1
+            self.frame()
+        self.ends.append(self.frames)
+        return path[:fed]
+
+    def recorded(self) -> list[tuple[SceneTree, int]]:
+        """After each frame: the browser's scene, and the bytes of trail arrays the frame sent."""
+        messages = decode_recording(self.serializer.serialize())["messages"]
+        tree, out, i = SceneTree(), [], 0
+        for frame in range(self.frames):
+            sent = 0
+            while i < len(messages) and messages[i][0] <= (frame + 0.5) / FRAME_RATE:
+                message = messages[i][1]
+                tree.apply(message)
+                if message.get("name", "").startswith("/chute/trail"):
+                    sent += _array_bytes(message)
+                i += 1
+            out.append((_copy(tree), sent))
+        return out
+
+
+def _array_bytes(value) -> int:
+    if isinstance(value, np.ndarray):
+        return value.nbytes
+    if isinstance(value, dict):
+        return sum(_array_bytes(item) for item in value.values())
+    return 0
+
+
+def _copy(tree: SceneTree) -> dict:
+    return {name: dict(node, props=dict(node["props"])) for name, node in tree.shown().items()}
+
+
+def trail_drawn(scene: dict) -> set[bytes]:
+    """The segments the trail nodes draw (those of some length), each as its float32 bytes."""
+    segments = [
+        node["props"]["points"].reshape(-1, 2, 3)
+        for name, node in scene.items()
+        if name.startswith("/chute/trail/") and node["kind"] == "LineSegmentsMessage"
+    ]
+    drawn = np.concatenate(segments) if segments else np.zeros((0, 2, 3), np.float32)
+    return {segment.tobytes() for segment in drawn if np.any(segment[0] != segment[1])}
+
+
+def segments_of(path: np.ndarray) -> set[bytes]:
+    return {segment.tobytes() for segment in polyline_segments(path).astype(np.float32)}
+
+
+@pytest.fixture
+def server():
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    yield server
+    server.stop()
+
+
+def test_the_live_trail_is_bounded_sent_a_piece_at_a_time_and_afresh_at_each_run(server):
+    live = Live(server)
+    first = live.run(30.0, start_height=0.1)  # 3000 tracker frames: more than the trail keeps
+    second = live.run(2.0, start_height=0.12)  # the robot back near the floor, its clock from 0
+    frames = live.recorded()
+
+    sent = [trail_bytes for _scene, trail_bytes in frames]
+    assert max(sent) <= FRAME_TRAIL_BYTES, f"a frame sent {max(sent)} B of trail: the trail is sent whole"
+
+    end_of_first, _ = frames[live.ends[0] - 1]
+    shown = trail_drawn(end_of_first)
+    assert shown == segments_of(first[-(len(shown) + 1) :]), "the trail is the robot's latest path, unbroken"
+    assert TRAIL_SEGMENTS <= len(shown) < TRAIL_SEGMENTS + PIECE_POINTS, "it keeps its bound: 9.6 s at 100 Hz"
+
+    run_one = segments_of(first)
+    for k in range(live.ends[0], live.ends[1]):
+        scene, _ = frames[k]
+        assert not trail_drawn(scene) & run_one, f"frame {k - live.ends[0]} of the second run draws the first's"
+    end_of_second, _ = frames[-1]
+    assert trail_drawn(end_of_second) == segments_of(second), "the second run's path from its start"
+
+
+def test_choosing_live_again_draws_the_runs_trail_and_markers_again(server):
+    live = Live(server)
+    path = live.run(3.0, start_height=0.1)
+    touchdowns = tuple(
+        Touchdown(k, 0.5 * (k + 1), wall, (-0.8, -0.15), float(path[50 * (k + 1), 1]), 0.1, 20)
+        for k, wall in enumerate((Wall.LEFT, Wall.RIGHT, Wall.LEFT))
+    )
+    live.robot.run = dataclasses.replace(live.robot.run, touchdowns=touchdowns)
+    live.frame()
+    live.mode.scene.clear_history()  # as choosing another mode does (ViewerSession.set_mode)
+    live.mode.activate()
+    live.frame()
+    scene, _ = live.recorded()[-1]
+    assert trail_drawn(scene) == segments_of(path), "the run's 3 s of frames, drawn again"
+    markers = [node["position"] for name, node in scene.items() if name.startswith("/chute/touchdowns/")]
+    assert len(markers) == len(touchdowns), "the run's touchdowns, marked again"
+
+
+@pytest.mark.parametrize("chunk", [1, 2, 7, PIECE_POINTS - 1, PIECE_POINTS, 100, 5000])
+def test_a_streamed_trail_draws_the_path_however_it_arrives(server, chunk):
+    """Points added one at a time or thousands at once: the same unbroken path, its newest part."""
+    trail = StreamedTrail(server.scene, "/chute/trail/live/", 4, (0, 0, 0), 0.003)
+    path = climb(np.arange(0.0, 7.0, 0.01), 0.1)  # 700 points
+    for start in range(0, len(path), chunk):
+        trail.extend(path[start : start + chunk])
+    shown = trail_drawn(browser_scene(server))
+    assert shown == segments_of(path[-(len(shown) + 1) :])
+    assert 4 * (PIECE_POINTS - 1) <= len(shown) < 5 * (PIECE_POINTS - 1)
+    trail.clear()
+    trail.extend(path[:3])
+    assert trail_drawn(browser_scene(server)) == segments_of(path[:3]), "cleared: the new path alone"
+
+
+def browser_scene(server: viser.ViserServer) -> dict:
+    """The scene a browser that connected now would get."""
+    tree = SceneTree()
+    for _t, message in decode_recording(server.get_scene_serializer().serialize())["messages"]:
+        tree.apply(message)
+    return _copy(tree)
