@@ -6,7 +6,8 @@ SQLite in a temporary directory) connects to ``socket://`` on a tap in this proc
 every byte to and from the virtual robot (``parkour robot-sim``, its own process) and timestamps each
 frame the PC sends, decoded with the link's own frame and message codecs. For each phase — idle,
 then ``--clients`` clients (default 20 and 50) POSTing ``/api/v1/sim/map`` back to back from another
-process — it reports the gaps between consecutive heartbeats (median, p99, max) and presses the
+process — it reports the gaps between consecutive heartbeats (median, p99, max; an ESTOP counts as
+the heartbeat it replaces, as during a press: ``heartbeat_only_gaps`` leaves them out) and presses the
 e-stop (no token) ``--presses`` times: the HTTP round trip (p50, p99, max) and how many the robot
 acknowledged; a RESET (the token's call) follows each press.
 
@@ -106,8 +107,8 @@ class Tap:
             self.frames.append((arrived, message.kind if isinstance(message, Command) else None))
 
 
-def gaps_ms(frames: list[tuple[float, Kind | None]], kind: Kind) -> dict:
-    times = [t for t, k in frames if k == kind]
+def gaps_ms(frames: list[tuple[float, Kind | None]], kinds: set[Kind]) -> dict:
+    times = [t for t, k in frames if k in kinds]
     gaps = sorted((b - a) * 1000 for a, b in itertools.pairwise(times))
     if not gaps:
         return {"n": 0}
@@ -143,7 +144,9 @@ def phase(client: httpx.Client, auth: dict, tap: Tap, seconds: float, presses: i
     time.sleep(max(0.0, start + seconds - time.monotonic()))
     frames = tap.since(start)
     return {
-        "heartbeat_gaps": gaps_ms(frames, Kind.HEARTBEAT),
+        # The robot's watchdog slots: a heartbeat, or the ESTOP the PC sends in its place (§3).
+        "heartbeat_gaps": gaps_ms(frames, {Kind.HEARTBEAT, Kind.ESTOP}),
+        "heartbeat_only_gaps": gaps_ms(frames, {Kind.HEARTBEAT}),
         "estop": {**round_trips_ms(http), "acknowledged": acknowledged} if http else {"n": 0},
     }
 

@@ -64,6 +64,7 @@ class RunSnapshot:
     end_reason: str | None = None
     disarm: str | None = None  # how the ending left the robot: "disarmed", "estopped" or why unconfirmed
     started_by: str | None = None  # who started it, as other panels are told
+    first_pose: int = 0  # the tracker's index of the run's first frame (its trail starts there)
 
     def command_for(self, leg: Leg) -> LegControl | None:
         return dict(self.commanded).get(leg)
@@ -111,7 +112,13 @@ class LiveRun:
 
     def __post_init__(self) -> None:
         self.snapshot = RunSnapshot(
-            self.run_id, self.started, self.jumps, self.max_seconds, self.target_m, started_by=self.started_by
+            self.run_id,
+            self.started,
+            self.jumps,
+            self.max_seconds,
+            self.target_m,
+            started_by=self.started_by,
+            first_pose=self.first_pose,
         )
 
     def stop(self, reason: str = "stopped") -> None:

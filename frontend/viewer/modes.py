@@ -359,9 +359,11 @@ class LiveMode(_Mode):
             self._ghosts, self._marked, self.last_error = {}, 0, None  # a new run
             self._ghost_drawn = (-1, 0)
             self.scene.clear_history()
-            # The frames not drawn yet are the run's (or from the moment before it: the view looks
-            # each frame); after a time in another mode its first is not known: from now on.
-            if self._trail_next is not None:
+            # A run's trail starts at its own first frame, however late this view first sees it;
+            # with no run, at the frames not drawn yet (or from now on).
+            if run is not None and tracker is not None:
+                self._trail_from, self._trail_next = run.first_pose, None
+            elif self._trail_next is not None:
                 self._trail_from = self._trail_next
             elif tracker is not None:
                 self._trail_from = tracker.count()

@@ -71,7 +71,10 @@ class Live:
 
     def run(self, seconds: float, start_height: float) -> np.ndarray:
         """A run of ``seconds``: its poses (n, 2) [m], fed at the tracker's rate while drawing."""
-        self.robot.run = RunSnapshot(run_id=len(self.ends) + 1, started=time.time(), jumps=100, max_seconds=60.0)
+        first = self.robot.tracker.count()
+        self.robot.run = RunSnapshot(
+            run_id=len(self.ends) + 1, started=time.time(), jumps=100, max_seconds=60.0, first_pose=first
+        )
         times = np.arange(0.0, seconds, 1 / TRACKER_RATE)  # the robot's clock: from 0 each run
         path = climb(times, start_height)
         fed = 0
@@ -171,6 +174,23 @@ def test_choosing_live_again_draws_the_runs_trail_and_markers_again(server):
     assert trail_drawn(scene) == segments_of(path), "the run's 3 s of frames, drawn again"
     markers = [node["position"] for name, node in scene.items() if name.startswith("/chute/touchdowns/")]
     assert len(markers) == len(touchdowns), "the run's touchdowns, marked again"
+
+
+def test_a_view_that_first_sees_a_run_under_way_draws_it_from_its_first_frame(server):
+    live = Live(server)
+    for k in range(50):  # the robot standing before the run: frames the view has drawn
+        live.robot.tracker.add(Pose(0.01 * k, 0.0, 0.05, 0.0))
+    live.frame()
+    first = live.robot.tracker.count()
+    live.robot.run = RunSnapshot(run_id=1, started=time.time(), jumps=100, max_seconds=60.0, first_pose=first)
+    path = climb(np.arange(0.0, 2.0, 1 / TRACKER_RATE), 0.1)
+    for t, (x, y) in zip(np.arange(0.0, 2.0, 1 / TRACKER_RATE), path, strict=True):
+        live.robot.tracker.add(Pose(float(t), float(x), float(y), 0.0))
+    live.mode.scene.clear_history()  # the browser was in another mode meanwhile, and comes back to live
+    live.mode.activate()
+    live.frame()
+    scene, _ = live.recorded()[-1]
+    assert trail_drawn(scene) == segments_of(path), "the run's own frames, from its first: none from before it"
 
 
 @pytest.mark.parametrize("chunk", [1, 2, 7, PIECE_POINTS - 1, PIECE_POINTS, 100, 5000])
