@@ -17,6 +17,7 @@ from cli.options import DataDirOption, handles_errors, note
 
 DEFAULT_VIEW_PORT = 8001
 YOUNG_COLLECTION_THRESHOLD = 20_000  # allocations between young collections (CPython 3.11: 700)
+GRACEFUL_SHUTDOWN_S = 10.0  # [s] a SIGTERM waits at most this long for responses still being sent
 
 app = typer.Typer(rich_markup_mode=None)
 
@@ -84,4 +85,6 @@ def serve_command(
     gc.collect()
     gc.freeze()
     gc.set_threshold(YOUNG_COLLECTION_THRESHOLD, 50, 100)
-    uvicorn.run(application, host=host, port=port, log_level="info")
+    # A backstop for responses that do not end by themselves at a SIGTERM (the robot's event streams
+    # do, backend/api/robot_events.py): uvicorn would otherwise wait for them for ever.
+    uvicorn.run(application, host=host, port=port, log_level="info", timeout_graceful_shutdown=GRACEFUL_SHUTDOWN_S)

@@ -11,8 +11,8 @@ import httpx
 import pytest
 import uvicorn
 
+from backend.api import robot_events
 from backend.api.app import create_app
-from backend.api.routes import robot as robot_routes
 from tests.helpers import free_port, start_service
 
 READ_GUARD_S = 5.0  # [s] a read that waits longer fails the test instead of hanging it (not a latency claim)
@@ -100,7 +100,7 @@ def test_the_first_event_is_the_robot_now_and_the_stream_is_held_to_the_security
             first = events.next()
             assert set(first) == {"estop", "state", "run"}
             assert (_latch(first), first["state"], first["run"]) == ((False, None), "disconnected", None)
-            assert events.other[0] == f"retry: {robot_routes.RECONNECT_MS}", "the browser reconnects soon"
+            assert events.other[0] == f"retry: {robot_events.RECONNECT_MS}", "the browser reconnects soon"
         finally:
             events.close()
         refused = client.get(f"{base}/api/v1/robot/events", headers={"Host": "evil.example"})
@@ -147,7 +147,7 @@ def test_the_stream_ends_when_its_client_goes_away(served):
 
 def test_a_quiet_stream_sends_keep_alive_comments(served, monkeypatch):
     base, _app, _auth = served
-    monkeypatch.setattr(robot_routes, "KEEP_ALIVE_S", 0.3)  # 10 s in service
+    monkeypatch.setattr(robot_events, "KEEP_ALIVE_S", 0.3)  # 10 s in service
     with _client() as client:
         events = Events(client, f"{base}/api/v1/robot/events")
         try:
@@ -159,7 +159,7 @@ def test_a_quiet_stream_sends_keep_alive_comments(served, monkeypatch):
 
 def test_streams_past_the_bound_are_refused_until_one_closes(served, monkeypatch):
     base, app, _auth = served
-    monkeypatch.setattr(robot_routes, "MAX_EVENT_STREAMS", 2)
+    monkeypatch.setattr(robot_events, "MAX_EVENT_STREAMS", 2)
     with _client() as client:
         held = [Events(client, f"{base}/api/v1/robot/events") for _ in range(2)]
         try:
@@ -167,7 +167,7 @@ def test_streams_past_the_bound_are_refused_until_one_closes(served, monkeypatch
                 events.next()
             refused = client.get(f"{base}/api/v1/robot/events")
             assert refused.status_code == 503
-            assert refused.json()["detail"] == robot_routes.TOO_MANY_STREAMS.format(2)
+            assert refused.json()["detail"] == robot_events.TOO_MANY_STREAMS.format(2)
             held.pop().close()
             _until(lambda: app.state.robot_event_streams.open == 1, "a closed stream gave its place back")
             again = Events(client, f"{base}/api/v1/robot/events")
