@@ -15,14 +15,20 @@ import dataclasses
 import json
 import math
 
-from sqlalchemy import Float, Integer, Select, case, cast, func, select
+from sqlalchemy import Float, Integer, case, cast, func, select
 from sqlalchemy.orm import Session
 from sqlalchemy.orm.attributes import set_committed_value
 
+from backend.errors import Conflict as Conflict  # re-exported until every caller imports backend.errors
+from backend.errors import NotFound as NotFound
+from backend.repositories.common import fetch as fetch  # re-exported until every caller imports repositories
+from backend.repositories.common import locked as locked
+from backend.repositories.common import newest_first as newest_first
+from backend.repositories.common import page as page
 from backend.schemas import ExperimentCreate, ExperimentUpdate, RunCreate
 from backend.services.exports import flat_record
 from backend.services.simulation import simulate_run
-from backend.store.database import freeing_space, lock_for_write
+from backend.store.database import freeing_space
 from backend.store.models import Experiment, Job, Run, RunTag
 from backend.store.run_record import RunRecord
 from backend.store.runs import SORTS as SORTS  # re-exported: the API's query parameters are checked against them
@@ -30,15 +36,6 @@ from backend.store.runs import RunFilter, add_run, filtered, listed_page
 from sim_core.errors import ParameterError
 
 MAX_PAGE = 500
-
-
-class NotFound(LookupError):
-    def __init__(self, what: str, identifier: int):
-        super().__init__(f"{what} {identifier} does not exist")
-
-
-class Conflict(RuntimeError):
-    """The request contradicts stored data (e.g. deleting an experiment that still has runs)."""
 
 
 def create_experiment(session: Session, body: ExperimentCreate) -> Experiment:
@@ -221,31 +218,3 @@ def aggregate_runs(session: Session, where: RunFilter, by: str, bins: int | None
             }
         groups.append(group)
     return groups
-
-
-def fetch(session: Session, model: type, identifier: int, what: str, **options):
-    """The row of ``model`` with primary key ``identifier``; :class:`NotFound` names ``what`` if none."""
-    row = session.get(model, identifier, **options)
-    if row is None:
-        raise NotFound(what, identifier)
-    return row
-
-
-def locked(session: Session, model: type, identifier: int, what: str):
-    """:func:`fetch` for a change: under the write lock (SQLite), the row locked ``FOR UPDATE``
-    (PostgreSQL), read fresh even if the session holds an older copy."""
-    lock_for_write(session)
-    return fetch(session, model, identifier, what, with_for_update=True, populate_existing=True)
-
-
-def newest_first(model: type, limit: int, cursor: int | None) -> Select:
-    """The query for one keyset page of ``model`` by ``id``, newest first (``limit + 1`` rows: see :func:`page`)."""
-    query = select(model).order_by(model.id.desc()).limit(limit + 1)
-    return query if cursor is None else query.where(model.id < cursor)
-
-
-def page(rows: list, limit: int) -> tuple[list, int | None]:
-    """A keyset page from ``limit + 1`` rows fetched newest first: the rows and the next cursor."""
-    if len(rows) > limit:
-        return rows[:limit], rows[limit - 1].id
-    return rows, None
