@@ -24,6 +24,7 @@ from backend.robot.link import EstopLatched, LinkError
 from backend.services import records
 from backend.services.compute import ComputeBusy, ComputeFailed, ComputeTimeout
 from backend.services.robot import RobotUnavailable
+from backend.services.robot_tracker import TrackerPortInUse
 from backend.store.database import StorageFull
 from sim_core import FixedPointNotFound, ParameterError
 
@@ -36,6 +37,7 @@ STATUS_OF: dict[type[Exception], tuple[int, str]] = {
     records.NotFound: (status.HTTP_404_NOT_FOUND, "{}"),
     records.Conflict: (status.HTTP_409_CONFLICT, "{}"),
     RobotUnavailable: (status.HTTP_409_CONFLICT, "{}"),
+    TrackerPortInUse: (status.HTTP_409_CONFLICT, "{}"),
     EstopLatched: (status.HTTP_409_CONFLICT, "{}"),  # before LinkError, its base: the latch is no outage
     LinkError: (status.HTTP_503_SERVICE_UNAVAILABLE, "robot link: {}"),
     FixedPointNotFound: (status.HTTP_422_UNPROCESSABLE_CONTENT, "{}"),

@@ -14,8 +14,6 @@ from __future__ import annotations
 
 import asyncio
 import concurrent.futures
-import errno
-import logging
 import threading
 from pathlib import Path
 
@@ -23,20 +21,16 @@ from backend.robot.latch import EstopLatch
 from backend.robot.limits import ServoLimits
 from backend.robot.link import EstopResult, LinkError, LinkState, RobotLink
 from backend.robot.live_run import LiveRun, RunSnapshot, execute, telemetry_dict
-from backend.robot.natnet import parse_version
-from backend.robot.natnet_source import NatNetPoseSource
 from backend.robot.supervisor import LinkSupervisor
-from backend.robot.tracker import Calibration, UdpPoseSource
 from backend.schemas import RobotConnect, RobotRunCreate
 from backend.services.records import NotFound
 from backend.services.robot_journal import JournalWriter
 from backend.services.robot_records import open_robot_run, recover_interrupted
+from backend.services.robot_tracker import PoseSource, TrackerSlot
 from experiments.manifest import json_safe
 from sim_core.controls import LegControl
-from sim_core.errors import ParameterError
 from sim_core.presets import get_preset
 
-log = logging.getLogger("parkourlab.robot")
 ESTOP_ANSWER = 0.17  # [s] the longest an e-stop request waits for its answer (the link gives up at 0.15 s)
 STOP_WAIT = 10.0  # [s] the longest a stop or a disconnect waits for the run to end and be stored
 
@@ -54,8 +48,7 @@ class RobotService:
         self.robot = robot or get_preset("paper")  # the robot's physical parameters
         self.supervisor = LinkSupervisor()  # the link's one owner (backend/robot/supervisor.py)
         self.latch = EstopLatch(latch_path)  # outlives every link: held until a RESET is acknowledged
-        self.tracker: UdpPoseSource | NatNetPoseSource | None = None
-        self._tracker_request: RobotConnect | None = None  # what the tracker was opened with
+        self._trackers = TrackerSlot()  # the tracker, replaced only once a new one is open
         self._run: LiveRun | None = None  # the latest live run (its loop's); read its snapshot
         self._lock = threading.Lock()  # connect, disconnect and starting a run, one at a time
         # The e-stop's own thread: not the request pool that compute can fill, and no lock that a
@@ -68,6 +61,10 @@ class RobotService:
     @property
     def link(self) -> RobotLink | None:
         return self.supervisor.link
+
+    @property
+    def tracker(self) -> PoseSource | None:
+        return self._trackers.tracker
 
     def run_snapshot(self) -> RunSnapshot | None:
         """The latest live run as it is now (immutable), or None before the first."""
@@ -85,20 +82,16 @@ class RobotService:
         with self._lock:
             self._refuse_during_run("connect")
             limits = ServoLimits(tuple(body.psi0_limits_deg), tuple(body.zeta0_limits))
-            tracker = self._replace_tracker(body)
+            tracker = self._trackers.open_beside(body)
             link = RobotLink(
                 body.url, baud=body.baud, limits=limits, robot_address=int(body.robot_address, 16), latch=self.latch
             )
             try:
                 self.supervisor.connect(link)
             except LinkError:
-                tracker.close()
-                if self.tracker is None:
-                    self._restore_tracker()  # it gave way to this one's port
+                self._trackers.give_up(tracker)
                 raise
-            if self.tracker is not None:
-                self.tracker.close()
-            self.tracker, self._tracker_request = tracker, body
+            self._trackers.take(tracker, body)
         return self.status()
 
     def disconnect(self) -> dict:
@@ -123,10 +116,7 @@ class RobotService:
     def _disconnect(self) -> None:
         """Close the link (no more reconnects) and the tracker."""
         self.supervisor.disconnect()
-        if self.tracker is not None:
-            self.tracker.close()
-            self.tracker = None
-        self._tracker_request = None
+        self._trackers.close()
 
     def _refuse_during_run(self, what: str) -> None:
         """One operator per run: a link change while a live run goes on is a 409 naming the run (the
@@ -135,34 +125,6 @@ class RobotService:
         if run is not None and run.active:
             who = f" by {run.started_by}" if run.started_by else ""
             raise RobotUnavailable(f"live run {run.run_id} (started{who}) is in progress: stop it before you {what}")
-
-    def _replace_tracker(self, body: RobotConnect) -> UdpPoseSource | NatNetPoseSource:
-        """The tracker ``body`` asks for, opened beside the current one; if its port is taken, the
-        current one gives way (it may hold that port) and is closed. A port another program holds
-        is a 409 naming it; an address this machine cannot bind, a 422 naming the field."""
-        try:
-            return open_tracker(body)
-        except OSError as error:
-            if error.errno != errno.EADDRINUSE or self.tracker is None:
-                raise _tracker_error(body, error) from None
-        self.tracker.close()
-        self.tracker = None
-        try:
-            return open_tracker(body)
-        except OSError as error:
-            self._restore_tracker()
-            raise _tracker_error(body, error) from None
-
-    def _restore_tracker(self) -> None:
-        """Open the tracker the working link had again, after it gave way to a connect that failed."""
-        if self._tracker_request is None:
-            return
-        try:
-            self.tracker = open_tracker(self._tracker_request)
-        except OSError as error:
-            log.error("could not reopen the tracker at %s:%s: %s", self._tracker_request.tracker_host,
-                      self._tracker_request.tracker_port, error)  # fmt: skip
-            self._tracker_request = None
 
     def status(self) -> dict:
         """The robot as it is now, from immutable parts only (cheap: the live view sends it 20 times
@@ -316,33 +278,6 @@ class RobotService:
             return None
         hover = find_in_place_zeta0(self.robot.to_model(), legs[0].psi0, zeta0_range=(loop.zeta0_min, loop.zeta0_max))
         return loop.target_m, (hover, loop.kp, loop.ki, loop.kd, loop.zeta0_min, loop.zeta0_max)
-
-
-def open_tracker(body: RobotConnect) -> UdpPoseSource | NatNetPoseSource:
-    """The pose source ``body`` asks for: PKT1 datagrams, or the NatNet stream's rigid body, with
-    its camera calibration. Raises OSError if its socket cannot be bound."""
-    calibration = Calibration(tuple(body.calibration_origin), body.calibration_angle, body.calibration_scale)
-    if body.tracker_protocol == "pkt1":
-        return UdpPoseSource(body.tracker_host, body.tracker_port, calibration=calibration)
-    return NatNetPoseSource(
-        body.natnet_rigid_body_id,
-        interface=body.tracker_host,
-        port=body.tracker_port,
-        multicast_group=body.natnet_multicast_group,
-        server=(body.natnet_server_host, body.natnet_command_port),
-        version=None if body.natnet_version == "auto" else parse_version(body.natnet_version),
-        calibration=calibration,
-    )
-
-
-def _tracker_error(body: RobotConnect, error: OSError) -> Exception:
-    """A tracker socket that could not be bound, in the operator's terms."""
-    where = f"{body.tracker_host}:{body.tracker_port}"
-    if error.errno == errno.EADDRINUSE:
-        return RobotUnavailable(f"tracker_port {body.tracker_port}: {where} is in use by another program")
-    if error.errno in (errno.EACCES, errno.EPERM):
-        return ParameterError("tracker_port", f"this service may not bind {where} ({error.strerror})")
-    return ParameterError("tracker_host", f"cannot listen on {where}: {error.strerror or error}")
 
 
 def _estop_latch(latch: EstopLatch, link: RobotLink | None) -> dict:

@@ -28,7 +28,7 @@ from backend.robot.touchdown import detect_touchdowns
 from backend.robot.tracker import Calibration, UdpPoseSource
 from backend.robot.virtual import VirtualRobot
 from backend.schemas import RobotConnect
-from backend.services.robot import open_tracker
+from backend.services.robot_tracker import open_tracker
 from sim_core import LegControl, get_preset
 from sim_core.errors import ParameterError
 from sim_core.noise import NO_NOISE
