@@ -35,7 +35,6 @@ import json
 import socket
 import statistics
 import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -44,10 +43,17 @@ import httpx
 
 from backend.robot.firmware import Firmware
 from backend.robot.messages import RobotState
-from tests.helpers import HEAVY_JOB, POOL_FILLERS, free_port, start_map_load, start_service, stop_map_load
+from tests.helpers import (
+    HEAVY_JOB,
+    POOL_FILLERS,
+    free_port,
+    start_map_load,
+    start_robot_sim,
+    start_service,
+    stop_map_load,
+)
 from tests.robot_rig import PtyRobot
 
-ROBOT_START_S = 30.0  # [s] for parkour robot-sim to listen
 JOB_START_S = 120.0  # [s] for the heavy job's first chunk (its kernels loaded)
 TIMEOUT_S = 60.0  # [s] any one request: a bound, not a measurement
 REARM_STEPS = 6
@@ -122,27 +128,13 @@ class Bench:
         return result
 
 
-def start_robot(port: int, tracker_port: int) -> subprocess.Popen:
-    command = [sys.executable, "-m", "cli", "robot-sim", "--port", str(port), "--tracker", f"127.0.0.1:{tracker_port}"]
-    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    deadline = time.monotonic() + ROBOT_START_S
-    while time.monotonic() < deadline:
-        try:
-            socket.create_connection(("127.0.0.1", port), timeout=1).close()
-            return process
-        except OSError:
-            time.sleep(0.1)
-    process.kill()
-    raise SystemExit(f"parkour robot-sim did not listen on {port} within {ROBOT_START_S:g} s")
-
-
 def measure(repeats: int, clients: int) -> dict:
     result = {}
     with tempfile.TemporaryDirectory(prefix="bench-estop-") as data:
         port, tracker_port = free_port(), free_port(socket.SOCK_DGRAM)
         service = start_service(Path(data), port, "--no-view")
         robot_port = free_port()
-        robot = start_robot(robot_port, tracker_port)
+        robot = start_robot_sim(robot_port, tracker_port)
         base = f"http://127.0.0.1:{port}"
         bench = Bench(base, (Path(data) / "api_token").read_text().strip(), tracker_port)
         try:

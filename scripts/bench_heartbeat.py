@@ -25,10 +25,10 @@ from __future__ import annotations
 import argparse
 import itertools
 import json
+import math
 import socket
 import statistics
 import subprocess
-import sys
 import tempfile
 import threading
 import time
@@ -38,9 +38,8 @@ import httpx
 
 from backend.robot.messages import Command, Kind, decode
 from backend.robot.xbee import TX_REQUEST, FrameError, FrameParser, parse_tx_request
-from tests.helpers import free_port, start_map_load, start_service, stop_map_load
+from tests.helpers import free_port, start_map_load, start_robot_sim, start_service, stop_map_load
 
-ROBOT_START_S = 30.0  # [s] for parkour robot-sim to listen
 TIMEOUT_S = 60.0  # [s] any one request: a bound, not a measurement
 PRESS_EVERY_S = 0.5  # [s] between e-stop presses within a phase
 
@@ -107,6 +106,11 @@ class Tap:
             self.frames.append((arrived, message.kind if isinstance(message, Command) else None))
 
 
+def nearest_rank(ordered: list[float], fraction: float) -> float:
+    """The ``fraction`` percentile of sorted values by nearest rank (never below the median of few)."""
+    return ordered[max(0, math.ceil(fraction * len(ordered)) - 1)]
+
+
 def gaps_ms(frames: list[tuple[float, Kind | None]], kinds: set[Kind]) -> dict:
     times = [t for t, k in frames if k in kinds]
     gaps = sorted((b - a) * 1000 for a, b in itertools.pairwise(times))
@@ -115,7 +119,7 @@ def gaps_ms(frames: list[tuple[float, Kind | None]], kinds: set[Kind]) -> dict:
     return {
         "n": len(gaps),
         "median_ms": round(statistics.median(gaps), 1),
-        "p99_ms": round(gaps[int(0.99 * (len(gaps) - 1))], 1),
+        "p99_ms": round(nearest_rank(gaps, 0.99), 1),
         "max_ms": round(gaps[-1], 1),
     }
 
@@ -125,7 +129,7 @@ def round_trips_ms(values: list[float]) -> dict:
     return {
         "n": len(values),
         "p50_ms": round(statistics.median(values), 1),
-        "p99_ms": round(values[int(0.99 * (len(values) - 1))], 1),
+        "p99_ms": round(nearest_rank(values, 0.99), 1),
         "max_ms": round(values[-1], 1),
     }
 
@@ -151,26 +155,12 @@ def phase(client: httpx.Client, auth: dict, tap: Tap, seconds: float, presses: i
     }
 
 
-def start_robot(port: int, tracker_port: int) -> subprocess.Popen:
-    command = [sys.executable, "-m", "cli", "robot-sim", "--port", str(port), "--tracker", f"127.0.0.1:{tracker_port}"]
-    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    deadline = time.monotonic() + ROBOT_START_S
-    while time.monotonic() < deadline:
-        try:
-            socket.create_connection(("127.0.0.1", port), timeout=1).close()
-            return process
-        except OSError:
-            time.sleep(0.1)
-    process.kill()
-    raise SystemExit(f"parkour robot-sim did not listen on {port} within {ROBOT_START_S:g} s")
-
-
 def measure(seconds: float, clients: list[int], presses: int, tree: Path | None) -> dict:
     result = {}
     with tempfile.TemporaryDirectory(prefix="bench-heartbeat-") as data:
         port, tracker_port, robot_port = free_port(), free_port(socket.SOCK_DGRAM), free_port()
         service = start_service(Path(data), port, "--no-view", tree=tree)
-        robot = start_robot(robot_port, tracker_port)
+        robot = start_robot_sim(robot_port, tracker_port)
         tap = Tap(robot_port)
         base = f"http://127.0.0.1:{port}"
         client = httpx.Client(base_url=base, timeout=TIMEOUT_S)

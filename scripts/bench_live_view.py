@@ -27,8 +27,6 @@ import json
 import os
 import shutil
 import socket
-import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -36,7 +34,7 @@ from pathlib import Path
 import httpx
 
 from tests.frontend.viewer.headless import HeadlessViewer
-from tests.helpers import ROOT, free_port, start_service
+from tests.helpers import free_port, start_robot_sim, start_service
 
 CONTROLS = [{"psi0_deg": 30, "zeta0": 0.87}, {"psi0_deg": 30, "zeta0": 0.9}]  # a steady climb
 SETTLE_S = 2.0  # [s] after the browsers join, before the first run: their first scene is sent
@@ -57,19 +55,6 @@ def _wait(condition, timeout: float, what: str, period: float = 0.05) -> None:
         if time.monotonic() > deadline:
             raise TimeoutError(what)
         time.sleep(period)
-
-
-def _start_robot(port: int, tracker_port: int, noise: str) -> subprocess.Popen:
-    command = [sys.executable, "-m", "cli", "robot-sim", "--port", str(port),
-               "--tracker", f"127.0.0.1:{tracker_port}", "--noise", noise]  # fmt: skip
-    robot = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-
-    def listening() -> bool:
-        with socket.socket() as probe:
-            return probe.connect_ex(("127.0.0.1", port)) == 0
-
-    _wait(listening, 30, "the virtual robot did not start")
-    return robot
 
 
 @contextlib.contextmanager
@@ -113,7 +98,7 @@ def measure(
         data, api_port, view_port = Path(tmp) / "data", free_port(), free_port()
         service = start_service(data, api_port, "--view-port", str(view_port), tree=tree)
         robot_port, tracker_port = free_port(), free_port(socket.SOCK_DGRAM)
-        robot = _start_robot(robot_port, tracker_port, noise)
+        robot = start_robot_sim(robot_port, tracker_port, "--noise", noise)
         viewers: list[HeadlessViewer] = []
         stack = contextlib.ExitStack()
         token = (data / "api_token").read_text().strip()

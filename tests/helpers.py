@@ -53,6 +53,24 @@ def start_service(data_dir: Path, port: int, *options: str, tree: Path | None = 
     pytest.fail(f"the service did not start within {SERVICE_START_TIMEOUT:g} s")
 
 
+def start_robot_sim(port: int, tracker_port: int, *options: str) -> subprocess.Popen:
+    """``parkour robot-sim --port PORT --tracker 127.0.0.1:TRACKER_PORT OPTIONS...`` (the virtual
+    robot) in a subprocess, returned once it listens; the caller ends it."""
+    command = [sys.executable, "-m", "cli", "robot-sim", "--port", str(port),
+               "--tracker", f"127.0.0.1:{tracker_port}", *options]  # fmt: skip
+    process = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + SERVICE_START_TIMEOUT
+    while time.monotonic() < deadline:
+        try:
+            socket.create_connection(("127.0.0.1", port), timeout=1).close()
+            return process
+        except OSError:
+            time.sleep(0.1)
+    process.kill()
+    process.wait()
+    raise RuntimeError(f"parkour robot-sim did not listen on {port} within {SERVICE_START_TIMEOUT:g} s")
+
+
 def answer_within(seconds: float, call, *args):
     """``call(*args)``'s result, or a test failure if it has not returned after ``seconds`` — so a
     call that regresses into a hang fails instead of hanging the suite (the thread is left behind)."""
