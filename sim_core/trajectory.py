@@ -24,6 +24,7 @@ from sim_core.integrate import PSI, PSI_DOT, STATE_SIZE, TIME, ZETA, ZETA_DOT
 from sim_core.params import ModelParams, PhysicalParams
 from sim_core.poincare import check_jumps, check_section_state
 from sim_core.validation import check_range
+from sim_core.walls import wall_of
 
 STANCE = 0
 FLIGHT = 1
@@ -118,7 +119,7 @@ def simulate_trajectory(
     xdot, ydot = section
     for k in range(jumps):
         leg, next_leg = schedule[k], schedule[k + 1]
-        side = 1.0 if k % 2 == 0 else -1.0  # +1: stance on the left wall; -1: the right
+        side = -float(wall_of(k))  # the flipped frame's sign: +1 for a stance on the left wall (x = -d/2)
         status, next_xdot, next_ydot, rise, stance_time, flight_time, rows = stride.jump(
             xdot, ydot, leg.psi0, leg.zeta0, next_leg.psi0, next_leg.zeta0, *args, record
         )
