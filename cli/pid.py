@@ -7,11 +7,8 @@ from typing import Annotated
 import typer
 
 from cli.options import JsonOption, ModelSetup, SeedOption, handles_errors, print_json, with_model, with_noise
-from sim_core.controls import ControlSchedule, LegControl
 from sim_core.height_controller import HeightController
 from sim_core.noise import NO_NOISE, NoiseModel
-from sim_core.presets import START_GUESS
-from sim_core.validation import check_range
 
 app = typer.Typer(rich_markup_mode=None)
 
@@ -41,29 +38,14 @@ def pid_command(
     as_json: JsonOption = False,
 ) -> None:
     """Closed-loop climb to a target height: a PID on the touchdown height sets the next zeta0."""
-    from sim_core.closed_loop import closed_loop_climb
-    from sim_core.fixed_points import gait_of
-    from sim_core.poincare import check_jumps
-    from sim_core.sweep import find_in_place_zeta0
+    from experiments.fig12 import Config, PidClimb
 
     scales = setup.robot.scales
-    target_l0 = check_range("target", target, 0.0, 1e3) / scales.length
-    leg = LegControl.from_degrees(psi0, start_zeta0)
-    HeightController(target_l0, (zeta0_min + zeta0_max) / 2, kp, ki, kd, zeta0_min, zeta0_max)  # check first
-    check_jumps(jumps)
-    hover = find_in_place_zeta0(setup.model, leg.psi0, zeta0_range=(zeta0_min, zeta0_max))
-    controller = HeightController(target_l0, hover, kp, ki, kd, zeta0_min, zeta0_max)
-    start = gait_of(setup.model, ControlSchedule.of(leg), guess=START_GUESS).state
-    run = closed_loop_climb(
-        setup.model,
-        controller,
-        leg.psi0,
-        start,
-        jumps,
-        start_zeta0=start_zeta0,
-        noise=noise if noisy else NO_NOISE,
-        seed=seed,
-    )
+    config = Config(target_m=target, psi0_deg=psi0, start_zeta0=start_zeta0, jumps=jumps, kp=kp, ki=ki, kd=kd,
+                    zeta0_min=zeta0_min, zeta0_max=zeta0_max)  # fmt: skip
+    loop = PidClimb.of(setup.model, config, scales.length)
+    hover = loop.hover
+    run = loop.climb(noise if noisy else NO_NOISE, seed)
     result = run.to_dict()
     result["si"] = {
         "target_m": target,

@@ -17,11 +17,13 @@ from sim_core.closed_loop import ClosedLoopRun, closed_loop_climb
 from sim_core.controls import ControlSchedule, LegControl
 from sim_core.fixed_points import gait_of
 from sim_core.height_controller import HeightController
-from sim_core.noise import NoiseModel
-from sim_core.params import PhysicalParams
+from sim_core.noise import NO_NOISE, NoiseModel
+from sim_core.params import ModelParams, PhysicalParams
+from sim_core.poincare import check_jumps
 from sim_core.presets import START_GUESS
 from sim_core.sweep import find_in_place_zeta0
 from sim_core.trajectory import Trajectory, simulate_trajectory
+from sim_core.validation import check_range
 
 TITLE = "Fig. 12 — closed-loop climbing to 55 cm"
 
@@ -54,41 +56,53 @@ class Result:
     noisy: tuple[ClosedLoopRun, ...]
 
 
+@dataclass(frozen=True)
+class PidClimb:
+    """The closed loop of ``config`` on one model: its PID (about the in-place zeta0, its
+    feed-forward ``hover``) and the climbing gait it starts on (section state ``start``)."""
+
+    model: ModelParams
+    config: Config
+    controller: HeightController
+    start: np.ndarray
+
+    @classmethod
+    def of(cls, model: ModelParams, config: Config, leg_length: float) -> PidClimb:
+        """Checked first (gains, leg range, jumps: a ParameterError naming the field), then the
+        in-place zeta0 and the starting gait found; ``leg_length`` [m] converts the target."""
+        target_l0 = check_range("target", config.target_m, 0.0, 1e3) / leg_length
+        limits = (config.zeta0_min, config.zeta0_max)
+        gains = (config.kp, config.ki, config.kd, *limits)
+        HeightController(target_l0, sum(limits) / 2, *gains)  # its checks, before any search
+        check_jumps(config.jumps)
+        psi0 = math.radians(config.psi0_deg)
+        hover = find_in_place_zeta0(model, psi0, zeta0_range=limits)
+        start = gait_of(model, ControlSchedule.of(LegControl(psi0, config.start_zeta0)), guess=START_GUESS).state
+        return cls(model, config, HeightController(target_l0, hover, *gains), start)
+
+    @property
+    def hover(self) -> float:
+        return self.controller.zeta0_hover
+
+    def climb(self, noise: NoiseModel = NO_NOISE, seed: int = 0) -> ClosedLoopRun:
+        config = self.config
+        return closed_loop_climb(self.model, self.controller, math.radians(config.psi0_deg), self.start,
+                                 config.jumps, start_zeta0=config.start_zeta0, noise=noise, seed=seed)  # fmt: skip
+
+
 def run(robot: PhysicalParams, config: Config, *, chunk_map: ChunkMap = in_process, progress: Progress | None = None):
     del chunk_map  # one short sequential run: nothing to distribute
-    model = robot.to_model()
-    psi0 = math.radians(config.psi0_deg)
-    hover = find_in_place_zeta0(model, psi0, zeta0_range=(config.zeta0_min, config.zeta0_max))
-    controller = HeightController(
-        config.target_m / robot.leg_length,
-        hover,
-        config.kp,
-        config.ki,
-        config.kd,
-        config.zeta0_min,
-        config.zeta0_max,
-    )
-    start = gait_of(model, ControlSchedule.of(LegControl(psi0, config.start_zeta0)), guess=START_GUESS).state
-    clean = closed_loop_climb(model, controller, psi0, start, config.jumps, start_zeta0=config.start_zeta0)
+    loop = PidClimb.of(robot.to_model(), config, robot.leg_length)
+    clean = loop.climb()
     # Replay the noise-free run's leg lengths to draw its path between the walls.
+    psi0 = math.radians(config.psi0_deg)
     schedule = ControlSchedule.of(*(LegControl(psi0, z) for z in clean.zeta0))
     path = simulate_trajectory(
-        model, schedule, start, clean.height.size - 1, start_height=float(clean.height[0])
+        loop.model, schedule, loop.start, clean.height.size - 1, start_height=float(clean.height[0])
     ).to_si(robot)
     noisy = []
     for done, seed in enumerate(config.noisy_seeds, start=1):
-        noisy.append(
-            closed_loop_climb(
-                model,
-                controller,
-                psi0,
-                start,
-                config.jumps,
-                start_zeta0=config.start_zeta0,
-                noise=config.noise,
-                seed=seed,
-            )
-        )
+        noisy.append(loop.climb(config.noise, seed))
         if progress is not None:
             progress(done, len(config.noisy_seeds))
     return Result(config, robot, clean, path, tuple(noisy))
