@@ -1,28 +1,20 @@
-"""The PC's side of the robot link: a pyserial URL, protocol v1, heartbeats, and safety.
+"""The PC's side of the robot link: protocol v1 over the radio, heartbeats, and safety.
 
-``RobotLink(url)`` opens ``/dev/ttyUSB0`` (the XBee), ``socket://host:port`` (the virtual robot)
-or ``loop://`` — pyserial's URLs. A reader thread decodes frames and tracks the robot's state
-from its telemetry and acknowledgements; a heartbeat thread keeps the robot armed. Silence from
-the robot for ``heartbeat_timeout`` is a lost link: the state becomes ``disconnected`` and the
-``on_lost`` callbacks run (a live run aborts, keeping what it recorded). Leg commands are checked
-against the servo limits before they are sent. Every state change is kept in ``transitions``.
+``RobotLink(url)`` opens its port (:class:`~backend.robot.link_port.LinkPort`: pyserial URLs,
+frames whole and bounded). A reader thread decodes frames and tracks the robot's state from its
+telemetry and acknowledgements; a heartbeat thread keeps the robot armed. Silence from the robot
+for ``heartbeat_timeout`` is a lost link: the state becomes ``disconnected`` and the ``on_lost``
+callbacks run (a live run aborts, keeping what it recorded). Leg commands are checked against the
+servo limits before they are sent. Every state change is kept in ``transitions``.
 
-Faults a lab meets are bounded and counted, never raised into a caller's lap: no write blocks
-longer than ``WRITE_TIMEOUT`` (pyserial's ``write_timeout``; a timeout is a ``write_timeouts``
-count and a :class:`LinkError`), and only Receive Packets from ``robot_address`` are heard — a
-frame from any other radio is a ``foreign_frames`` count and changes nothing. :meth:`RobotLink.estop`
-takes no lock that a command, a blocked write or a reconnect holds for longer than one bounded
-write, and gives up after its ``timeout`` with an honest :class:`EstopResult`; the heartbeat
-thread then sends that ESTOP instead of heartbeats until the robot acknowledges it.
-
-The e-stop latch is the service's (:class:`backend.robot.latch.EstopLatch`), handed to each link:
-it outlives a link that is lost, reconnected or replaced. While it holds, every connection sends
-the ESTOP first, in place of heartbeats, until the robot acknowledges it, and ARM and START are
-refused (:class:`EstopLatched`); only an acknowledged RESET releases it.
-
-Every Transmit Request carries a frame id (1..255), so the PC's radio answers each with a
-Transmit Status: delivered or not, after how many retries (``counters``). Those come from the
-local radio, not the robot: they are neither foreign frames nor a sign of the robot's life.
+Faults a lab meets are bounded and counted, never raised into a caller's lap: only Receive Packets
+from ``robot_address`` are heard (another radio's are ``foreign_frames``), and the radio's own
+Transmit Statuses are counted but are no sign of the robot's life. :meth:`RobotLink.estop` takes no
+lock held for longer than one bounded write, and gives up after its ``timeout`` with an honest
+:class:`EstopResult`; the heartbeat thread then sends that ESTOP instead of heartbeats until the
+robot acknowledges it. The e-stop latch is the service's (:class:`backend.robot.latch.EstopLatch`):
+it outlives the link, every connection sends the latched ESTOP first, and ARM and START are
+refused (:class:`EstopLatched`) until a RESET is acknowledged.
 """
 
 from __future__ import annotations
@@ -35,30 +27,18 @@ import serial
 
 from backend.robot.latch import EstopLatch
 from backend.robot.limits import ServoLimits
+from backend.robot.link_port import WRITE_TIMEOUT, LinkPort
 from backend.robot.link_types import FROM_ROBOT, SAFE, EstopResult, LinkError, LinkState, Transition
-from backend.robot.messages import Ack, Command, Kind, Leg, ProtocolError, Result, SetLeg, Telemetry, decode, encode
-from backend.robot.ports import check_port, no_delay, write_within
-from backend.robot.xbee import (
-    ROBOT_ADDRESS,
-    TX_STATUS,
-    FrameError,
-    FrameParser,
-    TransmitLog,
-    encode_frame,
-    parse_rx_packet,
-    parse_tx_status,
-    tx_request,
-)
+from backend.robot.messages import Ack, Command, Kind, Leg, ProtocolError, Result, SetLeg, Telemetry, decode
+from backend.robot.xbee import ROBOT_ADDRESS, TX_STATUS, FrameError, FrameParser, parse_rx_packet, parse_tx_status
 
 # [s] between the PC's heartbeats: half the protocol's 0.2 s, so a late one (a loaded machine) still
 # keeps the rule; the robot's watchdog allows 1 s.
 HEARTBEAT_PERIOD = 0.1
 HEARTBEAT_TIMEOUT = 1.0  # [s]
 COMMAND_TIMEOUT = 0.5  # [s] for an acknowledgement
-WRITE_TIMEOUT = 0.1  # [s] the longest any write may block its caller (pyserial's write_timeout)
 ESTOP_TIMEOUT = 0.15  # [s] an e-stop's whole budget, blocked writes included: the API answers within 200 ms
 ESTOP_REPEAT = 0.02  # [s] between e-stop repeats until acknowledged
-READ_TIMEOUT = 0.02  # [s]
 
 
 class EstopLatched(LinkError):
@@ -88,17 +68,13 @@ class RobotLink:
         self.parser = FrameParser()
         self.rejected_payloads = 0
         self.foreign_frames = 0  # Receive Packets from a radio that is not robot_address
-        self.write_timeouts = 0
         self.estops_unacknowledged = 0
-        self.frames_out = 0  # Transmit Requests the port took whole within WRITE_TIMEOUT
         self.estop_repeats = 0  # ESTOPs written again for an e-stop already sent (counted in "retries")
-        self.transmits = TransmitLog()  # frame ids, and the radio's Transmit Statuses for them
         self.on_lost: list[Callable[[str], None]] = []
-        self._port = None
+        self.port = LinkPort(url, baud, robot_address)  # frames out, whole and bounded, and their counts
         self._seq = 0
         self._acks: dict[int, tuple[threading.Event, list[Ack]]] = {}
         self._lock = threading.Lock()
-        self._write_lock = threading.RLock()  # reentrant: the heartbeat thread picks its frame under it
         self._last_heard = 0.0
         self._stop = threading.Event()
         self._threads: list[threading.Thread] = []
@@ -118,14 +94,7 @@ class RobotLink:
         if self.latch.held:
             self.latch.unconfirmed()  # the robot may have restarted, or never heard it
             self._pending_estop = Command(self._next_seq(), Kind.ESTOP)
-        try:
-            check_port(self.url)
-            self._port = serial.serial_for_url(
-                self.url, baudrate=self.baud, timeout=READ_TIMEOUT, write_timeout=WRITE_TIMEOUT
-            )
-        except (serial.SerialException, ValueError, OSError) as error:
-            raise LinkError(f"cannot open {self.url}: {error}") from None
-        no_delay(self._port)
+        self.port.open()
         self._stop.clear()
         self._last_heard = time.monotonic()
         self._threads = [
@@ -154,10 +123,7 @@ class RobotLink:
         for thread in self._threads:
             if thread is not threading.current_thread():
                 thread.join(2)
-        with self._write_lock:  # no write is under way on the port being closed (each is bounded)
-            port, self._port = self._port, None
-        if port is not None:
-            port.close()
+        self.port.close()
         self._move(LinkState.DISCONNECTED, "closed")
 
     # Commands -------------------------------------------------------------------------------
@@ -200,7 +166,7 @@ class RobotLink:
         """Clear an e-stop (to disarmed) and release the latch once the robot confirms it. Repeats of
         an unacknowledged ESTOP stop before the RESET is sent (none may follow it), and resume if the
         RESET is not confirmed."""
-        with self._write_lock:  # not between the heartbeat thread's pick of a repeat and its write
+        with self.port.write_lock:  # not between the heartbeat thread's pick of a repeat and its write
             pending = self._forget_estop()
         try:
             self._command(Command(self._next_seq(), Kind.RESET), expect=LinkState.DISARMED)
@@ -243,7 +209,7 @@ class RobotLink:
                         self._write(message, deadline=write_by)
                     except LinkError as error:
                         reason = str(error)
-                        if self._port is None:
+                        if not self.port.is_open:
                             break  # closed: nothing to retry on
                 event.wait(min(ESTOP_REPEAT, max(0.0, deadline - time.monotonic())))
         finally:
@@ -262,7 +228,11 @@ class RobotLink:
     @property
     def last_delivery_failure(self) -> str | None:
         """The last Transmit Status that said not delivered, by name and code, or None."""
-        return self.transmits.last_failure
+        return self.port.transmits.last_failure
+
+    @property
+    def write_timeouts(self) -> int:
+        return self.port.write_timeouts
 
     def counters(self) -> dict[str, int]:
         """Counts since the last connect (the parser's, ``frames_in`` to ``garbage_bytes``) and since
@@ -279,12 +249,12 @@ class RobotLink:
             "garbage_bytes": stats.garbage_bytes,
             "rejected_payloads": self.rejected_payloads,
             "foreign_frames": self.foreign_frames,
-            "write_timeouts": self.write_timeouts,
+            "write_timeouts": self.port.write_timeouts,
             "estops_unacknowledged": self.estops_unacknowledged,
-            "frames_out": self.frames_out,
-            "transmit_status": self.transmits.statuses,
-            "delivery_failures": self.transmits.failures,
-            "retries": self.transmits.retries + self.estop_repeats,
+            "frames_out": self.port.frames_out,
+            "transmit_status": self.port.transmits.statuses,
+            "delivery_failures": self.port.transmits.failures,
+            "retries": self.port.transmits.retries + self.estop_repeats,
         }
 
     # Internals ------------------------------------------------------------------------------
@@ -322,29 +292,7 @@ class RobotLink:
         return entry
 
     def _write(self, message, deadline: float | None = None) -> None:
-        """Send one frame, blocking at most WRITE_TIMEOUT once the port is ours; waits for the write
-        lock until ``deadline`` (monotonic), or without one as long as another writer's bounded write."""
-        payload = encode(message)
-        wait = -1 if deadline is None else max(0.0, deadline - time.monotonic())
-        if not self._write_lock.acquire(timeout=wait):
-            raise LinkError("another write is blocked on the port")
-        try:
-            port = self._port
-            if port is None:
-                raise LinkError("the link is down")
-            # Ids taken under the write lock go out in order: a Transmit Status names one frame.
-            frame_id = self.transmits.next_frame_id()
-            frame = encode_frame(tx_request(payload, frame_id=frame_id, destination64=self.robot_address))
-            write_within(port, frame, time.monotonic() + WRITE_TIMEOUT)
-            self.frames_out += 1
-        except serial.SerialTimeoutException:
-            # A partial frame may be on the wire: the robot's parser resynchronises on the next start byte.
-            self.write_timeouts += 1
-            raise LinkError(f"write blocked for {WRITE_TIMEOUT * 1000:.0f} ms: the line is jammed") from None
-        except (serial.SerialException, OSError) as error:
-            raise LinkError(f"write failed: {error}") from None
-        finally:
-            self._write_lock.release()
+        self.port.write(message, deadline)
 
     def _next_seq(self) -> int:
         with self._lock:
@@ -354,10 +302,7 @@ class RobotLink:
     def _read_loop(self) -> None:
         while not self._stop.is_set():
             try:
-                # Whatever is waiting, or block (up to READ_TIMEOUT) for the first byte: a full-size
-                # read would wait out the timeout on every call.
-                port = self._port
-                chunk = port.read(port.in_waiting or 1) if port is not None else b""
+                chunk = self.port.read()
             except (serial.SerialException, OSError):
                 chunk = b""
                 self._lost("read failed")
@@ -366,7 +311,7 @@ class RobotLink:
                 try:
                     if data[0] == TX_STATUS:
                         # The PC's own radio on a frame it sent: not the robot's voice or heartbeat.
-                        self.transmits.heard(parse_tx_status(data))
+                        self.port.transmits.heard(parse_tx_status(data))
                         continue
                     packet = parse_rx_packet(data)
                     if packet.source64 != self.robot_address:
@@ -406,7 +351,7 @@ class RobotLink:
             due += HEARTBEAT_PERIOD
             if due <= time.monotonic():  # more than a period late: start the cadence afresh
                 due = time.monotonic() + HEARTBEAT_PERIOD
-            with self._write_lock:  # picked and written at once: reset() forgets the repeat under it
+            with self.port.write_lock:  # picked and written at once: reset() forgets the repeat under it
                 message = self._pending_estop
                 if message is not None:
                     self.estop_repeats += 1
@@ -417,7 +362,7 @@ class RobotLink:
                 try:
                     self._write(message)
                 except LinkError:
-                    if self._port is None:
+                    if not self.port.is_open:
                         return
                     # Blocked (counted): the next one may pass; if none does, the robot disarms itself.
 

@@ -133,7 +133,7 @@ def test_a_write_that_went_out_is_not_a_jammed_line(answering, monkeypatch):
     gone), and an ARM the robot had received was reported as failed."""
     rig, link = answering
     link.disarm()
-    fd, write = link._port.fd, os.write
+    fd, write = link.port.serial.fd, os.write
 
     def late_after_write(target: int, data) -> int:
         written = write(target, data)

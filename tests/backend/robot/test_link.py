@@ -161,7 +161,7 @@ def test_a_blocked_write_is_a_counted_link_error(jammed):
 
     assert answer_within(JAMMED_ANSWER_S, set_leg)
     assert jammed.write_timeouts >= 1 and jammed.counters()["write_timeouts"] == jammed.write_timeouts
-    assert jammed._port.write_timeout == WRITE_TIMEOUT
+    assert jammed.port.serial.write_timeout == WRITE_TIMEOUT
 
 
 @pytest.fixture
@@ -326,12 +326,12 @@ def test_the_virtual_radio_reports_every_frame_delivered(robot, link):
     counters = link.counters
     _wait_for(lambda: counters()["frames_out"] >= 3 and counters()["transmit_status"] == counters()["frames_out"])
     assert counters()["delivery_failures"] == 0 and link.last_delivery_failure is None
-    assert link.transmits.retries == 0, "no radio retries on localhost"
+    assert link.port.transmits.retries == 0, "no radio retries on localhost"
 
 
 def test_both_ends_of_the_virtual_radio_disable_nagle(robot, link):
     _wait_for(lambda: robot._connection is not None)
-    for sock in (link._port._socket, robot._connection):
+    for sock in (link.port.serial._socket, robot._connection):
         assert sock.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY)
 
 
