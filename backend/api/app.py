@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import functools
 import logging
 from pathlib import Path
 
@@ -22,13 +23,14 @@ from backend.api import errors, security
 from backend.api.deps import Database
 from backend.api.routes import calibrations, experiments, jobs, robot, runs, sim, site, view
 from backend.api.security import api_token
+from backend.services import exports, records, simulation
 from backend.services import jobs as job_service
-from backend.services.compute import Compute
 from backend.services.robot import RobotService
-from backend.services.store_reads import StoreReads
 from backend.services.view import ViewContext, ViewFactory, ViewStarter
 from backend.settings import Settings
 from backend.store.database import ensure_reserve, make_engine, migrate, session_factory
+from backend.workers.pools import Compute
+from backend.workers.store_reads import RunReads, StoreReads, loaded
 
 log = logging.getLogger("parkourlab.api")
 # The control panel's static files (frontend/panel): located, not imported — the frontend sits above
@@ -42,6 +44,15 @@ ROUTERS = (site, experiments, runs, calibrations, jobs, robot, view, sim)
 # that would (a simulation, a job's compute) awaits a worker instead.
 REQUEST_THREADS = 4
 LATCH_FILE = "estop-latch.json"  # in the data directory: a held e-stop survives a restart
+# What the read workers run: the records and exports services' functions (the workers import no service).
+RUN_READS = RunReads(
+    list_runs=records.list_runs,
+    plan_export=exports.plan_export,
+    export_part=exports.export_part,
+    export_head=exports.export_head,
+    export_tail=exports.export_tail,
+    joined=exports.joined,
+)
 
 
 def create_app(
@@ -64,7 +75,7 @@ def create_app(
     sessions = session_factory(engine)
     token, _ = api_token(settings.data_dir)
     owns_compute = compute is None
-    compute = compute or Compute()
+    compute = compute or Compute(warm_up=simulation.warm_up, reads_warm_up=functools.partial(loaded, RUN_READS))
     runner = job_service.JobRunner(sessions, compute.jobs, dask_address=settings.dask_address)
     robot_service = RobotService(sessions, latch_path=settings.data_dir / LATCH_FILE)
 
@@ -107,7 +118,7 @@ def create_app(
     app.state.runner = runner if run_jobs else None
     app.state.robot = robot_service
     app.state.compute = compute
-    app.state.reads = StoreReads(compute.reads, settings.database_url)
+    app.state.reads = StoreReads(compute.reads, settings.database_url, RUN_READS)
     app.state.view_starter = None
     security.install(app, settings)  # headers, Host/Origin allow-list, token first, body limit
     errors.install(app)

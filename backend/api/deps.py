@@ -20,10 +20,10 @@ from sqlalchemy.orm import Session, sessionmaker
 from backend import schemas
 from backend.api.security import require_token
 from backend.services import calibrations, jobs, records
-from backend.services.compute import ComputePool
 from backend.services.robot import RobotService
-from backend.services.store_reads import StoreReads
 from backend.store.database import StorageFull, after_storage_full
+from backend.workers.pools import ComputePool
+from backend.workers.store_reads import StoreReads
 from sim_core.presets import PRESETS
 
 T = TypeVar("T")

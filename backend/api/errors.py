@@ -22,10 +22,10 @@ from fastapi.responses import JSONResponse
 from backend.api import security
 from backend.robot.link import EstopLatched, LinkError
 from backend.services import records
-from backend.services.compute import ComputeBusy, ComputeFailed, ComputeTimeout
 from backend.services.robot import RobotUnavailable
 from backend.services.robot_tracker import TrackerPortInUse
 from backend.store.database import StorageFull
+from backend.workers.pools import ComputeBusy, ComputeFailed, ComputeTimeout
 from sim_core import FixedPointNotFound, ParameterError
 
 log = logging.getLogger("parkourlab.api")

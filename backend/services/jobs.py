@@ -3,7 +3,7 @@
 A job is a row. An MJTF job survives crashes trial by trial: its trials are rows with the
 idempotent key ``(job, level, index)``. The runner (one background thread) works through a
 job in chunks of trials: it computes the trials still missing, runs the chunks — in the
-service's job worker process (:mod:`backend.services.compute`; never in the service's own, where
+service's job worker process (:mod:`backend.workers.pools`; never in the service's own, where
 they would hold up the API), or on the Dask cluster named by ``PARKOUR_DASK_ADDRESS`` — and
 commits each chunk's trials and the progress in one transaction as it finishes. Killed mid-job, the service finds
 the job at the next start, recomputes only the missing trials — their seeds depend on
@@ -33,12 +33,12 @@ import numpy as np
 from sqlalchemy import func, select, update
 from sqlalchemy.orm import Session, sessionmaker
 
-from backend.services.compute import ComputePool
 from backend.services.job_specs import decode, encode, spec_of
 from backend.services.records import fetch, locked, newest_first, page
 from backend.services.simulation import current_code_version, model_params, run_study, run_study_here
 from backend.store.database import StorageFull, after_storage_full
 from backend.store.models import Experiment, Job, Trial, utcnow
+from backend.workers.pools import ComputePool
 from experiments.cluster import as_completed_results, chunk_map_for, dask_client
 from experiments.manifest import json_safe
 from sim_core.chunks import Cancelled

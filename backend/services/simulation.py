@@ -1,10 +1,10 @@
 """Simulations the service runs: translating request bodies into sim_core calls and back.
 
-The functions here are what the service's compute workers run (:mod:`backend.services.compute`):
+The functions here are what the service's compute workers run (:mod:`backend.workers.pools`):
 module-level, with picklable arguments and results. The compiled kernels (numba, and scipy for
 the fixed points) load with a worker's first call, not with the service, so ``parkour serve``
-answers before they have loaded; :func:`warm_up` loads them in each worker at start-up. Hence
-the imports inside the functions below.
+answers before they have loaded; :func:`warm_up` (handed to the pools by ``create_app``) loads
+them in each worker at start-up. Hence the imports inside the functions below.
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ import numpy as np
 
 from backend.schemas import FixedPointIn, LegIn, MapIn, ModelIn, RunCreate, TrajectoryIn
 from backend.store.run_record import RunRecord
+from backend.workers.progress import report
 from experiments.manifest import code_version, json_safe
 from sim_core.basin_grid import DEFAULT_BASIN_WINDOW, BasinGrid
 from sim_core.controls import ControlSchedule
@@ -122,8 +123,7 @@ def _gait_of(model: ModelParams, schedule: ControlSchedule, period: int | None, 
 
 def run_study_here(spec) -> dict:
     """:func:`run_study` in the job worker: its chunks one after the other there (each uses every
-    core), progress reported to the service (:func:`backend.services.compute.report`)."""
-    from backend.services.compute import report
+    core), progress reported to the service (:func:`backend.workers.progress.report`)."""
     from sim_core.chunks import in_process
 
     return run_study(spec, in_process, report)

@@ -10,7 +10,7 @@ from fastapi import APIRouter, Path
 from backend import schemas
 from backend.api.deps import AUTHORIZED, Db, QuickCompute
 from backend.services import calibrations
-from backend.services.compute import ComputePool
+from backend.workers.pools import ComputePool
 
 router = APIRouter(prefix="/api/v1/calibrations", tags=["calibrations"])
 PresetPath = Annotated[str, Path(min_length=1, max_length=64, pattern=calibrations.PRESET_NAME.pattern)]

@@ -13,7 +13,7 @@ from fastapi.responses import Response
 from backend import schemas
 from backend.api.deps import QuickCompute, preset_resolved
 from backend.services import simulation
-from backend.services.compute import as_json
+from backend.workers.pools import as_json
 
 router = APIRouter(prefix="/api/v1/sim", tags=["simulate"])
 

@@ -10,9 +10,9 @@ from hypothesis import HealthCheck, settings
 
 from backend.api.app import create_app
 from backend.api.security import api_token
-from backend.services.compute import Compute
 from backend.settings import Settings
 from backend.store.database import make_engine, migrate
+from backend.workers.pools import Compute
 
 pytestmark = pytest.mark.slow  # a few hundred generated requests
 

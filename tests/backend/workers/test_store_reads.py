@@ -1,15 +1,18 @@
-"""The run list's pages read in worker processes (backend/services/store_reads.py): the same page
+"""The run list's pages read in worker processes (backend/workers/store_reads.py): the same page
 the records service lists, as the API's JSON, seeing what was just stored; a worker keeps few engines."""
 
 import asyncio
+import functools
 import json
 
+from backend.api.app import RUN_READS
 from backend.schemas import RunPage
-from backend.services import exports, records, store_reads
-from backend.services.compute import ComputePool
+from backend.services import exports, records
 from backend.services.records import RunFilter
 from backend.store import runs as store_runs
 from backend.store.database import make_engine, migrate, sqlite_url
+from backend.workers import store_reads
+from backend.workers.pools import ComputePool
 
 
 def test_a_page_read_in_a_worker_is_the_records_page_as_the_api_encodes_it(tmp_path, sessions, make_run):
@@ -18,7 +21,7 @@ def test_a_page_read_in_a_worker_is_the_records_page_as_the_api_encodes_it(tmp_p
     url = sqlite_url(tmp_path)
     pool = ComputePool("reads-test", max_pending=4, niceness=0)
     try:
-        reads = store_reads.StoreReads(pool, url)
+        reads = store_reads.StoreReads(pool, url, RUN_READS)
         where = RunFilter(zeta0_min=0.87)
         page = asyncio.run(reads.runs_page(where, limit=1, cursor=None, sort="-id", offset=0))
         with sessions() as session:
@@ -43,11 +46,15 @@ def test_a_worker_keeps_a_few_stores_open_and_lets_the_oldest_go(tmp_path, monke
         engine.dispose()
         urls.append(sqlite_url(tmp_path / f"store{k}"))
         page = json.loads(
-            store_reads._in_session(store_reads.runs_page_json, urls[-1], RunFilter(), 10, None, "-id", 0)
+            store_reads._in_session(
+                store_reads.runs_page_json, urls[-1], records.list_runs, RunFilter(), 10, None, "-id", 0
+            )
         )
         assert page == {"items": [], "next_cursor": None}
     assert list(store_reads._stores) == urls[-store_reads.STORES_KEPT :]
-    store_reads._in_session(store_reads.runs_page_json, urls[-store_reads.STORES_KEPT], RunFilter(), 10, None, "-id", 0)
+    store_reads._in_session(
+        store_reads.runs_page_json, urls[-store_reads.STORES_KEPT], records.list_runs, RunFilter(), 10, None, "-id", 0
+    )
     assert list(store_reads._stores)[-1] == urls[-store_reads.STORES_KEPT], "the store just read is kept longest"
 
 
@@ -58,7 +65,7 @@ def test_an_export_read_in_workers_is_the_export_read_here(tmp_path, sessions, m
         make_run(zeta0=0.86 + 0.005 * k, tags=[f"t{k % 3}"])
     pool = ComputePool("reads-test", 2, max_pending=8, niceness=0)
     try:
-        reads = store_reads.StoreReads(pool, sqlite_url(tmp_path))
+        reads = store_reads.StoreReads(pool, sqlite_url(tmp_path), RUN_READS)
         for format_ in ("json", "csv"):
             with sessions() as session:
                 plan = exports.plan_export(session, RunFilter(), format_)
@@ -70,3 +77,21 @@ def test_an_export_read_in_workers_is_the_export_read_here(tmp_path, sessions, m
             assert asyncio.run(read_all()) == list(exports.export(sessions, RunFilter(), format_))
     finally:
         pool.close()
+
+
+# Run in a worker as eval(LOADED): a builtin, so the worker imports no test module (which would load the services).
+LOADED = "sorted(m for m in ('backend.services.exports', 'backend.services.records') if m in __import__('sys').modules)"
+
+
+def test_a_read_worker_warms_up_by_receiving_the_read_functions():
+    """Its first task loads the modules the reads run from (the records and exports services)."""
+    warmed = ComputePool("reads-test", warm_up=functools.partial(store_reads.loaded, RUN_READS), niceness=0)
+    plain = ComputePool("reads-plain", niceness=0)
+    try:
+        warmed.warm()
+        assert warmed.run(eval, LOADED, timeout=60.0) == ["backend.services.exports", "backend.services.records"]
+        plain.warm()
+        assert plain.run(eval, LOADED, timeout=60.0) == [], "a worker without the warm-up has not loaded them"
+    finally:
+        warmed.close()
+        plain.close()

@@ -3,23 +3,18 @@ dead or stopped worker is replaced."""
 
 import asyncio
 import os
-import signal
-import subprocess
-import sys
 import time
-from pathlib import Path
 
 import pytest
 
-from backend.services.compute import (
-    PARENT_CHECK_S,
+from backend.workers.pools import (
     READ_NICENESS,
     WORKER_NICENESS,
+    Compute,
     ComputeBusy,
     ComputeFailed,
     ComputePool,
     ComputeTimeout,
-    report,
 )
 from sim_core.errors import ParameterError
 
@@ -45,12 +40,6 @@ def _die() -> None:
 
 def _refuse() -> None:
     raise ParameterError("zeta0", "must be in (0, 1), got 1.2")
-
-
-def _count_to(total: int) -> int:
-    for done in range(1, total + 1):
-        report(done, total)
-    return total
 
 
 @pytest.fixture
@@ -90,15 +79,6 @@ def test_a_dead_worker_is_replaced(pool):
     assert pool.run(_sleep, 0.0, timeout=WAIT_S) == 0.0
 
 
-def test_workers_report_progress(pool):
-    assert pool.run(_count_to, 3, timeout=WAIT_S) == 3
-    deadline = time.monotonic() + WAIT_S
-    reports = []
-    while len(reports) < 3 and time.monotonic() < deadline:
-        reports += pool.progress()
-    assert reports == [(1, 3), (2, 3), (3, 3)]
-
-
 def test_a_closed_pool_starts_afresh_when_called_again(pool):
     before = pool.run(_pid, timeout=WAIT_S)
     pool.close()
@@ -115,37 +95,31 @@ def test_a_pool_sets_its_workers_niceness():
         reads.close()
 
 
-def _gone(pid: int) -> bool:
-    """Whether process ``pid`` has ended (a zombie its new parent has not reaped yet counts)."""
-    try:
-        return Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()[0] == "Z"
-    except FileNotFoundError:
-        return True
+_warmed = False  # in a worker: whether its warm-up ran
 
 
-def test_workers_end_when_the_service_is_killed_outright():
-    owner = subprocess.Popen(
-        [sys.executable, "-c", ORPHANING_SERVICE], stdout=subprocess.PIPE, text=True, cwd=Path(__file__).parents[3]
-    )
+def _warm_up() -> None:
+    global _warmed
+    _warmed = True
+
+
+def _was_warmed() -> bool:
+    return _warmed
+
+
+def test_a_pool_runs_the_warm_up_it_was_handed_first():
+    warmed, plain = ComputePool("warmed", warm_up=_warm_up), ComputePool("plain")
     try:
-        worker = int(owner.stdout.readline())
-        assert not _gone(worker)
+        warmed.warm()  # one worker: the warm-up is its first task, the call its second
+        assert warmed.run(_was_warmed, timeout=WAIT_S) is True
+        plain.warm()
+        assert plain.run(_was_warmed, timeout=WAIT_S) is False, "without a warm-up, warm() only starts the workers"
     finally:
-        owner.kill()
-        owner.wait()
-    deadline = time.monotonic() + 10 * PARENT_CHECK_S
-    while not _gone(worker):
-        if time.monotonic() > deadline:
-            os.kill(worker, signal.SIGKILL)
-            pytest.fail("a worker outlived its killed service")
-        time.sleep(0.1)
+        warmed.close()
+        plain.close()
 
 
-# A service in miniature: a pool with a worker started, then killed with SIGKILL by the test.
-ORPHANING_SERVICE = """
-import os, time
-from backend.services.compute import ComputePool
-pool = ComputePool("orphaned")
-print(pool.run(os.getpid, timeout=60), flush=True)
-time.sleep(600)
-"""
+def test_the_service_pools_take_the_warm_ups_they_are_handed():
+    compute = Compute(warm_up=_warm_up, reads_warm_up=_was_warmed)  # no process starts until a call
+    assert compute.quick.warm_up is compute.jobs.warm_up is _warm_up and compute.reads.warm_up is _was_warmed
+    assert (compute.quick.workers, compute.jobs.workers, compute.reads.workers) == (1, 1, 2)

@@ -4,11 +4,12 @@ A simulation in the service's process holds its GIL and its request threads, so 
 live view or the e-stop would wait behind it. Every kernel call the API or a job makes goes
 instead to a :class:`ComputePool`: a small pool of worker processes (``spawn``: a fresh
 interpreter, no inherited threads or locks) that load sim_core once and keep it. The service's
-process only sends arguments and receives results.
+process only sends arguments and receives results. A pool runs whatever it is handed: the
+functions, and the warm-up each worker runs first, come from the caller (``create_app``).
 
 Three pools, so a long job never delays a quick call (:class:`Compute`): ``quick`` for the panel's
 ``/sim/*`` calls and ``POST /runs``, ``jobs`` for job chunks, and ``reads`` for the run list's
-pages and exports (``backend/services/store_reads.py``), which are not compute but held the
+pages and exports (:mod:`backend.workers.store_reads`), which are not compute but held the
 service's GIL as long. Work is bounded: a pool refuses a call when ``max_pending`` are already waiting
 (:class:`ComputeBusy`, a 503 with Retry-After), and a call that outlives its ``timeout`` stops its
 pool's workers, which start afresh for the next call (:class:`ComputeTimeout`). A worker that dies
@@ -26,9 +27,11 @@ import multiprocessing
 import os
 import queue as queue_module
 import threading
-import time
 from collections.abc import Callable
 from concurrent.futures.process import BrokenProcessPool
+
+from backend.workers import progress as progress_module
+from backend.workers.parent import watch_parent
 
 log = logging.getLogger("parkourlab.compute")
 
@@ -36,7 +39,6 @@ QUICK_TIMEOUT = 60.0  # [s] the longest a quick call may take (they are bounded 
 QUICK_PENDING = 64  # quick calls waiting at most; more get a 503
 JOB_PENDING = 8  # job chunks in flight at most (the runner keeps the worker fed, no more)
 WORKER_NICENESS = 10  # added to the workers' scheduling niceness (os.nice): compute yields to the service
-PARENT_CHECK_S = 1.0  # [s] how often a worker checks that the service that started it is alive
 READ_WORKERS = 2  # the reads pool's processes: on this 2-core machine a third gained nothing (docs/service.md)
 # The readers answer requests, so they sit above compute; below the service's own process, so its
 # event loop (the e-stop) still gets a core first when the readers fill both.
@@ -56,26 +58,12 @@ class ComputeFailed(RuntimeError):
     """A worker process died during the call (or was stopped for another call); the pool starts afresh."""
 
 
-_progress = None  # in a worker: the queue report() puts progress on (set as the worker starts)
-
-
 def _init_worker(progress, niceness: int) -> None:
-    global _progress
-    _progress = progress
+    progress_module.attach(progress)
     # Below the service in the OS's eyes: with every core busy, the service's own process — HTTP,
     # the live view, the e-stop — still gets the CPU first.
     os.nice(niceness)
-    threading.Thread(target=_exit_with_parent, args=(os.getppid(),), name="exit-with-parent", daemon=True).start()
-
-
-def _exit_with_parent(parent: int) -> None:
-    """In a worker: end this process once its parent is gone. A service killed outright (kill -9,
-    out of memory) stops no workers, and a worker waits on its task queue forever (it holds the
-    queue's writing end itself): each crash left its workers, a read worker's store connection
-    among them, until the machine restarted."""
-    while os.getppid() == parent:
-        time.sleep(PARENT_CHECK_S)
-    os._exit(0)
+    watch_parent()
 
 
 def as_json(function: Callable, *args) -> bytes:
@@ -86,23 +74,16 @@ def as_json(function: Callable, *args) -> bytes:
     return json.dumps(json_safe(function(*args)), allow_nan=False, separators=(",", ":")).encode()
 
 
-def report(done: int, total: int) -> None:
-    """In a worker: tell the service how far the call has got (a job's chunks done of total);
-    read with :meth:`ComputePool.progress`. Anywhere else, nothing."""
-    if _progress is not None:
-        _progress.put((done, total))
-
-
-def _warm() -> None:
-    """A worker's first task: load the kernels a first request needs."""
-    from backend.services.simulation import warm_up
-
-    warm_up()
+def started() -> None:
+    """A worker's first task when it is handed no warm-up: none; its process has started."""
 
 
 class ComputePool:
     """``workers`` processes running one call each at a time; :meth:`run` from a thread,
-    :meth:`call` from the event loop. Thread-safe; the executor is replaced only under its lock."""
+    :meth:`call` from the event loop. Thread-safe; the executor is replaced only under its lock.
+
+    ``warm_up`` (module-level, picklable, no arguments) is what :meth:`warm` runs in each worker:
+    loading what a first call needs, off the request path."""
 
     def __init__(
         self,
@@ -111,7 +92,7 @@ class ComputePool:
         *,
         max_pending: int = QUICK_PENDING,
         niceness: int = WORKER_NICENESS,
-        warm_up: Callable[[], None] = _warm,
+        warm_up: Callable[[], None] = started,
     ):
         self.name = name
         self.workers = workers
@@ -172,7 +153,8 @@ class ComputePool:
             raise ComputeFailed("the computation's worker process stopped; retry") from None
 
     def progress(self) -> list[tuple[int, int]]:
-        """What the workers have reported (:func:`report`) since the last look, oldest first."""
+        """What the workers have reported (:func:`backend.workers.progress.report`) since the last
+        look, oldest first."""
         with self._lock:
             queue = self._progress
         reports = []
@@ -184,7 +166,7 @@ class ComputePool:
         return reports
 
     def warm(self) -> None:
-        """Start the workers now and load the kernels in each (in the background)."""
+        """Start the workers now and run the warm-up in each (in the background)."""
         for _ in range(self.workers):
             self.submit(self.warm_up)
 
@@ -228,20 +210,24 @@ def _stop(executor: concurrent.futures.ProcessPoolExecutor) -> None:
         process.join(5)
 
 
-def _warm_reads() -> None:
-    """A read worker's first task: load the store and the schemas a first page needs."""
-    import backend.services.store_reads  # noqa: F401
-
-
 class Compute:
     """The service's pools: ``quick`` for API calls, ``jobs`` for job chunks, ``reads`` for the
-    run list's pages and exports."""
+    run list's pages and exports. ``warm_up`` is what the quick and job workers run first (the
+    kernels), ``reads_warm_up`` what the read workers do (the store and the schemas); without
+    them :meth:`warm` only starts the workers."""
 
-    def __init__(self, quick: ComputePool | None = None, jobs: ComputePool | None = None):
-        self.quick = quick or ComputePool("quick", max_pending=QUICK_PENDING)
-        self.jobs = jobs or ComputePool("jobs", max_pending=JOB_PENDING)
+    def __init__(
+        self,
+        quick: ComputePool | None = None,
+        jobs: ComputePool | None = None,
+        *,
+        warm_up: Callable[[], None] = started,
+        reads_warm_up: Callable[[], None] = started,
+    ):
+        self.quick = quick or ComputePool("quick", max_pending=QUICK_PENDING, warm_up=warm_up)
+        self.jobs = jobs or ComputePool("jobs", max_pending=JOB_PENDING, warm_up=warm_up)
         self.reads = ComputePool(
-            "reads", READ_WORKERS, max_pending=READ_PENDING, niceness=READ_NICENESS, warm_up=_warm_reads
+            "reads", READ_WORKERS, max_pending=READ_PENDING, niceness=READ_NICENESS, warm_up=reads_warm_up
         )
 
     def warm(self) -> None:

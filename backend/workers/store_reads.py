@@ -5,10 +5,14 @@ event loop answers the e-stop. Every page of ``GET /api/v1/runs`` it read itself
 4 ms of its GIL (the SQL's Python side, the rows, validating and encoding the JSON), and under 20
 clients that queue, not the cores, set the latency: p95 136 ms with a third of the machine idle
 (``scripts/bench_load.py``, docs/service.md). So a page is read where no request of the service
-waits for its GIL: in the compute module's ``reads`` pool, whose workers each keep an engine on
-the store and hand back the page's finished JSON, which the route forwards as it is. An export
-goes the same way, a part of 1000 runs per call (``exports.export_part``), so it streams without
-holding the service's GIL, and exports and pages take turns at the workers between parts.
+waits for its GIL: in the ``reads`` pool (:mod:`backend.workers.pools`), whose workers each keep an
+engine on the store and hand back the page's finished JSON, which the route forwards as it is. An
+export goes the same way, a part of 1000 runs per call (``exports.export_part``), so it streams
+without holding the service's GIL, and exports and pages take turns at the workers between parts.
+
+What the workers run — listing the runs and planning, reading and joining an export's parts — is
+the records and exports services' own functions, handed over as :class:`RunReads` (``create_app``
+assembles it): the workers import no service.
 
 A worker reads through its own connection, so it sees what was committed before the request
 came (a run just stored is listed); the page is the same JSON the route would encode itself
@@ -19,52 +23,80 @@ from __future__ import annotations
 
 import asyncio
 from collections import OrderedDict, deque
-from collections.abc import AsyncIterator
+from collections.abc import AsyncIterator, Callable
+from dataclasses import dataclass
+from typing import Any
 
 from pydantic import TypeAdapter
 from sqlalchemy.orm import Session, sessionmaker
 
 from backend.schemas import RunPage
-from backend.services.compute import ComputePool
-from backend.services.exports import ExportPlan, export_head, export_part, export_tail, joined, plan_export
-from backend.services.records import RunFilter, list_runs
 from backend.store.database import make_engine, session_factory
+from backend.workers.pools import ComputePool
 
 PAGE = TypeAdapter(RunPage)
 STORES_KEPT = 4  # engines a worker keeps open (one in service; tests open one per temporary store)
 _stores: OrderedDict[str, sessionmaker[Session]] = OrderedDict()  # in a worker: by database URL, newest last
 
 
-class StoreReads:
-    """Awaitable reads of the store at ``database_url``, each in a worker of ``pool``."""
+@dataclass(frozen=True)
+class RunReads:
+    """The functions the reads run, the services' own (module-level: they travel to the workers by name).
 
-    def __init__(self, pool: ComputePool, database_url: str):
+    Attributes:
+        list_runs: ``(session, where, *, limit, cursor, sort, offset) -> (rows, next_cursor)``, a page
+            of runs (``backend.services.records.list_runs``); run in a worker.
+        plan_export: ``(session, where, format_) -> plan``; run in a worker.
+        export_part: ``(session, where, plan, part) -> str``, one part's text; run in a worker.
+        export_head, export_tail: ``(plan) -> str``, the text before and after the parts; run here.
+        joined: ``(plan, text, follows) -> str``, a part's text as it goes out after the ones before.
+    """
+
+    list_runs: Callable[..., tuple[list, int | None]]
+    plan_export: Callable[..., Any]
+    export_part: Callable[..., str]
+    export_head: Callable[[Any], str]
+    export_tail: Callable[[Any], str]
+    joined: Callable[[Any, str, bool], str]
+
+
+def loaded(reads: RunReads) -> None:
+    """A read worker's first task (``functools.partial(loaded, reads)``): nothing to run — receiving
+    ``reads`` imported the modules its functions live in (the store, the schemas a first page needs)."""
+
+
+class StoreReads:
+    """Awaitable reads of the store at ``database_url``, each in a worker of ``pool``, running ``reads``."""
+
+    def __init__(self, pool: ComputePool, database_url: str, reads: RunReads):
         self.pool = pool
         self.database_url = database_url
+        self.reads = reads
 
-    async def runs_page(self, where: RunFilter, *, limit: int, cursor: int | None, sort: str, offset: int) -> bytes:
-        """A page of the runs ``where`` selects as the API's ``RunPage`` JSON (see
+    async def runs_page(self, where, *, limit: int, cursor: int | None, sort: str, offset: int) -> bytes:
+        """A page of the runs ``where`` (a ``RunFilter``) selects as the API's ``RunPage`` JSON (see
         :func:`backend.services.records.list_runs` for the sort, cursor and offset)."""
-        return await self._read(runs_page_json, where, limit, cursor, sort, offset)
+        return await self._read(runs_page_json, self.reads.list_runs, where, limit, cursor, sort, offset)
 
-    async def export_plan(self, where: RunFilter, format_: str) -> ExportPlan:
+    async def export_plan(self, where, format_: str):
         """An export's plan (``exports.plan_export``): asked before its response starts, so a busy
         pool or a failing store is a status, not a cut-off download."""
-        return await self._read(plan_export, where, format_)
+        return await self._read(self.reads.plan_export, where, format_)
 
-    async def export_text(self, where: RunFilter, plan: ExportPlan) -> AsyncIterator[str]:
+    async def export_text(self, where, plan) -> AsyncIterator[str]:
         """The export ``plan`` describes, as text: its head, a part per worker call, its tail
         (``exports.export``: the same parts read in this process). As many parts are read at
         once as the pool has workers, so the connection and the workers wait for each other
         least; they come out in order."""
-        yield export_head(plan)
+        reads = self.reads
+        yield reads.export_head(plan)
         parts = iter(range(len(plan.ends)))
         reading: deque[asyncio.Future] = deque()
 
         def read_next() -> None:
             part = next(parts, None)
             if part is not None:
-                reading.append(asyncio.ensure_future(self._read(export_part, where, plan, part)))
+                reading.append(asyncio.ensure_future(self._read(reads.export_part, where, plan, part)))
 
         for _ in range(self.pool.workers):
             read_next()
@@ -73,20 +105,22 @@ class StoreReads:
             while reading:
                 text = await reading.popleft()
                 read_next()
-                yield joined(plan, text, follows)
+                yield reads.joined(plan, text, follows)
                 follows = follows or bool(text)
         finally:
             for pending in reading:  # the client went away: no more parts (one under way finishes unread)
                 pending.cancel()
-        yield export_tail(plan)
+        yield reads.export_tail(plan)
 
     async def _read(self, work, *args):
         """``work(session, *args)`` in a worker, with a session on the store."""
         return await self.pool.call(_in_session, work, self.database_url, *args)
 
 
-def runs_page_json(session: Session, where: RunFilter, limit: int, cursor: int | None, sort: str, offset: int) -> bytes:
-    """The page, encoded (:meth:`StoreReads.runs_page`)."""
+def runs_page_json(
+    session: Session, list_runs: Callable, where, limit: int, cursor: int | None, sort: str, offset: int
+) -> bytes:
+    """In a worker: the page ``list_runs`` reads, encoded (:meth:`StoreReads.runs_page`)."""
     rows, next_cursor = list_runs(session, where, limit=limit, cursor=cursor, sort=sort, offset=offset)
     return PAGE.dump_json(PAGE.validate_python({"items": rows, "next_cursor": next_cursor}))
 
