@@ -5,17 +5,33 @@ import it: ``create_app`` takes a factory that builds one from a :class:`ViewCon
 routes under ``/api/v1/view`` talk to whatever it built through :class:`SceneView`.
 :class:`ViewStarter` builds it off the start-up path, so the API answers while viser and the
 simulator load.
+
+The view reads the store and the robot only through this module: :func:`stored_path` (a stored
+run's path, for replay and sharing), :func:`stored_path_key` (what a cached replay was made of)
+and :func:`commanded` (a live run's command for a leg, named by its wall).
 """
 
 from __future__ import annotations
 
 import logging
 import threading
+import zlib
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
+import numpy as np
+
+from backend.errors import Conflict
+from backend.robot.messages import Leg
+from backend.services import records
 from backend.services.robot import RobotService
+from backend.services.simulation import unpack_trajectory
+from sim_core.controls import LegControl
+from sim_core.walls import Wall
+
+if TYPE_CHECKING:
+    from backend.robot.live_run import RunSnapshot
 
 
 @dataclass(frozen=True)
@@ -35,8 +51,8 @@ class SceneView(Protocol):
         ...
 
     def open_run(self, viewer: str, run_id: int, overlay_run_id: int | None = None) -> dict:
-        """Replay a stored run in panel ``viewer``'s view only (records.NotFound /
-        records.Conflict when it cannot be); returns info(viewer)."""
+        """Replay a stored run in panel ``viewer``'s view only (NotFound / Conflict when it
+        cannot be); returns info(viewer)."""
         ...
 
     def share_html(self, run_id: int, overlay_run_id: int | None = None) -> str:
@@ -47,6 +63,70 @@ class SceneView(Protocol):
 
 
 ViewFactory = Callable[[ViewContext], SceneView]
+
+
+@dataclass(frozen=True)
+class StoredPath:
+    """A stored run as the 3D view replays it, read in one database session.
+
+    Attributes:
+        run_id, kind: which run, and its kind (``sim``, ``robot`` or ``replay``).
+        model: its nondimensional model parameters as stored (``ModelParams``' fields and more).
+        controls: ``[[psi0_deg, zeta0], ...]``, one pair per leg.
+        start_state: the section state it started from (nondimensional).
+        jumps: the jumps asked for.
+        path: the stored path's columns: a sim run's sampled path (nondimensional), or the
+            tracker frames (``time`` [s], ``x``, ``y`` [m]) of a robot run or of a replay run's
+            source run; None when none was stored.
+        touchdowns: the touchdowns found live (``time`` [s], ``wall``, ``foot_height`` [m]) of a
+            robot or replay run; empty for a sim run.
+    """
+
+    run_id: int
+    kind: str
+    model: dict
+    controls: list
+    start_state: list
+    jumps: int
+    path: dict[str, np.ndarray] | None
+    touchdowns: list[dict]
+
+
+def stored_path(sessions: Callable, run_id: int) -> StoredPath:
+    """Stored run ``run_id`` as the view replays it. Raises NotFound when there is no such run,
+    Conflict when a robot or replay run has no tracker frames."""
+    with sessions() as session:
+        run = records.get_run(session, run_id)
+        source = run
+        if run.kind == "replay":
+            source = records.get_run(session, int(run.results.get("source_run_id", 0)) or run_id)
+        if run.kind != "sim" and source.trajectory is None:
+            raise Conflict(f"run {run_id} has no tracker frames to replay")
+        path = None if source.trajectory is None else unpack_trajectory(source.trajectory)
+        touchdowns = [] if run.kind == "sim" else list(run.results.get("touchdowns", []))
+        return StoredPath(run.id, run.kind, run.model, run.controls, run.start_state, run.jumps, path, touchdowns)
+
+
+def stored_path_key(sessions: Callable, run_id: int) -> tuple:
+    """A short stand-in for what :func:`stored_path` reads of run ``run_id``: equal keys, equal
+    paths (for a cache). Runs change only in their tags and notes, which a path leaves out, but
+    an id is taken again after a deletion (SQLite reuses the highest), and a robot run gets its
+    frames when it ends: each run read is keyed by id, creation time, status and a checksum of
+    its stored path. Raises NotFound as stored_path does."""
+    with sessions() as session:
+        run = records.get_run(session, run_id)
+        read = [run]
+        if run.kind == "replay":
+            read.append(records.get_run(session, int(run.results.get("source_run_id", 0)) or run_id))
+        return tuple(
+            (r.id, r.created_at, r.status, None if r.trajectory is None else zlib.crc32(r.trajectory)) for r in read
+        )
+
+
+def commanded(run: RunSnapshot, wall: Wall) -> LegControl | None:
+    """What live run ``run`` commands the leg that stands on ``wall`` to now (None: nothing yet)."""
+    return run.command_for(Leg.of(wall))
+
 
 log = logging.getLogger("parkourlab.view")
 CLOSE_WAIT_S = 30.0  # a view still starting at shutdown is waited for, then closed

@@ -26,10 +26,10 @@ from types import MappingProxyType
 
 import viser
 
-from backend.services.view import ViewContext
+from backend.services.view import ViewContext, stored_path_key
 from backend.settings import LOOPBACK_HOSTS
 from frontend.viewer.handshake import refuse_foreign_origins, viewer_of
-from frontend.viewer.recordings import Recording, load_recording, recording_key
+from frontend.viewer.recordings import Recording, load_recording
 from frontend.viewer.scene import place_camera
 from frontend.viewer.session import ViewerSession
 from frontend.viewer.share import share_html
@@ -160,7 +160,7 @@ class ClimbView:
 
     def open_run(self, viewer: str, run_id: int, overlay_run_id: int | None = None) -> dict:
         """Replay stored run ``run_id`` in the view of the panel called ``viewer`` only
-        (records.NotFound / records.Conflict when it cannot be). A view still loading gets it
+        (NotFound / Conflict, :mod:`backend.errors`, when it cannot be). A view still loading gets it
         when it connects, within :data:`PENDING_REPLAY_S`."""
         sessions = self.context.sessions
         recording = load_recording(sessions, run_id)
@@ -182,7 +182,7 @@ class ClimbView:
         replay inside: it opens offline, from a file, in any browser; frontend/viewer/share.py).
         The last :data:`SHARED_FILES_KEPT` files are kept, by what they were made of."""
         sessions = self.context.sessions
-        key = tuple(None if i is None else recording_key(sessions, i) for i in (run_id, overlay_run_id))
+        key = tuple(None if i is None else stored_path_key(sessions, i) for i in (run_id, overlay_run_id))
         with self._shared_lock:
             if key in self._shared:
                 self._shared.move_to_end(key)

@@ -16,9 +16,9 @@ callbacks run right after the handshake, before viser sends the client anything 
 message from it, and the handshake's request is on the connection viser keeps per client
 (``_live_connections``). So the check runs there, and a connection from a foreign Origin is
 closed (1008, policy violation) with nothing exchanged. The handshake itself has succeeded by
-then (the browser sees an open socket, then the close), and the names used here are viser's
-private ones: :func:`refuse_foreign_origins` fails loudly, and the view does not start, if they
-are gone.
+then (the browser sees an open socket, then the close), and the names used are viser's private
+ones, read through :mod:`frontend.viewer.viser_adapter`: :func:`refuse_foreign_origins` fails
+loudly, and the view does not start, if they are gone.
 
 Viewer ids. The control panel embeds the view with ``?websocket=ws://HOST:PORT/viewer/ID`` (viser's
 client connects to the address in its ``websocket`` parameter, path included), ``ID`` a random
@@ -40,24 +40,17 @@ import viser
 from backend.api.security import origin_allowed
 from backend.schemas.view import VIEWER_ID_PATTERN
 from backend.settings import host_name
+from frontend.viewer.viser_adapter import event_loop, live_connections, websocket_server
 
 log = logging.getLogger("parkourlab.view")
 POLICY_VIOLATION = 1008
 VIEWER_PATH = re.compile(rf"/viewer/({VIEWER_ID_PATTERN.strip('^$')})/?")
 
 
-def _live_connections(server: viser.ViserServer) -> dict:
-    websock = getattr(server, "_websock_server", None)
-    live = getattr(websock, "_live_connections", None)
-    if websock is None or not isinstance(live, dict):
-        raise RuntimeError(f"viser {viser.__version__}: no per-client connections to check Origins on")
-    return live
-
-
 def viewer_of(server: viser.ViserServer, client: viser.ClientHandle) -> str | None:
     """The viewer id in ``client``'s websocket path (``/viewer/ID``), or None (any other path, or
     a connection already gone)."""
-    connection = _live_connections(server).get(client.client_id)
+    connection = live_connections(server).get(client.client_id)
     if connection is None:
         return None
     match = VIEWER_PATH.fullmatch(connection.request.path.partition("?")[0])
@@ -68,8 +61,8 @@ def refuse_foreign_origins(server: viser.ViserServer, allowed_hosts: Iterable[st
     """Close every websocket of ``server`` whose Origin is not an allowed host, from now on and
     any already open (the server was listening before this could be installed)."""
     allowed = frozenset(host_name(host) for host in allowed_hosts)
-    live = _live_connections(server)
-    websock = server._websock_server
+    live = live_connections(server)
+    websock = websocket_server(server)
 
     def foreign(connection) -> str | None:
         origin = connection.request.headers.get("Origin")
@@ -82,7 +75,7 @@ def refuse_foreign_origins(server: viser.ViserServer, allowed_hosts: Iterable[st
             await connection.close(POLICY_VIOLATION, "origin not allowed")
 
     websock.on_client_connect(check)
-    loop = websock._background_event_loop
+    loop = event_loop(server)
     for connection in list(live.values()):
         if foreign(connection) is not None and loop is not None:
             asyncio.run_coroutine_threadsafe(connection.close(POLICY_VIOLATION, "origin not allowed"), loop)

@@ -14,14 +14,12 @@ first foot touches at the floor.
 from __future__ import annotations
 
 import math
-import zlib
 from dataclasses import dataclass
 
 import numpy as np
 
-from backend.services import records
-from backend.services.simulation import unpack_trajectory
-from backend.store.models import Run
+from backend.errors import Conflict
+from backend.services.view import StoredPath, stored_path
 from frontend.viewer.motion import TRAIL_STRIDE, PathClip
 from sim_core import ControlSchedule, LegControl, ModelParams, PhysicalParams, get_preset, simulate_trajectory
 from sim_core.climb import start_height
@@ -93,69 +91,49 @@ class Recording:
 
 
 def load_recording(sessions, run_id: int) -> Recording:
-    """The stored run ``run_id`` as a :class:`Recording`.
+    """The stored run ``run_id`` as a :class:`Recording` (read by
+    :func:`backend.services.view.stored_path`).
 
-    Raises records.NotFound when there is no such run, records.Conflict when it has nothing to show.
+    Raises NotFound when there is no such run, Conflict when it has nothing to show
+    (:mod:`backend.errors`).
     """
-    with sessions() as session:
-        run = records.get_run(session, run_id)
-        if run.kind == "sim":
-            return _sim_recording(run)
-        source = run
-        if run.kind == "replay":
-            source = records.get_run(session, int(run.results.get("source_run_id", 0)) or run_id)
-        if source.trajectory is None:
-            raise records.Conflict(f"run {run_id} has no tracker frames to replay")
-        return _tracker_recording(run, unpack_trajectory(source.trajectory))
+    run = stored_path(sessions, run_id)
+    if run.kind == "sim":
+        return _sim_recording(run)
+    return _tracker_recording(run)
 
 
-def recording_key(sessions, run_id: int) -> tuple:
-    """A short stand-in for what :func:`load_recording` reads of run ``run_id``: equal keys, equal
-    recordings (for a cache). Runs change only in their tags and notes, which a recording leaves
-    out, but an id is taken again after a deletion (SQLite reuses the highest), and a robot run
-    gets its frames when it ends: each run read is keyed by id, creation time, status and a
-    checksum of its stored path. Raises records.NotFound as load_recording does."""
-    with sessions() as session:
-        run = records.get_run(session, run_id)
-        read = [run]
-        if run.kind == "replay":
-            read.append(records.get_run(session, int(run.results.get("source_run_id", 0)) or run_id))
-        return tuple(
-            (r.id, r.created_at, r.status, None if r.trajectory is None else zlib.crc32(r.trajectory)) for r in read
-        )
-
-
-def _model_of(run: Run) -> ModelParams:
+def _model_of(run: StoredPath) -> ModelParams:
     fields = {name: value for name, value in run.model.items() if name in ModelParams.__dataclass_fields__}
     if fields.get("mu") is None:
         fields["mu"] = math.inf
     return ModelParams(**fields)
 
 
-def _legs(run: Run) -> tuple[LegControl, LegControl]:
+def _legs(run: StoredPath) -> tuple[LegControl, LegControl]:
     pairs = [LegControl.from_degrees(*pair) for pair in run.controls]
     return pairs[0], pairs[1 % len(pairs)]
 
 
-def _label(run: Run) -> str:
+def _label(run: StoredPath) -> str:
     controls = ", ".join(f"{psi:g}°:{zeta:g}" for psi, zeta in run.controls)
-    return f"run {run.id} ({run.kind}, {controls})"
+    return f"run {run.run_id} ({run.kind}, {controls})"
 
 
-def _sim_recording(run: Run) -> Recording:
+def _sim_recording(run: StoredPath) -> Recording:
     paper = get_preset("paper")
     robot = PhysicalParams.from_model(
         _model_of(run), mass=paper.mass, leg_length=paper.leg_length, gravity=paper.gravity
     )
-    if run.trajectory is not None:
-        columns = unpack_trajectory(run.trajectory)
+    if run.path is not None:
+        columns = run.path
     else:
         schedule = ControlSchedule.from_degrees(run.controls)
         columns = simulate_trajectory(
             robot.to_model(), schedule, run.start_state, run.jumps, sample_rate=REPLAY_SAMPLE_RATE
         ).columns()
     if columns["time"].size == 0:
-        raise records.Conflict(f"run {run.id} failed at its first touchdown: there is no path to show")
+        raise Conflict(f"run {run.run_id} failed at its first touchdown: there is no path to show")
     length, time_scale = robot.scales.length, robot.scales.time
     jump, phase = columns["jump"].astype(int), columns["phase"].astype(int)
     # The drawn leg reaches for the stance wall in stance and for the next wall in flight.
@@ -174,14 +152,14 @@ def _sim_recording(run: Run) -> Recording:
     )
     stance_starts = np.flatnonzero((phase == STANCE) & np.r_[True, np.diff(jump) != 0])
     touchdowns = np.column_stack([clip.time[stance_starts], clip.leg_wall[stance_starts], clip.foot_y[stance_starts]])
-    return Recording(run.id, run.kind, _label(run), clip, robot, _legs(run), touchdowns)
+    return Recording(run.run_id, run.kind, _label(run), clip, robot, _legs(run), touchdowns)
 
 
-def _tracker_recording(run: Run, frames: dict[str, np.ndarray]) -> Recording:
+def _tracker_recording(run: StoredPath) -> Recording:
+    frames = run.path  # stored_path has refused a robot or replay run without frames
     if frames["time"].size == 0:
-        raise records.Conflict(f"run {run.id} has no tracker frames to replay")
+        raise Conflict(f"run {run.run_id} has no tracker frames to replay")
     t0 = float(frames["time"][0])
     clip = PathClip.from_body(frames["time"] - t0, frames["x"], frames["y"])
-    found = run.results.get("touchdowns", [])
-    touchdowns = np.array([[td["time"] - t0, td["wall"], td["foot_height"]] for td in found]).reshape(-1, 3)
-    return Recording(run.id, run.kind, _label(run), clip, get_preset("paper"), None, touchdowns)
+    touchdowns = np.array([[td["time"] - t0, td["wall"], td["foot_height"]] for td in run.touchdowns]).reshape(-1, 3)
+    return Recording(run.run_id, run.kind, _label(run), clip, get_preset("paper"), None, touchdowns)

@@ -19,7 +19,9 @@ import threading
 import viser
 
 from backend.services.view import ViewContext
-from frontend.viewer.modes import LiveMode, ReplayMode, SimulateMode
+from frontend.viewer.modes.live import LiveMode
+from frontend.viewer.modes.replay import ReplayMode
+from frontend.viewer.modes.simulate import SimulateMode
 from frontend.viewer.recordings import Recording
 from frontend.viewer.scene import ChuteScene
 from sim_core import PhysicalParams

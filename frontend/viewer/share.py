@@ -4,8 +4,8 @@ The file is viser's single-file client with a recording embedded (viser's format
 messages, msgpack and zstd, base64 in the page), which plays offline, from disk, looping, with a
 time slider. The recording is the chute as :class:`ChuteScene` builds it, then a frame every
 1/:data:`EXPORT_RATE` s of the run (at most :data:`MAX_EXPORT_SECONDS`): the scene the replay
-mode shows at that instant (``modes.show_frame``): the robot and its legs, its trail, touchdown
-markers and finished jumps' trails, the ghost.
+mode shows at that instant (:func:`frontend.viewer.modes.painter.show_frame`): the robot and its
+legs, its trail, touchdown markers and finished jumps' trails, the ghost.
 
 Made fast (issue 14: a 10-minute run took 20-26 s when each frame was drawn on a live scene
 through viser's handles, ~0.15 ms a property and ~0.5 ms a node, then compressed at zstd level 12):
@@ -13,30 +13,23 @@ through viser's handles, ~0.15 ms a property and ~0.5 ms a node, then compressed
 - every frame's pose, legs, colours and trail come from the recording's arrays at once (numpy),
   and only what differs from the frame before is written;
 - the writes go into a viser ``StateSerializer`` as the message dicts viser records for the same
-  handle assignments (:class:`_Writer`; tests/frontend/viewer/test_share.py holds them equal to
-  viser's), not through handles;
+  handle assignments (:class:`frontend.viewer.viser_adapter.RecordingWriter`, held equal to
+  viser's by tests/frontend/viewer/test_viser_adapter.py), not through handles;
 - the nodes are made by :class:`ChuteScene` on a private viser server (port 0, for the length of
   the call), so the scene is the live view's; those made during the run (touchdown markers, past
   trails, ruler sections and labels) are written like the ones it made;
-- :func:`serialize` lays the recording out as viser's ``StateSerializer.serialize`` does, at zstd
-  level 3 instead of 12.
+- :func:`frontend.viewer.viser_adapter.serialize` lays the recording out as viser's
+  ``StateSerializer.serialize`` does, at zstd level 3 instead of 12.
 """
 
 from __future__ import annotations
 
-import base64
 import contextlib
 import gc
 from collections.abc import Iterable
-from pathlib import Path
-from typing import Any
 
-import msgspec
 import numpy as np
 import viser
-import zstandard
-from viser import _messages
-from viser.infra._infra import _append_aligned_buffers
 
 from backend.settings import LOOPBACK_HOSTS
 from frontend.viewer.geometry import bow_legs, energy_colors, polyline_segments, to_scene
@@ -44,13 +37,13 @@ from frontend.viewer.handshake import refuse_foreign_origins
 from frontend.viewer.motion import STANCE, TRAIL_STRIDE
 from frontend.viewer.recordings import Recording
 from frontend.viewer.scene import FOLLOW_MARGIN, ChuteScene, NodeRing, place_camera
+from frontend.viewer.viser_adapter import NODE_UPDATE, RecordingWriter, embed, serialize
 from sim_core.walls import Wall
 
 EXPORT_RATE = 30.0  # frames per second of a shared replay (the browser paints at its own rate)
 MAX_EXPORT_SECONDS = 600.0
 LEG_TOLERANCE = 1e-6  # [m] a leg that moved less than this since the last frame is not written again
 ZSTD_LEVEL = 3  # viser's files use 12 (0.5 s for a 10-minute run, for 10% less), its live link 1
-CLIENT_HTML = Path(viser.__file__).parent / "client" / "build" / "index.html"
 
 
 def share_html(
@@ -77,10 +70,10 @@ def _recorded_html(recording: Recording, overlay: Recording | None, allowed_host
             ring.node(0)  # made by viser, hidden: the template of the ring's other nodes
         serializer = server.get_scene_serializer()
         times = frame_times(recording, overlay)
-        out = _Writer(serializer, len(times))
+        out = RecordingWriter(serializer, len(times))
         record(scene, out, recording, overlay, times)
         out.finish(times, duration=len(times) / EXPORT_RATE)
-        return embed(serialize(serializer))
+        return embed(serialize(serializer, ZSTD_LEVEL))
     finally:
         server.stop()
 
@@ -97,115 +90,6 @@ def _no_gc_pauses():
     finally:
         if was_enabled:
             gc.enable()
-
-
-class _Writer:
-    """Scene messages for a viser ``StateSerializer``, frame by frame: each the dict viser records
-    for the same handle assignment or ``add_*`` call (``Message.as_serializable_dict``), without
-    the handles' bookkeeping. It uses the serializer's private ``_messages``, ``_binary_buffers``
-    and ``_time`` (viser 1.1.1 is pinned); tests/frontend/viewer/test_share.py holds the dicts
-    equal to viser's own.
-
-    Arrays go into the serializer's binary buffers as viser puts them (a placeholder with the
-    buffer's index and dtype); colours, which repeat, share one per colour, as viser's
-    de-duplication would make them.
-    """
-
-    def __init__(self, serializer, frame_count: int):
-        self.serializer = serializer
-        self.frames: list[list[dict[str, Any]]] = [[] for _ in range(frame_count)]
-        self.frame = 0  # the frame that position(), visible(), update() and make_like() write to
-        self._buffers = serializer._binary_buffers
-        self._templates: dict[tuple[type, str], dict[str, Any]] = {}
-        self._shared: dict[bytes, int] = {}
-        # The nodes made so far, by name: their create messages are the templates of make_like.
-        self.made = {message["name"]: message for _t, message in serializer._messages if "props" in message}
-
-    def template(self, kind: type, name: str) -> dict[str, Any]:
-        """viser's dict of a ``kind`` message (SetPosition, SetSceneNodeVisibility, SceneNodeUpdate,
-        RemoveSceneNode) for node ``name``; its value field is replaced in each use."""
-        key = (kind, name)
-        template = self._templates.get(key)
-        if template is None:
-            fields = {
-                _messages.SetPositionMessage: ((0.0, 0.0, 0.0),),
-                _messages.SetSceneNodeVisibilityMessage: (True,),
-                _messages.SceneNodeUpdateMessage: ({},),
-            }.get(kind, ())
-            template = self._templates[key] = kind(name, *fields).as_serializable_dict()
-        return template
-
-    def value(self, value, *, share: bool = False):
-        """``value`` as ``as_serializable_dict`` puts it: an array as a placeholder for its binary
-        buffer (``_prepare_for_serialization``), a tuple as floats. ``share``: an array equal to one
-        written before takes its buffer (for small ones that repeat: colours)."""
-        if not isinstance(value, np.ndarray):
-            return tuple(float(v) for v in value) if isinstance(value, tuple) else value
-        data = np.ascontiguousarray(value)
-        key = data.tobytes() if share else None
-        index = self._shared.get(key) if share else None
-        if index is None:
-            index = len(self._buffers)
-            self._buffers.append(data.data)
-            if share:
-                self._shared[key] = index
-        return {"__binary_index": index, "dtype": data.dtype.str}
-
-    def position(self, name: str, position) -> None:
-        """``handle.position = position`` (three floats)."""
-        template = self.template(_messages.SetPositionMessage, name)
-        self.frames[self.frame].append({**template, "position": tuple(float(v) for v in position)})
-
-    def visible(self, name: str, visible: bool) -> None:
-        """``handle.visible = visible``."""
-        template = self.template(_messages.SetSceneNodeVisibilityMessage, name)
-        self.frames[self.frame].append({**template, "visible": bool(visible)})
-
-    def update(self, name: str, prop: str, value) -> None:
-        """``handle.<prop> = value``, cast as the handle casts it (``points`` float32, ``colors`` uint8)."""
-        template = self.template(_messages.SceneNodeUpdateMessage, name)
-        self.frames[self.frame].append({**template, "updates": {prop: self.value(value)}})
-
-    def make_like(self, prototype: str, name: str, *, position=None, **props) -> None:
-        """A node ``name`` made as node ``prototype`` was (its kind and props, but ``props``), at
-        ``position`` (its parent's origin if None), shown: what viser sends for that ``add_*``
-        call (create, position, visibility)."""
-        template = self.made[prototype]
-        same = {prop: dict(value) if isinstance(value, dict) else value for prop, value in template["props"].items()}
-        made = {**template, "name": name, "props": {**same, **{k: self.value(v) for k, v in props.items()}}}
-        self.frames[self.frame].append(made)
-        self.made[name] = made
-        if position is not None:
-            self.position(name, position)
-        self.visible(name, True)
-
-    def positions(self, name: str, writes: np.ndarray, positions: np.ndarray) -> None:
-        """``position()`` of node ``name`` at each frame where ``writes``: ``positions[k]`` (K, 3)."""
-        template = self.template(_messages.SetPositionMessage, name)
-        frames = np.flatnonzero(writes)
-        for k, position in zip(frames.tolist(), positions[frames].tolist(), strict=True):
-            self.frames[k].append({**template, "position": tuple(position)})
-
-    def visibles(self, name: str, writes: np.ndarray, visible: np.ndarray) -> None:
-        """``visible()`` of node ``name`` at each frame where ``writes``: ``visible[k]``."""
-        template = self.template(_messages.SetSceneNodeVisibilityMessage, name)
-        frames = np.flatnonzero(writes)
-        for k, shown in zip(frames.tolist(), visible[frames].tolist(), strict=True):
-            self.frames[k].append({**template, "visible": shown})
-
-    def updates(self, name: str, prop: str, writes: np.ndarray, values: np.ndarray, *, share: bool = False) -> None:
-        """``update()`` of node ``name``'s ``prop`` at each frame where ``writes``: ``values[k]``."""
-        template = self.template(_messages.SceneNodeUpdateMessage, name)
-        for k in np.flatnonzero(writes).tolist():
-            self.frames[k].append({**template, "updates": {prop: self.value(values[k], share=share)}})
-
-    def finish(self, times: np.ndarray, *, duration: float) -> None:
-        """Into the serializer: frame k's messages at ``times[k]``, the recording ``duration`` s long."""
-        self.serializer._messages.extend(
-            [(t, message) for t, frame in zip(times.tolist(), self.frames, strict=True) for message in frame]
-        )
-        self.serializer._time = duration
-        self.frames = []
 
 
 def _writes(values: np.ndarray, initial, updated: np.ndarray | None = None, tolerance: float = 0.0) -> np.ndarray:
@@ -240,8 +124,8 @@ class _Trail:
         starts = np.flatnonzero(np.r_[True, self.lo[1:] != self.lo[:-1]])
         self.longest = np.repeat(np.maximum.reduceat(self.count, starts), np.diff(np.r_[starts, len(self.lo)]))
 
-    def write(self, out: _Writer) -> None:
-        template = out.template(_messages.SceneNodeUpdateMessage, self.node)
+    def write(self, out: RecordingWriter) -> None:
+        template = out.template(NODE_UPDATE, self.node)
         since, segments = -1, None
         for k in np.flatnonzero(self.writes).tolist():
             lo, count = int(self.lo[k]), int(self.count[k])
@@ -273,7 +157,7 @@ def _leg_frames(recording: Recording, frames, wall: int) -> tuple[np.ndarray, np
     return points, colors, drawn
 
 
-def _show_item(out: _Writer, ring: NodeRing, k: int, **props) -> None:
+def _show_item(out: RecordingWriter, ring: NodeRing, k: int, **props) -> None:
     """Item ``k`` of ``ring`` shown with ``props``, as ``NodeRing.show_next``; its node made like
     node 0 the first time."""
     name = f"{ring.prefix}{k % ring.size}"
@@ -288,7 +172,7 @@ def _show_item(out: _Writer, ring: NodeRing, k: int, **props) -> None:
     out.visible(name, True)
 
 
-def _history(out: _Writer, scene: ChuteScene, recording: Recording, times: np.ndarray, ghost: bool) -> None:
+def _history(out: RecordingWriter, scene: ChuteScene, recording: Recording, times: np.ndarray, ghost: bool) -> None:
     """Touchdown markers and finished jumps' trails (``ghost``: the ghost's jump trails), each at
     the frame where its touchdown is passed, as ``show_frame`` adds them."""
     marked = np.r_[0, recording.touchdowns_until(times)]
@@ -307,7 +191,9 @@ def _history(out: _Writer, scene: ChuteScene, recording: Recording, times: np.nd
                 shown += 1
 
 
-def record(scene: ChuteScene, out: _Writer, recording: Recording, overlay: Recording | None, times: np.ndarray) -> None:
+def record(
+    scene: ChuteScene, out: RecordingWriter, recording: Recording, overlay: Recording | None, times: np.ndarray
+) -> None:
     """Write the replay of ``recording`` (``overlay`` as the ghost) at ``times`` into ``out``, on
     ``scene``: fresh from ``ChuteScene(...)``, its rings' node 0 made (the templates of the others),
     in ``out``'s serializer already. What each frame sets is computed for all frames at once; a
@@ -358,40 +244,3 @@ def record(scene: ChuteScene, out: _Writer, recording: Recording, overlay: Recor
     trail.write(out)
     out.visibles(scene.ghost_trail.name, _writes(trail.drawn, scene.ghost_trail.visible), trail.drawn)
     _history(out, scene, overlay, times, ghost=True)
-
-
-def serialize(serializer) -> bytes:
-    """The recording as viser's ``StateSerializer.serialize`` lays it out (its "hybrid" format: the
-    uncompressed size, then zstd of [msgpack length, msgpack of the messages with placeholders,
-    8-byte aligned binary buffers]), compressed at :data:`ZSTD_LEVEL`. Its buffers are not
-    de-duplicated again (:class:`_Writer` shares the small ones). Like viser's, it ends the
-    recording: the server no longer feeds it, nor keeps it alive."""
-    handler = serializer._handler
-    with handler._record_lock:
-        handler._record_handles.remove(serializer)
-    buffers = serializer._binary_buffers
-    payload = msgspec.msgpack.encode(
-        {
-            "durationSeconds": serializer._time,
-            "messages": serializer._messages,
-            "viserVersion": viser.__version__,
-            "binaryBufferLengths": tuple(buffer.nbytes for buffer in buffers),
-        }
-    )
-    parts: list = [len(payload).to_bytes(8, "little"), payload]
-    _append_aligned_buffers(parts, buffers, 8 + len(payload))
-    size = sum(memoryview(part).nbytes for part in parts)
-    compressor = zstandard.ZstdCompressor(level=ZSTD_LEVEL, threads=-1).compressobj(size=size)
-    out = [size.to_bytes(8, "little")]
-    out.extend(compressor.compress(part) for part in parts)
-    out.append(compressor.flush())
-    return b"".join(out)
-
-
-def embed(recording: bytes) -> str:
-    """viser's single-file client with ``recording`` inside, as ``StateSerializer.as_html`` makes it."""
-    client = CLIENT_HTML.read_text()
-    data = base64.b64encode(recording).decode("ascii")
-    script = f'<script>window.__VISER_EMBED_DATA__="{data}";window.__VISER_EMBED_CONFIG__={{darkMode:false}};</script>'
-    head_end = client.index("</head>")
-    return client[:head_end] + script + client[head_end:]

@@ -1,13 +1,16 @@
-"""What a recording's frame shows, as the replay and the shared file both take it: touchdowns passed
-and the trail of the jump under way. (Loading stored runs is tested in test_view.py.)"""
+"""Recordings (frontend/viewer/recordings.py): what a recording's frame shows, as the replay and the
+shared file both take it (touchdowns passed, the trail of the jump under way), and stored runs
+loaded through the service. (Robot and replay runs are loaded in test_share.py's fixture.)"""
 
 import numpy as np
 from numpy.testing import assert_array_equal
 
 from frontend.viewer.motion import PathClip
-from frontend.viewer.recordings import MAX_TRAIL_SECONDS, Recording
+from frontend.viewer.recordings import MAX_TRAIL_SECONDS, Recording, load_recording
 from sim_core import get_preset
+from tests.frontend.viewer.view_service import RUN
 
+ROBOT = get_preset("paper")
 TIME = np.round(np.arange(0.0, 20.0, 0.01), 2)  # tracker frames at 100 Hz for 20 s
 CLIP = PathClip.from_body(TIME, np.sin(TIME), 0.1 * TIME)
 TOUCHDOWNS = np.array([[1.0, -1, 0.05], [2.0, 1, 0.15]])
@@ -34,3 +37,14 @@ def test_without_touchdowns_the_trail_reaches_back_a_few_seconds_at_most():
     lo, hi = recording.trail_span(12.0)
     assert TIME[hi - 1] == 12.0 and TIME[lo] == 12.0 - MAX_TRAIL_SECONDS
     assert recording.trail_span(3.0) == (0, 301)
+
+
+def test_recordings_put_sim_runs_between_the_walls(service):
+    client, auth, view = service
+    run = client.post("/api/v1/runs", json=RUN | {"trajectory_rate": 200}, headers=auth).json()
+    recording = load_recording(view.context.sessions, run["id"])
+    half = 0.5 * ROBOT.wall_distance
+    assert set(np.unique(recording.touchdowns[:, 1])) == {-1, 1}
+    stance_feet = recording.clip.foot_x[recording.clip.phase == 0]
+    assert np.allclose(np.abs(stance_feet), half), "stance feet are on the walls"
+    assert np.all(np.abs(recording.clip.x) < half)

@@ -26,7 +26,7 @@ from backend.store.database import make_engine, migrate, session_factory, sqlite
 from backend.store.models import Run
 from frontend.viewer import share
 from frontend.viewer.geometry import to_scene
-from frontend.viewer.modes import show_frame
+from frontend.viewer.modes.painter import show_frame
 from frontend.viewer.recordings import load_recording
 from frontend.viewer.scene import TOUCHDOWN_MARKERS, TRAIL_JUMPS, ChuteScene
 
@@ -236,50 +236,3 @@ def test_a_run_longer_than_ten_minutes_is_cut_at_ten(runs):
 
 def _slowed(clip, factor):
     return type(clip)(**{name: getattr(clip, name) * (factor if name == "time" else 1) for name in clip.COLUMNS})
-
-
-def test_the_writer_writes_what_viser_records_for_the_same_handle_calls():
-    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
-    try:
-        scene = server.scene
-        box = scene.add_box("/a", color=(240, 150, 0), dimensions=(0.1, 0.2, 0.3), position=(1.0, 0.0, 0.0))
-        line = scene.add_line_segments("/l", points=np.zeros((1, 2, 3)), colors=(60, 60, 60), thickness=0.002)
-        label = scene.add_label("/t", "0.00 m", position=(0.1, 0.0, 0.0), font_screen_scale=0.7)
-        serializer = server.get_scene_serializer()
-        writer = share._Writer(serializer, 1)
-        start = len(serializer._messages)
-        points = np.random.default_rng(1).normal(size=(4, 2, 3))
-        box.position = (0.5, 0.0, 2.0)
-        box.visible = False
-        box.dimensions = (0.1, 0.2, 4.0)
-        line.points = points
-        line.colors = np.full((4, 2, 3), 7, dtype=np.uint8)
-        scene.add_box("/b", color=(240, 150, 0), dimensions=(0.1, 0.2, 0.3), position=(0.0, 0.0, 3.0))
-        scene.add_line_segments("/m", points=points, colors=(60, 60, 60), thickness=0.002)
-        scene.add_label("/u", "0.25 m", position=(0.1, 0.0, 0.25), font_screen_scale=0.7)
-        viser_wrote = [message for _t, message in serializer._messages[start:]]
-        writer.position("/a", (0.5, 0.0, 2.0))
-        writer.visible("/a", False)
-        writer.update("/a", "dimensions", (0.1, 0.2, 4.0))
-        writer.update("/l", "points", points.astype(np.float32))
-        writer.update("/l", "colors", np.full((4, 2, 3), 7, dtype=np.uint8))
-        writer.make_like("/a", "/b", position=(0.0, 0.0, 3.0))
-        writer.make_like("/l", "/m", points=points.astype(np.float32))
-        writer.make_like("/t", "/u", text="0.25 m", position=(0.1, 0.0, 0.25))
-        buffers = serializer._binary_buffers
-        resolved = [_resolved(message, buffers) for message in writer.frames[0]]
-        assert resolved == [_resolved(message, buffers) for message in viser_wrote]
-        assert label.text == "0.00 m"
-    finally:
-        server.stop()
-
-
-def _resolved(value, buffers):
-    """Placeholders replaced by (dtype, bytes): equal when they stand for equal arrays."""
-    if isinstance(value, dict):
-        if "__binary_index" in value:
-            return (value["dtype"], bytes(buffers[value["__binary_index"]]))
-        return {key: _resolved(item, buffers) for key, item in value.items()}
-    if isinstance(value, list | tuple):
-        return [_resolved(item, buffers) for item in value]
-    return value

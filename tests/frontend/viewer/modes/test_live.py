@@ -1,5 +1,8 @@
-"""Live mode's trail: bounded, sent a piece at a time (``StreamedTrail``), and drawn afresh at
-each run's start.
+"""Live mode (frontend/viewer/modes/live.py): the robot as everyone who chooses it sees it, the
+model's ghost beside it (the paper's or a calibration), and its trail: bounded, sent a piece at a
+time (``StreamedTrail``), and drawn afresh at each run's start.
+
+The first tests run the service with a virtual robot and headless browsers (conftest.py).
 
 :class:`LiveMode` draws frame by frame (60 a second) on a private viser server's scene while its
 tracker is fed as the virtual robot feeds it: 100 frames a second, the clock starting again at
@@ -22,11 +25,12 @@ from backend.robot.live_run import RunSnapshot
 from backend.robot.touchdown import Touchdown
 from backend.robot.tracker import Calibration, Pose, PoseHistory
 from frontend.viewer.geometry import polyline_segments
-from frontend.viewer.modes import LiveMode
+from frontend.viewer.modes.live import LiveMode
 from frontend.viewer.scene import LIVE_TRAIL_PIECES, PIECE_POINTS, ChuteScene, StreamedTrail
 from sim_core import get_preset
 from sim_core.walls import Wall
 from tests.frontend.viewer.test_share import SceneTree, decode_recording
+from tests.frontend.viewer.view_service import wait_for
 
 ROBOT = get_preset("paper")
 TRACKER_RATE = 100.0  # [Hz] the virtual robot's tracker frames
@@ -127,6 +131,79 @@ def trail_drawn(scene: dict) -> set[bytes]:
 
 def segments_of(path: np.ndarray) -> set[bytes]:
     return {segment.tobytes() for segment in polyline_segments(path).astype(np.float32)}
+
+
+def test_live_mode_shows_the_robot_to_everyone_who_chooses_it_with_the_model_beside_it(service, browsers, virtual):
+    client, auth, _view = service
+    robot, port = virtual
+    (_, watching), (_, also), (_, simulating) = browsers(), browsers(), browsers()
+    try:
+        answer = client.post("/api/v1/robot/connect", json={"url": robot.url, "tracker_port": port}, headers=auth)
+        assert answer.status_code == 200, answer.text
+        watching.set_mode("live")
+        also.set_mode("live")
+        live = watching.modes["live"]
+        controls = [{"psi0_deg": 30, "zeta0": 0.87}, {"psi0_deg": 30, "zeta0": 0.9}]
+        assert (
+            client.post("/api/v1/robot/runs", json={"controls": controls, "jumps": 6}, headers=auth).status_code == 202
+        )
+        wait_for(lambda: not client.get("/api/v1/robot").json()["run"]["active"], timeout=30)
+        # A loaded machine's control loop may see a touchdown or more past the sixth before it ends the
+        # run: the views show what the run recorded, however many that was.
+        recorded = client.get("/api/v1/robot").json()["run"]["touchdowns"]
+        assert recorded >= 6
+        wait_for(lambda: live._marked == recorded and also.modes["live"]._marked == recorded)
+        assert watching.scene.ghost.visible, "the model's jump from the last touchdown is drawn"
+        ghost_trail = watching.scene.live_ghost_trail
+        assert ghost_trail.finished.count or len(ghost_trail.piece) >= 2, "and its trail since the touchdown"
+        assert simulating.mode.name == "simulate" and simulating.modes["live"]._marked == 0, "choosing is each one's"
+        # Without noise the robot is the model: the ghost lands where the robot touched down.
+        assert abs(live.last_error) < 0.01, f"model's touchdown height error {live.last_error:+.4f} m"
+        assert f"Touchdowns this run:** {recorded} " in live.readout(60.0)
+    finally:
+        client.post("/api/v1/robot/disconnect", headers=auth)
+
+
+def test_the_live_ghost_can_predict_with_a_calibrated_model(service, browsers):
+    """A robot unlike the paper's: the ghost of a calibration of it lands where the robot touches
+    down, the paper's does not; each browser chooses its own."""
+    import socket
+
+    from backend.robot.virtual import VirtualRobot
+    from backend.store.models import ModelPreset
+    from sim_core.noise import NO_NOISE
+    from tests.helpers import free_port
+    from tests.tracked_climbs import Truth
+
+    client, auth, _view = service
+    truth = Truth.of(alpha=72.0, c_zeta=1.25, c_psi=0.8, psi0_offset_deg=(0.6, -0.8), zeta0_offset=(0.004, -0.005))
+    with client.app.state.sessions() as session:
+        session.add(ModelPreset(name="truth", base="paper", physical=dataclasses.asdict(truth.robot),
+                                offsets=truth.offsets.to_dict(), fit={}, runs=[], code_version="test"))  # fmt: skip
+        session.commit()
+    port = free_port(socket.SOCK_DGRAM)
+    robot = VirtualRobot(tracker_to=("127.0.0.1", port), robot=truth.robot, leg_offsets=truth.offsets,
+                         noise=NO_NOISE, tracker_noise=0.0, drop_rate=0.0, speed=4.0).start()  # fmt: skip
+    (_, paper_view), (_, calibrated_view) = browsers(), browsers()
+    try:
+        answer = client.post("/api/v1/robot/connect", json={"url": robot.url, "tracker_port": port}, headers=auth)
+        assert answer.status_code == 200, answer.text
+        paper, calibrated = paper_view.modes["live"], calibrated_view.modes["live"]
+        assert calibrated.gui_ghost_model.options == ("paper", "truth")
+        calibrated.use_ghost_model("truth")
+        paper_view.set_mode("live")
+        calibrated_view.set_mode("live")
+        controls = [{"psi0_deg": 30, "zeta0": 0.87}, {"psi0_deg": 30, "zeta0": 0.9}]
+        assert (
+            client.post("/api/v1/robot/runs", json={"controls": controls, "jumps": 6}, headers=auth).status_code == 202
+        )
+        wait_for(lambda: not client.get("/api/v1/robot").json()["run"]["active"], timeout=30)
+        wait_for(lambda: paper._marked >= 6 and calibrated._marked >= 6)
+        assert abs(calibrated.last_error) < 0.002, f"the calibrated ghost's error {calibrated.last_error:+.4f} m"
+        assert abs(paper.last_error) > 3 * abs(calibrated.last_error), (paper.last_error, calibrated.last_error)
+    finally:
+        client.post("/api/v1/robot/disconnect", headers=auth)
+        robot.stop()
 
 
 @pytest.fixture

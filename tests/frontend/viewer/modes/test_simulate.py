@@ -1,0 +1,63 @@
+"""Simulate mode (frontend/viewer/modes/simulate.py) in a browser's view of the service's 3D view:
+presets and sliders without feedback loops, half-typed values kept from the simulator, the gait
+readout, and a climb that ends at the floor."""
+
+import pytest
+
+from frontend.viewer.modes.gait_search import GAIT_PRESETS
+from sim_core.climb import ClimbEnd
+from tests.frontend.viewer.view_service import wait_for
+
+
+def test_presets_and_sliders_do_not_feed_back(browsers):
+    _, session = browsers()
+    simulate = session.modes["simulate"]
+    name = list(GAIT_PRESETS)[2]
+    simulate.set_preset(name)
+    assert simulate.gui_preset.value == name, "setting the sliders from a preset does not mark it custom"
+    assert not simulate.gui_symmetric.value and simulate.gui_zeta0_right.value == pytest.approx(0.9505)
+    controls = simulate.controls()
+    assert (controls.left.zeta0, controls.right.zeta0, controls.right.psi0_deg) == (0.90, 0.9505, pytest.approx(35))
+    wait_for(lambda: simulate.gait is not None and simulate.gait_note != "searching…")
+    assert simulate.gait.period == 4 and simulate.gait.stable, simulate.gait_note
+    simulate.gui_zeta0_left.value = 0.88  # as if a person moved it (the callback runs)
+    assert simulate.gui_preset.value == "custom"
+    simulate.gui_symmetric.value = True
+    assert simulate.gui_zeta0_right.value == 0.88 and simulate.gui_zeta0_right.disabled
+    assert simulate.climb.controls.right.zeta0 == 0.88
+
+
+def test_half_typed_values_never_reach_the_simulator(browsers):
+    _, session = browsers()
+    simulate = session.modes["simulate"]
+    wait_for(lambda: simulate.gait_note != "searching…")
+    in_use = simulate.climb.controls
+    for handle, typed in ((simulate.gui_psi0_left, 0.0), (simulate.gui_zeta0_left, 0.9999), (simulate.gui_gravity, 0)):
+        whole = handle.value
+        handle.value = typed  # what a number box sends on the way to a whole value
+        assert simulate.climb.controls == in_use, handle.label
+        assert handle.label in simulate.input_note and "must be" in simulate.input_note
+        assert "**Not in use yet:**" in simulate.readout(60.0)
+        handle.value = whole  # typed to the end
+        assert simulate.input_note is None and simulate.climb.controls == in_use
+    simulate.gui_speed.value, before = -3.0, simulate.time
+    simulate.frame(0.1)
+    assert simulate.time > before, "a half-typed speed plays at the slowest, never backwards"
+
+
+def test_simulate_mode_stops_a_descending_climb_at_the_floor_and_says_so(browsers):
+    _, session = browsers()
+    simulate = session.modes["simulate"]
+    wait_for(lambda: simulate.gait_note != "searching…")  # the first search, which restarts the climb
+    simulate.gui_psi0_left.value = 30.0
+    simulate.gui_zeta0_left.value = 0.99  # beyond jumping in place: the gait descends
+    wait_for(lambda: simulate.gait_note != "searching…")
+    with session.lock:
+        simulate.restart()
+        simulate.playback("Pause")
+        simulate.time = 300.0
+        simulate.frame(0.0)
+        readout = simulate.readout(60.0)
+    assert simulate.climb.current.failure is ClimbEnd.FLOOR
+    assert "**Failure:** **floor** at jump" in readout and "the body reached the chute's floor" in readout, readout
+    assert "height** 0.000 m" in readout, readout
