@@ -5,6 +5,11 @@ A trial starts on the gait's fixed point and jumps with the disturbances of
 ``trials`` trials give the mean and standard deviation of the jumps completed, a 95%
 confidence interval of the mean, and a histogram of how the trials ended. Capped trials count
 as ``cap`` jumps, so with capped trials the mean is a lower bound; the result says how many.
+
+A study is planned once — its levels' starts here (:func:`level_starts`), its trials in chunks in
+:mod:`sim_core.mjtf_plan` (each trial's seed fixed by ``(seed, level, index)``) — and its statistics
+computed there once, whether it runs whole (:func:`mjtf_study`) or as a stored job that resumes
+with the trials it is missing (``backend.services.job_runner``).
 """
 
 from __future__ import annotations
@@ -17,11 +22,12 @@ import numpy as np
 from numba import prange
 
 from sim_core._jit import kernel, parallel_kernel
-from sim_core.chunks import ChunkMap, Progress, chunk_slices, in_process
+from sim_core.chunks import ChunkMap, Progress, in_process
 from sim_core.controls import LegControl
 from sim_core.failures import OK, Failure
 from sim_core.integrate import STATE_SIZE
-from sim_core.noise import NoiseModel, trial_seeds
+from sim_core.mjtf_plan import CAPPED, jump_moments, jump_statistics, no_outcomes, plan_trials
+from sim_core.noise import NoiseModel
 from sim_core.noise_rules import disturbed_state, perturbed_controls, pitch_step, seed_trial
 from sim_core.params import ModelParams
 from sim_core.stride import jump
@@ -31,7 +37,6 @@ from sim_core.validation import ParameterError
 MAX_TRIALS = 1_000_000
 MAX_CAP = 1_000_000
 DEFAULT_CHUNK_TRIALS = 256
-CAPPED = "capped"  # histogram key of trials that reached the cap
 
 
 @dataclass(frozen=True)
@@ -54,12 +59,12 @@ class MJTFLevel:
 
     @property
     def mean(self) -> float:
-        return float(np.mean(self.jumps))
+        return jump_statistics(*jump_moments(self.jumps))[0]
 
     @property
     def std(self) -> float:
         """Sample standard deviation (ddof = 1; 0 for a single trial)."""
-        return float(np.std(self.jumps, ddof=1)) if self.jumps.size > 1 else 0.0
+        return jump_statistics(*jump_moments(self.jumps))[1]
 
     @property
     def ci95(self) -> tuple[float, float]:
@@ -68,7 +73,8 @@ class MJTFLevel:
         return self.mean - half, self.mean + half
 
     def histogram(self) -> dict[str, int]:
-        counts = {CAPPED: int(np.count_nonzero(self.status == OK))}
+        counts = no_outcomes()
+        counts[CAPPED] = int(np.count_nonzero(self.status == OK))
         for failure in Failure:
             counts[failure.code] = int(np.count_nonzero(self.status == failure.value))
         return counts
@@ -142,17 +148,12 @@ def mjtf_study(
     (:mod:`sim_core.chunks`), so results do not depend on how the work is split.
     """
     trials, cap = check_trials(trials, cap)
-    seeds = [trial_seeds(seed, index, trials) for index in range(len(zeta0s))]
     levels = level_starts(model, psi0, zeta0s, fixed_leg=fixed_leg, guess=guess)
-    chunks, owners = [], []
-    for index, level in enumerate(levels):
-        for part in chunk_slices(trials, chunk_trials):
-            chunks.append((model, level.schedule, level.start, noise, seeds[index][part], cap))
-            owners.append(index)
-    results = chunk_map(run_trials, chunks, progress)
+    chunks = plan_trials(len(levels), trials, seed, chunk_trials)
+    results = chunk_map(run_trials, [chunk.arguments(model, levels, noise, cap) for chunk in chunks], progress)
     out = []
     for index, level in enumerate(levels):
-        mine = [result for owner, result in zip(owners, results, strict=True) if owner == index]
+        mine = [result for chunk, result in zip(chunks, results, strict=True) if chunk.level == index]
         jumps = np.concatenate([jumps for jumps, _ in mine])
         status = np.concatenate([status for _, status in mine])
         out.append(MJTFLevel(level.zeta0, level.energy, level.start, jumps, status, cap))

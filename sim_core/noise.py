@@ -5,8 +5,10 @@ component of the section state; a constant L/R asymmetry (the right leg's contro
 as the paper observed on the robot); and a body pitch that drifts as a random walk and
 offsets both leg angles — the paper's main failure mode.
 
-This module is the model's parameters (:class:`NoiseModel`), the clamps and the trial seeds:
-numpy only, so options and request schemas read its defaults without loading the kernels. How
+This module is the model's parameters (:class:`NoiseModel`: their defaults, and their ranges in
+:data:`SIGMA_LIMITS` and :data:`ASYMMETRY_LIMITS`), the clamps and the trial seeds: numpy only, so
+options, request schemas and stored job specs read its defaults and ranges without loading the
+kernels. How
 the noise is drawn — each rule once, compiled, and the two samplers that feed it — is
 :mod:`sim_core.noise_rules`.
 
@@ -37,6 +39,10 @@ PSI0_LIMITS = (CONTROL_MARGIN, 0.5 * math.pi - CONTROL_MARGIN)  # [rad]
 ZETA0_LIMITS = (CONTROL_MARGIN, 1.0 - CONTROL_MARGIN)  # [l0]
 PSI0_MIN, PSI0_MAX = PSI0_LIMITS
 ZETA0_MIN, ZETA0_MAX = ZETA0_LIMITS
+# The noise's ranges, by NoiseModel field: each standard deviation in [0, limit), each asymmetry
+# offset in (-limit, limit). The API's request schema states the same ranges from these.
+SIGMA_LIMITS = {"psi0_deg": 30.0, "zeta0": 0.2, "velocity": 1.0, "pitch_drift_deg": 30.0}
+ASYMMETRY_LIMITS = {"asymmetry_psi0_deg": 30.0, "asymmetry_zeta0": 0.5}
 
 
 @dataclass(frozen=True)
@@ -59,9 +65,9 @@ class NoiseModel:
     asymmetry_zeta0: float = 0.0
 
     def __post_init__(self) -> None:
-        for field, limit in (("psi0_deg", 30.0), ("zeta0", 0.2), ("velocity", 1.0), ("pitch_drift_deg", 30.0)):
+        for field, limit in SIGMA_LIMITS.items():
             check_range(f"noise.{field}", getattr(self, field), 0.0, limit, low_open=False)  # sigmas: [0, limit)
-        for field, limit in (("asymmetry_psi0_deg", 30.0), ("asymmetry_zeta0", 0.5)):
+        for field, limit in ASYMMETRY_LIMITS.items():
             check_range(f"noise.{field}", getattr(self, field), -limit, limit)
 
     def kernel_args(self) -> tuple[float, ...]:

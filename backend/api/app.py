@@ -24,7 +24,7 @@ from backend.api.deps import Database
 from backend.api.routes import calibrations, experiments, jobs, robot, runs, sim, site, view
 from backend.api.security import api_token
 from backend.services import exports, records, simulation
-from backend.services import jobs as job_service
+from backend.services.job_runner import JobRunner
 from backend.services.robot import RobotService
 from backend.services.view import ViewContext, ViewFactory, ViewStarter
 from backend.settings import Settings
@@ -76,7 +76,7 @@ def create_app(
     token, _ = api_token(settings.data_dir)
     owns_compute = compute is None
     compute = compute or Compute(warm_up=simulation.warm_up, reads_warm_up=functools.partial(loaded, RUN_READS))
-    runner = job_service.JobRunner(sessions, compute.jobs, dask_address=settings.dask_address)
+    runner = JobRunner(sessions, compute.jobs, dask_address=settings.dask_address)
     robot_service = RobotService(sessions, latch_path=settings.data_dir / LATCH_FILE)
 
     @contextlib.asynccontextmanager

@@ -19,7 +19,8 @@ from sqlalchemy.orm import Session, sessionmaker
 
 from backend import schemas
 from backend.api.security import require_token
-from backend.services import calibrations, jobs, records
+from backend.services import calibrations, records
+from backend.services import job_runner as jobs
 from backend.services.robot import RobotService
 from backend.store.database import StorageFull, after_storage_full
 from backend.workers.pools import ComputePool

@@ -22,6 +22,7 @@ from backend.schemas.common import (
     Strict,
     Zeta0,
 )
+from sim_core.noise import ASYMMETRY_LIMITS, SIGMA_LIMITS, NoiseModel
 
 # A job's work, in jumps at its worst (every trial to its cap, every basin point to its jump limit):
 # about an hour of the job worker on the lab's machine (1.35e5-1.6e5 jumps/s measured by
@@ -38,13 +39,20 @@ class JobState(enum.StrEnum):
     FAILED = "failed"
 
 
+_NOISE = NoiseModel()  # the noise's defaults; its ranges: SIGMA_LIMITS, ASYMMETRY_LIMITS (sim_core.noise)
+
+
 class NoiseIn(Strict):
-    psi0_deg: Annotated[float, Field(ge=0.0, lt=30.0)] = 0.5
-    zeta0: Annotated[float, Field(ge=0.0, lt=0.2)] = 0.003
-    velocity: Annotated[float, Field(ge=0.0, lt=1.0)] = 0.01
-    pitch_drift_deg: Annotated[float, Field(ge=0.0, lt=30.0)] = 0.5
-    asymmetry_psi0_deg: Annotated[float, Field(gt=-30.0, lt=30.0)] = 0.0
-    asymmetry_zeta0: Annotated[float, Field(gt=-0.5, lt=0.5)] = 0.0
+    psi0_deg: Annotated[float, Field(ge=0.0, lt=SIGMA_LIMITS["psi0_deg"])] = _NOISE.psi0_deg
+    zeta0: Annotated[float, Field(ge=0.0, lt=SIGMA_LIMITS["zeta0"])] = _NOISE.zeta0
+    velocity: Annotated[float, Field(ge=0.0, lt=SIGMA_LIMITS["velocity"])] = _NOISE.velocity
+    pitch_drift_deg: Annotated[float, Field(ge=0.0, lt=SIGMA_LIMITS["pitch_drift_deg"])] = _NOISE.pitch_drift_deg
+    asymmetry_psi0_deg: Annotated[
+        float, Field(gt=-ASYMMETRY_LIMITS["asymmetry_psi0_deg"], lt=ASYMMETRY_LIMITS["asymmetry_psi0_deg"])
+    ] = _NOISE.asymmetry_psi0_deg
+    asymmetry_zeta0: Annotated[
+        float, Field(gt=-ASYMMETRY_LIMITS["asymmetry_zeta0"], lt=ASYMMETRY_LIMITS["asymmetry_zeta0"])
+    ] = _NOISE.asymmetry_zeta0
 
 
 class MJTFJobCreate(Strict):

@@ -14,8 +14,10 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field, fields
 
 from experiments.manifest import json_safe
+from sim_core.noise import NoiseModel
 
 SPEC_VERSION = 1
+_NOISE = NoiseModel()  # the noise's defaults: one home, sim_core.noise
 
 
 @dataclass(frozen=True)
@@ -44,12 +46,19 @@ class StateSpec:
 
 @dataclass(frozen=True)
 class NoiseSpec:
-    psi0_deg: float = 0.5
-    zeta0: float = 0.003
-    velocity: float = 0.01
-    pitch_drift_deg: float = 0.5
-    asymmetry_psi0_deg: float = 0.0
-    asymmetry_zeta0: float = 0.0
+    """:class:`~sim_core.noise.NoiseModel`'s fields as stored, not validated here (the runner's
+    ``NoiseModel`` is): a spec stays readable whatever the ranges become."""
+
+    psi0_deg: float = _NOISE.psi0_deg
+    zeta0: float = _NOISE.zeta0
+    velocity: float = _NOISE.velocity
+    pitch_drift_deg: float = _NOISE.pitch_drift_deg
+    asymmetry_psi0_deg: float = _NOISE.asymmetry_psi0_deg
+    asymmetry_zeta0: float = _NOISE.asymmetry_zeta0
+
+    def model(self) -> NoiseModel:
+        """The noise as sim_core runs it (a ParameterError naming the field if out of range)."""
+        return NoiseModel(**asdict(self))
 
 
 @dataclass(frozen=True)

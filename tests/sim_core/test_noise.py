@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from sim_core import ParameterError
-from sim_core.noise import NO_NOISE, NoiseModel, trial_seeds
+from sim_core.noise import ASYMMETRY_LIMITS, NO_NOISE, SIGMA_LIMITS, NoiseModel, trial_seeds
 
 
 @pytest.mark.parametrize(
@@ -26,6 +26,19 @@ from sim_core.noise import NO_NOISE, NoiseModel, trial_seeds
 def test_out_of_range_noise_names_its_field(field, value):
     with pytest.raises(ParameterError, match=rf"^noise\.{field}:"):
         NoiseModel(**{field: value})
+
+
+def test_every_field_has_one_range_and_its_default_lies_in_it():
+    """The ranges the API's request schema states (backend/schemas/jobs.py reads them from here)."""
+    assert set(SIGMA_LIMITS) | set(ASYMMETRY_LIMITS) == set(NoiseModel().to_dict())
+    assert not set(SIGMA_LIMITS) & set(ASYMMETRY_LIMITS)
+    for field, limit in SIGMA_LIMITS.items():
+        NoiseModel(**{field: 0.0})  # a sigma's range includes 0 ...
+        with pytest.raises(ParameterError, match=rf"^noise\.{field}:"):
+            NoiseModel(**{field: limit})  # ... and stops short of its limit
+    for field, limit in ASYMMETRY_LIMITS.items():
+        with pytest.raises(ParameterError, match=rf"^noise\.{field}:"):
+            NoiseModel(**{field: -limit})
 
 
 def test_kernel_arguments_are_in_radians_and_l0():

@@ -1,0 +1,109 @@
+"""The jobs and their trials in the store: SQL and only SQL (the services commit).
+
+A job's state changes with conditional UPDATEs (:func:`change_state`, :func:`claim`): the job
+runner and a cancel request may write the same row at once, and reading the state first and then
+writing it could overwrite a state the other just wrote. A job's trials are summed per level and
+outcome by the database (:func:`outcome_moments`), never read one by one.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from sqlalchemy import func, select, update
+from sqlalchemy.orm import Session
+
+from backend.repositories.common import fetch, newest_first, page
+from backend.schemas.jobs import JobState
+from backend.store.models import Job, Trial, utcnow
+
+_UNSYNCHRONIZED = {"synchronize_session": False}  # a conditional UPDATE: the session's copy is refreshed after
+
+
+def add(session: Session, job: Job) -> Job:
+    session.add(job)
+    return job
+
+
+def get(session: Session, job_id: int) -> Job:
+    """The job; :class:`~backend.errors.NotFound` if there is none."""
+    return fetch(session, Job, job_id, "job")
+
+
+def find(session: Session, job_id: int) -> Job | None:
+    return session.get(Job, job_id)
+
+
+def state_of(session: Session, job_id: int) -> str | None:
+    """The job's state as committed (None if there is no such job)."""
+    return session.scalar(select(Job.state).where(Job.id == job_id))
+
+
+def newest(
+    session: Session, *, state: JobState | None, limit: int, cursor: int | None, experiment_id: int | None
+) -> tuple[list[Job], int | None]:
+    """A keyset page of jobs, newest first, of one ``state`` and ``experiment_id`` where given."""
+    query = newest_first(Job, limit, cursor)
+    if state is not None:
+        query = query.where(Job.state == state)
+    if experiment_id is not None:
+        query = query.where(Job.experiment_id == experiment_id)
+    return page(list(session.scalars(query)), limit)
+
+
+def change_state(session: Session, job_id: int, was: JobState, **values) -> int:
+    """Set ``values`` on the job if it is in state ``was``, in one UPDATE; the rows changed (0 or 1)."""
+    changed = update(Job).where(Job.id == job_id, Job.state == was).values(**values)
+    return session.execute(changed, execution_options=_UNSYNCHRONIZED).rowcount
+
+
+def claim(session: Session, job_id: int) -> bool:
+    """Mark a queued (or interrupted, still running) job running, its first start kept; whether it was."""
+    claimed = (
+        update(Job)
+        .where(Job.id == job_id, Job.state.in_((JobState.QUEUED, JobState.RUNNING)))
+        .values(state=JobState.RUNNING, started_at=func.coalesce(Job.started_at, utcnow()))
+    )
+    return bool(session.execute(claimed, execution_options=_UNSYNCHRONIZED).rowcount)
+
+
+def recover_interrupted(session: Session) -> None:
+    """After a restart: jobs left running are queued again, jobs left cancelling are cancelled."""
+    session.execute(update(Job).where(Job.state == JobState.RUNNING).values(state=JobState.QUEUED))
+    session.execute(
+        update(Job).where(Job.state == JobState.CANCELLING).values(state=JobState.CANCELLED, finished_at=utcnow())
+    )
+
+
+def queued_ids(session: Session) -> list[int]:
+    """The queued jobs' ids, oldest first."""
+    return list(session.scalars(select(Job.id).where(Job.state == JobState.QUEUED).order_by(Job.id)))
+
+
+def stored_indices(session: Session, job_id: int) -> dict[int, set[int]]:
+    """The indices of the job's stored trials, by level (levels without any are absent)."""
+    stored: dict[int, set[int]] = {}
+    for level, index in session.execute(select(Trial.level, Trial.index).where(Trial.job_id == job_id)):
+        stored.setdefault(level, set()).add(index)
+    return stored
+
+
+def add_trials(session: Session, job_id: int, trials: Iterable[Trial]) -> None:
+    """Store trials of the job and count them into its ``completed`` (one transaction with the caller's commit)."""
+    session.add_all(trials)
+    session.flush()
+    completed = session.scalar(select(func.count()).select_from(Trial).where(Trial.job_id == job_id))
+    session.execute(update(Job).where(Job.id == job_id).values(completed=completed, updated_at=utcnow()))
+
+
+def outcome_moments(session: Session, job_id: int) -> list[tuple[int, str | None, int, int, int]]:
+    """Per level and failure code (None: capped): ``(level, code, trials, sum of jumps, sum of
+    squares)``, in one GROUP BY. PostgreSQL sums integers as numeric: they come back as ints."""
+    groups = session.execute(
+        select(
+            Trial.level, Trial.failure_code, func.count(), func.sum(Trial.jumps), func.sum(Trial.jumps * Trial.jumps)
+        )
+        .where(Trial.job_id == job_id)
+        .group_by(Trial.level, Trial.failure_code)
+    ).all()
+    return [(level, code, int(trials), int(total), int(squares)) for level, code, trials, total, squares in groups]

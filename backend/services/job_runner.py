@@ -1,0 +1,286 @@
+"""The job runner: one background thread that takes the stored jobs to their end, one at a time.
+
+An MJTF job survives crashes trial by trial. The runner takes the study's one plan from sim_core
+— the levels' starts (:func:`sim_core.mjtf.level_starts`, in the job worker), then the trials in
+chunks (:func:`sim_core.mjtf_plan.plan_trials`) leaving out the trials already stored — runs the
+chunks in the service's job worker process (:mod:`backend.workers.pools`; never in the service's
+own, where they would hold up the API) or on the Dask cluster named by ``PARKOUR_DASK_ADDRESS``,
+and commits each chunk's trials and the progress in one transaction as it finishes. Killed
+mid-job, the service finds the job at the next start, recomputes only the missing trials — their
+seeds depend on ``(seed, level, index)`` alone — and ends with exactly the trials asked for, none
+lost and none duplicated (the unique key refuses a second copy). Sweeps, basins and gait searches
+are deterministic: they run whole through the chunk map, report progress per chunk, and store
+their result on the job when done; a restart recomputes them. Cancelling marks the job; the runner
+sees it within ``CANCEL_POLL`` and stops the worker at once (a chunk under way is dropped: its
+trials are not committed, and nothing else depends on it). On a full disk a job pauses: what it
+computed waits in memory and is committed when there is room again (tried every
+``STORAGE_RETRY``); stopped meanwhile, it stays running and the next start resumes it.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import contextlib
+import functools
+import logging
+import queue
+import threading
+from collections.abc import Callable, Iterator
+
+import numpy as np
+from sqlalchemy.orm import Session, sessionmaker
+
+from backend.repositories import jobs as stored_jobs
+from backend.schemas.jobs import JobState
+from backend.services.job_specs import MJTFSpec, decode
+from backend.services.simulation import model_params, run_study, run_study_here
+from backend.store.database import StorageFull, after_storage_full
+from backend.store.models import Trial, utcnow
+from backend.workers.pools import ComputePool
+from experiments.cluster import as_completed_results, chunk_map_for, dask_client
+from experiments.manifest import json_safe
+from sim_core.chunks import Cancelled
+from sim_core.failures import OK, Failure
+from sim_core.mjtf_plan import TrialChunk, plan_trials
+
+log = logging.getLogger("parkourlab.jobs")
+
+CHUNK_TRIALS = 32  # tens of trials per commit: a 3 ms trial alone would drown in overhead
+STORAGE_RETRY = 5.0  # [s] between tries to store a paused job's results on a full disk
+CANCEL_POLL = 0.2  # [s] how often the runner looks for a cancel while a worker computes
+IN_FLIGHT = 4  # chunks handed to the worker ahead of the one awaited: it never idles between chunks
+
+
+class _Stopped(Exception):
+    """The runner is stopping while a job waits for disk space."""
+
+
+class JobRunner:
+    """Runs jobs one at a time on a background thread, resuming unfinished ones at start."""
+
+    def __init__(
+        self,
+        sessions: sessionmaker[Session],
+        pool: ComputePool,
+        *,
+        chunk_trials: int = CHUNK_TRIALS,
+        dask_address: str | None = None,
+    ):
+        self.sessions = sessions
+        self.pool = pool  # the job worker: chunks run there, not in this process
+        self.chunk_trials = chunk_trials
+        self.dask_address = dask_address
+        self.queue: queue.Queue[int | None] = queue.Queue()
+        self.thread: threading.Thread | None = None
+        self._stopping = threading.Event()  # set by stop(): a job paused on a full disk gives up its wait
+
+    def start(self) -> None:
+        with self.sessions() as session:
+            stored_jobs.recover_interrupted(session)  # a job running when the process died resumes from its trials
+            session.commit()
+            pending = stored_jobs.queued_ids(session)
+        for job_id in pending:
+            self.queue.put(job_id)
+        self.thread = threading.Thread(target=self._loop, name="parkourlab-jobs", daemon=True)
+        self.thread.start()
+
+    def submit(self, job_id: int) -> None:
+        self.queue.put(job_id)
+
+    def stop(self, timeout: float = 10.0) -> None:
+        self._stopping.set()
+        if self.thread is not None:
+            self.queue.put(None)
+            self.thread.join(timeout)
+
+    def _loop(self) -> None:
+        while (job_id := self.queue.get()) is not None:
+            try:
+                self.run(job_id)
+            except _Stopped:  # paused on a full disk at shutdown: still running, the next start resumes it
+                return
+            except Exception as error:  # a job's failure is recorded; the runner goes on
+                log.exception("job %s failed", job_id)
+                with self.sessions() as session:
+                    job = stored_jobs.find(session, job_id)
+                    if job is not None:
+                        job.state, job.error, job.finished_at = (
+                            JobState.FAILED,
+                            f"{type(error).__name__}: {error}",
+                            utcnow(),
+                        )
+                        session.commit()
+
+    def run(self, job_id: int) -> None:
+        """Run (or resume) one job to its end, committing every chunk."""
+        with self.sessions() as session:
+            # Claimed with one conditional UPDATE, as cancel_job changes state: a cancel that lands
+            # between reading the job and writing "running" is not overwritten.
+            claimed = stored_jobs.claim(session, job_id)
+            session.commit()
+            if not claimed:
+                return
+            job = stored_jobs.get(session, job_id)
+            kind, spec = job.kind, decode(job.spec)
+        if kind == "mjtf":
+            self._run_mjtf(job_id, spec)
+        else:
+            self._run_study(job_id, spec)
+
+    def _run_mjtf(self, job_id: int, spec: MJTFSpec) -> None:
+        """The study's trials not stored yet, chunk by chunk as sim_core plans them."""
+        from sim_core.mjtf import level_starts, run_trials  # the kernels load with the first job (simulation.py)
+
+        model, noise = model_params(spec.model), spec.noise.model()
+        guess = None if spec.guess is None else (spec.guess.xdot, spec.guess.ydot)
+        try:
+            starts = self.pool.submit(functools.partial(level_starts, guess=guess), model, np.radians(spec.psi0_deg),
+                                      spec.zeta0s)  # fmt: skip
+            levels = self._await(job_id, starts)
+        except Cancelled:
+            self._cancelled(job_id)  # marks it cancelled
+            return
+        with self.sessions() as session:
+            stored = stored_jobs.stored_indices(session, job_id)
+        done = [stored.get(level, set()) for level in range(len(levels))]
+        chunks = plan_trials(len(levels), spec.trials, spec.seed, self.chunk_trials, done)
+        if self._cancelled(job_id):
+            return
+        arguments = [chunk.arguments(model, levels, noise, spec.cap) for chunk in chunks]
+        results = self._execute(job_id, run_trials, arguments)
+        try:
+            for index, (jumps, status) in results:
+                chunk = chunks[index]
+                self._until_stored(job_id, self._commit_chunk, job_id, chunk, levels[chunk.level].zeta0, jumps, status)
+                if self._cancelled(job_id):
+                    return
+        except Cancelled:
+            self._cancelled(job_id)  # marks it cancelled
+            return
+        finally:
+            results.close()  # on a Dask cluster, cancels the chunks not yet finished
+        with self.sessions() as session:
+            job = stored_jobs.get(session, job_id)
+            job.state, job.finished_at = JobState.DONE, utcnow()
+            session.commit()
+
+    def _run_study(self, job_id: int, spec) -> None:
+        """Sweeps, basins and gait searches: computed whole (a restart recomputes them — they are
+        deterministic), chunked through the chunk map, progress per chunk, result stored at the end."""
+
+        def progress(done: int, total: int) -> None:
+            with self.sessions() as session:
+                job = stored_jobs.get(session, job_id)
+                if job.state == JobState.CANCELLING:
+                    raise Cancelled
+                job.completed, job.total = done, total
+                with contextlib.suppress(StorageFull):  # progress can wait for space; the result cannot
+                    session.commit()
+
+        try:
+            if self.dask_address is None:
+                result = self._await(job_id, self.pool.submit(run_study_here, spec), progress)
+            else:
+                with chunk_map_for(self.dask_address) as chunk_map:
+                    result = run_study(spec, chunk_map, progress)
+        except Cancelled:
+            with self.sessions() as session:
+                job = stored_jobs.get(session, job_id)
+                job.state, job.finished_at = JobState.CANCELLED, utcnow()
+                session.commit()
+            return
+        self._until_stored(job_id, self._store_result, job_id, json_safe(result))
+
+    def _store_result(self, job_id: int, result: dict) -> None:
+        with self.sessions() as session:
+            job = stored_jobs.get(session, job_id)
+            job.result = result
+            job.completed = job.total
+            job.state, job.finished_at = JobState.DONE, utcnow()
+            session.commit()
+
+    def _until_stored(self, job_id: int, write: Callable, *args) -> None:
+        """``write(*args)`` (one transaction), again every STORAGE_RETRY while the disk is full: the
+        job pauses with what it computed in memory, and goes on when space returns."""
+        paused = False
+        while True:
+            try:
+                write(*args)
+            except StorageFull:
+                after_storage_full(self.sessions.kw["bind"])
+                if not paused:
+                    log.warning("job %s paused: the disk holding the database is full; it goes on when there is room",
+                                job_id)  # fmt: skip
+                    paused = True
+                if self._stopping.wait(STORAGE_RETRY):
+                    raise _Stopped from None
+                continue
+            if paused:
+                log.warning("job %s goes on: its results fit again", job_id)
+            return
+
+    def _execute(
+        self, job_id: int, function: Callable, arguments: list[tuple]
+    ) -> Iterator[tuple[int, tuple[np.ndarray, np.ndarray]]]:
+        """``(chunk index, function(*arguments[index]))`` as chunks finish: from the job worker in
+        order, a few handed to it ahead, or from the Dask cluster. Raises Cancelled (the worker
+        stopped) on a cancel."""
+        if self.dask_address is not None:
+            with dask_client(self.dask_address) as client:
+                yield from as_completed_results(client, function, arguments)
+            return
+        in_flight: dict[int, concurrent.futures.Future] = {}
+        for index in range(len(arguments)):
+            for ahead in range(index, min(index + IN_FLIGHT, len(arguments))):
+                if ahead not in in_flight:
+                    in_flight[ahead] = self.pool.submit(function, *arguments[ahead])
+            yield index, self._await(job_id, in_flight.pop(index))
+
+    def _await(self, job_id: int, future: concurrent.futures.Future, progress: Callable | None = None):
+        """The worker's result, looking every CANCEL_POLL for a cancel (then the worker is stopped
+        and Cancelled raised) and passing on the progress it reports."""
+        while True:
+            try:
+                return future.result(CANCEL_POLL)
+            except concurrent.futures.TimeoutError:
+                pass
+            finally:
+                for done, total in self.pool.progress() if progress is not None else ():
+                    progress(done, total)
+            if self._cancel_requested(job_id):
+                self.pool.restart(f"job {job_id} was cancelled")
+                raise Cancelled
+
+    def _cancel_requested(self, job_id: int) -> bool:
+        with self.sessions() as session:
+            return stored_jobs.state_of(session, job_id) == JobState.CANCELLING
+
+    def _cancelled(self, job_id: int) -> bool:
+        """Whether the job is to stop: a cancel asked for is marked done (cancelled) here."""
+        with self.sessions() as session:
+            job = stored_jobs.get(session, job_id)
+            if job.state == JobState.CANCELLING:
+                job.state, job.finished_at = JobState.CANCELLED, utcnow()
+                session.commit()
+                return True
+            return job.state != JobState.RUNNING
+
+    def _commit_chunk(self, job_id: int, chunk: TrialChunk, zeta0: float, jumps, status) -> None:
+        with self.sessions() as session:
+            stored_jobs.add_trials(
+                session,
+                job_id,
+                (
+                    Trial(
+                        job_id=job_id,
+                        level=chunk.level,
+                        index=int(i),
+                        zeta0=float(zeta0),
+                        seed=int(seed),
+                        jumps=int(n),
+                        failure_code=None if code == OK else Failure(int(code)).code,
+                    )
+                    for i, seed, n, code in zip(chunk.indices, chunk.seeds, jumps, status, strict=True)
+                ),
+            )
+            session.commit()
