@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from sqlalchemy import delete, select, update
 
+from backend.errors import NotFound
 from backend.schemas import BasinJobCreate, GaitSearchJobCreate, LegIn, MJTFJobCreate, StateIn
 from backend.services import job_runner, jobs
-from backend.services.records import NotFound
 from backend.store.models import Job, Trial
 from sim_core import get_preset
 from sim_core.mjtf import mjtf_study

@@ -5,10 +5,10 @@ import math
 import pytest
 from sqlalchemy import update
 
-from backend.schemas import ExperimentCreate, GaitSearchJobCreate, JobState, LegIn, MJTFJobCreate
+from backend.errors import NotFound
+from backend.schemas import GaitSearchJobCreate, JobState, LegIn, MJTFJobCreate
 from backend.services import jobs
-from backend.services.records import NotFound, create_experiment
-from backend.store.models import Job, Trial
+from backend.store.models import Experiment, Job, Trial
 from tests.backend.services.jobs_helpers import SMALL
 
 
@@ -23,7 +23,9 @@ class _Runner:
 
 
 def test_a_stored_job_counts_what_it_will_do(session):
-    experiment = create_experiment(session, ExperimentCreate(name="mjtf"))
+    experiment = Experiment(name="mjtf")
+    session.add(experiment)
+    session.commit()
     mjtf = jobs.create_job(session, MJTFJobCreate(experiment_id=experiment.id, **SMALL))
     assert (mjtf.kind, mjtf.state, mjtf.total, mjtf.completed, mjtf.experiment_id) == ("mjtf", "queued", 20, 0, 1)
     assert mjtf.spec["zeta0s"] == [0.88, 0.94] and mjtf.spec["guess"] == {"xdot": -0.93, "ydot": -0.2}
