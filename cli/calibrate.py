@@ -44,8 +44,8 @@ def calibrate_command(
     The fit is stored as a preset every command accepts (--preset NAME), with the runs, date and
     code version it came from.
     """
+    from backend.errors import Conflict, NotFound
     from backend.services.calibrations import calibrate_runs
-    from backend.services.records import Conflict, NotFound
 
     run_ids = parse_run_ids(runs)
     name = name or "calibrated-" + "-".join(map(str, run_ids))[:50]
@@ -96,7 +96,7 @@ def robustness_command(
 
     The model simulates with the noise the calibration estimated from the runs (docs/calibration.md).
     """
-    from backend.services.records import Conflict, NotFound
+    from backend.errors import Conflict, NotFound
     from backend.services.robustness import robustness
 
     run_ids = None if runs is None else parse_run_ids(runs)

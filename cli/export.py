@@ -26,13 +26,14 @@ def export_command(
     json_output: JsonOption = False,
 ) -> None:
     """Export a robot or replay run as MCAP: tracker poses, touchdowns, commands, telemetry, the model's prediction."""
-    from backend.services import mcap_export, records
+    from backend.errors import Conflict, NotFound
+    from backend.services import mcap_export
 
     stream = io.BytesIO()
     with store_sessions(data_dir) as sessions, sessions() as session:
         try:
             counts = mcap_export.export_run(session, run_id, stream)
-        except (records.NotFound, records.Conflict) as error:
+        except (NotFound, Conflict) as error:
             raise ParameterError("run_id", str(error)) from None
     path = out or Path(f"parkourlab-run-{run_id}.mcap")
     path.write_bytes(stream.getvalue())

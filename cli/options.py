@@ -79,8 +79,11 @@ class ModelSetup:
 
 
 def build_setup(preset: str, **overrides: float | None) -> ModelSetup:
-    """The preset's model with any non-None nondimensional override applied."""
-    robot = get_preset(preset) if preset in PRESETS else stored_preset(preset)
+    """The preset's model with any non-None nondimensional override applied; the preset resolved
+    as every caller resolves one (:func:`backend.services.models.resolve_model`)."""
+    from backend.services.models import resolve_model  # light: it loads the store only for a stored preset
+
+    robot = resolve_model(None, preset).robot if preset in PRESETS else stored_preset(preset)
     chosen = {name: value for name, value in overrides.items() if value is not None}
     model = replace(robot.to_model(), **chosen)
     if chosen:
@@ -91,11 +94,11 @@ def build_setup(preset: str, **overrides: float | None) -> ModelSetup:
 def stored_preset(name: str) -> PhysicalParams:
     """A preset ``parkour calibrate`` stored, from the database of ``$PARKOUR_DATA_DIR`` (default
     ./data) or ``$DATABASE_URL``; the unknown-preset error if there is none (no store is created)."""
-    from backend.services.calibrations import preset_params
+    from backend.services.models import resolve_model
 
     try:
         with store_sessions(None) as sessions, sessions() as session:
-            return preset_params(session, name)[0]
+            return resolve_model(session, name).robot
     except ParameterError as error:
         if error.field != "data_dir":
             raise

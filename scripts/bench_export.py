@@ -18,7 +18,7 @@ from bench_store import seed  # scripts/ is on the path when this script runs
 
 from backend.services import exports
 from backend.store.database import make_engine, session_factory
-from backend.store.runs import RunFilter
+from backend.repositories.runs import RunFilter
 
 
 def main() -> None:

@@ -13,10 +13,10 @@ import math
 
 import numpy as np
 
+from backend.repositories import runs as run_store
 from backend.robot.touchdown import detect_touchdowns
 from backend.robot.tracker import Calibration
 from backend.schemas import LegIn, RobotRunCreate
-from backend.services import records
 from backend.services.robot_records import fold_journal, open_robot_run
 from backend.store.models import RunJournal
 from experiments.manifest import json_safe
@@ -74,7 +74,7 @@ def store_journaled_run(
     writer folds one; its id."""
     robot = get_preset("paper")
     run_id = open_robot_run(session, request, robot, Calibration())
-    created = records.get_run(session, run_id).created_at.replace(tzinfo=datetime.UTC)
+    created = run_store.get_run(session, run_id).created_at.replace(tzinfo=datetime.UTC)
     for index, entry in enumerate(entries(created.timestamp())):
         written = created + datetime.timedelta(seconds=index + 1)
         session.add(RunJournal(run_id=run_id, data=json_safe(entry), written_at=written))

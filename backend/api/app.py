@@ -23,7 +23,8 @@ from backend.api import errors, security
 from backend.api.deps import Database
 from backend.api.routes import calibrations, experiments, jobs, robot, runs, sim, site, view
 from backend.api.security import api_token
-from backend.services import exports, records, simulation
+from backend.services import exports, simulation
+from backend.services import runs as records  # the read workers list runs with its list_runs
 from backend.services.job_runner import JobRunner
 from backend.services.robot import RobotService
 from backend.services.view import ViewContext, ViewFactory, ViewStarter

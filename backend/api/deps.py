@@ -19,13 +19,13 @@ from sqlalchemy.orm import Session, sessionmaker
 
 from backend import schemas
 from backend.api.security import require_token
-from backend.services import calibrations, records
+from backend.repositories.runs import RunFilter
+from backend.services import calibrations
 from backend.services import job_runner as jobs
 from backend.services.robot import RobotService
 from backend.store.database import StorageFull, after_storage_full
 from backend.workers.pools import ComputePool
 from backend.workers.store_reads import StoreReads
-from sim_core.presets import PRESETS
 
 T = TypeVar("T")
 VIEW_NOT_STARTED = "the 3D view is not running (it starts with `parkour serve`)"
@@ -77,9 +77,9 @@ async def run_filter(
     psi0_max: Annotated[float | None, Query(ge=0.0, le=90.0, allow_inf_nan=False)] = None,
     created_after: datetime.datetime | None = None,
     created_before: datetime.datetime | None = None,
-) -> records.RunFilter:
+) -> RunFilter:
     """The run filters shared by list, export and aggregate."""
-    return records.RunFilter(
+    return RunFilter(
         experiment_id=experiment_id,
         kind=kind,
         status=status_,
@@ -133,14 +133,14 @@ async def scene_view(request: Request):
 
 
 Db = Annotated[Database, Depends(database)]
-RunQuery = Annotated[records.RunFilter, Depends(run_filter)]
+RunQuery = Annotated[RunFilter, Depends(run_filter)]
 Robot = Annotated[RobotService, Depends(robot_service)]
 Runner = Annotated[jobs.JobRunner | None, Depends(job_runner)]
 QuickCompute = Annotated[ComputePool, Depends(quick_compute)]
 Reads = Annotated[StoreReads, Depends(store_reads)]
 SceneView = Annotated[object, Depends(scene_view)]  # frontend.viewer's view (the backend does not import it)
 AUTHORIZED = [Depends(require_token)]  # every mutating route's dependencies
-PageLimit = Annotated[int, Query(ge=1, le=records.MAX_PAGE, description="items per page")]
+PageLimit = Annotated[int, Query(ge=1, le=schemas.MAX_PAGE, description="items per page")]
 Cursor = Annotated[int | None, Query(ge=1, le=schemas.MAX_ID, description="next_cursor of the previous page")]
 RecordId = Annotated[int, FastAPIPath(ge=1, le=schemas.MAX_ID)]
 OptionalRecordId = Annotated[int | None, Query(ge=1, le=schemas.MAX_ID)]
@@ -150,8 +150,7 @@ PresetQuery = Annotated[
 
 
 async def preset_resolved(request: Request, body):
-    """``body`` with a stored preset resolved (:func:`backend.services.calibrations.with_preset_resolved`):
-    at once for a built-in one, in a request thread when the store must be read."""
-    if body.model.preset in PRESETS:
-        return body
-    return await request.app.state.database(calibrations.with_preset_resolved, body)
+    """``body`` with a stored preset resolved (:func:`backend.services.calibrations.preset_resolved`,
+    over :func:`backend.services.models.resolve_model`): at once for a built-in one, in a request
+    thread when the store must be read."""
+    return await calibrations.preset_resolved(request.app.state.database, body)

@@ -20,8 +20,8 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 
 from backend.api import security
+from backend.errors import Conflict, NotFound
 from backend.robot.link import EstopLatched, LinkError
-from backend.services import records
 from backend.services.robot import RobotUnavailable
 from backend.services.robot_tracker import TrackerPortInUse
 from backend.store.database import StorageFull
@@ -34,8 +34,8 @@ MAX_ERRORS = 20  # listed in one 422; the rest are counted
 SERVER_ERROR = "internal server error (logged by the service)"
 
 STATUS_OF: dict[type[Exception], tuple[int, str]] = {
-    records.NotFound: (status.HTTP_404_NOT_FOUND, "{}"),
-    records.Conflict: (status.HTTP_409_CONFLICT, "{}"),
+    NotFound: (status.HTTP_404_NOT_FOUND, "{}"),
+    Conflict: (status.HTTP_409_CONFLICT, "{}"),
     RobotUnavailable: (status.HTTP_409_CONFLICT, "{}"),
     TrackerPortInUse: (status.HTTP_409_CONFLICT, "{}"),
     EstopLatched: (status.HTTP_409_CONFLICT, "{}"),  # before LinkError, its base: the latch is no outage

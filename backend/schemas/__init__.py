@@ -17,6 +17,7 @@ from backend.schemas.common import (
     MAX_ID,
     MAX_JUMPS,
     MAX_LEVELS,
+    MAX_PAGE,
     MAX_PATH_SAMPLES,
     MAX_TRIALS,
     Health,
@@ -54,7 +55,7 @@ from backend.schemas.jobs import (
     NoiseIn,
     SweepJobCreate,
 )
-from backend.schemas.robot import ClosedLoopIn, RobotConnect, RobotRunCreate
+from backend.schemas.robot import ClosedLoopIn, EstopLatchOut, RobotConnect, RobotEstopOut, RobotRunCreate, RobotStatus
 from backend.schemas.runs import (
     RunAggregate,
     RunBase,
@@ -70,7 +71,7 @@ from backend.schemas.runs import (
     RunUpdate,
     Stats,
 )
-from backend.schemas.sim import FixedPointIn, MapIn, TrajectoryIn
+from backend.schemas.sim import FixedPointIn, FixedPointOut, MapIn, MapOut, TrajectoryIn, TrajectoryOut
 from backend.schemas.view import VIEWER_ID_PATTERN, ViewerId, ViewOut, ViewReplay
 
 __all__ = [
@@ -78,6 +79,7 @@ __all__ = [
     "MAX_ID",
     "MAX_JUMPS",
     "MAX_LEVELS",
+    "MAX_PAGE",
     "MAX_PATH_SAMPLES",
     "MAX_TRIALS",
     "PRESET_PATTERN",
@@ -88,12 +90,14 @@ __all__ = [
     "CalibrationList",
     "CalibrationOut",
     "ClosedLoopIn",
+    "EstopLatchOut",
     "ExperimentBase",
     "ExperimentCreate",
     "ExperimentOut",
     "ExperimentPage",
     "ExperimentUpdate",
     "FixedPointIn",
+    "FixedPointOut",
     "GaitSearchJobCreate",
     "Health",
     "JobCreate",
@@ -106,13 +110,16 @@ __all__ = [
     "MJTFJobCreate",
     "MJTFLevelOut",
     "MapIn",
+    "MapOut",
     "ModelIn",
     "NoiseIn",
     "Page",
     "Psi0Deg",
     "RecordRef",
     "RobotConnect",
+    "RobotEstopOut",
     "RobotRunCreate",
+    "RobotStatus",
     "RunAggregate",
     "RunBase",
     "RunComparison",
@@ -132,6 +139,7 @@ __all__ = [
     "TokenAccepted",
     "TouchdownComparison",
     "TrajectoryIn",
+    "TrajectoryOut",
     "ViewOut",
     "ViewReplay",
     "ViewerId",

@@ -18,6 +18,7 @@ MAX_JUMPS = 10_000
 MAX_TRIALS = 100_000
 MAX_LEVELS = 100
 MAX_PATH_SAMPLES = 100_000
+MAX_PAGE = 500  # items in one page of a list
 MAX_ID = 2**31 - 1  # integer keys: the smallest range among the supported databases (PostgreSQL)
 RecordRef = Annotated[int, Field(ge=1, le=MAX_ID)]
 Item = TypeVar("Item")  # what a Page lists

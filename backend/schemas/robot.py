@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import ipaddress
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
-from pydantic import Field, field_validator
+from pydantic import BaseModel, Field, field_validator
 
 from backend.robot.natnet import COMMAND_PORT, MULTICAST_GROUP, parse_version
 from backend.robot.ports import check_port
@@ -109,3 +109,39 @@ class RobotRunCreate(Strict):
         str | None,
         Field(min_length=1, max_length=80, description="who runs it, as every panel is told (default: the client)"),
     ] = None
+
+
+class EstopLatchOut(BaseModel):
+    """The e-stop latch: held until a RESET is acknowledged."""
+
+    latched: bool
+    acknowledged: bool = Field(description="the robot has confirmed the ESTOP on this connection")
+    since: float | int | None = Field(description="when it was pressed [Unix time, s], or null")
+    reason: str | None
+
+
+class RobotStatus(BaseModel):
+    """The robot as it is now (``GET /api/v1/robot``, and the answer of every command): the link,
+    its counters and the robot's telemetry, the e-stop latch, the tracker, the live run and the
+    link's last transitions. Nested shapes that grow with the link and tracker are open objects."""
+
+    state: str = Field(description="the link's state: disconnected, disarmed, armed, estopped, ...")
+    url: str | None
+    robot_address: str | None = Field(description="the robot radio's 64-bit address, 0x + 16 hex digits")
+    counters: dict[str, Any] | None = Field(description="the link's frame counts and reconnects")
+    estop: EstopLatchOut
+    last_delivery_failure: Any
+    telemetry: dict[str, Any] | None
+    tracker: dict[str, Any] | None = Field(description="the tracker's address, counts, protocol and latest pose")
+    run: dict[str, Any] | None = Field(description="the live run, or the last one")
+    transitions: list[dict[str, Any]] = Field(description="the link's last 20 state changes")
+
+
+class EstopAnswer(BaseModel):
+    acknowledged: bool = Field(description="whether the robot confirmed the e-stop")
+    latency_ms: float
+    reason: str | None = Field(None, description="why not acknowledged (absent when it was)")
+
+
+class RobotEstopOut(RobotStatus, EstopAnswer):
+    """The e-stop's answer: whether the robot acknowledged it, how fast, and the status after it."""

@@ -11,20 +11,26 @@ the code version. A stored preset is used by name wherever a built-in one is
 from __future__ import annotations
 
 import re
-from collections.abc import Callable
+from collections.abc import Awaitable, Callable
 from dataclasses import asdict
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from sqlalchemy import select
-from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
 
+from backend.errors import Conflict
+from backend.repositories import calibrations as stored_presets
+from backend.repositories import runs as stored_runs
 from backend.robot.messages import Fault
-from backend.schemas.calibrations import PRESET_PATTERN
-from backend.services.records import Conflict, NotFound, fetch
+from backend.schemas.calibrations import (
+    PRESET_PATTERN,
+    CalibrationCreate,
+    CalibrationList,
+    CalibrationOut,
+    TouchdownComparison,
+)
+from backend.services.models import resolve_model
 from backend.services.simulation import current_code_version, unpack_trajectory
-from backend.store.database import lock_for_write
 from backend.store.models import ModelPreset, Run
 from experiments.manifest import json_safe
 from sim_core.controls import NO_OFFSETS, LegControl, LegOffsets
@@ -108,21 +114,21 @@ def calibrate_runs(
     check_preset_name(name)
     if not 1 <= len(run_ids) <= MAX_RUNS:
         raise ParameterError("runs", f"give 1 to {MAX_RUNS} run ids, got {len(run_ids)}")
-    if session.scalar(select(ModelPreset.id).where(ModelPreset.name == name)) is not None:
+    if stored_presets.exists(session, name):
         raise Conflict(f"a preset named {name!r} exists; choose another name or delete it")
     robot = get_preset(base)
     series = [touchdown_series(session, _calibration_run(session, run_id), robot) for run_id in run_ids]
     session.rollback()  # no read transaction held open while the fit runs
     fitted = fit(series, robot.to_model())
     preset = _stored(fitted, name=name, base=base, robot=robot, run_ids=run_ids)
-    lock_for_write(session)
-    session.add(preset)
-    try:
-        session.commit()
-    except IntegrityError:  # stored by someone else meanwhile
-        session.rollback()
-        raise Conflict(f"a preset named {name!r} exists; choose another name or delete it") from None
+    stored_presets.add(session, preset)  # a Conflict if stored by someone else meanwhile
+    session.commit()
     return preset_payload(preset)
+
+
+def create(session: Session, body: CalibrationCreate, *, fit: Fitter = fit_touchdowns) -> CalibrationOut:
+    """:func:`calibrate_runs` for the API's request, answered as the API gives a calibration."""
+    return CalibrationOut.model_validate(calibrate_runs(session, body.runs, name=body.name, base=body.preset, fit=fit))
 
 
 def preset_payload(preset: ModelPreset) -> dict:
@@ -142,53 +148,59 @@ def preset_payload(preset: ModelPreset) -> dict:
     )
 
 
+def list_calibrations(session: Session) -> CalibrationList:
+    """Every stored calibration's :func:`preset_payload`, oldest first."""
+    return CalibrationList.model_validate(
+        {"items": [preset_payload(preset) for preset in stored_presets.all_presets(session)]}
+    )
+
+
+def get_calibration(session: Session, name: str) -> CalibrationOut:
+    return CalibrationOut.model_validate(preset_payload(stored_presets.get(session, name)))
+
+
 def list_presets(session: Session) -> list[ModelPreset]:
-    return list(session.scalars(select(ModelPreset).order_by(ModelPreset.id)))
+    """Every stored preset, oldest first (the 3D view offers them as ghosts)."""
+    return stored_presets.all_presets(session)
 
 
 def get_stored_preset(session: Session, name: str) -> ModelPreset:
-    preset = session.scalar(select(ModelPreset).where(ModelPreset.name == name))
-    if preset is None:
-        raise NotFound("preset", name)
-    return preset
+    return stored_presets.get(session, name)
 
 
 def delete_preset(session: Session, name: str) -> None:
-    lock_for_write(session)
-    session.delete(get_stored_preset(session, name))
+    stored_presets.delete(session, name)
     session.commit()
 
 
 def preset_params(session: Session | None, name: str) -> tuple[PhysicalParams, LegOffsets]:
     """The robot and leg offsets of preset ``name``: a built-in one, else one stored in ``session``'s
     database; a :class:`ParameterError` naming the known presets if neither has it."""
-    if name in PRESETS:
-        return PRESETS[name], NO_OFFSETS
-    stored = None if session is None else session.scalar(select(ModelPreset).where(ModelPreset.name == name))
-    if stored is None:
-        known = sorted(PRESETS) + ([] if session is None else [p.name for p in list_presets(session)])
-        raise ParameterError("preset", f"unknown preset {name!r}; known presets: {', '.join(known)}")
-    offsets = stored.offsets
-    return PhysicalParams(**stored.physical), LegOffsets(
-        psi0_offset_deg=tuple(offsets["psi0_offset_deg"]), zeta0_offset=tuple(offsets["zeta0_offset"])
-    )
+    resolved = resolve_model(session, name)
+    return resolved.robot, resolved.offsets
 
 
 def with_preset_resolved(session: Session, body):
     """``body`` (a request with ``model``, a :class:`~backend.schemas.ModelIn`) with a stored preset
-    replaced by what it is: its base preset and the fitted ``alpha``, ``c_zeta``, ``c_psi`` where the
-    request does not override them — numbers a job keeps even if the preset is deleted later. A
-    built-in preset passes through; an unknown name is a :class:`ParameterError` naming ``model.preset``."""
+    replaced by what it is (:func:`~backend.services.models.resolve_model`): its base preset and the
+    fitted ``alpha``, ``c_zeta``, ``c_psi`` where the request does not override them — numbers a job
+    keeps even if the preset is deleted later. A built-in preset passes through; an unknown name is
+    a :class:`ParameterError` naming ``model.preset``."""
     model = body.model
     if model.preset in PRESETS:
         return body
-    stored = session.scalar(select(ModelPreset).where(ModelPreset.name == model.preset))
-    if stored is None:
-        known = ", ".join([*sorted(PRESETS), *(preset.name for preset in list_presets(session))])
-        raise ParameterError("model.preset", f"unknown preset {model.preset!r}; known presets: {known}")
-    fitted = PhysicalParams(**stored.physical).to_model()
-    fields = {name: getattr(fitted, name) for name in ("alpha", "c_zeta", "c_psi") if getattr(model, name) is None}
-    return body.model_copy(update={"model": model.model_copy(update={"preset": stored.base, **fields})})
+    resolved = resolve_model(session, model.preset, field="model.preset")
+    fields = {name: value for name, value in resolved.fitted.items() if getattr(model, name) is None}
+    return body.model_copy(update={"model": model.model_copy(update={"preset": resolved.preset, **fields})})
+
+
+async def preset_resolved(in_session: Callable[..., Awaitable[Any]], body):
+    """:func:`with_preset_resolved` for an ``async`` caller: at once for a built-in preset, else
+    through ``in_session`` (``await in_session(work, *args)`` runs ``work(session, *args)`` in a
+    request thread: the API's ``Database``)."""
+    if body.model.preset in PRESETS:
+        return body
+    return await in_session(with_preset_resolved, body)
 
 
 def _stored(fit: CalibrationFit, *, name: str, base: str, robot: PhysicalParams, run_ids: list[int]) -> ModelPreset:
@@ -213,7 +225,7 @@ def _with_run_ids(report: dict, run_ids: list[int]) -> dict:
 
 
 def _calibration_run(session: Session, run_id: int) -> Run:
-    run = fetch(session, Run, run_id, "run")
+    run = stored_runs.get_run(session, run_id)
     if run.kind not in CALIBRATED_KINDS:
         raise Conflict(f"run {run_id} is a {run.kind} run; calibration fits robot and replay runs")
     if run.status == "running":
@@ -224,7 +236,7 @@ def _calibration_run(session: Session, run_id: int) -> Run:
 def _tracked(session: Session, run: Run) -> Run | None:
     """The robot run whose tracker frames and commands ``run`` has: itself, or a replay's source."""
     if run.kind == "replay":
-        return session.get(Run, run.results.get("source_run_id"))
+        return stored_runs.find(session, run.results.get("source_run_id"))
     return run
 
 
@@ -246,7 +258,7 @@ def _pitch_at(run: Run | None, times: list[float]) -> np.ndarray:
     return pitch_at(times, frames["time"], frames["pitch"])
 
 
-def touchdown_predictions(session: Session, run_id: int, *, preset: str | None, predict=None) -> dict:
+def touchdown_predictions(session: Session, run_id: int, *, preset: str | None, predict=None) -> TouchdownComparison:
     """A robot or replay run's touchdowns as measured, as the base model predicts each from the one
     before, and (``preset``, a stored calibration) as the calibrated model does, with the residuals
     and their RMS. ``predict`` is :func:`sim_core.calibration.one_jump_predictions` or a call of it
@@ -273,7 +285,9 @@ def touchdown_predictions(session: Session, run_id: int, *, preset: str | None, 
             entry[f"{name}_residual"] = _channels(predicted - found["measured"][row])
         rows.append(entry)
     rms = {name: _channels(finite_rms(found[name] - found["measured"], axis=0)) for name in models}
-    return json_safe({"run_id": run_id, "base": base_name, "preset": preset, "touchdowns": rows, "rms": rms})
+    return TouchdownComparison.model_validate(
+        json_safe({"run_id": run_id, "base": base_name, "preset": preset, "touchdowns": rows, "rms": rms})
+    )
 
 
 def _channels(values) -> dict:

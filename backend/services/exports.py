@@ -1,5 +1,5 @@
 """Runs as flat records — one value per column: ``model.alpha``, ``leg0.zeta0`` … — exported as CSV
-or JSON, streamed in batches, and lined up side by side by compare (``records.compare_runs``).
+or JSON, streamed in batches, and lined up side by side by compare (``services.runs.compare``).
 
 An export reads plain rows of the columns it writes (never a run's results or trajectory), their
 JSON columns as text decoded once per batch of 1000, and writes each batch in one call of the
@@ -17,11 +17,17 @@ import json
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 
-from sqlalchemy import Text, cast
 from sqlalchemy.orm import Session
 
-from backend.store.models import Run
-from backend.store.runs import RunFilter, decode_json_texts, export_part_ends, exported_batch, widest_schedule
+from backend.repositories.runs import (
+    EXPORTED,
+    JSON_COLUMNS,
+    RunFilter,
+    decode_json_texts,
+    export_part_ends,
+    exported_batch,
+    widest_schedule,
+)
 from experiments.manifest import json_safe
 from sim_core.params import ModelParams
 
@@ -32,11 +38,6 @@ TEXT_COLUMNS = tuple(RECORD_FIELDS.index(name) for name in ("kind", "status", "c
                                                            "failure_code"))  # fmt: skip
 FORMULA_START = frozenset("=+-@\t\r")  # a spreadsheet reads a cell starting with one as a formula
 CHUNK_CHARS = 64_000  # what a streamed export yields at a time
-JSON_COLUMNS = ("model", "controls", "start_state")
-# What an export reads of each run: the record's own columns, then its JSON columns as text.
-EXPORTED = (Run.id, Run.experiment_id, Run.kind, Run.status, Run.created_at, Run.duration_s, Run.code_version,
-            Run.notes, Run.jumps, Run.jumps_completed, Run.failure_code, Run.climb,
-            *(cast(getattr(Run, name), Text).label(name) for name in JSON_COLUMNS))  # fmt: skip
 
 
 @functools.cache
@@ -74,7 +75,7 @@ class ExportPlan:
     """What every part of one export shares, fixed at its start: the format, the CSV's legs (as
     many as the widest run: its columns come before the first row), and where each part ends:
     part k holds the matching runs with ids in (``ends[k - 1]``, ``ends[k]``] (from 0), at most
-    :data:`backend.store.runs.EXPORT_BATCH` of them. Runs stored after the export began are not
+    :data:`backend.repositories.runs.EXPORT_BATCH` of them. Runs stored after the export began are not
     in it; one deleted meanwhile is left out of a part not read yet."""
 
     format: str

@@ -36,8 +36,9 @@ from typing import BinaryIO
 
 from sqlalchemy.orm import Session
 
+from backend.errors import Conflict
+from backend.repositories import runs as stored_runs
 from backend.services.mcap_schemas import CHANNELS
-from backend.services.records import Conflict, get_run
 from backend.services.robot_records import recorded_leg_for
 from backend.services.simulation import unpack_trajectory
 from backend.store.models import Run
@@ -72,7 +73,7 @@ def export_run(session: Session, run_id: int, stream: BinaryIO) -> dict[str, int
 
 def recording_of(session: Session, run_id: int) -> Recording:
     """The recording of a robot run that has ended, or of a replay whose source run is stored."""
-    run = get_run(session, run_id)
+    run = stored_runs.get_run(session, run_id)
     if run.kind not in EXPORTED_KINDS:
         raise Conflict(f"run {run_id} is a {run.kind} run: only robot and replay runs are recordings (MCAP);"
                        f" its path is at /api/v1/runs/{run_id}/trajectory")  # fmt: skip
@@ -81,7 +82,7 @@ def recording_of(session: Session, run_id: int) -> Recording:
     source = run
     if run.kind == "replay":
         source_id = run.results.get("source_run_id")
-        source = session.get(Run, source_id) if isinstance(source_id, int) else None
+        source = stored_runs.find(session, source_id) if isinstance(source_id, int) else None
         if source is None:
             raise Conflict(f"replay run {run_id}'s source run {source_id} is gone: its frames were not kept")
     frames = unpack_trajectory(source.trajectory) if source.trajectory is not None else None

@@ -17,13 +17,13 @@ import concurrent.futures
 import threading
 from pathlib import Path
 
+from backend.errors import NotFound
 from backend.robot.latch import EstopLatch
 from backend.robot.limits import ServoLimits
 from backend.robot.link import EstopResult, LinkError, LinkState, RobotLink
 from backend.robot.live_run import LiveRun, RunSnapshot, execute, telemetry_dict
 from backend.robot.supervisor import LinkSupervisor
 from backend.schemas import RobotConnect, RobotRunCreate
-from backend.services.records import NotFound
 from backend.services.robot_journal import JournalWriter
 from backend.services.robot_records import open_robot_run, recover_interrupted
 from backend.services.robot_tracker import PoseSource, TrackerSlot

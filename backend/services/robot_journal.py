@@ -18,11 +18,12 @@ from dataclasses import asdict
 
 from sqlalchemy.exc import SQLAlchemyError
 
+from backend.repositories import robot_runs
+from backend.repositories import runs as stored_runs
 from backend.robot.link import RobotLink
 from backend.robot.live_run import CLEAN_ENDINGS, LiveRun, Record
 from backend.robot.tracker import UdpPoseSource
 from backend.services.robot_records import FRAME_COLUMNS, fold_journal
-from backend.store.models import Run, RunJournal
 from experiments.manifest import json_safe
 
 log = logging.getLogger("parkourlab.robot")
@@ -105,8 +106,8 @@ class JournalWriter:
         started = time.time()
         try:
             with self.sessions() as session:
-                session.add_all([RunJournal(run_id=self.run.run_id, data=data) for data in self._unwritten])
-                run = session.get(Run, self.run.run_id)
+                robot_runs.append_journal(session, self.run.run_id, self._unwritten)
+                run = stored_runs.find(session, self.run.run_id)
                 run.duration_s = started - self.run.started
                 session.commit()
         except SQLAlchemyError as error:

@@ -19,14 +19,17 @@ from collections.abc import Callable
 from dataclasses import asdict
 
 import numpy as np
-from sqlalchemy import delete, select
 
+from backend.errors import Conflict, NotFound
+from backend.repositories import experiments as stored_experiments
+from backend.repositories import robot_runs
+from backend.repositories import runs as stored_runs
 from backend.robot.touchdown import Touchdown, detect_touchdowns, height_gains
-from backend.services.records import Conflict, NotFound, locked
+from backend.schemas import RunDetail
+from backend.services.runs import run_detail
 from backend.services.simulation import current_code_version, pack_trajectory, unpack_trajectory
-from backend.store.models import Experiment, Run, RunJournal
+from backend.store.models import Run
 from backend.store.run_record import RunRecord
-from backend.store.runs import add_run
 from experiments.manifest import json_safe
 from sim_core.controls import ControlSchedule, LegControl
 from sim_core.presets import get_preset
@@ -43,7 +46,7 @@ def open_robot_run(
     started it, ``link`` the radio link it runs on (``url``, ``robot_address``)."""
     model = robot.to_model()
     if request.experiment_id is not None:  # before anything moves: a 404, and the robot stays as it is
-        locked(session, Experiment, request.experiment_id, "experiment")
+        stored_experiments.locked_experiment(session, request.experiment_id)
     record = RunRecord(
         kind="robot",
         status="running",
@@ -63,7 +66,7 @@ def open_robot_run(
         ),
         tags=tuple(request.tags),
     )
-    run = add_run(session, record, experiment_id=request.experiment_id)
+    run = stored_runs.add_run(session, record, experiment_id=request.experiment_id)
     session.commit()
     return run.id
 
@@ -72,8 +75,8 @@ def fold_journal(session, run_id: int, *, status: str, end_reason: str, disarm: 
     """The run's journal entries folded into the run (results, tracker frames, the touchdown
     columns) and deleted, in one transaction; ``status`` and ``end_reason`` say how it ended."""
     robot = robot or get_preset("paper")
-    run = session.get(Run, run_id)
-    entries = session.scalars(select(RunJournal).where(RunJournal.run_id == run_id).order_by(RunJournal.id)).all()
+    run = stored_runs.find(session, run_id)
+    entries = robot_runs.journal(session, run_id)
     frames = {name: [] for name in FRAME_COLUMNS}
     touchdowns, controls, commands, telemetry, transitions, tracker = [], [], [], [], [], None
     for entry in entries:
@@ -108,7 +111,7 @@ def fold_journal(session, run_id: int, *, status: str, end_reason: str, disarm: 
         setattr(run, name, value)
     columns = {name: np.asarray(values, dtype=float) for name, values in frames.items()}
     run.trajectory = pack_trajectory(columns) if frames["time"] else None
-    session.execute(delete(RunJournal).where(RunJournal.run_id == run_id))
+    robot_runs.delete_journal(session, run_id)
     session.commit()
     return run
 
@@ -118,7 +121,7 @@ def recover_interrupted(sessions, robot=None) -> list[int]:
     its journal as ``interrupted`` (the disarm unconfirmed: the robot's watchdog saw to it).
     Returns their ids. Nothing is sent to any robot."""
     with sessions() as session:
-        ids = session.scalars(select(Run.id).where(Run.kind == "robot", Run.status == "running")).all()
+        ids = robot_runs.running_robot_run_ids(session)
         for run_id in ids:
             fold_journal(session, run_id, status="interrupted", end_reason=INTERRUPTED,
                          disarm="not confirmed: the service stopped", robot=robot)  # fmt: skip
@@ -158,7 +161,7 @@ def replay_run(session, run_id: int, robot=None) -> Run:
     """A stored robot run's tracker frames analysed again (kind ``replay``): touchdowns, gains and
     the model's prediction, with today's detection — e.g. after a calibration or detector change."""
     robot = robot or get_preset("paper")
-    source = session.get(Run, run_id)
+    source = stored_runs.find(session, run_id)
     if source is None:
         raise NotFound("run", run_id)
     if source.kind == "robot" and source.status == "running":
@@ -186,9 +189,14 @@ def replay_run(session, run_id: int, robot=None) -> Run:
         ),
         tags=(*source.tags, "replay"),
     )
-    replay = add_run(session, record, experiment_id=source.experiment_id)
+    replay = stored_runs.add_run(session, record, experiment_id=source.experiment_id)
     session.commit()
     return replay
+
+
+def replay(session, run_id: int) -> RunDetail:
+    """:func:`replay_run` with the paper's robot, answered as the API gives a run."""
+    return run_detail(replay_run(session, run_id))
 
 
 def recorded_leg_for(source: Run) -> Callable[[int], LegControl]:

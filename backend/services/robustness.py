@@ -14,9 +14,10 @@ from collections import defaultdict
 import numpy as np
 from sqlalchemy.orm import Session
 
+from backend.errors import Conflict
+from backend.repositories import runs as stored_runs
 from backend.robot.messages import Fault
 from backend.services.calibrations import get_stored_preset, preset_params, touchdown_series
-from backend.services.records import Conflict, fetch
 from backend.store.models import Run
 from sim_core.errors import ParameterError
 from sim_core.presets import get_preset
@@ -60,9 +61,9 @@ def robustness(
 
 
 def _robot_run(session: Session, run_id: int) -> Run:
-    run = fetch(session, Run, run_id, "run")
+    run = stored_runs.get_run(session, run_id)
     if run.kind == "replay":
-        run = fetch(session, Run, run.results.get("source_run_id"), "run")
+        run = stored_runs.get_run(session, run.results.get("source_run_id"))
     if run.kind != "robot":
         raise Conflict(f"run {run_id} is a {run.kind} run; the study compares the robot's runs")
     if run.status == "running":

@@ -23,8 +23,8 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 
 from backend.errors import Conflict
+from backend.repositories import runs as records
 from backend.robot.messages import Leg
-from backend.services import records
 from backend.services.robot import RobotService
 from backend.services.simulation import unpack_trajectory
 from sim_core.controls import LegControl

@@ -1,6 +1,6 @@
 """A new run, as produced and before it is stored: a plain frozen dataclass with no database
 imports, so the compute workers that produce runs never load SQLAlchemy
-(:func:`backend.store.runs.add_run` turns one into the row)."""
+(:func:`backend.repositories.runs.add_run` turns one into the row)."""
 
 from __future__ import annotations
 

@@ -17,23 +17,19 @@ PresetPath = Annotated[str, Path(min_length=1, max_length=64, pattern=calibratio
 
 
 @router.post("", status_code=201, dependencies=AUTHORIZED, response_model=schemas.CalibrationOut)
-async def create_calibration(body: schemas.CalibrationCreate, db: Db, compute: QuickCompute):
+async def create_calibration(body: schemas.CalibrationCreate, db: Db, compute: QuickCompute) -> schemas.CalibrationOut:
     """Fit ``alpha``, ``c_zeta``, ``c_psi`` and the legs' offsets to the runs; stored as preset ``name``."""
-    fit = functools.partial(_fit_in_worker, compute)
-    return await db(calibrations.calibrate_runs, body.runs, name=body.name, base=body.preset, fit=fit)
+    return await db(calibrations.create, body, fit=functools.partial(_fit_in_worker, compute))
 
 
 @router.get("", response_model=schemas.CalibrationList)
-async def list_calibrations(db: Db):
-    def listed(session) -> list[dict]:
-        return [calibrations.preset_payload(preset) for preset in calibrations.list_presets(session)]
-
-    return {"items": await db(listed)}
+async def list_calibrations(db: Db) -> schemas.CalibrationList:
+    return await db(calibrations.list_calibrations)
 
 
 @router.get("/{name}", response_model=schemas.CalibrationOut)
-async def get_calibration(name: PresetPath, db: Db):
-    return await db(lambda session: calibrations.preset_payload(calibrations.get_stored_preset(session, name)))
+async def get_calibration(name: PresetPath, db: Db) -> schemas.CalibrationOut:
+    return await db(calibrations.get_calibration, name)
 
 
 @router.delete("/{name}", status_code=204, dependencies=AUTHORIZED)

@@ -16,9 +16,9 @@ from backend.api.robot_events import open_event_stream
 router = APIRouter(prefix="/api/v1/robot", tags=["robot"])
 
 
-@router.get("")
-def robot_status(robot: Robot) -> dict:
-    return robot.status()
+@router.get("", response_model=schemas.RobotStatus)
+def robot_status(robot: Robot) -> schemas.RobotStatus:
+    return schemas.RobotStatus.model_validate(robot.status())
 
 
 @router.websocket("/live")
@@ -49,51 +49,51 @@ async def robot_events(request: Request, robot: Robot) -> StreamingResponse:
     return open_event_stream(request, robot)
 
 
-@router.post("/connect", dependencies=AUTHORIZED)
-def robot_connect(body: schemas.RobotConnect, robot: Robot) -> dict:
-    return robot.connect(body)
+@router.post("/connect", dependencies=AUTHORIZED, response_model=schemas.RobotStatus)
+def robot_connect(body: schemas.RobotConnect, robot: Robot) -> schemas.RobotStatus:
+    return schemas.RobotStatus.model_validate(robot.connect(body))
 
 
-@router.post("/disconnect", dependencies=AUTHORIZED)
-def robot_disconnect(robot: Robot) -> dict:
-    return robot.disconnect()
+@router.post("/disconnect", dependencies=AUTHORIZED, response_model=schemas.RobotStatus)
+def robot_disconnect(robot: Robot) -> schemas.RobotStatus:
+    return schemas.RobotStatus.model_validate(robot.disconnect())
 
 
-@router.post("/arm", dependencies=AUTHORIZED)
-def robot_arm(robot: Robot) -> dict:
-    return robot.arm()
+@router.post("/arm", dependencies=AUTHORIZED, response_model=schemas.RobotStatus)
+def robot_arm(robot: Robot) -> schemas.RobotStatus:
+    return schemas.RobotStatus.model_validate(robot.arm())
 
 
-@router.post("/disarm", dependencies=AUTHORIZED)
-def robot_disarm(robot: Robot) -> dict:
-    return robot.disarm()
+@router.post("/disarm", dependencies=AUTHORIZED, response_model=schemas.RobotStatus)
+def robot_disarm(robot: Robot) -> schemas.RobotStatus:
+    return schemas.RobotStatus.model_validate(robot.disarm())
 
 
-@router.post("/reset", dependencies=AUTHORIZED)
-def robot_reset(robot: Robot) -> dict:
-    return robot.reset()
+@router.post("/reset", dependencies=AUTHORIZED, response_model=schemas.RobotStatus)
+def robot_reset(robot: Robot) -> schemas.RobotStatus:
+    return schemas.RobotStatus.model_validate(robot.reset())
 
 
 # No token, async, and on the robot service's own e-stop thread: a request pool filled by compute
 # cannot hold it back.
-@router.post("/estop")
-async def robot_estop(robot: Robot) -> dict:
+@router.post("/estop", response_model=schemas.RobotEstopOut, response_model_exclude_unset=True)
+async def robot_estop(robot: Robot) -> schemas.RobotEstopOut:
     """Emergency stop, at any moment and without the token; answers within 200 ms. A live run
     ends (and is stored). ``acknowledged`` says whether the robot confirmed it (``latency_ms``);
     if not (``reason``: link blocked or lost), the robot's 1 s watchdog disarms it."""
-    return await robot.estop_now()
+    return schemas.RobotEstopOut.model_validate(await robot.estop_now())
 
 
-@router.post("/runs", status_code=202, dependencies=AUTHORIZED)
-def robot_run(body: schemas.RobotRunCreate, robot: Robot, request: Request) -> dict:
+@router.post("/runs", status_code=202, dependencies=AUTHORIZED, response_model=schemas.RobotStatus)
+def robot_run(body: schemas.RobotRunCreate, robot: Robot, request: Request) -> schemas.RobotStatus:
     """Start a live run: stored at once (status running, ``run.id``), journaled while it runs,
     complete when it ends (see GET /api/v1/robot). Every panel is told who started it: ``operator``,
     or the client's address. While it runs, link changes are refused (409 naming it)."""
     client = request.client.host if request.client is not None else "unknown"
     robot.start_run(body, started_by=body.operator or f"a client at {client}")
-    return robot.status()
+    return schemas.RobotStatus.model_validate(robot.status())
 
 
-@router.post("/runs/stop", dependencies=AUTHORIZED)
-def robot_run_stop(robot: Robot) -> dict:
-    return robot.stop_run()
+@router.post("/runs/stop", dependencies=AUTHORIZED, response_model=schemas.RobotStatus)
+def robot_run_stop(robot: Robot) -> schemas.RobotStatus:
+    return schemas.RobotStatus.model_validate(robot.stop_run())

@@ -6,26 +6,14 @@ import functools
 import io
 from typing import Annotated
 
-from fastapi import APIRouter, Query, Request
+from fastapi import APIRouter, Query
 from fastapi.responses import Response, StreamingResponse
 from pydantic import Field
-from sqlalchemy.orm import Session
 
 from backend import schemas
-from backend.api.deps import (
-    AUTHORIZED,
-    Cursor,
-    Db,
-    PageLimit,
-    PresetQuery,
-    QuickCompute,
-    Reads,
-    RecordId,
-    RunQuery,
-    preset_resolved,
-)
-from backend.services import calibrations, mcap_export, records, simulation
-from backend.services.robot_records import replay_run
+from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, PresetQuery, QuickCompute, Reads, RecordId, RunQuery
+from backend.services import calibrations, mcap_export, robot_records
+from backend.services import runs as service
 
 router = APIRouter(prefix="/api/v1/runs", tags=["runs"])
 
@@ -35,14 +23,10 @@ class McapResponse(Response):
 
 
 @router.post("", status_code=201, dependencies=AUTHORIZED, response_model=schemas.RunDetail)
-async def create_run(body: schemas.RunCreate, request: Request, db: Db, compute: QuickCompute):
+async def create_run(body: schemas.RunCreate, db: Db, compute: QuickCompute) -> schemas.RunDetail:
     """Simulate (in the quick compute worker) and store a run. The simulation is awaited, so no
     request thread waits for it; the database work before and after takes one briefly."""
-    body = await preset_resolved(request, body)
-    if body.experiment_id is not None:  # it exists: checked before the simulation is paid for
-        await db(records.check_run_request, body)
-    record = await compute.call(simulation.simulate_run, body)
-    return await db(lambda session: run_out(records.store_run(session, body, record), detail=True))
+    return await service.create(db, compute, body)
 
 
 @router.get("", response_model=schemas.RunPage)
@@ -51,12 +35,12 @@ async def list_runs(
     where: RunQuery,
     limit: PageLimit = 50,
     cursor: Cursor = None,
-    sort: Annotated[str, Query(pattern=f"^({'|'.join(records.SORTS)})$", description="-climb: best first")] = "-id",
+    sort: Annotated[str, Query(pattern=f"^({'|'.join(service.SORTS)})$", description="-climb: best first")] = "-id",
     offset: Annotated[int, Query(ge=0, le=10_000_000, description="for sorts other than id")] = 0,
-):
+) -> Response:
     """Runs matching the filters. Sorted by id, ``next_cursor`` pages by keyset; sorted by another
     field, pass ``next_cursor`` back as ``offset``. Read and encoded in a worker process
-    (services/store_reads.py): the service's own process only forwards the page."""
+    (backend/workers/store_reads.py): the service's own process only forwards the page."""
     page = await reads.runs_page(where, limit=limit, cursor=cursor, sort=sort, offset=offset)
     return Response(page, media_type="application/json")
 
@@ -64,7 +48,7 @@ async def list_runs(
 @router.get("/export", response_class=StreamingResponse)
 async def export_runs(
     reads: Reads, where: RunQuery, format_: Annotated[str, Query(alias="format", pattern="^(csv|json)$")] = "csv"
-):
+) -> StreamingResponse:
     """Every run matching the filters when the export began, streamed, with tags, timings and
     parameters (not the path); read and encoded by the read workers, a part of 1000 runs at a time."""
     plan = await reads.export_plan(where, format_)
@@ -79,57 +63,40 @@ async def compare_runs(
     db: Db,
     ids: Annotated[
         list[Annotated[int, Field(ge=1, le=schemas.MAX_ID)]],
-        Query(min_length=2, max_length=records.MAX_COMPARE, description="run ids"),
+        Query(min_length=2, max_length=service.MAX_COMPARE, description="run ids"),
     ],
     only_differences: bool = True,
-):
+) -> schemas.RunComparison:
     """Runs side by side as flat fields; by default only the fields whose values differ."""
-    return await db(records.compare_runs, ids, only_differences=only_differences)
+    return await db(service.compare, ids, only_differences=only_differences)
 
 
 @router.get("/aggregate", response_model=schemas.RunAggregate)
 async def aggregate_runs(
     db: Db,
     where: RunQuery,
-    by: Annotated[str, Query(pattern=f"^({'|'.join(records.GROUP_BY)})$")] = "zeta0",
+    by: Annotated[str, Query(pattern=f"^({'|'.join(service.GROUP_BY)})$")] = "zeta0",
     bins: Annotated[
         int | None,
-        Query(ge=1, le=records.MAX_BINS, description="continuous parameters: equal bins over their range"),
+        Query(ge=1, le=service.MAX_BINS, description="continuous parameters: equal bins over their range"),
     ] = None,
-):
+) -> schemas.RunAggregate:
     """Runs grouped by a parameter or tag: count, mean, std, min and max of climb and jumps completed.
     A continuous parameter (zeta0, psi0_deg, alpha) groups by exact value — at most 1000 — or in
     ``bins`` equal bins (each group then has ``low`` and ``high``)."""
-    return {"by": by, "bins": bins, "groups": await db(records.aggregate_runs, where, by, bins)}
+    return await db(service.aggregate, where, by, bins)
 
 
 @router.get("/{run_id}", response_model=schemas.RunDetail)
-async def get_run(run_id: RecordId, db: Db):
-    return await db(lambda session: run_out(records.get_run(session, run_id), detail=True))
+async def get_run(run_id: RecordId, db: Db) -> schemas.RunDetail:
+    return await db(service.get, run_id)
 
 
 @router.get("/{run_id}/trajectory", response_model=schemas.RunTrajectory)
 async def get_trajectory(run_id: RecordId, db: Db) -> Response:
     """The run's sampled path, column by column. Encoded in the request thread: a long run's path
     is megabytes of JSON, kept off the event loop that the e-stop shares."""
-    return Response(await db(trajectory_json, run_id), media_type="application/json")
-
-
-# A simulated run's path is nondimensional (docs/model.md §1); a robot or replay run's is the tracker's frames.
-SIMULATED_UNITS = {"time": "sqrt(l0/g)", "x": "l0", "y": "l0", "foot_x": "l0", "foot_y": "l0", "psi": "rad",
-                   "zeta": "l0", "phase": "0 stance, 1 flight", "jump": "index"}  # fmt: skip
-RECORDED_UNITS = {"time": "s", "x": "m", "y": "m", "pitch": "rad"}
-
-
-def trajectory_json(session: Session, run_id: int) -> bytes:
-    run = records.get_run(session, run_id)
-    if run.trajectory is None:
-        raise records.NotFound("trajectory of run", run_id)
-    columns = simulation.unpack_trajectory(run.trajectory)
-    listed = {name: values.tolist() for name, values in columns.items()}
-    units, table = ("nondimensional", SIMULATED_UNITS) if run.kind == "sim" else ("SI", RECORDED_UNITS)
-    column_units = {name: table.get(name, "") for name in listed}
-    return schemas.RunTrajectory(units=units, column_units=column_units, columns=listed).model_dump_json().encode()
+    return Response(await db(service.trajectory_json, run_id), media_type="application/json")
 
 
 @router.get("/{run_id}/export.mcap", response_class=McapResponse)
@@ -144,7 +111,9 @@ async def export_mcap(run_id: RecordId, db: Db) -> McapResponse:
 
 
 @router.get("/{run_id}/touchdowns", response_model=schemas.TouchdownComparison)
-async def touchdown_predictions(run_id: RecordId, db: Db, compute: QuickCompute, preset: PresetQuery = None):
+async def touchdown_predictions(
+    run_id: RecordId, db: Db, compute: QuickCompute, preset: PresetQuery = None
+) -> schemas.TouchdownComparison:
     """A robot or replay run's touchdowns as measured beside the paper's model's one-jump prediction
     of each and, with ``preset`` (a stored calibration), the calibrated model's, with residuals."""
     predict = functools.partial(compute.run, calibrations.predict_touchdowns)
@@ -152,41 +121,16 @@ async def touchdown_predictions(run_id: RecordId, db: Db, compute: QuickCompute,
 
 
 @router.post("/{run_id}/replay", status_code=201, dependencies=AUTHORIZED, response_model=schemas.RunDetail)
-async def replay(run_id: RecordId, db: Db):
+async def replay(run_id: RecordId, db: Db) -> schemas.RunDetail:
     """Analyse a robot run's recorded tracker frames again, stored as a run of kind replay."""
-    return await db(lambda session: run_out(replay_run(session, run_id), detail=True))
+    return await db(robot_records.replay, run_id)
 
 
 @router.patch("/{run_id}", dependencies=AUTHORIZED, response_model=schemas.RunOut)
-async def update_run(run_id: RecordId, body: schemas.RunUpdate, db: Db):
-    return await db(lambda session: run_out(records.update_run(session, run_id, tags=body.tags, notes=body.notes)))
+async def update_run(run_id: RecordId, body: schemas.RunUpdate, db: Db) -> schemas.RunOut:
+    return await db(service.update, run_id, tags=body.tags, notes=body.notes)
 
 
 @router.delete("/{run_id}", status_code=204, dependencies=AUTHORIZED)
 async def delete_run(run_id: RecordId, db: Db) -> None:
-    await db(records.delete_run, run_id)
-
-
-def run_out(run, *, detail: bool = False) -> dict:
-    out = {
-        "id": run.id,
-        "experiment_id": run.experiment_id,
-        "kind": run.kind,
-        "status": run.status,
-        "created_at": run.created_at,
-        "duration_s": run.duration_s,
-        "code_version": run.code_version,
-        "model": run.model,
-        "controls": run.controls,
-        "start_state": run.start_state,
-        "jumps": run.jumps,
-        "jumps_completed": run.jumps_completed,
-        "failure_code": run.failure_code,
-        "climb": run.climb,
-        "tags": run.tags,
-        "notes": run.notes,
-        "has_trajectory": run.has_trajectory,
-    }
-    if detail:
-        out["results"] = run.results
-    return out
+    await db(service.delete, run_id)

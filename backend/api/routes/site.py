@@ -73,12 +73,12 @@ def swagger_init(request: Request) -> Response:
 
 
 @router.get("/api/v1/health", tags=["service"], response_model=schemas.Health)
-async def health(db: Db):
-    return {"status": "ok", "database": await db(ping), "code_version": simulation.current_code_version()}
+async def health(db: Db) -> schemas.Health:
+    return schemas.Health(status="ok", database=await db(ping), code_version=simulation.current_code_version())
 
 
 @router.get("/api/v1/auth", tags=["service"], dependencies=AUTHORIZED, response_model=schemas.TokenAccepted)
-async def check_token():
+async def check_token() -> schemas.TokenAccepted:
     """Whether the bearer token is the service's: 200 if so, 401 if not. The panel shows it beside
     the token field; reads need no token, changes do."""
-    return {"accepted": True}
+    return schemas.TokenAccepted(accepted=True)

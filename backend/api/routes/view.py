@@ -14,21 +14,23 @@ router = APIRouter(tags=["view"])
 
 
 @router.get("/api/v1/view", response_model=schemas.ViewOut)
-def view_info(request: Request, viewer: Annotated[str | None, Query(pattern=schemas.VIEWER_ID_PATTERN)] = None):
+def view_info(
+    request: Request, viewer: Annotated[str | None, Query(pattern=schemas.VIEWER_ID_PATTERN)] = None
+) -> schemas.ViewOut:
     """Where the 3D view is (its own port on this host), and what the panel ``viewer``'s view shows."""
     try:
-        return view_of(request).info(viewer)
+        return schemas.ViewOut.model_validate(view_of(request).info(viewer))
     except HTTPException:
         starter = request.app.state.view_starter
         starting = starter is not None and starter.starting
-        return {"available": False, "reason": view_unavailable_reason(request), "starting": starting}
+        return schemas.ViewOut(available=False, reason=view_unavailable_reason(request), starting=starting)
 
 
 @router.post("/api/v1/view/replay", dependencies=AUTHORIZED, response_model=schemas.ViewOut)
-def view_replay(body: schemas.ViewReplay, view: SceneView):
+def view_replay(body: schemas.ViewReplay, view: SceneView) -> schemas.ViewOut:
     """Show a stored run in the 3D view of the panel ``viewer`` (replay mode), optionally with
     another as a ghost. Nobody else's view changes; a view still loading gets it when it connects."""
-    return view.open_run(body.viewer, body.run_id, body.overlay_run_id)
+    return schemas.ViewOut.model_validate(view.open_run(body.viewer, body.run_id, body.overlay_run_id))
 
 
 @router.get("/api/v1/runs/{run_id}/share.html", response_class=HTMLResponse)

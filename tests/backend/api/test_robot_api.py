@@ -22,7 +22,7 @@ CONTROLS = [{"psi0_deg": 30, "zeta0": 0.87}, {"psi0_deg": 30, "zeta0": 0.9}]
 @pytest.fixture
 def database_url():
     """SQLite only: these are tests of the robot path; what it stores goes through the run
-    repository (backend/store/runs.py), which every store and API test of runs checks on both
+    repository (backend/repositories/runs.py), which every store and API test of runs checks on both
     databases. Running them twice cost CI about 25 s of real-time robot runs."""
     return None
 
@@ -76,17 +76,17 @@ def test_estop_answers_while_the_request_pool_is_full(client, auth, connected, m
     """45 stored-run requests hold every request thread (each waits inside the route, storing its
     run): the e-stop, async and on its own thread, answers all the same. Real compute under load:
     test_estop_load.py."""
-    from backend.services import records
+    from backend.services import runs
 
     release, entered = threading.Event(), threading.Semaphore(0)
-    store_run = records.store_run
+    store_run = runs.store_run
 
     def held(*args, **kwargs):
         entered.release()
         release.wait(60)
         return store_run(*args, **kwargs)
 
-    monkeypatch.setattr(records, "store_run", held)
+    monkeypatch.setattr(runs, "store_run", held)
     body = {"controls": CONTROLS[:1], "start": {"xdot": -0.9, "ydot": -0.2}, "jumps": 3}
     answers = []
 

@@ -2,8 +2,9 @@
 
 import pytest
 
+from backend.repositories import runs as run_store
 from backend.schemas import ExperimentCreate
-from backend.services import records
+from backend.services import experiments, runs
 from backend.store.database import make_engine, migrate, session_factory, sqlite_url
 from backend.store.models import Run
 from tests.backend.services.bodies import run_body
@@ -26,10 +27,11 @@ def session(sessions):
 
 @pytest.fixture
 def make_run(session):
-    """``make_run(zeta0=..., psi0_deg=..., **fields)``: a simulated run stored through the records service."""
+    """``make_run(zeta0=..., psi0_deg=..., **fields)``: a simulated run stored through the runs
+    service, as the session holds its row."""
 
     def make(zeta0: float = 0.9, psi0_deg: float = 30.0, **fields) -> Run:
-        return records.create_run(session, run_body(zeta0, psi0_deg, **fields))
+        return run_store.get_run(session, runs.create_run(session, run_body(zeta0, psi0_deg, **fields)).id)
 
     return make
 
@@ -59,7 +61,7 @@ def connected(service, virtual):
 def stored_runs(session, make_run):
     """Five runs: zeta0 0.86 .. 0.94 at psi0 = 30°, the middle one tagged and in an experiment,
     and one slipping run at psi0 = 60°."""
-    experiment = records.create_experiment(session, ExperimentCreate(name="energy"))
+    experiment = experiments.create(session, ExperimentCreate(name="energy"))
     runs = {}
     for zeta0 in (0.86, 0.88, 0.9, 0.92, 0.94):
         tags = ["middle"] if zeta0 == 0.9 else []

@@ -6,7 +6,10 @@ import socket
 import numpy as np
 import pytest
 
-from backend.services import calibrations, records
+from backend import errors
+from backend.repositories import calibrations as stored_presets
+from backend.repositories import runs as run_store
+from backend.services import calibrations
 from backend.services.robot_records import replay_run
 from sim_core.errors import ParameterError
 from sim_core.noise import NO_NOISE, NoiseModel
@@ -50,10 +53,10 @@ def test_a_run_that_fell_is_cut_before_its_fall_and_named_in_the_report(session,
     legs = VARIED_LEGS[1]
     climb = tracked_climb(TRUTH, legs, jumps=30, noise=NoiseModel(pitch_drift_deg=0.2), rng=np.random.default_rng(7))
     fallen = store_tracked_run(session, climb, legs, fell=True)
-    assert calibrations.run_fell(records.get_run(session, fallen))
-    assert not calibrations.run_fell(records.get_run(session, robot_runs[0]))
+    assert calibrations.run_fell(run_store.get_run(session, fallen))
+    assert not calibrations.run_fell(run_store.get_run(session, robot_runs[0]))
     replay = replay_run(session, fallen).id  # a replay fell as its robot run did
-    assert calibrations.touchdown_series(session, records.get_run(session, replay), PAPER).fell
+    assert calibrations.touchdown_series(session, run_store.get_run(session, replay), PAPER).fell
     runs = [*robot_runs[:3], replay]
     payload = calibrations.calibrate_runs(session, runs, name="with-a-fall")
     assert payload["cut_at_fall"] == [{"series": 3, "touchdown": len(climb.touchdowns) - 1, "run_id": replay}]
@@ -71,16 +74,16 @@ def test_a_replay_calibrates_like_its_robot_run(session, robot_runs):
 
 def test_what_cannot_be_calibrated_says_why(session, robot_runs, make_run):
     simulated = make_run()
-    with pytest.raises(records.Conflict, match="robot and replay runs"):
+    with pytest.raises(errors.Conflict, match="robot and replay runs"):
         calibrations.calibrate_runs(session, [robot_runs[0], simulated.id], name="x")
-    with pytest.raises(records.NotFound, match="run 999"):
+    with pytest.raises(errors.NotFound, match="run 999"):
         calibrations.calibrate_runs(session, [999], name="x")
     for name in ("paper", "", "-x", "a b", "x" * 65):
         with pytest.raises(ParameterError) as error:
             calibrations.calibrate_runs(session, robot_runs, name=name)
         assert error.value.field == "name"
     calibrations.calibrate_runs(session, robot_runs[:2], name="once")
-    with pytest.raises(records.Conflict, match="exists"):
+    with pytest.raises(errors.Conflict, match="exists"):
         calibrations.calibrate_runs(session, robot_runs[:2], name="once")
     with pytest.raises(ParameterError, match="known presets: paper, once"):
         calibrations.preset_params(session, "nothing")
@@ -91,13 +94,13 @@ def test_a_run_too_short_to_fit_is_a_parameter_error(session):
     with pytest.raises(ParameterError) as error:
         calibrations.calibrate_runs(session, [run_id], name="short")
     assert error.value.field == "runs"
-    assert calibrations.list_presets(session) == []
+    assert stored_presets.all_presets(session) == []
 
 
 def test_a_deleted_preset_is_gone(session, robot_runs):
     calibrations.calibrate_runs(session, robot_runs[:2], name="old")
     calibrations.delete_preset(session, "old")
-    with pytest.raises(records.NotFound):
+    with pytest.raises(errors.NotFound):
         calibrations.get_stored_preset(session, "old")
 
 

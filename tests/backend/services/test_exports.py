@@ -7,10 +7,11 @@ import math
 
 import pytest
 
+from backend.repositories import runs as run_store
+from backend.repositories import runs as store_runs
+from backend.repositories.runs import RunFilter
 from backend.schemas import LegIn
-from backend.services import exports, records
-from backend.services.records import RunFilter
-from backend.store import runs as store_runs
+from backend.services import exports, runs
 from experiments.manifest import json_safe
 from sim_core.presets import get_preset
 
@@ -45,7 +46,7 @@ def test_an_exported_record_is_the_runs_flat_record(sessions, stored_runs, sessi
     _, runs = stored_runs
     exported = {row["id"]: row for row in _exported(sessions, RunFilter())}
     for run in runs.values():
-        assert exported[run.id] == json.loads(json.dumps(json_safe(_flat(records.get_run(session, run.id)))))
+        assert exported[run.id] == json.loads(json.dumps(json_safe(_flat(run_store.get_run(session, run.id)))))
 
 
 def test_csv_export_parses_back(sessions, stored_runs):
@@ -83,7 +84,7 @@ def test_an_export_reads_a_part_at_a_time_and_ends_at_the_runs_it_began_with(ses
     make_run(controls=two_legs)  # stored while the export streams
     with sessions() as session:
         for run_id in ids[2:4]:  # the whole second part
-            records.delete_run(session, run_id)
+            runs.delete(session, run_id)
     assert [row["id"] for row in json.loads(head + first + "".join(chunks))] == [*ids[:2], ids[4]]
     parts = list(exports.export(sessions, RunFilter(zeta0_max=0.95), "csv"))
     assert len(parts) == 1 + 2 + 1, "the header, two parts of at most two runs, the (empty) tail"
@@ -110,7 +111,7 @@ def test_csv_export_keeps_every_runs_legs(sessions, make_run):
 
 @pytest.mark.parametrize("text", ['=HYPERLINK("http://x")', "+1+1", "-2+3", "@SUM(A1)", "\tx", "\rx"])
 def test_csv_cells_a_spreadsheet_would_run_are_escaped(sessions, make_run, session, text):
-    records.update_run(session, make_run().id, notes=text)
+    runs.update(session, make_run().id, notes=text)
     (row,) = _exported(sessions, RunFilter(), "csv")
     assert row["notes"] == "'" + text and float(row["start_xdot"]) == -0.93, "numbers, negative ones too, as they are"
 

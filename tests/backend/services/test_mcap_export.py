@@ -8,8 +8,10 @@ import math
 import pytest
 from mcap.reader import make_reader
 
+from backend import errors
+from backend.repositories import runs as run_store
 from backend.robot.tracker import Calibration
-from backend.services import records
+from backend.services import runs
 from backend.services.mcap_export import METADATA_NAME, export_run
 from backend.services.mcap_schemas import CHANNELS
 from backend.services.robot_records import open_robot_run, replay_run
@@ -68,7 +70,7 @@ def utc_ns(moment: datetime.datetime) -> int:
 
 
 def test_a_robot_run_reads_back_channel_by_channel(session):
-    run = records.get_run(session, store_robot_run(session))
+    run = run_store.get_run(session, store_robot_run(session))
     data, counts = exported(session, run.id)
     summary, metadata, messages = read(data)
 
@@ -130,7 +132,7 @@ def test_a_robot_run_reads_back_channel_by_channel(session):
 
 
 def test_pose_in_frame_is_foxglove_s_pose_up_on_z(session):
-    run = records.get_run(session, store_robot_run(session))
+    run = run_store.get_run(session, store_robot_run(session))
     _summary, _metadata, messages = read(exported(session, run.id)[0])
     poses = [(time, m) for topic, _s, time, m in messages if topic == "/tracker/pose"]
     framed = [(time, m) for topic, _s, time, m in messages if topic == "/tracker/pose_in_frame"]
@@ -149,7 +151,7 @@ def test_pose_in_frame_is_foxglove_s_pose_up_on_z(session):
 
 
 def test_a_replay_is_its_source_s_recording_with_its_own_touchdowns(session):
-    source = records.get_run(session, store_robot_run(session))
+    source = run_store.get_run(session, store_robot_run(session))
     replay = replay_run(session, source.id)
     data, counts = exported(session, replay.id)
     _summary, metadata, messages = read(data)
@@ -167,15 +169,15 @@ def test_a_replay_is_its_source_s_recording_with_its_own_touchdowns(session):
 
 def test_runs_that_are_no_recordings_are_refused(session, make_run):
     simulated = make_run()
-    with pytest.raises(records.Conflict, match="sim run: only robot and replay runs are recordings"):
+    with pytest.raises(errors.Conflict, match="sim run: only robot and replay runs are recordings"):
         export_run(session, simulated.id, io.BytesIO())
     running = open_robot_run(session, REQUEST, get_preset("paper"), Calibration())
-    with pytest.raises(records.Conflict, match="still running"):
+    with pytest.raises(errors.Conflict, match="still running"):
         export_run(session, running, io.BytesIO())
-    with pytest.raises(records.NotFound, match="run 999 does not exist"):
+    with pytest.raises(errors.NotFound, match="run 999 does not exist"):
         export_run(session, 999, io.BytesIO())
     source = store_robot_run(session)
     replay = replay_run(session, source)
-    records.delete_run(session, source)
-    with pytest.raises(records.Conflict, match=f"source run {source} is gone"):
+    runs.delete(session, source)
+    with pytest.raises(errors.Conflict, match=f"source run {source} is gone"):
         export_run(session, replay.id, io.BytesIO())

@@ -11,12 +11,13 @@ import time
 
 import pytest
 
+from backend import errors
+from backend.repositories import runs as run_store
 from backend.robot.link import LinkError
 from backend.robot.live_run import LiveRun, RunSnapshot
 from backend.robot.messages import Fault, RobotState
 from backend.robot.virtual import VirtualRobot
 from backend.schemas import LegIn, RobotConnect, RobotRunCreate
-from backend.services import records
 from backend.services.robot import ESTOP_ANSWER, RobotUnavailable
 from backend.services.robot_records import replay_run, touchdown_results
 from backend.services.simulation import unpack_trajectory
@@ -50,7 +51,7 @@ def test_without_a_robot_nothing_moves(service):
     assert (stopped["acknowledged"], stopped["reason"]) == (False, "the robot is not connected")
     with pytest.raises(RobotUnavailable):
         service.start_run(RobotRunCreate(controls=LEGS))
-    with pytest.raises(records.NotFound):
+    with pytest.raises(errors.NotFound):
         service.stop_run()
 
 
@@ -58,7 +59,7 @@ def test_a_live_run_is_stored_with_the_models_prediction(connected, session):
     status = _live_run(connected, tags=["live"])
     assert status["run"]["end_reason"] == "jumps done" and not status["run"]["active"]
     assert status["state"] == "disarmed", "the robot is disarmed when the run ends"
-    stored = records.get_run(session, status["run"]["stored_run_id"])
+    stored = run_store.get_run(session, status["run"]["stored_run_id"])
     assert (stored.kind, stored.status, stored.tags, stored.jumps) == ("robot", "done", ["live"], JUMPS)
     assert stored.controls == [[30.0, 0.87], [30.0, 0.9]] and stored.jumps_completed == JUMPS - 1
     results = stored.results
@@ -73,13 +74,13 @@ def test_a_live_run_is_stored_with_the_models_prediction(connected, session):
 def test_a_recorded_run_replays_to_the_same_touchdowns(connected, session, make_run):
     live_id = _live_run(connected)["run"]["stored_run_id"]
     replay = replay_run(session, live_id)
-    live = records.get_run(session, live_id)
+    live = run_store.get_run(session, live_id)
     assert (replay.kind, replay.results["source_run_id"], replay.tags) == ("replay", live_id, ["replay"])
     assert replay.results["states"] == live.results["states"] and replay.climb == pytest.approx(live.climb)
     simulated = make_run()
-    with pytest.raises(records.Conflict, match="only robot runs"):
+    with pytest.raises(errors.Conflict, match="only robot runs"):
         replay_run(session, simulated.id)
-    with pytest.raises(records.NotFound):
+    with pytest.raises(errors.NotFound):
         replay_run(session, 999)
 
 
@@ -121,7 +122,7 @@ def test_a_foreign_radio_cannot_end_a_live_run(connected, virtual, session):
     assert robot.firmware.state == RobotState.RUNNING
     status = connected.stop_run()
     assert status["run"]["end_reason"] == "stopped" and status["state"] == "disarmed"
-    assert records.get_run(session, status["run"]["stored_run_id"]).status == "done"
+    assert run_store.get_run(session, status["run"]["stored_run_id"]).status == "done"
 
 
 def test_estop_ends_a_live_run_even_unacknowledged(service):
@@ -250,7 +251,7 @@ def test_every_ending_disarms_the_robot(connected, virtual, session, end):
     assert not run.active and run.disarm == "disarmed", (run.end_reason, run.disarm)
     assert robot.firmware.state == RobotState.DISARMED, run.end_reason
     assert not robot.firmware.faults & Fault.HEARTBEAT_LOST, "disarmed by a DISARM, not by its watchdog"
-    assert records.get_run(session, run.run_id).results["disarm"] == "disarmed"
+    assert run_store.get_run(session, run.run_id).results["disarm"] == "disarmed"
 
 
 def test_an_estop_ending_leaves_the_robot_estopped(connected, virtual):

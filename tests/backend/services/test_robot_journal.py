@@ -5,12 +5,12 @@ import time
 from sqlalchemy import func, select
 from sqlalchemy.exc import OperationalError
 
+from backend.repositories import runs as run_store
 from backend.robot.link import Transition
 from backend.robot.live_run import LiveRun
 from backend.robot.touchdown import Touchdown
 from backend.robot.tracker import Calibration, Pose, UdpPoseSource
 from backend.schemas import LegIn, RobotRunCreate
-from backend.services import records
 from backend.services.robot_journal import JournalWriter
 from backend.services.robot_records import open_robot_run
 from backend.store.models import RunJournal
@@ -39,11 +39,11 @@ def test_a_live_run_is_journaled_while_it_runs(connected, session):
 
     _wait_for(lambda: journaled_touchdowns() >= 3, "the touchdowns in the journal")
     session.expire_all()
-    stored = records.get_run(session, run_id)
+    stored = run_store.get_run(session, run_id)
     assert stored.status == "running" and stored.duration_s > 0
     connected.stop_run()
     session.expire_all()
-    assert records.get_run(session, run_id).status == "done"
+    assert run_store.get_run(session, run_id).status == "done"
     assert session.scalar(select(func.count()).select_from(RunJournal)) == 0, "folded into the run at its end"
 
 
@@ -81,7 +81,7 @@ def test_a_failed_journal_write_loses_nothing(sessions, session):
     run.end_reason, run.disarm = "stopped", "disarmed"
     writer.start().finish(run)
     tracker.close()
-    stored = records.get_run(session, run_id)
+    stored = run_store.get_run(session, run_id)
     assert [td["index"] for td in stored.results["touchdowns"]] == [0, 1, 2]
     assert stored.results["tracker"]["frames"] == 3 and stored.status == "done"
 
@@ -101,7 +101,7 @@ def test_a_runs_tracker_figures_are_its_own_not_the_connections(sessions, sessio
     run.end_reason, run.disarm = "stopped", "disarmed"
     writer.start().finish(run)
     tracker.close()
-    figures = records.get_run(session, run_id).results["tracker"]
+    figures = run_store.get_run(session, run_id).results["tracker"]
     assert (figures["received"], figures["dropped"], figures["malformed"], figures["restarts"]) == (5, 1, 1, 0)
     assert figures["loss"] == 1 / 6 and (figures["protocol"], figures["version"]) == ("pkt1", "1")
     assert figures["address"] == list(tracker.address) and tracker.stats.dropped == 3, "the connection's own"

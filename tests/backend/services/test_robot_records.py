@@ -5,10 +5,11 @@ import datetime
 import pytest
 from sqlalchemy import func, select
 
+from backend import errors
+from backend.repositories import runs as run_store
 from backend.robot.touchdown import Touchdown
 from backend.robot.tracker import Calibration
 from backend.schemas import LegIn, RobotRunCreate
-from backend.services import records
 from backend.services.robot_records import INTERRUPTED, fold_journal, open_robot_run, recover_interrupted, replay_run
 from backend.services.simulation import unpack_trajectory
 from backend.store.models import RunJournal
@@ -43,7 +44,7 @@ def _entry(run_id: int, first: int, frames: int, touchdowns: list[int], written_
 def journaled(session):
     """A robot run opened and given two journal entries (50 frames, 3 touchdowns), never ended."""
     run_id = open_robot_run(session, REQUEST, get_preset("paper"), Calibration())
-    created = records.get_run(session, run_id).created_at
+    created = run_store.get_run(session, run_id).created_at
     session.add_all([
         _entry(run_id, 0, 30, [0, 1], created + datetime.timedelta(seconds=0.5)),
         _entry(run_id, 30, 20, [2], created + datetime.timedelta(seconds=1.0)),
@@ -53,10 +54,10 @@ def journaled(session):
 
 
 def test_a_run_is_stored_running_from_its_start(session, journaled):
-    run = records.get_run(session, journaled)
+    run = run_store.get_run(session, journaled)
     assert (run.kind, run.status, run.tags, run.jumps, run.jumps_completed) == ("robot", "running", ["t"], 20, 0)
     assert run.results["end_reason"] is None and run.results["calibration"]["scale"] == 1.0
-    with pytest.raises(records.Conflict, match="still running"):
+    with pytest.raises(errors.Conflict, match="still running"):
         replay_run(session, journaled)
 
 
@@ -64,7 +65,7 @@ def test_recovery_folds_the_journal_into_an_interrupted_run(sessions, session, j
     done = make_run()
     assert recover_interrupted(sessions) == [journaled]
     session.expire_all()
-    run = records.get_run(session, journaled)
+    run = run_store.get_run(session, journaled)
     assert (run.status, run.results["end_reason"], run.jumps_completed) == ("interrupted", INTERRUPTED, 2)
     assert run.results["disarm"].startswith("not confirmed")
     assert [td["index"] for td in run.results["touchdowns"]] == [0, 1, 2]
@@ -77,7 +78,7 @@ def test_recovery_folds_the_journal_into_an_interrupted_run(sessions, session, j
     assert run.duration_s == pytest.approx(1.0) and run.start_state == [-0.9, 0.1]
     assert unpack_trajectory(run.trajectory)["time"].size == 50
     assert session.scalar(select(func.count()).select_from(RunJournal)) == 0, "the journal is folded away"
-    assert records.get_run(session, done.id).status == "done", "finished runs are left alone"
+    assert run_store.get_run(session, done.id).status == "done", "finished runs are left alone"
     assert recover_interrupted(sessions) == [], "once"
 
 

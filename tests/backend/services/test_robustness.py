@@ -4,7 +4,8 @@ calibrated model's MJTF (backend/services/robustness.py)."""
 import numpy as np
 import pytest
 
-from backend.services import calibrations, records
+from backend import errors
+from backend.services import calibrations
 from backend.services.robot_records import replay_run
 from backend.services.robustness import robustness
 from sim_core.errors import ParameterError
@@ -48,9 +49,9 @@ def test_by_default_the_study_compares_the_runs_the_preset_came_from(session, ca
 
 
 def test_what_the_study_cannot_compare_says_why(session, calibrated, make_run):
-    with pytest.raises(records.NotFound, match="preset nothing"):
+    with pytest.raises(errors.NotFound, match="preset nothing"):
         robustness(session, "nothing", trials=5, cap=50)
-    with pytest.raises(records.Conflict, match="robot's runs"):
+    with pytest.raises(errors.Conflict, match="robot's runs"):
         robustness(session, "bench", [make_run().id], trials=5, cap=50)
     for field, options in (("trials", {"trials": 0, "cap": 50}), ("cap", {"trials": 5, "cap": 10**6})):
         with pytest.raises(ParameterError) as error:

@@ -10,7 +10,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from backend.api.app import create_app
-from backend.services.records import list_experiments
+from backend.services.experiments import list_page
 from backend.services.robot import RobotService
 from backend.services.view import SceneView, ViewContext, ViewStarter
 from backend.settings import Settings
@@ -57,7 +57,9 @@ def test_the_view_gets_the_services_sessions_and_robot_and_is_closed(settings):
         view = app.state.view_starter.wait(10)
         assert built == [view] and not view.closed
         with view.context.sessions() as session:
-            assert list_experiments(session, limit=5, cursor=None) == ([], None), "a migrated database"
+            assert list_page(session, limit=5, cursor=None).model_dump() == {"items": [], "next_cursor": None}, (
+                "a migrated database"
+            )
         assert isinstance(view.context.robot_service, RobotService)
         assert view.context.robot_service.status()["state"] == "disconnected"
     assert view.closed, "the service closes its view at shutdown"

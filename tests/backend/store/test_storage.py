@@ -16,8 +16,9 @@ import pytest
 from sqlalchemy import event, text
 from sqlalchemy.exc import IntegrityError, OperationalError
 
+from backend.repositories import runs as run_store
 from backend.schemas import RunCreate
-from backend.services import records
+from backend.services import runs
 from backend.store import database
 from backend.store.database import (
     FULL_MESSAGE,
@@ -161,7 +162,7 @@ def _create_until_full(sessions, ids: list[int], limit: int = 10_000) -> int:
     for created in range(limit):
         try:
             with sessions() as session:
-                ids.append(records.create_run(session, BIG_RUN).id)
+                ids.append(runs.create_run(session, BIG_RUN).id)
         except StorageFull:
             return created
     return limit
@@ -190,12 +191,12 @@ def test_deletes_free_space_on_a_really_full_disk(tmp_path):
         for _round in range(3):
             for _ in range(5):
                 with sessions() as session:
-                    records.delete_run(session, ids.pop(0))
+                    runs.delete(session, ids.pop(0))
             assert _create_until_full(sessions, ids) >= 2, "new runs fit in the pages the deletes freed"
             reserves.append(reserve_file(engine).stat().st_size)
         assert RESERVE_BYTES / 2 < reserves[0] == reserves[1] == reserves[2] < RESERVE_BYTES
         with sessions() as session:  # reads never stopped
-            assert len(records.list_runs(session, records.RunFilter(), limit=500, cursor=None)[0]) == len(ids)
+            assert len(runs.list_runs(session, run_store.RunFilter(), limit=500, cursor=None)[0]) == len(ids)
         other.unlink()  # the operator frees space
         assert _create_until_full(sessions, ids, limit=20) == 20
         assert reserve_file(engine).stat().st_size == RESERVE_BYTES
@@ -216,10 +217,10 @@ def test_a_delete_on_a_full_disk_without_the_reserve_fails_clearly(tmp_path):
         ballast = fill(disk)
         assert _create_until_full(sessions, ids) == 0
         with pytest.raises(StorageFull, match="delete runs"), sessions() as session:
-            records.delete_run(session, ids[0])
+            runs.delete(session, ids[0])
         ballast.unlink()
         with sessions() as session:
-            records.delete_run(session, ids[0])
+            runs.delete(session, ids[0])
         engine.dispose()
 
 

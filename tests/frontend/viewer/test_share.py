@@ -20,7 +20,7 @@ import viser
 import zstandard
 
 from backend.schemas import LegIn, RunCreate, StateIn
-from backend.services import records
+from backend.services import runs as run_service
 from backend.services.simulation import pack_trajectory
 from backend.store.database import make_engine, migrate, session_factory, sqlite_url
 from backend.store.models import Run
@@ -44,8 +44,8 @@ def runs(tmp_path_factory):
     sessions = session_factory(engine)
     with sessions() as session:
         body = {"controls": CONTROLS, "start": START, "jumps": JUMPS}
-        stored = records.create_run(session, RunCreate(**body, trajectory_rate=60)).id
-        again = records.create_run(session, RunCreate(**body)).id
+        stored = run_service.create_run(session, RunCreate(**body, trajectory_rate=60)).id
+        again = run_service.create_run(session, RunCreate(**body)).id
     path = load_recording(sessions, stored)
     t = np.arange(0.0, path.duration, 1 / 120)
     body = path.clip.sampled_at(t)

@@ -193,10 +193,10 @@ def test_a_continuous_parameter_aggregates_in_bins(client, auth):
 
 
 def test_more_distinct_values_than_groups_allowed_ask_for_bins(client, auth, monkeypatch):
-    from backend.services import records
+    from backend.services import runs
 
     _seed_runs(client, auth)
-    monkeypatch.setattr(records, "MAX_GROUPS", 1)
+    monkeypatch.setattr(runs, "MAX_GROUPS", 1)
     response = client.get("/api/v1/runs/aggregate", params={"by": "zeta0"})
     assert response.status_code == 422 and "ask for bins" in response.text
     assert client.get("/api/v1/runs/aggregate", params={"by": "zeta0", "bins": 1}).json()["groups"][0]["runs"] == 3

@@ -1,13 +1,15 @@
-"""The records service called directly: experiments and runs, filters, pages, export and comparison."""
+"""The runs service called directly: store, read, edit, delete, filters, pages, comparison, groups."""
 
 import math
 
 import pytest
 
-from backend.schemas import ExperimentCreate, ExperimentUpdate, MJTFJobCreate
-from backend.services import records
-from backend.services.jobs import create_job
-from backend.services.records import Conflict, NotFound, RunFilter
+from backend.errors import NotFound
+from backend.repositories import runs as run_store
+from backend.repositories.common import locked
+from backend.repositories.runs import RunFilter
+from backend.services import runs
+from backend.store.models import Run
 from sim_core import ControlSchedule, iterate_map
 from tests.backend.services.bodies import START
 
@@ -29,44 +31,6 @@ def _all_pages(fetch, limit: int) -> list[list[int]]:
             return pages
 
 
-def test_experiment_lifecycle(session):
-    experiment = records.create_experiment(session, ExperimentCreate(name="gaits", tags=["paper"]))
-    assert records.get_experiment(session, experiment.id).name == "gaits"
-    assert records.run_count(session, experiment.id) == 0
-    updated = records.update_experiment(session, experiment.id, ExperimentUpdate(notes="period 2 next"))
-    assert (updated.name, updated.notes, updated.tags) == ("gaits", "period 2 next", ["paper"]), "unset fields stay"
-    records.delete_experiment(session, experiment.id)
-    with pytest.raises(NotFound, match=f"experiment {experiment.id} does not exist"):
-        records.get_experiment(session, experiment.id)
-    with pytest.raises(NotFound):
-        records.update_experiment(session, experiment.id, ExperimentUpdate(name="again"))
-
-
-def test_an_experiment_with_runs_is_not_deleted(session, make_run):
-    experiment = records.create_experiment(session, ExperimentCreate(name="busy"))
-    run = make_run(experiment_id=experiment.id)
-    assert records.run_count(session, experiment.id) == 1
-    with pytest.raises(Conflict, match="still has runs"):
-        records.delete_experiment(session, experiment.id)
-    records.delete_run(session, run.id)
-    records.delete_experiment(session, experiment.id)
-
-
-def test_an_experiment_with_jobs_is_not_deleted(session):
-    """Its jobs are its record (the foreign key restricts; it used to surface as an IntegrityError)."""
-    experiment = records.create_experiment(session, ExperimentCreate(name="studies"))
-    create_job(session, MJTFJobCreate(experiment_id=experiment.id, zeta0s=[0.9], trials=2))
-    with pytest.raises(Conflict, match="has jobs"):
-        records.delete_experiment(session, experiment.id)
-    assert records.get_experiment(session, experiment.id).name == "studies"
-
-
-def test_experiments_page_newest_first(session):
-    made = [records.create_experiment(session, ExperimentCreate(name=f"e{i}")).id for i in range(5)]
-    pages = _all_pages(lambda **page: records.list_experiments(session, **page), limit=2)
-    assert pages == [made[:2:-1], made[2:0:-1], made[:1]]
-
-
 def test_a_run_stores_what_the_map_computes(session, make_run, paper):
     run = make_run(zeta0=0.9, tags=["b", "a", "b"])
     orbit = iterate_map(paper, ControlSchedule.from_degrees([(30.0, 0.9)]), (START.xdot, START.ydot), 4)
@@ -76,7 +40,7 @@ def test_a_run_stores_what_the_map_computes(session, make_run, paper):
     assert run.tags == ["a", "b"], "tags are a sorted set"
     assert (run.controls, run.start_state, run.zeta0, run.psi0_deg) == ([[30.0, 0.9]], [-0.93, -0.17], 0.9, 30.0)
     assert run.trajectory is None and run.notes == ""
-    assert records.get_run(session, run.id).climb == run.climb
+    assert runs.get(session, run.id).climb == run.climb
 
 
 def test_a_physical_failure_is_a_done_run_with_its_code(make_run):
@@ -87,19 +51,19 @@ def test_a_physical_failure_is_a_done_run_with_its_code(make_run):
 def test_a_run_in_a_missing_experiment_is_not_stored(session, make_run):
     with pytest.raises(NotFound, match="experiment 999"):
         make_run(experiment_id=999)
-    assert records.list_runs(session, RunFilter(), limit=10, cursor=None) == ([], None)
+    assert runs.list_runs(session, RunFilter(), limit=10, cursor=None) == ([], None)
 
 
 def test_update_and_delete_a_run(session, make_run):
     run = make_run(tags=["first"])
-    records.update_run(session, run.id, notes="left foot slipped")
+    runs.update(session, run.id, notes="left foot slipped")
     assert (run.tags, run.notes) == (["first"], "left foot slipped"), "tags left out stay"
-    records.update_run(session, run.id, tags=["keep", "best", "keep"])
+    runs.update(session, run.id, tags=["keep", "best", "keep"])
     assert (run.tags, run.notes) == (["best", "keep"], "left foot slipped"), "notes left out stay"
-    records.update_run(session, run.id, tags=[])
+    runs.update(session, run.id, tags=[])
     assert run.tags == []
-    records.delete_run(session, run.id)
-    for call in (records.get_run, records.delete_run, records.update_run):
+    runs.delete(session, run.id)
+    for call in (runs.get, runs.delete, runs.update):
         with pytest.raises(NotFound, match=f"run {run.id}"):
             call(session, run.id)
 
@@ -110,13 +74,13 @@ def test_an_edit_replaces_the_stored_tags_not_the_ones_its_session_read(sessions
     used to insert a tag still there (UNIQUE failed) or leave the other edit's tags in place."""
     run = make_run(tags=["a", "b"])
     with sessions() as first, sessions() as second:
-        stale = records.get_run(first, run.id)  # held: the session keeps its copy
+        stale = run_store.get_run(first, run.id)  # held: the session keeps its copy
         assert stale.tags == ["a", "b"]
-        records.update_run(second, run.id, tags=["c", "d"], notes="second")
-        assert records.update_run(first, run.id, tags=["a", "c"]) is stale
+        runs.update(second, run.id, tags=["c", "d"], notes="second")
+        assert runs.update(first, run.id, tags=["a", "c"]).tags == ["a", "c"]
         assert (stale.tags, stale.notes) == (["a", "c"], "second")
     with sessions() as fresh:
-        stored = records.get_run(fresh, run.id)
+        stored = run_store.get_run(fresh, run.id)
         assert (stored.tags, stored.notes) == (["a", "c"], "second")
 
 
@@ -128,14 +92,14 @@ def test_an_edit_waits_for_the_write_lock_and_reads_after_it(sessions, make_run)
     run = make_run(tags=["a"])
     outcome = []
     with sessions() as holder:
-        records.locked(holder, records.Run, run.id, "run")
-        holder.delete(holder.get(records.Run, run.id))
+        locked(holder, Run, run.id, "run")
+        holder.delete(holder.get(Run, run.id))
         holder.flush()
 
         def edit():
             with sessions() as editor:
                 try:
-                    records.update_run(editor, run.id, tags=["b"])
+                    runs.update(editor, run.id, tags=["b"])
                     outcome.append("updated")
                 except NotFound:
                     outcome.append("not found")
@@ -162,66 +126,68 @@ def test_an_edit_waits_for_the_write_lock_and_reads_after_it(sessions, make_run)
     ],
 )
 def test_filters_select_runs(session, stored_runs, where, expected):
-    _, runs = stored_runs
-    rows, cursor = records.list_runs(session, where, limit=50, cursor=None)
-    assert sorted(_ids(rows)) == sorted(runs[key].id for key in expected) and cursor is None
+    _, stored = stored_runs
+    rows, cursor = runs.list_runs(session, where, limit=50, cursor=None)
+    assert sorted(_ids(rows)) == sorted(stored[key].id for key in expected) and cursor is None
 
 
 def test_filter_by_experiment_and_creation_time(session, stored_runs):
-    experiment, runs = stored_runs
-    rows, _ = records.list_runs(session, RunFilter(experiment_id=experiment.id), limit=50, cursor=None)
-    assert _ids(rows) == [runs[0.9].id]
-    after = runs[0.92].created_at
-    rows, _ = records.list_runs(session, RunFilter(created_after=after), limit=50, cursor=None)
-    assert set(_ids(rows)) >= {runs[0.92].id, runs[0.94].id, runs["slip"].id} and runs[0.86].id not in _ids(rows)
-    rows, _ = records.list_runs(session, RunFilter(created_before=after), limit=50, cursor=None)
-    assert runs[0.92].id not in _ids(rows), "created_before is exclusive"
+    experiment, stored = stored_runs
+    rows, _ = runs.list_runs(session, RunFilter(experiment_id=experiment.id), limit=50, cursor=None)
+    assert _ids(rows) == [stored[0.9].id]
+    after = stored[0.92].created_at
+    rows, _ = runs.list_runs(session, RunFilter(created_after=after), limit=50, cursor=None)
+    assert set(_ids(rows)) >= {stored[0.92].id, stored[0.94].id, stored["slip"].id} and stored[0.86].id not in _ids(
+        rows
+    )
+    rows, _ = runs.list_runs(session, RunFilter(created_before=after), limit=50, cursor=None)
+    assert stored[0.92].id not in _ids(rows), "created_before is exclusive"
 
 
 def test_keyset_pages_cover_every_run_once(session, stored_runs):
-    _, runs = stored_runs
-    newest_first = sorted((run.id for run in runs.values()), reverse=True)
-    pages = _all_pages(lambda **page: records.list_runs(session, RunFilter(), **page), limit=4)
+    _, stored = stored_runs
+    newest_first = sorted((run.id for run in stored.values()), reverse=True)
+    pages = _all_pages(lambda **page: runs.list_runs(session, RunFilter(), **page), limit=4)
     assert pages == [newest_first[:4], newest_first[4:]]
-    ascending = _all_pages(lambda **page: records.list_runs(session, RunFilter(), sort="id", **page), limit=4)
+    ascending = _all_pages(lambda **page: runs.list_runs(session, RunFilter(), sort="id", **page), limit=4)
     assert ascending == [newest_first[::-1][:4], newest_first[::-1][4:]]
 
 
 def test_other_orders_page_by_offset(session, stored_runs):
-    first, next_offset = records.list_runs(session, RunFilter(), limit=4, cursor=None, sort="-climb")
+    first, next_offset = runs.list_runs(session, RunFilter(), limit=4, cursor=None, sort="-climb")
     climbs = [run["climb"] for run in first]
     assert climbs == sorted(climbs, reverse=True) and next_offset == 4
-    rest, end = records.list_runs(session, RunFilter(), limit=4, cursor=None, sort="-climb", offset=next_offset)
+    rest, end = runs.list_runs(session, RunFilter(), limit=4, cursor=None, sort="-climb", offset=next_offset)
     assert len(rest) == 2 and end is None and max(run["climb"] for run in rest) <= climbs[-1]
-    by_zeta0, _ = records.list_runs(session, RunFilter(psi0_max=45.0), limit=10, cursor=None, sort="zeta0")
+    by_zeta0, _ = runs.list_runs(session, RunFilter(psi0_max=45.0), limit=10, cursor=None, sort="zeta0")
     assert [run["controls"][0][1] for run in by_zeta0] == [0.86, 0.88, 0.9, 0.92, 0.94]
 
 
 def test_compare_lines_runs_up_and_can_show_only_differences(session, stored_runs):
-    _, runs = stored_runs
-    ids = [runs[0.88].id, runs[0.9].id]
-    everything = records.compare_runs(session, ids, only_differences=False)
+    _, stored = stored_runs
+    ids = [stored[0.88].id, stored[0.9].id]
+    everything = runs.compare(session, ids, only_differences=False).model_dump()
     assert [run["id"] for run in everything["runs"]] == ids and "model.alpha" in everything["fields"]
     assert {"id", "leg0.zeta0", "climb", "tags", "experiment_id"} <= set(everything["differing"])
     assert "model.alpha" not in everything["differing"] and "jumps" not in everything["differing"]
-    only = records.compare_runs(session, ids, only_differences=True)
+    only = runs.compare(session, ids, only_differences=True).model_dump()
     assert only["fields"][0] == "id" and set(only["fields"]) == set(everything["differing"])
     assert all(set(run) == set(only["fields"]) for run in only["runs"])
     with pytest.raises(NotFound):
-        records.compare_runs(session, [runs[0.9].id, 999], only_differences=True)
+        runs.compare(session, [stored[0.9].id, 999], only_differences=True)
 
 
 def test_aggregate_groups_by_a_column_and_by_tag(session, stored_runs):
-    _, runs = stored_runs
-    groups = records.aggregate_runs(session, RunFilter(), "failure_code")
+    _, stored = stored_runs
+    groups = runs.aggregate(session, RunFilter(), "failure_code").model_dump()["groups"]
     by_key = {group["key"]: group for group in groups}
     assert {key: group["runs"] for key, group in by_key.items()} == {None: 5, "slip": 1}
-    climbs = [runs[z].climb for z in (0.86, 0.88, 0.9, 0.92, 0.94)]
+    climbs = [stored[z].climb for z in (0.86, 0.88, 0.9, 0.92, 0.94)]
     mean = sum(climbs) / 5
     climbed = by_key[None]["climb"]
     assert climbed["mean"] == pytest.approx(mean, rel=1e-12)
     assert climbed["std"] == pytest.approx(math.sqrt(sum((c - mean) ** 2 for c in climbs) / 5), rel=1e-6)
     assert (climbed["min"], climbed["max"]) == (min(climbs), max(climbs))
     assert by_key["slip"]["jumps_completed"] == {"mean": 0.0, "std": 0.0, "min": 0, "max": 0}
-    tagged = records.aggregate_runs(session, RunFilter(psi0_max=45.0), "tag")
+    tagged = runs.aggregate(session, RunFilter(psi0_max=45.0), "tag").model_dump()["groups"]
     assert [(group["key"], group["runs"]) for group in tagged] == [("middle", 1)]

@@ -1,4 +1,4 @@
-"""The runs repository's pages (backend/store/runs.py), on SQLite and PostgreSQL, against a plain
+"""The runs repository's pages (backend/repositories/runs.py), on SQLite and PostgreSQL, against a plain
 Python reference: every filter and sort, walked page by page, gives the same runs in the same order
 with the same tags."""
 
@@ -8,9 +8,9 @@ import random
 import pytest
 from sqlalchemy import insert
 
+from backend.repositories.runs import SORTS, RunFilter, listed_page
 from backend.store.database import make_engine, migrate, session_factory, sqlite_url
 from backend.store.models import Run, RunTag
-from backend.store.runs import SORTS, RunFilter, listed_page
 
 TAGS = ["fig8", "fig11", "robot-a", "pid", "zeta:0.9", "a/b", "größe"]  # what a Label allows
 FILTERS = {

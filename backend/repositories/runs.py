@@ -1,4 +1,5 @@
-"""Runs in the database: the one place a run's row is built, and the SQL that reads runs back.
+"""Runs in the store: the one place a run's row is built, and the SQL that reads, relabels, groups
+and exports runs.
 
 A new run is a :class:`RunRecord` (what a simulation, a live robot run or a replay produced);
 :func:`add_run` turns it into the row, with the indexed copies of its parameters (alpha, the first
@@ -14,9 +15,11 @@ import functools
 import json
 from dataclasses import asdict, dataclass
 
-from sqlalchemy import Integer, Select, Text, bindparam, cast, func, select
+from sqlalchemy import Float, Integer, Select, Text, bindparam, case, cast, func, select
 from sqlalchemy.orm import Session
+from sqlalchemy.orm.attributes import set_committed_value
 
+from backend.repositories.common import fetch, locked
 from backend.store.models import Run, RunTag
 from backend.store.run_record import RunRecord
 
@@ -33,6 +36,11 @@ TAG_SEPARATOR = "\x1f"
 _TAG_LIST = (
     select(func.aggregate_strings(RunTag.tag, TAG_SEPARATOR)).where(RunTag.run_id == Run.id).scalar_subquery()
 ).label("tag_list")
+# What an export reads of each run: the record's own columns, then its JSON columns as text.
+JSON_COLUMNS = ("model", "controls", "start_state")
+EXPORTED = (Run.id, Run.experiment_id, Run.kind, Run.status, Run.created_at, Run.duration_s, Run.code_version,
+            Run.notes, Run.jumps, Run.jumps_completed, Run.failure_code, Run.climb,
+            *(cast(getattr(Run, name), Text).label(name) for name in JSON_COLUMNS))  # fmt: skip
 SORTS = ("-id", "id", "-created_at", "created_at", "-climb", "climb", "-zeta0", "zeta0", "-duration_s", "duration_s")
 EXPORT_BATCH = 1000
 
@@ -47,6 +55,41 @@ def add_run(session: Session, record: RunRecord, *, experiment_id: int | None = 
     run.run_tags = [RunTag(tag=tag) for tag in sorted(set(tags))]
     session.add(run)
     return run
+
+
+def get_run(session: Session, run_id: int) -> Run:
+    return fetch(session, Run, run_id, "run")
+
+
+def find(session: Session, run_id: int | None) -> Run | None:
+    """The run, or None if there is none with that id."""
+    return None if run_id is None else session.get(Run, run_id)
+
+
+def locked_run(session: Session, run_id: int) -> Run:
+    """The run, read fresh under the write lock for a change (:func:`~backend.repositories.common.locked`)."""
+    return locked(session, Run, run_id, "run")
+
+
+def stored_has_trajectory(run: Run, has_trajectory: bool) -> None:
+    """Set the flushed ``run``'s ``has_trajectory`` (an SQL expression the flush expired) to what is
+    known of it: it saves a SELECT of the row just written (a tenth of POST /runs's CPU)."""
+    set_committed_value(run, "has_trajectory", has_trajectory)
+
+
+def relabel(run: Run, tags: list[str]) -> None:
+    """Replace a locked run's tags with ``tags``: the ones kept stay rows, the rest are deleted (orphans)."""
+    wanted = set(tags)
+    kept = [row for row in run.run_tags if row.tag in wanted]
+    run.run_tags = kept + [RunTag(tag=tag) for tag in sorted(wanted - {row.tag for row in kept})]
+
+
+def flushed(session: Session, run: Run) -> None:
+    """Flush a change of ``run`` and read back its ``has_trajectory`` (an SQL expression the flush
+    expired) inside the transaction: after the commit a concurrent delete may have removed the row
+    it would be read from."""
+    session.flush()
+    session.refresh(run, ["has_trajectory"])
 
 
 @dataclass(frozen=True)
@@ -144,6 +187,46 @@ def _page_statement(sort: str, criteria: tuple[str, ...], keyset: bool) -> Selec
     elif name != "id":
         ids = ids.offset(bindparam("page_offset", type_=Integer))
     return select(*LISTED, _TAG_LIST).where(Run.id.in_(ids)).order_by(*order)
+
+
+def value_range(session: Session, where: RunFilter, by: str) -> tuple:
+    """The smallest and largest of column ``by`` over the matching runs ((None, None) when none match)."""
+    column = getattr(Run, by)
+    return tuple(session.execute(filtered(select(func.min(column), func.max(column)), where)).one())
+
+
+def group_stats(session: Session, where: RunFilter, by: str, bins: tuple[float, float, float, int] | None = None):
+    """The matching runs grouped by ``by`` (a column, or ``tag``): each group's ``key``, ``runs``,
+    and for climb and jumps completed ``<name>_mean``, ``_mean_square``, ``_min`` and ``_max``,
+    all as floats (PostgreSQL averages integers as numeric). ``bins`` = (low, high, width, count):
+    groups are then equal bins and ``key`` the bin's index (the last bin includes ``high``)."""
+    column = RunTag.tag if by == "tag" else getattr(Run, by)
+    key = column
+    if bins is not None:
+        low, high, width, count = bins
+        key = case((column >= high, count - 1), else_=cast((column - low) / width, Integer))
+    return session.execute(_grouped(by, column, key, where)).mappings().all()
+
+
+def group_count(session: Session, where: RunFilter, by: str) -> int:
+    """How many distinct values of ``by`` the matching runs have (the groups :func:`group_stats` makes)."""
+    column = RunTag.tag if by == "tag" else getattr(Run, by)
+    return session.scalar(select(func.count()).select_from(_grouped(by, column, column, where).subquery()))
+
+
+def _grouped(by: str, column, key, where: RunFilter) -> Select:
+    columns = [key.label("key"), func.count(Run.id).label("runs")]
+    for name in ("climb", "jumps_completed"):
+        value = getattr(Run, name)
+        columns += [
+            cast(func.avg(value), Float).label(f"{name}_mean"),
+            cast(func.avg(value * value), Float).label(f"{name}_mean_square"),
+            cast(func.min(value), Float).label(f"{name}_min"),
+            cast(func.max(value), Float).label(f"{name}_max"),
+        ]
+    query = select(*columns)
+    query = query.join(RunTag, RunTag.run_id == Run.id) if by == "tag" else query.select_from(Run)
+    return filtered(query, where).group_by(key).order_by(key)
 
 
 def decode_json_texts(rows: list[list[str]]) -> list[list]:
