@@ -24,7 +24,7 @@ from backend.api.deps import Database
 from backend.api.routes import calibrations, experiments, jobs, robot, runs, sim, site, view
 from backend.api.security import api_token
 from backend.services import exports, simulation
-from backend.services import runs as records  # the read workers list runs with its list_runs
+from backend.services import runs as run_service
 from backend.services.job_runner import JobRunner
 from backend.services.robot import RobotService
 from backend.services.view import ViewContext, ViewFactory, ViewStarter
@@ -45,9 +45,9 @@ ROUTERS = (site, experiments, runs, calibrations, jobs, robot, view, sim)
 # that would (a simulation, a job's compute) awaits a worker instead.
 REQUEST_THREADS = 4
 LATCH_FILE = "estop-latch.json"  # in the data directory: a held e-stop survives a restart
-# What the read workers run: the records and exports services' functions (the workers import no service).
+# What the read workers run: the run and export services' functions (the workers import no service).
 RUN_READS = RunReads(
-    list_runs=records.list_runs,
+    list_runs=run_service.list_runs,
     plan_export=exports.plan_export,
     export_part=exports.export_part,
     export_head=exports.export_head,

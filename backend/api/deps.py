@@ -21,7 +21,7 @@ from backend import schemas
 from backend.api.security import require_token
 from backend.repositories.runs import RunFilter
 from backend.services import calibrations
-from backend.services import job_runner as jobs
+from backend.services.job_runner import JobRunner
 from backend.services.robot import RobotService
 from backend.store.database import StorageFull, after_storage_full
 from backend.workers.pools import ComputePool
@@ -108,7 +108,7 @@ async def store_reads(request: Request) -> StoreReads:
     return request.app.state.reads
 
 
-async def job_runner(request: Request) -> jobs.JobRunner | None:
+async def job_runner(request: Request) -> JobRunner | None:
     """The service's job runner, or None when it runs no jobs (``create_app(run_jobs=False)``)."""
     return request.app.state.runner
 
@@ -135,7 +135,7 @@ async def scene_view(request: Request):
 Db = Annotated[Database, Depends(database)]
 RunQuery = Annotated[RunFilter, Depends(run_filter)]
 Robot = Annotated[RobotService, Depends(robot_service)]
-Runner = Annotated[jobs.JobRunner | None, Depends(job_runner)]
+Runner = Annotated[JobRunner | None, Depends(job_runner)]
 QuickCompute = Annotated[ComputePool, Depends(quick_compute)]
 Reads = Annotated[StoreReads, Depends(store_reads)]
 SceneView = Annotated[object, Depends(scene_view)]  # frontend.viewer's view (the backend does not import it)

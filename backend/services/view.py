@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 
 from backend.errors import Conflict
-from backend.repositories import runs as records
+from backend.repositories import runs as run_rows
 from backend.robot.messages import Leg
 from backend.services.robot import RobotService
 from backend.services.simulation import unpack_trajectory
@@ -96,10 +96,10 @@ def stored_path(sessions: Callable, run_id: int) -> StoredPath:
     """Stored run ``run_id`` as the view replays it. Raises NotFound when there is no such run,
     Conflict when a robot or replay run has no tracker frames."""
     with sessions() as session:
-        run = records.get_run(session, run_id)
+        run = run_rows.get_run(session, run_id)
         source = run
         if run.kind == "replay":
-            source = records.get_run(session, int(run.results.get("source_run_id", 0)) or run_id)
+            source = run_rows.get_run(session, int(run.results.get("source_run_id", 0)) or run_id)
         if run.kind != "sim" and source.trajectory is None:
             raise Conflict(f"run {run_id} has no tracker frames to replay")
         path = None if source.trajectory is None else unpack_trajectory(source.trajectory)
@@ -114,10 +114,10 @@ def stored_path_key(sessions: Callable, run_id: int) -> tuple:
     frames when it ends: each run read is keyed by id, creation time, status and a checksum of
     its stored path. Raises NotFound as stored_path does."""
     with sessions() as session:
-        run = records.get_run(session, run_id)
+        run = run_rows.get_run(session, run_id)
         read = [run]
         if run.kind == "replay":
-            read.append(records.get_run(session, int(run.results.get("source_run_id", 0)) or run_id))
+            read.append(run_rows.get_run(session, int(run.results.get("source_run_id", 0)) or run_id))
         return tuple(
             (r.id, r.created_at, r.status, None if r.trajectory is None else zlib.crc32(r.trajectory)) for r in read
         )

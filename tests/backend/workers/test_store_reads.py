@@ -6,10 +6,11 @@ import functools
 import json
 
 from backend.api.app import RUN_READS
+from backend.repositories import runs as store_runs
+from backend.repositories.runs import RunFilter
 from backend.schemas import RunPage
-from backend.services import exports, records
-from backend.services.records import RunFilter
-from backend.store import runs as store_runs
+from backend.services import exports
+from backend.services import runs as records
 from backend.store.database import make_engine, migrate, sqlite_url
 from backend.workers import store_reads
 from backend.workers.pools import ComputePool
@@ -80,7 +81,7 @@ def test_an_export_read_in_workers_is_the_export_read_here(tmp_path, sessions, m
 
 
 # Run in a worker as eval(LOADED): a builtin, so the worker imports no test module (which would load the services).
-LOADED = "sorted(m for m in ('backend.services.exports', 'backend.services.records') if m in __import__('sys').modules)"
+LOADED = "sorted(m for m in ('backend.services.exports', 'backend.services.runs') if m in __import__('sys').modules)"
 
 
 def test_a_read_worker_warms_up_by_receiving_the_read_functions():
@@ -89,7 +90,7 @@ def test_a_read_worker_warms_up_by_receiving_the_read_functions():
     plain = ComputePool("reads-plain", niceness=0)
     try:
         warmed.warm()
-        assert warmed.run(eval, LOADED, timeout=60.0) == ["backend.services.exports", "backend.services.records"]
+        assert warmed.run(eval, LOADED, timeout=60.0) == ["backend.services.exports", "backend.services.runs"]
         plain.warm()
         assert plain.run(eval, LOADED, timeout=60.0) == [], "a worker without the warm-up has not loaded them"
     finally:
