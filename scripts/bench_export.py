@@ -16,9 +16,9 @@ from pathlib import Path
 
 from bench_store import seed  # scripts/ is on the path when this script runs
 
+from backend.repositories.runs import RunFilter
 from backend.services import exports
 from backend.store.database import make_engine, session_factory
-from backend.repositories.runs import RunFilter
 
 
 def main() -> None:
