@@ -4,16 +4,7 @@ import pytest
 
 from backend.errors import Conflict, NotFound
 from backend.repositories import calibrations as stored
-from backend.store.database import make_engine, migrate, session_factory, sqlite_url
 from backend.store.models import ModelPreset
-
-
-@pytest.fixture
-def sessions(tmp_path):
-    engine = make_engine(sqlite_url(tmp_path))
-    migrate(engine)
-    yield session_factory(engine)
-    engine.dispose()
 
 
 def _preset(name: str) -> ModelPreset:

@@ -6,17 +6,7 @@ import pytest
 from backend.errors import NotFound
 from backend.repositories import jobs as stored_jobs
 from backend.schemas import JobState
-from backend.store.database import make_engine, migrate, session_factory, sqlite_url
 from backend.store.models import Experiment, Job, Trial
-
-
-@pytest.fixture
-def session(tmp_path):
-    engine = make_engine(sqlite_url(tmp_path))
-    migrate(engine)
-    with session_factory(engine)() as session:
-        yield session
-    engine.dispose()
 
 
 def _job(session, state: JobState = JobState.QUEUED, **fields) -> Job:

@@ -1,19 +1,7 @@
 """Robot runs' journal SQL (backend/repositories/robot_runs.py) on a migrated SQLite file."""
 
-import pytest
-
 from backend.repositories import robot_runs
-from backend.store.database import make_engine, migrate, session_factory, sqlite_url
 from backend.store.models import Run
-
-
-@pytest.fixture
-def session(tmp_path):
-    engine = make_engine(sqlite_url(tmp_path))
-    migrate(engine)
-    with session_factory(engine)() as session:
-        yield session
-    engine.dispose()
 
 
 def _run(session, kind: str, status: str) -> int:

@@ -5,24 +5,8 @@ import pytest
 from backend.repositories import runs as run_store
 from backend.schemas import ExperimentCreate
 from backend.services import experiments, runs
-from backend.store.database import make_engine, migrate, session_factory, sqlite_url
 from backend.store.models import Run
 from tests.backend.services.bodies import run_body
-
-
-@pytest.fixture
-def sessions(tmp_path):
-    """The session factory the service hands its parts (``sessionmaker``, expire_on_commit off)."""
-    engine = make_engine(sqlite_url(tmp_path))
-    migrate(engine)
-    yield session_factory(engine)
-    engine.dispose()
-
-
-@pytest.fixture
-def session(sessions):
-    with sessions() as session:
-        yield session
 
 
 @pytest.fixture
