@@ -101,7 +101,7 @@ def export_part(session: Session, where: RunFilter, plan: ExportPlan, part: int)
     """Part ``part`` of the export as text: CSV rows, or JSON records without the array's brackets
     and commas around them (:func:`joined` puts them in). The parts depend on nothing but the
     plan, so they can be read anywhere, in any order, a short transaction each
-    (services/store_reads.py: in the read workers, two at a time)."""
+    (backend/workers/store_reads.py: in the read workers, two at a time)."""
     after_id = plan.ends[part - 1] if part else 0
     batch, tags = exported_batch(session, where, EXPORTED, after_id, plan.ends[part])
     decoded = decode_json_texts([[getattr(row, name) for name in JSON_COLUMNS] for row in batch])

@@ -226,7 +226,7 @@ def lock_for_write(session: Session) -> None:
 
     SQLite: ``BEGIN IMMEDIATE`` (waiting up to the busy timeout; a transaction that has already
     written holds the lock). Other databases lock the rows the change reads instead: load them with
-    ``with_for_update`` (``SELECT … FOR UPDATE``), as :func:`backend.services.records.locked` does."""
+    ``with_for_update`` (``SELECT … FOR UPDATE``), as :func:`backend.repositories.common.locked` does."""
     connection = session.connection()
     if connection.dialect.name == "sqlite" and not connection.connection.dbapi_connection.in_transaction:
         connection.exec_driver_sql("BEGIN IMMEDIATE")

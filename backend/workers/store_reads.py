@@ -45,7 +45,7 @@ class RunReads:
 
     Attributes:
         list_runs: ``(session, where, *, limit, cursor, sort, offset) -> (rows, next_cursor)``, a page
-            of runs (``backend.services.records.list_runs``); run in a worker.
+            of runs (``backend.services.runs.list_runs``); run in a worker.
         plan_export: ``(session, where, format_) -> plan``; run in a worker.
         export_part: ``(session, where, plan, part) -> str``, one part's text; run in a worker.
         export_head, export_tail: ``(plan) -> str``, the text before and after the parts; run here.
@@ -75,7 +75,7 @@ class StoreReads:
 
     async def runs_page(self, where, *, limit: int, cursor: int | None, sort: str, offset: int) -> bytes:
         """A page of the runs ``where`` (a ``RunFilter``) selects as the API's ``RunPage`` JSON (see
-        :func:`backend.services.records.list_runs` for the sort, cursor and offset)."""
+        :func:`backend.services.runs.list_runs` for the sort, cursor and offset)."""
         return await self._read(runs_page_json, self.reads.list_runs, where, limit, cursor, sort, offset)
 
     async def export_plan(self, where, format_: str):
