@@ -34,7 +34,6 @@ import argparse
 import json
 import socket
 import statistics
-import subprocess
 import tempfile
 import time
 from pathlib import Path
@@ -51,6 +50,7 @@ from tests.helpers import (
     start_robot_sim,
     start_service,
     stop_map_load,
+    stop_processes,
 )
 from tests.robot_rig import PtyRobot
 
@@ -178,12 +178,7 @@ def measure(repeats: int, clients: int) -> dict:
                 rig.stop()
         finally:
             bench.client.close()
-            for process in (robot, service):
-                process.terminate()
-                try:
-                    process.wait(30)
-                except subprocess.TimeoutExpired:
-                    process.kill()
+            stop_processes(robot, service)
     return result
 
 

@@ -28,7 +28,6 @@ import json
 import math
 import socket
 import statistics
-import subprocess
 import tempfile
 import threading
 import time
@@ -38,7 +37,7 @@ import httpx
 
 from backend.robot.messages import Command, Kind, decode
 from backend.robot.xbee import TX_REQUEST, FrameError, FrameParser, parse_tx_request
-from tests.helpers import free_port, start_map_load, start_robot_sim, start_service, stop_map_load
+from tests.helpers import free_port, start_map_load, start_robot_sim, start_service, stop_map_load, stop_processes
 
 TIMEOUT_S = 60.0  # [s] any one request: a bound, not a measurement
 PRESS_EVERY_S = 0.5  # [s] between e-stop presses within a phase
@@ -180,12 +179,7 @@ def measure(seconds: float, clients: list[int], presses: int, tree: Path | None)
         finally:
             client.close()
             tap.listener.close()
-            for process in (robot, service):
-                process.terminate()
-                try:
-                    process.wait(30)
-                except subprocess.TimeoutExpired:
-                    process.kill()
+            stop_processes(robot, service)
     return result
 
 

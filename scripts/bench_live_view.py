@@ -34,7 +34,7 @@ from pathlib import Path
 import httpx
 
 from tests.frontend.viewer.headless import HeadlessViewer
-from tests.helpers import free_port, start_robot_sim, start_service
+from tests.helpers import free_port, start_robot_sim, start_service, stop_processes
 
 CONTROLS = [{"psi0_deg": 30, "zeta0": 0.87}, {"psi0_deg": 30, "zeta0": 0.9}]  # a steady climb
 SETTLE_S = 2.0  # [s] after the browsers join, before the first run: their first scene is sent
@@ -157,9 +157,7 @@ def measure(
             for viewer in viewers:
                 viewer.close()
             api.close()
-            for process in (robot, service):
-                process.terminate()
-                process.wait(30)
+            stop_processes(robot, service)
 
 
 def main() -> None:

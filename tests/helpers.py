@@ -71,6 +71,17 @@ def start_robot_sim(port: int, tracker_port: int, *options: str) -> subprocess.P
     raise RuntimeError(f"parkour robot-sim did not listen on {port} within {SERVICE_START_TIMEOUT:g} s")
 
 
+def stop_processes(*processes: subprocess.Popen, timeout: float = 30.0) -> None:
+    """SIGTERM each, wait up to ``timeout`` [s] for it to end, and kill it if it has not."""
+    for process in processes:
+        process.terminate()
+        try:
+            process.wait(timeout)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()
+
+
 def answer_within(seconds: float, call, *args):
     """``call(*args)``'s result, or a test failure if it has not returned after ``seconds`` — so a
     call that regresses into a hang fails instead of hanging the suite (the thread is left behind)."""
