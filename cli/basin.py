@@ -19,7 +19,7 @@ from cli.options import (
     progress_bar,
     with_model,
 )
-from sim_core.basin_grid import DEFAULT_JUMPS, DEFAULT_TOLERANCE, BasinGrid
+from sim_core.basin_grid import DEFAULT_JUMPS, DEFAULT_TOLERANCE
 
 app = typer.Typer(rich_markup_mode=None)
 
@@ -51,29 +51,24 @@ def basin_command(
 ) -> None:
     """Basin of attraction of a gait over a grid of section states (xdot, ydot)."""
     from experiments.cluster import chunk_map_for, scheduler_address
-    from sim_core.basin import check_convergence_test, compute_basin
-    from sim_core.fixed_points import gait_of
+    from experiments.gait_basin import gait_basin
 
     schedule = parse_controls(controls)
-    period = period or len(schedule)
-    # The whole spec is checked before the (slow) gait search; placeholders stand in for default ranges.
-    BasinGrid(xdot_range or (-2.0, -1.0), ydot_range or (-1.0, 1.0), grid)
-    check_convergence_test(jumps, tolerance)
-    with chunk_map_for(scheduler_address(scheduler)) as chunk_map:
-        gait = gait_of(setup.model, schedule, period, guess)
-        default = BasinGrid.around(gait.state, grid)
-        cells = BasinGrid(xdot_range or default.xdot_range, ydot_range or default.ydot_range, grid)
-        with progress_bar(f"basin: {grid}x{grid} cells") as progress:
-            basin = compute_basin(
-                setup.model,
-                schedule,
-                gait,
-                cells,
-                max_jumps=jumps,
-                tolerance=tolerance,
-                chunk_map=chunk_map,
-                progress=progress,
-            )
+    with chunk_map_for(scheduler_address(scheduler)) as chunk_map, progress_bar(f"basin: {grid}x{grid} cells") as bar:
+        basin = gait_basin(
+            setup.model,
+            schedule,
+            period=period,
+            guess=guess,
+            grid=grid,
+            xdot_range=xdot_range,
+            ydot_range=ydot_range,
+            max_jumps=jumps,
+            tolerance=tolerance,
+            chunk_map=chunk_map,
+            progress=bar,
+        )
+    gait, cells = basin.gait, basin.grid
     if as_json:
         print_json(basin.to_dict(include_grids=not summary))
         return

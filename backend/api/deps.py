@@ -20,7 +20,6 @@ from sqlalchemy.orm import Session, sessionmaker
 from backend import schemas
 from backend.api.security import require_token
 from backend.repositories.runs import RunFilter
-from backend.services import calibrations
 from backend.services.job_runner import JobRunner
 from backend.services.robot import RobotService
 from backend.store.database import StorageFull, after_storage_full
@@ -147,10 +146,3 @@ OptionalRecordId = Annotated[int | None, Query(ge=1, le=schemas.MAX_ID)]
 PresetQuery = Annotated[
     str | None, Query(min_length=1, max_length=64, pattern=schemas.PRESET_PATTERN, description="a stored calibration")
 ]
-
-
-async def preset_resolved(request: Request, body):
-    """``body`` with a stored preset resolved (:func:`backend.services.calibrations.preset_resolved`,
-    over :func:`backend.services.models.resolve_model`): at once for a built-in one, in a request
-    thread when the store must be read."""
-    return await calibrations.preset_resolved(request.app.state.database, body)

@@ -5,15 +5,15 @@ section state and foot height, the controls commanded for it, the body's pitch f
 frames just after it), fits the model (:func:`sim_core.calibration.calibrate`) and stores the
 result as a :class:`~backend.store.models.ModelPreset` with its provenance: the runs, the date and
 the code version. A stored preset is used by name wherever a built-in one is
-(:func:`preset_params`): the CLI's ``--preset``, the API's ``model.preset``.
+(:func:`backend.services.models.resolve_model`): the CLI's ``--preset``, the API's ``model.preset``.
 """
 
 from __future__ import annotations
 
 import re
-from collections.abc import Awaitable, Callable
+from collections.abc import Callable
 from dataclasses import asdict
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from sqlalchemy.orm import Session
@@ -178,29 +178,6 @@ def preset_params(session: Session | None, name: str) -> tuple[PhysicalParams, L
     database; a :class:`ParameterError` naming the known presets if neither has it."""
     resolved = resolve_model(session, name)
     return resolved.robot, resolved.offsets
-
-
-def with_preset_resolved(session: Session, body):
-    """``body`` (a request with ``model``, a :class:`~backend.schemas.ModelIn`) with a stored preset
-    replaced by what it is (:func:`~backend.services.models.resolve_model`): its base preset and the
-    fitted ``alpha``, ``c_zeta``, ``c_psi`` where the request does not override them — numbers a job
-    keeps even if the preset is deleted later. A built-in preset passes through; an unknown name is
-    a :class:`ParameterError` naming ``model.preset``."""
-    model = body.model
-    if model.preset in PRESETS:
-        return body
-    resolved = resolve_model(session, model.preset, field="model.preset")
-    fields = {name: value for name, value in resolved.fitted.items() if getattr(model, name) is None}
-    return body.model_copy(update={"model": model.model_copy(update={"preset": resolved.preset, **fields})})
-
-
-async def preset_resolved(in_session: Callable[..., Awaitable[Any]], body):
-    """:func:`with_preset_resolved` for an ``async`` caller: at once for a built-in preset, else
-    through ``in_session`` (``await in_session(work, *args)`` runs ``work(session, *args)`` in a
-    request thread: the API's ``Database``)."""
-    if body.model.preset in PRESETS:
-        return body
-    return await in_session(with_preset_resolved, body)
 
 
 def _stored(fit: CalibrationFit, *, name: str, base: str, robot: PhysicalParams, run_ids: list[int]) -> ModelPreset:

@@ -16,8 +16,8 @@ from sqlalchemy.orm import Session
 from backend.repositories import jobs as stored_jobs
 from backend.repositories.common import locked
 from backend.schemas.jobs import JobOut, JobPage, JobResults, JobState, MJTFLevelOut
-from backend.services import calibrations
 from backend.services.job_specs import decode, encode, spec_of
+from backend.services.models import with_preset_resolved
 from backend.services.simulation import current_code_version
 from backend.store.models import Experiment, Job, utcnow
 from sim_core.mjtf_plan import CAPPED, jump_statistics, no_outcomes
@@ -33,7 +33,7 @@ def create_job(session: Session, body, runner: JobRunner | None = None) -> JobOu
     MJTF totals count trials, other kinds chunks. Its experiment is read under the write lock
     (``locked``), so a concurrent delete of it waits for this commit (and then refuses: the
     experiment has a job) or has removed it first (404)."""
-    body = calibrations.with_preset_resolved(session, body)
+    body = with_preset_resolved(session, body)
     if body.experiment_id is not None:
         locked(session, Experiment, body.experiment_id, "experiment")
     spec = spec_of(body)  # stored as its own versioned record: job_specs.py says why

@@ -1,7 +1,7 @@
 """Which model a request means: a preset's name — built in (:data:`sim_core.presets.PRESETS`) or a
 calibration stored by ``parkour calibrate`` — resolved to the robot it describes, in one place for
-the API (``deps.preset_resolved``, :func:`backend.services.calibrations.with_preset_resolved`), the
-jobs and the CLI (``cli.options.build_setup``).
+the API (:func:`preset_resolved` for runs and quick calls), the jobs (:func:`with_preset_resolved`:
+a job keeps the numbers), the 3D view and the CLI (``cli.options.build_setup``).
 
 Light: a built-in preset needs neither the store nor SQLAlchemy; the store's repository is loaded
 only for a name that is not built in, so a command with ``--preset paper`` starts at once.
@@ -9,8 +9,9 @@ only for a name that is not built in, so a command with ``--preset paper`` start
 
 from __future__ import annotations
 
+from collections.abc import Awaitable, Callable
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from sim_core.controls import NO_OFFSETS, LegOffsets
 from sim_core.errors import ParameterError
@@ -63,3 +64,31 @@ def resolve_model(session: Session | None, preset: str, *, field: str = "preset"
     )
     fitted_model = robot.to_model()
     return ResolvedModel(stored.base, robot, offsets, {name: getattr(fitted_model, name) for name in FITTED})
+
+
+def with_preset_resolved(session: Session, body):
+    """``body`` (a request with ``model``, a :class:`~backend.schemas.ModelIn`) with a stored preset
+    replaced by what it is (:func:`resolve_model`): its base preset and the
+    fitted ``alpha``, ``c_zeta``, ``c_psi`` where the request does not override them — numbers a job
+    keeps even if the preset is deleted later. A built-in preset passes through; an unknown name is
+    a :class:`ParameterError` naming ``model.preset``."""
+    model = body.model
+    if model.preset in PRESETS:
+        return body
+    resolved = resolve_model(session, model.preset, field="model.preset")
+    fields = {name: value for name, value in resolved.fitted.items() if getattr(model, name) is None}
+    return body.model_copy(update={"model": model.model_copy(update={"preset": resolved.preset, **fields})})
+
+
+# ``await in_session(work, *args)``: ``work(session, *args)`` in a request thread with a session of
+# its own (the API's ``Database``).
+InSession = Callable[..., Awaitable[Any]]
+
+
+async def preset_resolved(in_session: InSession, body):
+    """:func:`with_preset_resolved` for an ``async`` caller: at once for a built-in preset, else
+    through ``in_session`` (``await in_session(work, *args)`` runs ``work(session, *args)`` in a
+    request thread: the API's ``Database``)."""
+    if body.model.preset in PRESETS:
+        return body
+    return await in_session(with_preset_resolved, body)

@@ -17,8 +17,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-from collections.abc import Awaitable, Callable
-from typing import Any
 
 from sqlalchemy.orm import Session
 
@@ -27,8 +25,8 @@ from backend.repositories import experiments as stored_experiments
 from backend.repositories import runs as stored_runs
 from backend.repositories.runs import RunFilter
 from backend.schemas import RunAggregate, RunComparison, RunCreate, RunDetail, RunOut, RunTrajectory
-from backend.services.calibrations import preset_resolved
 from backend.services.exports import flat_record
+from backend.services.models import InSession, preset_resolved
 from backend.services.simulation import simulate_run, unpack_trajectory
 from backend.store.database import freeing_space
 from backend.store.models import Run
@@ -45,10 +43,6 @@ MAX_BINS = 1000
 SIMULATED_UNITS = {"time": "sqrt(l0/g)", "x": "l0", "y": "l0", "foot_x": "l0", "foot_y": "l0", "psi": "rad",
                    "zeta": "l0", "phase": "0 stance, 1 flight", "jump": "index"}  # fmt: skip
 RECORDED_UNITS = {"time": "s", "x": "m", "y": "m", "pitch": "rad"}
-
-# ``await in_session(work, *args)``: ``work(session, *args)`` in a request thread with a session of
-# its own (the API's ``Database``).
-InSession = Callable[..., Awaitable[Any]]
 
 
 async def create(in_session: InSession, compute, body: RunCreate) -> RunDetail:

@@ -14,13 +14,17 @@ import math
 import threading
 import time
 import zlib
-from dataclasses import asdict, replace
-from typing import TYPE_CHECKING
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import asdict
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from backend.schemas import FixedPointIn, LegIn, MapIn, ModelIn, RunCreate, TrajectoryIn
+from backend.services.models import InSession, preset_resolved, resolve_model
 from backend.store.run_record import RunRecord
+from backend.workers.pools import as_json
 from backend.workers.progress import report
 from experiments.manifest import code_version, json_safe
 from sim_core.basin_grid import DEFAULT_BASIN_WINDOW, BasinGrid
@@ -30,6 +34,7 @@ from sim_core.params import ModelParams
 from sim_core.presets import START_GUESS, get_preset
 
 if TYPE_CHECKING:
+    from backend.workers.pools import ComputePool
     from sim_core.fixed_points import FixedPoint
 
 _CODE_VERSION = None
@@ -48,10 +53,12 @@ def current_code_version() -> str:
 
 
 def model_params(body) -> ModelParams:
-    """A request's :class:`~backend.schemas.ModelIn` or a stored job's ModelSpec as the model."""
+    """A request's :class:`~backend.schemas.ModelIn` or a stored job's ModelSpec as the model: its
+    preset (:func:`~backend.services.models.resolve_model`; a stored one is resolved to its base
+    before it gets here) with the request's overrides."""
     fields = body.model_dump() if isinstance(body, ModelIn) else asdict(body)
-    overrides = {k: v for k, v in fields.items() if k != "preset" and v is not None}
-    return replace(get_preset(fields["preset"]).to_model(), **overrides)
+    overrides = {name: value for name, value in fields.items() if name != "preset"}
+    return resolve_model(None, fields["preset"], field="model.preset").model(**overrides)
 
 
 def schedule_of(controls: list[LegIn]) -> ControlSchedule:
@@ -70,6 +77,14 @@ def warm_up() -> None:
         simulate_trajectory(model, schedule, gait.state, 1)
 
 
+async def computed(in_session: InSession, compute: ComputePool, work: Callable[[Any], dict], body) -> bytes:
+    """A quick call's answer as JSON: ``body``'s stored preset resolved (through ``in_session`` only
+    when the store must be read), then ``work(body)`` in the quick compute worker, which encodes
+    the JSON too — the service's process computes nothing and waits in no thread."""
+    body = await preset_resolved(in_session, body)
+    return await compute.call(as_json, work, body)
+
+
 def map_orbit(body: MapIn) -> dict:
     from sim_core.poincare import iterate_map
 
@@ -84,7 +99,7 @@ def trajectory_columns(body: TrajectoryIn) -> dict:
     start = (body.start.xdot, body.start.ydot)
     model = model_params(body.model)
     path = simulate_trajectory(model, schedule_of(body.controls), start, body.jumps, sample_rate=body.rate)
-    scales = get_preset(body.model.preset).scales  # l0 and g are the preset's: they set the units
+    scales = resolve_model(None, body.model.preset).robot.scales  # l0 and g are the preset's: they set the units
     return json_safe(
         {
             "units": path.units,
@@ -109,13 +124,21 @@ def fixed_point(body: FixedPointIn) -> dict:
 
 
 def _gait_of(model: ModelParams, schedule: ControlSchedule, period: int | None, guess) -> FixedPoint:
-    """:func:`sim_core.fixed_points.gait_of` for a request; a search that finds nothing is a 422
-    naming the controls. ``guess`` is the request's state (``xdot``, ``ydot``) or None."""
-    from sim_core.errors import NoGaitFound
+    """:func:`sim_core.fixed_points.gait_of` for a request. ``guess`` is the request's state
+    (``xdot``, ``ydot``) or None."""
     from sim_core.fixed_points import gait_of
 
-    try:
+    with _no_gait_is_a_parameter_error():
         return gait_of(model, schedule, period, None if guess is None else (guess.xdot, guess.ydot))
+
+
+@contextmanager
+def _no_gait_is_a_parameter_error() -> Iterator[None]:
+    """A gait search that finds nothing is a 422 naming the controls (a guess may find one)."""
+    from sim_core.errors import NoGaitFound
+
+    try:
+        yield
     except NoGaitFound as error:
         message = f"no period-{error.period} gait found from a grid of guesses; give a guess"
         raise ParameterError("controls", message) from None
@@ -131,7 +154,6 @@ def run_study_here(spec) -> dict:
 
 def run_study(spec, chunk_map, progress) -> dict:
     """A sweep, basin or gait-search job's computation; returns its JSON result."""
-    from sim_core.basin import compute_basin
     from sim_core.fixed_points import search_gaits
     from sim_core.sweep import energy_sweep, zeta0_values
 
@@ -157,17 +179,21 @@ def run_study(spec, chunk_map, progress) -> dict:
         progress(1, 1)
         return {"gaits": [gait.to_dict() for gait in gaits]}
     # basin
-    gait = _gait_of(model, schedule, spec.period, spec.guess)
-    basin = compute_basin(
-        model,
-        schedule,
-        gait,
-        BasinGrid.around(gait.state, spec.grid),
-        max_jumps=spec.jumps,
-        tolerance=spec.tolerance,
-        chunk_map=chunk_map,
-        progress=progress,
-    )
+    from experiments.gait_basin import gait_basin
+
+    guess = None if spec.guess is None else (spec.guess.xdot, spec.guess.ydot)
+    with _no_gait_is_a_parameter_error():
+        basin = gait_basin(
+            model,
+            schedule,
+            period=spec.period,
+            guess=guess,
+            grid=spec.grid,
+            max_jumps=spec.jumps,
+            tolerance=spec.tolerance,
+            chunk_map=chunk_map,
+            progress=progress,
+        )
     return basin.to_dict()
 
 

@@ -7,34 +7,30 @@ worker even encodes the JSON, which the route forwards as it is (the response mo
 
 from __future__ import annotations
 
-from fastapi import APIRouter, Request
+from fastapi import APIRouter
 from fastapi.responses import Response
 
 from backend import schemas
-from backend.api.deps import QuickCompute, preset_resolved
+from backend.api.deps import Db, QuickCompute
 from backend.services import simulation
-from backend.workers.pools import as_json
 
 router = APIRouter(prefix="/api/v1/sim", tags=["simulate"])
 
 
 @router.post("/map", response_model=schemas.MapOut)
-async def sim_map(body: schemas.MapIn, request: Request, compute: QuickCompute) -> Response:
-    body = await preset_resolved(request, body)
-    return _json(await compute.call(as_json, simulation.map_orbit, body))
+async def sim_map(body: schemas.MapIn, database: Db, compute: QuickCompute) -> Response:
+    return _json(await simulation.computed(database, compute, simulation.map_orbit, body))
 
 
 @router.post("/trajectory", response_model=schemas.TrajectoryOut)
-async def sim_trajectory(body: schemas.TrajectoryIn, request: Request, compute: QuickCompute) -> Response:
+async def sim_trajectory(body: schemas.TrajectoryIn, database: Db, compute: QuickCompute) -> Response:
     """The sampled path in wall coordinates (nondimensional), for drawing; not stored."""
-    body = await preset_resolved(request, body)
-    return _json(await compute.call(as_json, simulation.trajectory_columns, body))
+    return _json(await simulation.computed(database, compute, simulation.trajectory_columns, body))
 
 
 @router.post("/fixed-point", response_model=schemas.FixedPointOut)
-async def sim_fixed_point(body: schemas.FixedPointIn, request: Request, compute: QuickCompute) -> Response:
-    body = await preset_resolved(request, body)
-    return _json(await compute.call(as_json, simulation.fixed_point, body))
+async def sim_fixed_point(body: schemas.FixedPointIn, database: Db, compute: QuickCompute) -> Response:
+    return _json(await simulation.computed(database, compute, simulation.fixed_point, body))
 
 
 def _json(encoded: bytes) -> Response:
