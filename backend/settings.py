@@ -47,9 +47,11 @@ class Settings:
         """``allowed_hosts``: names to answer to beside the loopback's and ``$PARKOUR_ALLOWED_HOSTS``
         (comma- or space-separated); wildcard addresses such as ``0.0.0.0`` are not names and are left out."""
         from backend.store.database import sqlite_url  # SQLAlchemy loads here, not when the CLI lists options
+        from backend.store.drivers import with_driver
 
         directory = Path(data_dir or os.environ.get("PARKOUR_DATA_DIR") or Path.cwd() / "data").resolve()
-        url = database_url or os.environ.get("DATABASE_URL") or sqlite_url(directory)
+        named_url = database_url or os.environ.get("DATABASE_URL")
+        url = with_driver(named_url) if named_url else sqlite_url(directory)
         named = re.split(r"[,\s]+", os.environ.get("PARKOUR_ALLOWED_HOSTS", "")) + list(allowed_hosts)
         hosts = dict.fromkeys(LOOPBACK_HOSTS)
         hosts.update(dict.fromkeys(host_name(entry) for entry in named if host_name(entry) not in WILDCARD_ADDRESSES))

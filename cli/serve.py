@@ -13,7 +13,7 @@ from typing import Annotated
 import typer
 
 from backend.settings import DEFAULT_HOST, DEFAULT_PORT, WILDCARD_ADDRESSES, Settings
-from cli.options import DataDirOption, handles_errors, note
+from cli.options import EXIT_USAGE, DataDirOption, handles_errors, note
 
 DEFAULT_VIEW_PORT = 8001
 YOUNG_COLLECTION_THRESHOLD = 20_000  # allocations between young collections (CPython 3.11: 700)
@@ -53,8 +53,14 @@ def serve_command(
 
     from backend.api.app import create_app
     from backend.api.security import api_token
+    from backend.store.drivers import StoreUnavailable, check_store
 
-    settings = Settings.from_environment(data_dir, allowed_hosts=[host])
+    try:
+        settings = Settings.from_environment(data_dir, allowed_hosts=[host])
+        check_store(settings.database_url)
+    except StoreUnavailable as error:
+        typer.echo(f"error: {error}", err=True)
+        raise typer.Exit(EXIT_USAGE) from None
     token, created = api_token(settings.data_dir)
     # What a browser opens: a wildcard interface is no address to visit (nor a name the service answers to).
     shown = "127.0.0.1" if host in WILDCARD_ADDRESSES else f"[{host}]" if ":" in host else host
