@@ -52,7 +52,7 @@ def serve_command(
     import uvicorn
 
     from backend.api.app import create_app
-    from backend.api.security import api_token
+    from backend.api.token_file import api_token
     from backend.store.drivers import StoreUnavailable, check_store
 
     try:

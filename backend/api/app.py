@@ -22,7 +22,7 @@ from fastapi.staticfiles import StaticFiles
 from backend.api import errors, security
 from backend.api.deps import Database
 from backend.api.routes import calibrations, experiments, jobs, robot, runs, sim, site, view
-from backend.api.security import api_token
+from backend.api.token_file import api_token
 from backend.services import exports, simulation
 from backend.services import runs as run_service
 from backend.services.job_runner import JobRunner

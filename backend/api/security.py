@@ -1,9 +1,9 @@
 """Who may change what, and what every request is held to before a route sees it.
 
 Mutating calls carry ``Authorization: Bearer <token>``; the token is created once in the data
-directory (``api_token``, mode 600). Reads are open, and so is the robot's e-stop (stopping is
-always allowed: docs/service.md). :func:`install` puts four ASGI middlewares in front of the
-routes, outermost first:
+directory (``api_token``, mode 600: :mod:`backend.api.token_file` keeps it). Reads are open, and
+so is the robot's e-stop (stopping is always allowed: docs/service.md). :func:`install` puts four
+ASGI middlewares in front of the routes, outermost first:
 
 - :class:`SecurityHeaders`: a Content-Security-Policy without inline script, ``nosniff``,
   ``no-referrer``, framing by the service's own origin only — on every response;
@@ -19,15 +19,9 @@ Each refusal is JSON and closes the connection (the body it did not read goes wi
 
 from __future__ import annotations
 
-import contextlib
-import errno
-import logging
-import os
 import re
 import secrets
-import tempfile
 from collections.abc import Iterable
-from pathlib import Path
 from typing import Annotated
 from urllib.parse import urlsplit
 
@@ -41,74 +35,7 @@ from starlette.types import ASGIApp, Receive, Scope, Send
 
 from backend.settings import Settings, host_name
 
-TOKEN_FILE = "api_token"
 bearer = HTTPBearer(auto_error=False)
-
-
-log = logging.getLogger("parkourlab.api")
-MIN_TOKEN_LENGTH = 16  # token_urlsafe(32) makes 43 characters; a token set by hand may be shorter, not this short
-
-
-def api_token(data_dir: Path) -> tuple[str, bool]:
-    """The bearer token for mutating calls: ``(token, created_now)``; created once, kept in the data dir.
-
-    The file is written whole or not at all (:func:`_write_atomically`): a first start on a full
-    disk fails, saying so, and leaves no file — it used to leave an empty one, which the next start
-    took as the token (every change then answered 401). An empty or corrupt file is replaced by a
-    new token, with a warning naming it (``created_now`` is then true: ``parkour serve`` prints it)."""
-    path = Path(data_dir) / TOKEN_FILE
-    if path.exists():
-        token, problem = _read_token(path)
-        if token is not None:
-            return token, False
-        log.warning("the API token file %s is %s: replacing it with a new token (clients need it)", path, problem)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    token = secrets.token_urlsafe(32)
-    try:
-        _write_atomically(path, (token + "\n").encode())
-    except OSError as error:
-        if error.errno in (errno.ENOSPC, errno.EDQUOT):
-            raise OSError(error.errno, f"the disk holding {path.parent} is full: cannot store the API token") from error
-        raise
-    return token, True
-
-
-def _read_token(path: Path) -> tuple[str | None, str]:
-    """The token in ``path``, or None and what is wrong with the file."""
-    try:
-        token = path.read_bytes().decode("ascii").strip()
-    except UnicodeDecodeError:
-        return None, "corrupt (not text)"
-    if not token:
-        return None, "empty"
-    if len(token) < MIN_TOKEN_LENGTH or not token.isprintable() or any(char.isspace() for char in token):
-        return None, f"corrupt (not one token of {MIN_TOKEN_LENGTH} or more printable characters)"
-    return token, ""
-
-
-def _write_atomically(path: Path, data: bytes) -> None:
-    """Write ``data`` to a temporary file beside ``path`` (mode 600), fsync it, rename it over
-    ``path`` and fsync the directory: whoever reads ``path`` — after a crash or a full disk too —
-    finds the old file or the whole new one, never part of one."""
-    descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        try:
-            remaining = memoryview(data)
-            while remaining:
-                remaining = remaining[os.write(descriptor, remaining) :]
-            os.fsync(descriptor)
-        finally:
-            os.close(descriptor)
-        os.replace(temporary, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(temporary)
-        raise
-    directory = os.open(path.parent, os.O_RDONLY)
-    try:
-        os.fsync(directory)
-    finally:
-        os.close(directory)
 
 
 async def require_token(

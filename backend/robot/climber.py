@@ -7,7 +7,7 @@ truth a calibration should recover) and :mod:`sim_core.noise` (control noise, pi
 offsetting the leg angles, noisy section states), and the body's path is
 streamed as tracker datagrams in real time (or ``speed`` times faster), with position noise and
 dropped frames, as PKT1 datagrams or, with ``tracker_protocol="natnet"``, as the camera software's
-NatNet frames (:mod:`backend.robot.natnet`: one rigid body, the table plane its x–y plane, the
+NatNet frames (:mod:`backend.robot.natnet_frame`: one rigid body, the table plane its x–y plane, the
 pitch its rotation about z). Each stance is streamed before the next leg is read, as the real robot positions
 that leg during the stance. The climb ends when a jump fails (slip, no flight, ...) or the body
 reaches the chute's floor (:data:`sim_core.climb.FLOOR`, where the first foot touches): the
@@ -24,7 +24,8 @@ from collections.abc import Callable
 import numpy as np
 
 from backend.robot.messages import Leg
-from backend.robot.natnet import RigidBody, encode_frame, parse_version, quaternion_about_z
+from backend.robot.natnet import parse_version
+from backend.robot.natnet_frame import RigidBody, encode_frame, quaternion_about_z
 from backend.robot.tracker import Pose, encode_datagram
 from sim_core import ControlSchedule, LegControl, PhysicalParams, climb, gait_of, get_preset
 from sim_core.climb import ClimbSetup, End, Samples

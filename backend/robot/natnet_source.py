@@ -43,13 +43,13 @@ from backend.robot.natnet import (
     NatNetError,
     Version,
     connect_request,
-    decode_frame,
     decode_server_info,
     format_version,
     is_known,
     keep_alive,
     message_id,
 )
+from backend.robot.natnet_frame import decode_frame
 from backend.robot.tracker import Calibration, Pose, PoseHistory, TrackerStats
 
 log = logging.getLogger("parkourlab.robot")

@@ -9,7 +9,7 @@ import schemathesis
 from hypothesis import HealthCheck, settings
 
 from backend.api.app import create_app
-from backend.api.security import api_token
+from backend.api.token_file import api_token
 from backend.settings import Settings
 from backend.store.database import make_engine, migrate
 from backend.workers.pools import Compute

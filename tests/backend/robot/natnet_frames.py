@@ -1,6 +1,6 @@
 """NatNet packets for the tests, written from the published frame layout (the NatNet SDK's
-PacketClient.cpp and NatNetClient.py), separately from :mod:`backend.robot.natnet`, so the decoder is
-checked against another reading of the layout, not against itself.
+PacketClient.cpp and NatNetClient.py), separately from :mod:`backend.robot.natnet_frame`, so the decoder
+is checked against another reading of the layout, not against itself.
 
 Versions are numbers ``100 * major + minor`` here (2.9 is 209, 4.1 is 401). A scene holds something
 in every block the version has, so a decoder that misplaces one block misreads everything after it.
@@ -10,6 +10,7 @@ The suffix follows PacketClient.cpp: a 2.x frame's software latency before the t
 
 from __future__ import annotations
 
+import math
 import struct
 from dataclasses import dataclass, field
 
@@ -22,6 +23,15 @@ class Body:
     markers: tuple[tuple[float, float, float], ...] = ((0.01, 0.02, 0.0), (-0.01, 0.0, 0.0))
     error: float = 0.0005
     valid: bool = True
+
+
+VERSIONS = [200, 201, 203, 205, 206, 207, 209, 210, 211, 300, 301, 400, 401]
+PITCH = 0.3  # [rad] body 2's rotation about z
+BODIES = (  # what the tests' camera sees: a body, a pitched one, an untracked one
+    Body(1, (0.1, 0.2, 0.05), (0.0, 0.0, 0.0, 1.0)),
+    Body(2, (-0.25, 1.5, 0.02), (0.0, 0.0, math.sin(PITCH / 2), math.cos(PITCH / 2)), error=0.0007),
+    Body(3, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0), markers=(), valid=False),
+)
 
 
 @dataclass(frozen=True)

@@ -1,51 +1,18 @@
-"""NatNet: frames of every version read as the SDK lays them out, bad packets refused and counted,
-the pose source over unicast (with a fake server) and multicast, and the virtual robot's NatNet stream."""
+"""NatNet frames of data (backend/robot/natnet_frame.py): every version read as the SDK lays it out,
+the production encoder agreeing with the published layout, and bad packets refused, never crashing."""
 
 import contextlib
 import math
-import socket
 import struct
-import time
 
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from pydantic import ValidationError
 
-from backend.robot import natnet_source
-from backend.robot.messages import Leg
-from backend.robot.natnet import (
-    NatNetError,
-    connect_request,
-    decode_frame,
-    decode_server_info,
-    encode_frame,
-    keep_alive,
-    parse_version,
-)
-from backend.robot.natnet_source import NatNetPoseSource
-from backend.robot.touchdown import detect_touchdowns
-from backend.robot.tracker import Calibration, UdpPoseSource
-from backend.robot.virtual import VirtualRobot
-from backend.schemas import RobotConnect
-from backend.services.robot_tracker import open_tracker
-from sim_core import LegControl, get_preset
-from sim_core.errors import ParameterError
-from sim_core.noise import NO_NOISE
-from sim_core.walls import wall_of
-from tests.backend.robot.natnet_frames import Body, Scene, frame_packet, server_info_packet
-from tests.helpers import free_port
-from tests.robot_rig import climb_open_loop
+from backend.robot.natnet import NatNetError
+from backend.robot.natnet_frame import RigidBody, decode_frame, encode_frame, quaternion_about_z
+from tests.backend.robot.natnet_frames import BODIES, PITCH, VERSIONS, Body, Scene, frame_packet
 
-VERSIONS = [200, 201, 203, 205, 206, 207, 209, 210, 211, 300, 301, 400, 401]
-PITCH = 0.3
-BODIES = (
-    Body(1, (0.1, 0.2, 0.05), (0.0, 0.0, 0.0, 1.0)),
-    Body(2, (-0.25, 1.5, 0.02), (0.0, 0.0, math.sin(PITCH / 2), math.cos(PITCH / 2)), error=0.0007),
-    Body(3, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0), markers=(), valid=False),
-)
-LEGS = {Leg.LEFT: (30.0, 0.87), Leg.RIGHT: (30.0, 0.9)}
-ROBOT = get_preset("paper")
 SCENE = Scene(frame=4321, timestamp=12.345678, bodies=BODIES)
 
 
@@ -183,269 +150,25 @@ def test_corrupted_frames_never_crash_the_decoder(v, data):
     assert len(frame.rigid_bodies) <= len(packet) // 32
 
 
-def test_server_info_and_requests():
-    old = decode_server_info(server_info_packet("Tracking Tools", (2, 5, 0, 0), (2, 5, 0, 0)))
-    new = decode_server_info(server_info_packet("Motive", (3, 1, 0, 0), (4, 1, 0, 0)))
-    assert (old.application, old.natnet_version) == ("Tracking Tools", (2, 5, 0, 0))
-    assert (new.application, new.application_version, new.natnet_version) == ("Motive", (3, 1, 0, 0), (4, 1, 0, 0))
-    with pytest.raises(NatNetError):
-        decode_server_info(server_info_packet("Motive", (3, 1, 0, 0), (4, 1, 0, 0))[:-1])
-    request = connect_request((4, 1))
-    assert struct.unpack_from("<HH", request) == (0, 271) and len(request) == 275
-    assert request[4:8] == b"Ping" and request[4 + 265 : 4 + 269] == bytes([4, 1, 0, 0])
-    assert connect_request()[4 + 265 : 4 + 269] == bytes(4), "zeros: the server's own version"
-    assert keep_alive() == struct.pack("<HH", 10, 0) + b"\0"
+@pytest.mark.parametrize("angle", [0.0, 0.3, -1.2, math.pi - 1e-9, -math.pi + 1e-9])
+def test_a_pitch_written_as_a_quaternion_reads_back_as_the_angle_about_z(angle):
+    body = RigidBody(5, (0.0, 0.0, 0.0), quaternion_about_z(angle))
+    assert body.angle_about_z == pytest.approx(angle, abs=1e-12)
+    assert math.fsum(q * q for q in body.orientation) == pytest.approx(1.0), "a unit quaternion"
 
 
-@pytest.mark.parametrize(
-    ("text", "ok"),
-    [("2.5", (2, 5)), ("4.1", (4, 1)), ("4.2", (4, 2)), ("1.9", None), ("5.0", None), ("3", None), ("x.1", None)],
-)
-def test_versions_are_checked(text, ok):
-    if ok:
-        assert parse_version(text) == ok
-    else:
-        with pytest.raises(ParameterError, match="natnet_version"):
-            parse_version(text)
+def test_an_unknown_pitch_is_the_identity_rotation():
+    assert quaternion_about_z(math.nan) == (0.0, 0.0, 0.0, 1.0)
 
 
-def _until(condition, timeout=3.0):
-    deadline = time.monotonic() + timeout
-    while not condition():
-        assert time.monotonic() < deadline, "timed out"
-        time.sleep(0.01)
-
-
-def _scene(frame, bodies=BODIES):
-    return Scene(frame, 100.0 + frame / 100, bodies)
-
-
-def test_unicast_source_connects_learns_the_version_and_counts(monkeypatch):
-    monkeypatch.setattr(natnet_source, "REQUEST_EVERY", 0.1)
-    server = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    server.bind(("127.0.0.1", 0))
-    server.settimeout(3.0)
-    source = NatNetPoseSource(
-        2,
-        interface="127.0.0.1",
-        port=0,
-        multicast_group=None,
-        server=server.getsockname(),
-        calibration=Calibration(origin=(-0.5, 0.0)),
-    )
-    try:
-        request, client = server.recvfrom(1024)
-        assert request == connect_request() and client == source.address, "the connect comes from the data socket"
-        server.sendto(frame_packet(_scene(1), 209), client)  # before the version is known: ignored
-        _until(lambda: source.stats.ignored == 1)
-        server.sendto(server_info_packet("Motive", (1, 10, 0, 0), (2, 9, 0, 0)), client)
-        _until(lambda: source.version == "2.9")
-        assert (source.protocol, source.error, source.server_info_refused) == ("natnet", None, 0)
-        for frame in (2, 3, 6):  # 4 and 5 lost; ended with the end-of-data tag, as Motive sends them
-            server.sendto(frame_packet(_scene(frame), 209, end_tag=0), client)
-        server.sendto(frame_packet(_scene(7, BODIES[:1]), 209), client)  # body 2 not seen
-        server.sendto(frame_packet(_scene(8), 209)[:-3], client)  # truncated
-        server.sendto(b"\x07\x00", client)
-        server.sendto(b"\x08\x00\x03\x00abc", client)  # a message string: no pose, not malformed
-        _until(lambda: source.stats.malformed == 2 and source.stats.ignored == 2)
-        assert (source.stats.received, source.stats.dropped) == (4, 2)
-        pose = source.latest()
-        assert pose.time == pytest.approx(100.06) and pose.pitch == pytest.approx(PITCH, abs=1e-6)
-        assert (pose.x, pose.y) == pytest.approx((0.25, 1.5), abs=1e-6), "calibrated as PKT1 poses are"
-        # Connected: keep-alives every REQUEST_EVERY, no more connects.
-        assert server.recvfrom(1024)[0] == keep_alive()
-    finally:
-        source.close()
-        server.close()
-
-
-@contextlib.contextmanager
-def _fake_server(monkeypatch, rigid_body_id=2):
-    """A unicast source and the NatNet server it asks (a socket on 127.0.0.1), once its first connect
-    request has arrived there: ``(source, server, client address)``."""
-    monkeypatch.setattr(natnet_source, "REQUEST_EVERY", 0.1)
-    server = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    server.bind(("127.0.0.1", 0))
-    server.settimeout(3.0)
-    source = NatNetPoseSource(
-        rigid_body_id, interface="127.0.0.1", port=0, multicast_group=None, server=server.getsockname()
-    )
-    try:
-        _request, client = server.recvfrom(1024)
-        yield source, server, client
-    finally:
-        source.close()
-        server.close()
-
-
-def _info(version: tuple[int, int]) -> bytes:
-    return server_info_packet("Motive", (3, 1, 0, 0), (*version, 0, 0))
-
-
-def test_server_info_is_taken_only_from_the_server_and_only_once(monkeypatch):
-    stranger = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    stranger.bind(("127.0.0.1", 0))  # the server's host, another port
-    with _fake_server(monkeypatch) as (source, server, client):
-        try:
-            stranger.sendto(_info((2, 0)), client)
-            _until(lambda: source.server_info_refused == 1)
-            assert source.version is None and source.server_info is None, "a stranger's answer is not taken"
-            server.sendto(_info((4, 1)), client)
-            _until(lambda: source.version == "4.1")
-            server.sendto(_info((2, 0)), client)  # a stray second answer from the server itself
-            _until(lambda: source.server_info_refused == 2)
-            assert source.version == "4.1" and source.error is None
-            for frame in range(1, 101):
-                server.sendto(frame_packet(_scene(frame), 401, end_tag=0), client)
-            _until(lambda: source.stats.received == 100)
-            assert (source.stats.malformed, source.stats.ignored, source.stats.dropped) == (0, 0, 0)
-        finally:
-            stranger.close()
-
-
-def test_server_info_before_any_request_is_not_taken(monkeypatch):
-    """The server's name does not resolve, so no connect request goes out: nothing is awaited."""
-
-    def unresolvable(host):
-        raise socket.gaierror(f"{host}: no such host")
-
-    monkeypatch.setattr(natnet_source.socket, "gethostbyname", unresolvable)
-    server = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    server.bind(("127.0.0.1", 0))
-    source = NatNetPoseSource(2, interface="127.0.0.1", port=0, multicast_group=None, server=server.getsockname())
-    try:
-        server.sendto(_info((4, 1)), source.address)
-        _until(lambda: source.server_info_refused == 1)
-        assert source.version is None and source.server_info is None
-    finally:
-        source.close()
-        server.close()
-
-
-@pytest.mark.parametrize(("reported", "says"), [((200, 7), "200.7"), ((1, 9), "1.9"), ((5, 0), "5.0")])
-def test_a_version_this_reader_does_not_know_is_an_error_not_a_guess(monkeypatch, reported, says):
-    with _fake_server(monkeypatch) as (source, server, client):
-        server.sendto(_info(reported), client)
-        _until(lambda: source.error is not None)
-        assert source.error == f"NatNet server Motive reports version {says}; this reader knows 2.0 to 4.x"
-        assert source.version is None
-        server.sendto(frame_packet(_scene(1), 401, end_tag=0), client)
-        _until(lambda: source.stats.ignored == 1)
-        assert (source.stats.received, source.stats.malformed) == (0, 0), "no frame read with a guessed layout"
-        assert source.server_info.natnet_version[:2] == reported, "answered: no more connect requests"
-
-
-def test_a_configured_version_wins_and_needs_no_answer():
-    source = NatNetPoseSource(
-        1, interface="127.0.0.1", port=0, multicast_group=None, server=("127.0.0.1", 9), version=(2, 5)
-    )
-    sender = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    try:
-        sender.sendto(frame_packet(_scene(1), 205), source.address)
-        _until(lambda: source.stats.received == 1)
-        assert source.latest().x == pytest.approx(0.1)
-    finally:
-        sender.close()
-        source.close()
-
-
-def test_multicast_source_joins_the_group():
-    port = free_port(socket.SOCK_DGRAM)
-    try:
-        source = NatNetPoseSource(2, interface="127.0.0.1", port=port, server=("127.0.0.1", 9), version=(3, 1))
-    except OSError as error:
-        pytest.skip(f"no multicast on this host's loopback: {error}")
-    sender = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    try:
-        sender.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, socket.inet_aton("127.0.0.1"))
-        sender.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
-        for frame in (1, 2):
-            sender.sendto(frame_packet(_scene(frame), 301), ("239.255.42.99", port))
-        _until(lambda: source.stats.received == 2)
-        assert source.latest().y == pytest.approx(1.5)
-    finally:
-        sender.close()
-        source.close()
-
-
-def _climb(tracker, protocol: str, jumps: int = 8):
-    """An open-loop climb of the noiseless virtual robot at 6x real time, its camera on ``protocol``
-    (tracker noise and dropped frames as usual, from the same seed): the touchdowns its tracker saw."""
-    robot = VirtualRobot(
-        tracker_to=tracker.address,
-        noise=NO_NOISE,
-        speed=6.0,
-        seed=1,
-        tracker_protocol=protocol,
-        natnet_version="2.9",
-        natnet_rigid_body_id=3,
-    ).start()
-    try:
-        climb_open_loop(robot, LEGS, jumps)
-    finally:
-        robot.stop()
-        tracker.close()
-    poses = tracker.as_arrays()
-    leg_for = lambda k: LegControl.from_degrees(*LEGS[Leg.of(wall_of(k + 1))])  # noqa: E731
-    return detect_touchdowns(poses["time"], poses["x"], poses["y"], ROBOT, leg_for), tracker.stats, robot.climber
-
-
-def test_a_live_climb_over_natnet_sees_the_touchdowns_pkt1_sees():
-    over_pkt1, pkt1_stats, _ = _climb(UdpPoseSource(), "pkt1")
-    natnet = NatNetPoseSource(
-        3, interface="127.0.0.1", port=0, multicast_group=None, server=("127.0.0.1", 9), version=(2, 9)
-    )
-    over_natnet, stats, climber = _climb(natnet, "natnet")
-    common = min(len(over_pkt1), len(over_natnet))
-    assert common >= 6, (len(over_pkt1), len(over_natnet))
-    # The same seed streams the same poses; NatNet's f32 positions differ from PKT1's f64 by ~1e-7 m,
-    # and a pose lost to real-time jitter (a late frame) moves a fitted touchdown by far less than 1e-3.
-    for ours, theirs in zip(over_natnet[:common], over_pkt1[:common], strict=True):
-        assert ours.wall == theirs.wall
-        assert ours.time == pytest.approx(theirs.time, abs=1e-3)
-        assert ours.state == pytest.approx(theirs.state, abs=1e-3)
-    assert stats.malformed == 0 and stats.ignored == 0
-    assert stats.dropped == pytest.approx(climber.frames_dropped, abs=2), "the robot's dropped frames, seen as gaps"
-    assert abs(stats.loss - pkt1_stats.loss) < 0.02
-
-
-@pytest.mark.parametrize(
-    ("field", "value", "says"),
-    [
-        ("tracker_protocol", "vrpn", "'pkt1' or 'natnet'"),
-        ("natnet_version", "1.5", "from 2.0 to 4.x"),
-        ("natnet_version", "latest", "MAJOR.MINOR"),
-        ("natnet_multicast_group", "10.0.0.1", "multicast address"),
-        ("natnet_multicast_group", "239.255.42", "IPv4 multicast address"),
-        ("natnet_rigid_body_id", -1, "greater than or equal to 0"),
-        ("natnet_command_port", 0, "greater than or equal to 1"),
-    ],
-)
-def test_connect_options_are_checked_naming_the_field(field, value, says):
-    with pytest.raises(ValidationError) as raised:
-        RobotConnect(url="loop://", **{field: value})
-    [error] = raised.value.errors()
-    assert error["loc"] == (field,) and says in error["msg"]
-
-
-def test_connect_opens_the_tracker_it_names():
-    body = RobotConnect(
-        url="loop://",
-        tracker_protocol="natnet",
-        tracker_port=0,
-        natnet_multicast_group=None,
-        natnet_version="2.5",
-        natnet_rigid_body_id=4,
-        natnet_server_host="127.0.0.1",
-        calibration_scale=0.001,
-    )
-    tracker = open_tracker(body)
-    try:
-        assert isinstance(tracker, NatNetPoseSource) and tracker.version == "2.5" and tracker.rigid_body_id == 4
-        assert tracker.multicast_group is None and tracker.server == ("127.0.0.1", 1510)
-        assert tracker.calibration.scale == 0.001
-    finally:
-        tracker.close()
-    pkt1 = open_tracker(RobotConnect(url="loop://", tracker_port=0))
-    pkt1.close()
-    assert isinstance(pkt1, UdpPoseSource)
+@pytest.mark.parametrize("v", VERSIONS)
+def test_an_encoded_body_reads_back_as_it_was_written(v):
+    """What the virtual robot's camera sends is what the pose source reads: the frame number (to 32
+    bits), the timestamp and the body (its tracking flag from 2.6 on)."""
+    body = RigidBody(7, (0.5, -0.25, 0.125), quaternion_about_z(0.5), tracked=False)
+    frame = decode_frame(encode_frame(2**32 + 9, 3.5, body, _version(v)), _version(v))
+    assert (frame.number, frame.timestamp, [b.id for b in frame.rigid_bodies]) == (9, 3.5, [7])
+    [read] = frame.rigid_bodies
+    assert read.position == body.position and read.orientation == pytest.approx(body.orientation, abs=1e-7)
+    assert read.tracked is (v < 206), "no tracking flag before 2.6: tracked"
+    assert read.mean_error == 0.0, "an unknown (NaN) mean error is sent as 0"
