@@ -8,7 +8,6 @@ for a request thread that compute or a busy store holds."""
 
 from __future__ import annotations
 
-import datetime
 from collections.abc import Callable
 from typing import Annotated, TypeVar
 
@@ -74,8 +73,8 @@ async def run_filter(
     zeta0_max: Annotated[float | None, Query(ge=0.0, le=1.0, allow_inf_nan=False)] = None,
     psi0_min: Annotated[float | None, Query(ge=0.0, le=90.0, allow_inf_nan=False)] = None,
     psi0_max: Annotated[float | None, Query(ge=0.0, le=90.0, allow_inf_nan=False)] = None,
-    created_after: datetime.datetime | None = None,
-    created_before: datetime.datetime | None = None,
+    created_after: Annotated[schemas.IsoDateTime | None, Query(description="ISO 8601, e.g. 2026-12-03")] = None,
+    created_before: Annotated[schemas.IsoDateTime | None, Query(description="ISO 8601, e.g. 2026-12-03")] = None,
 ) -> RunFilter:
     """The run filters shared by list, export and aggregate."""
     return RunFilter(

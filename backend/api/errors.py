@@ -32,6 +32,7 @@ log = logging.getLogger("parkourlab.api")
 PREVIEW_CHARS = 200  # of an input quoted back in a 422
 MAX_ERRORS = 20  # listed in one 422; the rest are counted
 SERVER_ERROR = "internal server error (logged by the service)"
+VALUE_ERROR_PREFIX = "Value error, "  # pydantic's, before the message of a validator's ValueError
 
 STATUS_OF: dict[type[Exception], tuple[int, str]] = {
     NotFound: (status.HTTP_404_NOT_FOUND, "{}"),
@@ -92,7 +93,7 @@ def compact_errors(errors: list[dict]) -> list[dict]:
 def _compact(error: dict) -> dict:
     out = {
         "loc": [part if isinstance(part, int) else _text(str(part), 100) for part in error.get("loc", ())],
-        "msg": _text(str(error.get("msg", "")), 500),
+        "msg": _text(str(error.get("msg", "")).removeprefix(VALUE_ERROR_PREFIX), 500),
         "type": _text(str(error.get("type", "")), 100),
     }
     if "input" in error:

@@ -3,18 +3,46 @@ inputs, the limits, record references and the page of a list."""
 
 from __future__ import annotations
 
+import datetime
 import math
 from typing import Annotated, Generic, Literal, TypeVar
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field
 
-Psi0Deg = Annotated[float, Field(gt=0.0, lt=90.0, description="leg angle at touchdown [degrees], in (0, 90)")]
+
+def _inside_in_radians(psi0_deg: float) -> float:
+    # The kernel takes radians: an angle a hair inside (0, 90) degrees (5e-324) must not become 0 there.
+    if not 0.0 < math.radians(psi0_deg) < math.pi / 2:
+        raise ValueError(f"must be in (0, 90) degrees, got {psi0_deg!r}, which is 0 or 90 once in radians")
+    return psi0_deg
+
+
+Psi0Deg = Annotated[
+    float,
+    Field(gt=0.0, lt=90.0, description="leg angle at touchdown [degrees], in (0, 90)"),
+    AfterValidator(_inside_in_radians),
+]
+
+
+def _iso_8601(value: object) -> object:
+    # Pydantic alone takes a number as seconds since 1970: "0.5" would be a date.
+    if isinstance(value, str):
+        try:
+            return datetime.datetime.fromisoformat(value)
+        except ValueError:
+            example = "e.g. 2026-12-03 or 2026-12-03T14:00:00Z"
+            raise ValueError(f"must be an ISO 8601 date or time, {example}, got {value!r}") from None
+    return value
+
+
+IsoDateTime = Annotated[datetime.datetime, BeforeValidator(_iso_8601)]
 Zeta0 = Annotated[float, Field(gt=0.0, lt=1.0, description="leg length at touchdown [l0], in (0, 1)")]
 Label = Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[\w.:/-]+$")]  # a tag
 Tags = Annotated[list[Label], Field(max_length=32)]
 Notes = Annotated[str, Field(max_length=100_000)]
 
 MAX_JUMPS = 10_000
+MAX_FRICTION = 100.0  # a friction coefficient past any real wall's (rubber on rock is about 1)
 MAX_TRIALS = 100_000
 MAX_LEVELS = 100
 MAX_PATH_SAMPLES = 100_000
@@ -49,7 +77,9 @@ class ModelIn(Strict):
     d_hat: Annotated[float, Field(gt=0.0, le=100.0)] | None = None
     c_zeta: Annotated[float, Field(ge=0.0, le=1e3)] | None = None
     c_psi: Annotated[float, Field(ge=0.0, le=1e3)] | None = None
-    mu: Annotated[float, Field(gt=0.0)] | None = Field(None, description="friction coefficient; omit for the preset")
+    mu: Annotated[float, Field(gt=0.0, le=MAX_FRICTION)] | None = Field(
+        None, description=f"friction coefficient, in (0, {MAX_FRICTION:g}]; omit for the preset (no slip)"
+    )
 
 
 class StateIn(Strict):

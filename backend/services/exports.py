@@ -36,7 +36,7 @@ RECORD_FIELDS = ("id", "experiment_id", "kind", "status", "created_at", "duratio
 MODEL_FIELDS = tuple(field.name for field in dataclasses.fields(ModelParams))
 TEXT_COLUMNS = tuple(RECORD_FIELDS.index(name) for name in ("kind", "status", "code_version", "tags", "notes",
                                                            "failure_code"))  # fmt: skip
-FORMULA_START = frozenset("=+-@\t\r")  # a spreadsheet reads a cell starting with one as a formula
+FORMULA_START = frozenset("=+-@\t\r\n")  # a spreadsheet reads a cell starting with one as a formula
 CHUNK_CHARS = 64_000  # what a streamed export yields at a time
 
 
@@ -136,15 +136,16 @@ def export(sessions, where: RunFilter, format_: str) -> Iterator[str]:
 
 def csv_text(batches: Iterable[list[list]], text_columns=TEXT_COLUMNS) -> Iterator[str]:
     """Batches of rows of values as CSV text in chunks of about :data:`CHUNK_CHARS`. Text that a spreadsheet
-    would run as a formula (starting with = + - @, a tab or a return) in a ``text_columns`` cell is
-    written with a leading apostrophe, as OWASP advises; numbers are written as they are."""
+    would run as a formula (starting with = + - @, a tab or a line break — or with spaces before
+    any of them, which spreadsheets skip) in a ``text_columns`` cell is written with a leading
+    apostrophe, as OWASP advises; numbers are written as they are."""
     buffer = io.StringIO()
     writer = csv.writer(buffer)
     for batch in batches:
         for row in batch:
             for column in text_columns:
                 value = row[column]
-                if value and value[0] in FORMULA_START:
+                if value and (value[0] in FORMULA_START or value.lstrip()[:1] in FORMULA_START):
                     row[column] = "'" + value
         writer.writerows(batch)
         if buffer.tell() > CHUNK_CHARS:

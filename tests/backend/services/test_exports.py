@@ -109,11 +109,21 @@ def test_csv_export_keeps_every_runs_legs(sessions, make_run):
     assert parsed[1]["leg1.zeta0"] == "0.9" and parsed[0]["leg1.zeta0"] == ""
 
 
-@pytest.mark.parametrize("text", ['=HYPERLINK("http://x")', "+1+1", "-2+3", "@SUM(A1)", "\tx", "\rx"])
+@pytest.mark.parametrize(
+    "text",
+    ['=HYPERLINK("http://x")', "+1+1", "-2+3", "@SUM(A1)", "\tx", "\rx", "\n=1+1", "  =1+1", " \n @SUM(A1)"],
+)
 def test_csv_cells_a_spreadsheet_would_run_are_escaped(sessions, make_run, session, text):
     runs.update(session, make_run().id, notes=text)
     (row,) = _exported(sessions, RunFilter(), "csv")
     assert row["notes"] == "'" + text and float(row["start_xdot"]) == -0.93, "numbers, negative ones too, as they are"
+
+
+@pytest.mark.parametrize("text", ["a = b", " plain note", "3 jumps"])
+def test_csv_text_that_is_no_formula_is_kept_as_it_is(sessions, make_run, session, text):
+    runs.update(session, make_run().id, notes=text)
+    (row,) = _exported(sessions, RunFilter(), "csv")
+    assert row["notes"] == text
 
 
 def test_json_export_is_strict_json():

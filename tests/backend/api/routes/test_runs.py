@@ -119,6 +119,8 @@ def test_aggregate_groups_runs(client, auth):
     [
         (RUN | {"controls": [{"psi0_deg": 30, "zeta0": 1.2}]}, "zeta0"),
         (RUN | {"controls": [{"psi0_deg": 95, "zeta0": 0.9}]}, "psi0_deg"),
+        (RUN | {"controls": [{"psi0_deg": 5e-324, "zeta0": 0.9}]}, "psi0_deg"),  # 0 once in radians
+        (RUN | {"model": {"mu": 1e308}}, "mu"),
         (RUN | {"start": {"xdot": 0.5, "ydot": 0}}, "xdot"),
         (RUN | {"jumps": 10**7}, "jumps"),
         (RUN | {"model": {"alpha": -1}}, "alpha"),
@@ -128,7 +130,22 @@ def test_aggregate_groups_runs(client, auth):
 def test_bad_input_is_a_422_naming_the_field(client, auth, body, field):
     response = client.post("/api/v1/runs", json=body, headers=auth)
     assert response.status_code == 422
-    assert any(field in error["loc"] for error in response.json()["detail"]), response.json()
+    assert any(error["loc"][-1] == field for error in response.json()["detail"]), response.json()
+    assert not any(error["msg"].startswith("Value error") for error in response.json()["detail"]), "the user's words"
+
+
+@pytest.mark.parametrize("moment", ["0.5", "1700000000", "yesterday", "2026-13-01"])
+def test_created_before_and_after_take_only_iso_dates(client, moment):
+    for name in ("created_before", "created_after"):
+        response = client.get("/api/v1/runs", params={name: moment})
+        assert response.status_code == 422 and response.json()["detail"][0]["loc"] == ["query", name]
+        assert "ISO 8601" in response.json()["detail"][0]["msg"]
+
+
+def test_an_iso_date_filters_runs(client, auth):
+    client.post("/api/v1/runs", json=RUN, headers=auth)
+    assert client.get("/api/v1/runs", params={"created_before": "2000-01-01"}).json()["items"] == []
+    assert client.get("/api/v1/runs", params={"created_after": "2000-01-01T00:00:00Z"}).json()["items"]
 
 
 def test_concurrent_clients_do_not_corrupt_state(client, auth):
