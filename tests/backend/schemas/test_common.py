@@ -1,0 +1,172 @@
+"""What every request body shares (backend/schemas/common.py): the strict base, the leg, model and
+state inputs with their ranges, record references, tags and the page of a list."""
+
+import math
+
+import pytest
+from pydantic import BaseModel, TypeAdapter, ValidationError
+
+from backend.schemas.common import (
+    MAX_ID,
+    Label,
+    LegIn,
+    ModelIn,
+    Notes,
+    Page,
+    Psi0Deg,
+    RecordRef,
+    StateIn,
+    Tags,
+    Zeta0,
+    finite_or_none,
+)
+from tests.backend.schemas.refusals import LEG, START, accepted, refused
+
+NON_FINITE = [math.nan, math.inf, -math.inf]
+
+
+@pytest.mark.parametrize(
+    ("kind", "inside", "outside"),
+    [
+        (Psi0Deg, [1e-9, 45.0, 89.999], [0.0, -1.0, 90.0, 120.0]),
+        (Zeta0, [1e-9, 0.9, 0.999999], [0.0, -0.1, 1.0, 1.2]),
+        (RecordRef, [1, MAX_ID], [0, -1, MAX_ID + 1]),
+    ],
+    ids=["psi0_deg (0, 90)", "zeta0 (0, 1)", "record id [1, 2^31-1]"],
+)
+def test_scalar_ranges_accept_just_inside_and_refuse_just_outside(kind, inside, outside):
+    adapter = TypeAdapter(kind)
+    for value in inside:
+        assert adapter.validate_python(value) == value
+    for value in outside:
+        with pytest.raises(ValidationError):
+            adapter.validate_python(value)
+
+
+@pytest.mark.parametrize(
+    ("field", "inside", "outside"),
+    [
+        ("psi0_deg", 89.99, 90.0),
+        ("psi0_deg", 0.01, 0.0),
+        ("zeta0", 0.99, 1.0),
+        ("zeta0", 0.01, 0.0),
+    ],
+)
+def test_a_leg_outside_its_range_is_refused_naming_the_field(field, inside, outside):
+    assert getattr(accepted(LegIn, LEG | {field: inside}), field) == inside
+    assert refused(LegIn, LEG | {field: outside}) == [(field,)]
+
+
+@pytest.mark.parametrize(
+    ("field", "inside", "outside"),
+    [
+        ("xdot", -1e-9, 0.0),  # the section is crossed moving left: xdot < 0
+        ("xdot", -100.0, -100.01),
+        ("ydot", 100.0, 100.01),
+        ("ydot", -100.0, -100.01),
+    ],
+)
+def test_a_state_outside_its_range_is_refused_naming_the_field(field, inside, outside):
+    assert getattr(accepted(StateIn, START | {field: inside}), field) == inside
+    assert refused(StateIn, START | {field: outside}) == [(field,)]
+
+
+@pytest.mark.parametrize(
+    ("field", "inside", "outside"),
+    [
+        ("alpha", 1e4, 1e4 + 1),
+        ("alpha", 1e-9, 0.0),
+        ("d_hat", 100.0, 100.01),
+        ("d_hat", 1e-9, 0.0),
+        ("c_zeta", 0.0, -1e-9),
+        ("c_zeta", 1e3, 1e3 + 1),
+        ("c_psi", 0.0, -1e-9),
+        ("c_psi", 1e3, 1e3 + 1),
+        ("mu", 1e-9, 0.0),
+    ],
+)
+def test_model_overrides_outside_their_range_are_refused_naming_the_field(field, inside, outside):
+    assert getattr(accepted(ModelIn, {field: inside}), field) == inside
+    assert refused(ModelIn, {field: outside}) == [(field,)]
+
+
+def test_a_model_is_the_paper_preset_with_no_overrides_unless_told():
+    model = ModelIn()
+    assert model.preset == "paper"
+    assert (model.alpha, model.d_hat, model.c_zeta, model.c_psi, model.mu) == (None,) * 5
+
+
+@pytest.mark.parametrize("preset", ["paper", "table.v1", "lab-2026_12", "x" * 64])
+def test_a_preset_name_may_be_a_stored_calibrations(preset):
+    assert accepted(ModelIn, {"preset": preset}).preset == preset
+
+
+@pytest.mark.parametrize("preset", ["", "-x", ".hidden", "a b", "x/y", "x" * 65])
+def test_a_preset_name_outside_the_pattern_is_refused(preset):
+    assert refused(ModelIn, {"preset": preset}) == [("preset",)]
+
+
+@pytest.mark.parametrize("value", NON_FINITE)
+@pytest.mark.parametrize(
+    ("schema", "body", "loc"),
+    [
+        (LegIn, LEG | {"zeta0": "@"}, ("zeta0",)),
+        (StateIn, START | {"ydot": "@"}, ("ydot",)),
+        (ModelIn, {"mu": "@"}, ("mu",)),  # infinite friction is the kernels' "no slip", never a request's
+    ],
+)
+def test_non_finite_numbers_are_refused_naming_the_field(schema, body, loc, value):
+    body = {key: value if item == "@" else item for key, item in body.items()}
+    assert refused(schema, body) == [loc]
+
+
+def test_a_number_json_makes_infinite_is_refused():
+    """``1e309`` is a finite literal that JSON parsing turns into infinity."""
+    with pytest.raises(ValidationError) as refusal:
+        StateIn.model_validate_json('{"xdot": -1e309, "ydot": 0}')
+    assert [error["loc"] for error in refusal.value.errors()] == [("xdot",)]
+
+
+@pytest.mark.parametrize("schema", [LegIn, StateIn, ModelIn])
+def test_unknown_fields_are_refused_by_name(schema):
+    body = {LegIn: LEG, StateIn: START, ModelIn: {}}[schema]
+    assert refused(schema, body | {"colour": "red"}) == [("colour",)]
+
+
+@pytest.mark.parametrize("label", ["a", "zeta0:0.9", "run/2026-12.v1", "x" * 64])
+def test_a_label_is_a_short_word_with_dots_colons_slashes_and_dashes(label):
+    assert TypeAdapter(Label).validate_python(label) == label
+
+
+@pytest.mark.parametrize("label", ["", "x" * 65, "two words", "semi;colon", "new\nline", "a\ud800"])
+def test_a_label_outside_the_pattern_is_refused(label):
+    with pytest.raises(ValidationError):
+        TypeAdapter(Label).validate_python(label)
+
+
+def test_tags_are_at_most_32_labels_and_notes_at_most_100_000_characters():
+    assert len(TypeAdapter(Tags).validate_python([f"t{i}" for i in range(32)])) == 32
+    with pytest.raises(ValidationError):
+        TypeAdapter(Tags).validate_python([f"t{i}" for i in range(33)])
+    assert len(TypeAdapter(Notes).validate_python("n" * 100_000)) == 100_000
+    with pytest.raises(ValidationError):
+        TypeAdapter(Notes).validate_python("n" * 100_001)
+
+
+class _Item(BaseModel):
+    id: int
+
+
+def test_a_page_ends_with_a_null_cursor_unless_one_is_given():
+    last = Page[_Item](items=[_Item(id=2), _Item(id=1)])
+    assert last.next_cursor is None
+    assert Page[_Item].model_validate_json(last.model_dump_json()) == last
+    middle = Page[_Item](items=[{"id": 9}], next_cursor=9)
+    assert middle.items == [_Item(id=9)] and middle.model_dump() == {"items": [{"id": 9}], "next_cursor": 9}
+
+
+@pytest.mark.parametrize(
+    ("value", "sent"), [(0.5, 0.5), (-3.0, -3.0), (math.nan, None), (math.inf, None), (-math.inf, None)]
+)
+def test_finite_or_none_sends_null_for_what_json_cannot_hold(value, sent):
+    assert finite_or_none(value) == sent
