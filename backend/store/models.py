@@ -36,6 +36,12 @@ class UTCDateTime(TypeDecorator):
     impl = DateTime(timezone=True)
     cache_ok = True
 
+    def process_bind_param(self, value, _dialect):
+        # SQLite keeps the wall time and drops the offset: 14:00+02:00 must go in (or be compared) as 12:00.
+        if value is not None and value.tzinfo is not None:
+            return value.astimezone(datetime.UTC)
+        return value
+
     def process_result_value(self, value, _dialect):
         if value is not None and value.tzinfo is None:
             return value.replace(tzinfo=datetime.UTC)
