@@ -1,13 +1,16 @@
 """What every request body shares (backend/schemas/common.py): the strict base, the leg, model and
 state inputs with their ranges, record references, tags and the page of a list."""
 
+import datetime
 import math
 
 import pytest
 from pydantic import BaseModel, TypeAdapter, ValidationError
 
 from backend.schemas.common import (
+    MAX_FRICTION,
     MAX_ID,
+    IsoDateTime,
     Label,
     LegIn,
     ModelIn,
@@ -57,6 +60,12 @@ def test_a_leg_outside_its_range_is_refused_naming_the_field(field, inside, outs
     assert refused(LegIn, LEG | {field: outside}) == [(field,)]
 
 
+def test_a_leg_angle_that_is_0_once_in_radians_is_refused_on_psi0_deg():
+    """5e-324 degrees is inside (0, 90) but 0 radians: the kernels would get a leg along the wall."""
+    assert refused(LegIn, LEG | {"psi0_deg": 5e-324}) == [("psi0_deg",)]
+    assert accepted(LegIn, LEG | {"psi0_deg": 1e-300}).psi0_deg == 1e-300
+
+
 @pytest.mark.parametrize(
     ("field", "inside", "outside"),
     [
@@ -83,6 +92,7 @@ def test_a_state_outside_its_range_is_refused_naming_the_field(field, inside, ou
         ("c_psi", 0.0, -1e-9),
         ("c_psi", 1e3, 1e3 + 1),
         ("mu", 1e-9, 0.0),
+        ("mu", MAX_FRICTION, MAX_FRICTION + 0.01),
     ],
 )
 def test_model_overrides_outside_their_range_are_refused_naming_the_field(field, inside, outside):
@@ -162,7 +172,8 @@ def test_a_page_ends_with_a_null_cursor_unless_one_is_given():
     assert last.next_cursor is None
     assert Page[_Item].model_validate_json(last.model_dump_json()) == last
     middle = Page[_Item](items=[{"id": 9}], next_cursor=9)
-    assert middle.items == [_Item(id=9)] and middle.model_dump() == {"items": [{"id": 9}], "next_cursor": 9}
+    assert middle.items == [_Item(id=9)] and middle.next_cursor == 9
+    assert Page[_Item].model_validate_json(middle.model_dump_json()) == middle
 
 
 @pytest.mark.parametrize(
@@ -170,3 +181,22 @@ def test_a_page_ends_with_a_null_cursor_unless_one_is_given():
 )
 def test_finite_or_none_sends_null_for_what_json_cannot_hold(value, sent):
     assert finite_or_none(value) == sent
+
+
+@pytest.mark.parametrize(
+    ("text", "moment"),
+    [
+        ("2026-12-03", datetime.datetime(2026, 12, 3)),
+        ("2026-12-03T14:00:00Z", datetime.datetime(2026, 12, 3, 14, 0, tzinfo=datetime.UTC)),
+        ("2026-12-03T14:00:00+02:00", datetime.datetime(2026, 12, 3, 12, 0, tzinfo=datetime.UTC)),
+    ],
+)
+def test_a_moment_is_an_iso_8601_date_or_time(text, moment):
+    assert TypeAdapter(IsoDateTime).validate_python(text) == moment
+
+
+@pytest.mark.parametrize("text", ["0.5", "1733234400", "yesterday", "03/12/2026", ""])
+def test_anything_but_iso_8601_is_refused_with_an_example(text):
+    """Pydantic alone reads a number as seconds since 1970: "0.5" would be a date."""
+    with pytest.raises(ValidationError, match=r"must be an ISO 8601 date or time, e\.g\. 2026-12-03"):
+        TypeAdapter(IsoDateTime).validate_python(text)

@@ -7,7 +7,6 @@ import pytest
 from sqlalchemy import make_url
 from typer.testing import CliRunner
 
-from backend.settings import Settings
 from backend.store.drivers import StoreUnavailable, check_store, with_driver
 from cli.app import app
 from tests.helpers import free_port
@@ -25,11 +24,6 @@ from tests.helpers import free_port
 def test_postgresql_without_a_driver_means_psycopg(named, meant):
     assert with_driver(named) == meant
     assert make_url(with_driver(named)).password == make_url(named).password  # the password survives
-
-
-def test_settings_apply_the_driver_to_database_url(monkeypatch, tmp_path):
-    monkeypatch.setenv("DATABASE_URL", "postgresql://lab@db/parkour")
-    assert Settings.from_environment(tmp_path).database_url == "postgresql+psycopg://lab@db/parkour"
 
 
 def test_a_missing_driver_names_it_and_what_to_install():
