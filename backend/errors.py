@@ -11,6 +11,10 @@ class NotFound(LookupError):
 
     def __init__(self, what: str, identifier: int):
         super().__init__(f"{what} {identifier} does not exist")
+        self.what, self.identifier = what, identifier
+
+    def __reduce__(self):  # picklable as made: the store is read in worker processes too
+        return type(self), (self.what, self.identifier)
 
 
 class Conflict(RuntimeError):

@@ -2,6 +2,7 @@
 table gives each one a status a client can act on (backend/api/errors.py)."""
 
 import inspect
+import pickle
 
 import pytest
 
@@ -32,3 +33,10 @@ def test_each_domain_error_has_its_status_in_the_apis_table():
 
     assert sorted(kind.__name__ for kind in DOMAIN_ERRORS) == ["Conflict", "NotFound"]
     assert {kind: STATUS_OF[kind][0] for kind in DOMAIN_ERRORS} == {NotFound: 404, Conflict: 409}
+
+
+@pytest.mark.parametrize("error", [NotFound("run", 42), Conflict("experiment 1 still has 2 runs")])
+def test_domain_errors_cross_process_boundaries_as_made(error):
+    """The store is read in worker processes: an error raised there is pickled back to the service."""
+    copy = pickle.loads(pickle.dumps(error))
+    assert type(copy) is type(error) and str(copy) == str(error)
