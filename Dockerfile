@@ -7,6 +7,7 @@ COPY experiments experiments
 COPY backend backend
 COPY frontend frontend
 COPY cli cli
+COPY parkourlab parkourlab
 RUN pip install --no-cache-dir ".[postgres]"
 ENV PARKOUR_DATA_DIR=/data \
     PARKOUR_CACHE_DIR=/data/cache

@@ -1,0 +1,126 @@
+"""The shapes of what the API answers, as the client hands them on: plain dicts (JSON as it
+came), typed for editors and type checkers. The service's OpenAPI document (``/openapi.json``)
+is the reference; these name the fields a script reads most. Nothing is checked at run time."""
+
+from __future__ import annotations
+
+from datetime import datetime
+from typing import Any, Generic, Literal, TypedDict, TypeVar
+
+T = TypeVar("T")
+RunKind = Literal["sim", "robot", "replay"]
+RunStatus = Literal["done", "failed", "running", "interrupted"]
+JobState = Literal["queued", "running", "cancelling", "cancelled", "done", "failed"]
+FINAL_JOB_STATES: frozenset[str] = frozenset({"done", "cancelled", "failed"})
+
+
+class Page(TypedDict, Generic[T]):
+    """One page of a list: its ``items`` and ``next_cursor`` (None on the last page). Sorted by id,
+    pass it back as ``cursor``; sorted by another field, as ``offset``. The API gives no total."""
+
+    items: list[T]
+    next_cursor: int | None
+
+
+class Run(TypedDict):
+    """A run as listed. ``model``: the nondimensional model (alpha, d_hat, c_zeta, c_psi, mu;
+    docs/model.md §1); ``controls``: ``[psi0 [deg], zeta0 [l0]]`` per leg of the schedule;
+    ``start_state``: ``[xdot, ydot]`` [sqrt(g l0)]; ``climb`` [l0]; ``duration_s`` [s]."""
+
+    id: int
+    experiment_id: int | None
+    kind: RunKind
+    status: RunStatus
+    created_at: str
+    duration_s: float
+    code_version: str
+    model: dict[str, Any]
+    controls: list[list[float]]
+    start_state: list[float]
+    jumps: int
+    jumps_completed: int
+    failure_code: str | None
+    climb: float
+    tags: list[str]
+    notes: str
+    has_trajectory: bool
+
+
+class RunDetail(Run):
+    """A run in full: with its ``results`` (section states, ``rises`` per jump [l0], ``failure``)."""
+
+    results: dict[str, Any]
+
+
+class Experiment(TypedDict):
+    """An experiment: a named folder of runs and jobs; ``runs`` counts its runs."""
+
+    id: int
+    name: str
+    description: str
+    notes: str
+    tags: list[str]
+    created_at: str
+    updated_at: str
+    runs: int
+
+
+class Job(TypedDict):
+    """A batch job. ``completed`` of ``total`` units (trials for MJTF) are done; ``progress`` is
+    their ratio in [0, 1]; ``spec`` is the job's body with the service's defaults filled in."""
+
+    id: int
+    experiment_id: int | None
+    kind: str
+    state: JobState
+    total: int
+    completed: int
+    progress: float
+    error: str | None
+    spec: dict[str, Any]
+    created_at: str
+    started_at: str | None
+    finished_at: str | None
+
+
+class MJTFLevel(TypedDict):
+    """One energy level of an MJTF job: ``zeta0`` [l0], its ``trials``, the ``mean`` and ``std``
+    of the jumps to failure, and how many trials ended each way (``outcomes``: ``capped`` or a
+    failure code → count)."""
+
+    zeta0: float
+    trials: int
+    mean: float
+    std: float
+    outcomes: dict[str, int]
+
+
+class JobResults(TypedDict):
+    """A job's results: ``partial`` until it is done; ``levels`` and ``missing_zeta0s`` for MJTF,
+    ``result`` (the study's JSON) for the other kinds."""
+
+    job: Job
+    partial: bool
+    levels: list[MJTFLevel] | None
+    missing_zeta0s: list[float] | None
+    result: dict[str, Any] | None
+
+
+class RunFilters(TypedDict, total=False):
+    """The filters every run query takes (list, export, aggregate, frame). Ranges are inclusive:
+    zeta0 [l0] in [0, 1], psi0 [deg] in [0, 90] (the first leg's); datetimes or ISO 8601 text."""
+
+    experiment_id: int
+    kind: RunKind
+    status: RunStatus
+    tag: str
+    failure_code: str
+    zeta0_min: float
+    zeta0_max: float
+    psi0_min: float
+    psi0_max: float
+    created_after: datetime | str
+    created_before: datetime | str
+
+
+RUN_FILTERS: frozenset[str] = frozenset(RunFilters.__annotations__)
