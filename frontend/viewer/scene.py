@@ -3,7 +3,8 @@
 Nodes are named as paths under ``/chute`` and created once; each frame only moves them
 (``ChuteScene.show``). ``/chute`` itself slides down as the robot climbs when "follow" is on,
 so the camera a person has placed keeps the robot in view. Works on any viser ``SceneApi``: the
-service's live view or a private server that records a replay for export.
+service's live view or a private server that records a replay for export. Touchdown markers and
+trails are rings of reused nodes (:mod:`frontend.viewer.node_rings`).
 """
 
 from __future__ import annotations
@@ -22,16 +23,17 @@ from frontend.viewer.geometry import (
     ruler_ticks,
     to_scene,
 )
-from frontend.viewer.motion import STANCE, Pose
+from frontend.viewer.motion import Pose
+from frontend.viewer.node_rings import NodeRing, StreamedTrail, hidden_lines
 from sim_core import LegControl, PhysicalParams
+from sim_core.trajectory import STANCE
 
 WALL_THICKNESS = 0.03  # [m]
 DEPTH = 0.35  # [m] how deep the walls are drawn (the model is planar)
 BODY_RADIUS = 0.022  # [m]
 LEG_THICKNESS = 0.012  # [m]
 TRAIL_JUMPS = 30  # past jumps whose trail stays drawn
-# Live mode's trails are streamed (StreamedTrail): pieces of PIECE_POINTS points, each sent once.
-PIECE_POINTS = 25  # a piece's points (the next piece starts at its last): 0.24 s of the tracker's 100 Hz
+# Live mode's trails are streamed (StreamedTrail): pieces of node_rings.PIECE_POINTS points, each sent once.
 LIVE_TRAIL_PIECES = 40  # finished pieces of the robot's path kept: 960 tracker frames, 9.6 s at 100 Hz
 GHOST_TRAIL_PIECES = 16  # finished pieces of the live ghost's jump kept: 1.1 s of the model's path
 TOUCHDOWN_MARKERS = 60
@@ -125,9 +127,9 @@ class ChuteScene:
                 name, color=TOUCHDOWN_COLOR, dimensions=(0.006, 0.06, 0.012), position=(0.0, 0.0, 0.0), visible=False
             ),
         )
-        self.jump_trails = NodeRing("/chute/trail/jump_", TRAIL_JUMPS, self._trail_maker(TRAIL_COLOR, 0.002))
+        self.jump_trails = NodeRing("/chute/trail/jump_", TRAIL_JUMPS, hidden_lines(scene, TRAIL_COLOR, 0.002))
         self.ghost_jump_trails = NodeRing(
-            "/chute/ghost/jump_", TRAIL_JUMPS, self._trail_maker(GHOST_TRAIL_COLOR, 0.003)
+            "/chute/ghost/jump_", TRAIL_JUMPS, hidden_lines(scene, GHOST_TRAIL_COLOR, 0.003)
         )
         # Live mode's: its nodes are made when first drawn (none in simulate, replay or a shared file).
         self.live_trail = StreamedTrail(scene, "/chute/trail/live/", LIVE_TRAIL_PIECES, TRAIL_COLOR, 0.003)
@@ -227,13 +229,6 @@ class ChuteScene:
         leg.colors = np.broadcast_to(np.array(energy_color(zeta, self.robot), dtype=np.uint8), segments.shape).copy()
 
     # Jump history -------------------------------------------------------------------------------
-    def _trail_maker(self, color, thickness: float):
-        def make(name: str) -> viser.LineSegmentsHandle:
-            points = np.zeros((1, 2, 3))
-            return self.scene.add_line_segments(name, points=points, colors=color, thickness=thickness, visible=False)
-
-        return make
-
     def add_jump_trail(self, points: np.ndarray) -> None:
         """Keep a finished jump's path drawn (the last TRAIL_JUMPS of them)."""
         if len(points) >= 2:
@@ -260,84 +255,3 @@ class ChuteScene:
         self.trail.points = np.zeros((1, 2, 3))
         self.offset = 0.0
         self.root.position = (0.0, 0.0, 0.0)
-
-
-class NodeRing:
-    """The last ``size`` of a kind of node (touchdown markers, past trails): item ``k`` is drawn by
-    node ``prefix + str(k % size)``, made by ``make(name)`` (hidden) the first time it is needed
-    and reused after; the oldest item's node shows the newest."""
-
-    def __init__(self, prefix: str, size: int, make):
-        self.prefix, self.size, self._make = prefix, size, make
-        self.nodes: list = []
-        self.count = 0  # items shown since the last clear
-
-    def node(self, k: int):
-        """The node that shows item ``k`` (made now if it is new)."""
-        slot = k % self.size
-        while len(self.nodes) <= slot:
-            self.nodes.append(self._make(f"{self.prefix}{len(self.nodes)}"))
-        return self.nodes[slot]
-
-    def show_next(self, **props) -> None:
-        """Show the next item: its node gets ``props`` (``position``, ``points``) and is made visible."""
-        node = self.node(self.count)
-        for name, value in props.items():
-            setattr(node, name, value)
-        node.visible = True
-        self.count += 1
-
-    def clear(self) -> None:
-        for node in self.nodes:
-            node.visible = False
-        self.count = 0
-
-
-class StreamedTrail:
-    """A path drawn as it grows, each point sent to the browser about once (live mode: the
-    robot's tracked path, the ghost's jump under way).
-
-    viser sends a node's whole ``points`` each time they change, so a trail drawn as one node is
-    sent whole every frame, and grows. Here the path is cut into pieces of :data:`PIECE_POINTS`
-    points, each starting at the last point of the one before (the line is unbroken). The piece
-    under way is node ``prefix + "now"``, sent again as it grows (at most PIECE_POINTS - 1
-    segments); a finished piece is shown by a node of a :class:`NodeRing` (``prefix + "piece_k"``)
-    and not sent again: the last ``pieces`` finished pieces stay drawn, the oldest node reused
-    for the newest. Nodes are made when first needed. :meth:`clear` starts afresh.
-    """
-
-    def __init__(self, scene: viser.SceneApi, prefix: str, pieces: int, color, thickness: float):
-        self.scene, self.prefix, self.color, self.thickness = scene, prefix, color, thickness
-        self.finished = NodeRing(f"{prefix}piece_", pieces, self._make)
-        self.now: viser.LineSegmentsHandle | None = None
-        self.piece = np.empty((0, 2))  # the piece under way's points (n, 2) [m]
-
-    def _make(self, name: str) -> viser.LineSegmentsHandle:
-        points = np.zeros((1, 2, 3))
-        return self.scene.add_line_segments(
-            name, points=points, colors=self.color, thickness=self.thickness, visible=False
-        )
-
-    def extend(self, points: np.ndarray) -> None:
-        """Add ``points`` (n, 2) [m, model plane] to the path's end."""
-        if len(points) == 0:
-            return
-        path = np.concatenate([self.piece, np.asarray(points, dtype=float).reshape(-1, 2)])
-        step = PIECE_POINTS - 1
-        done = (len(path) - 1) // step  # pieces finished by these points
-        # Only the last ``size`` of them would stay drawn.
-        for k in range(max(done - self.finished.size, 0), done):
-            self.finished.show_next(points=polyline_segments(path[k * step : (k + 1) * step + 1]))
-        self.piece = path[done * step :]
-        if self.now is None:
-            self.now = self._make(f"{self.prefix}now")
-            self.now.visible = True
-        # One point left: a segment of no length (the next point makes it a line).
-        self.now.points = polyline_segments(self.piece if len(self.piece) >= 2 else self.piece[[0, 0]])
-
-    def clear(self) -> None:
-        """Nothing drawn; the next point starts a new path."""
-        self.finished.clear()
-        self.piece = np.empty((0, 2))
-        if self.now is not None:
-            self.now.points = np.zeros((1, 2, 3))

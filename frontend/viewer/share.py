@@ -34,10 +34,12 @@ import viser
 from backend.settings import LOOPBACK_HOSTS
 from frontend.viewer.geometry import bow_legs, energy_colors, polyline_segments, to_scene
 from frontend.viewer.handshake import refuse_foreign_origins
-from frontend.viewer.motion import STANCE, TRAIL_STRIDE
+from frontend.viewer.motion import TRAIL_STRIDE
+from frontend.viewer.node_rings import NodeRing
 from frontend.viewer.recordings import Recording
-from frontend.viewer.scene import FOLLOW_MARGIN, ChuteScene, NodeRing, place_camera
+from frontend.viewer.scene import FOLLOW_MARGIN, ChuteScene, place_camera
 from frontend.viewer.viser_adapter import NODE_UPDATE, RecordingWriter, embed, serialize
+from sim_core.trajectory import STANCE
 from sim_core.walls import Wall
 
 EXPORT_RATE = 30.0  # frames per second of a shared replay (the browser paints at its own rate)

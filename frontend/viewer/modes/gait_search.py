@@ -4,7 +4,7 @@ worker)."""
 
 from __future__ import annotations
 
-from frontend.viewer.motion import Controls
+from frontend.viewer.simulated_climb import Controls
 from sim_core import ControlSchedule, FixedPoint
 from sim_core.errors import NoGaitFound
 from sim_core.fixed_points import gait_of

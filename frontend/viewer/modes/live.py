@@ -14,8 +14,9 @@ import viser
 from backend.services.view import commanded
 from frontend.viewer.ghost_models import BASE, ghost_model, model_choices, realised
 from frontend.viewer.modes import Mode
-from frontend.viewer.motion import TRAIL_STRIDE, JumpPlan, PathClip, model_jump
+from frontend.viewer.motion import TRAIL_STRIDE, PathClip
 from frontend.viewer.scene import TOUCHDOWN_MARKERS, ChuteScene
+from frontend.viewer.simulated_climb import JumpPlan, model_jump
 
 
 class LiveMode(Mode):

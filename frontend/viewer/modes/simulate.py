@@ -1,6 +1,6 @@
 """Simulate mode: the model climbing in real time with the sliders' controls.
 
-A slider acts from the next touchdown (:class:`frontend.viewer.motion.SimulatedClimb`); the
+A slider acts from the next touchdown (:class:`frontend.viewer.simulated_climb.SimulatedClimb`); the
 readout names the gait of the controls in use, looked for in the background
 (:mod:`frontend.viewer.modes.gait_search`).
 """
@@ -15,9 +15,11 @@ import viser
 
 from frontend.viewer.modes import Mode
 from frontend.viewer.modes.gait_search import CUSTOM, DEFAULT_START, GAIT_PRESETS, find_gait
-from frontend.viewer.motion import STANCE, TRAIL_STRIDE, Controls, SimulatedClimb
+from frontend.viewer.motion import TRAIL_STRIDE
 from frontend.viewer.scene import ChuteScene
+from frontend.viewer.simulated_climb import Controls, SimulatedClimb
 from sim_core import FixedPoint, LegControl, PhysicalParams
+from sim_core.trajectory import STANCE
 
 
 class SimulateMode(Mode):

@@ -1,8 +1,10 @@
 """The 3D view inside the service: a real viser server on a free port, and headless browsers
-(tests/frontend/viewer/headless.py) whose GUI is driven from Python as its callbacks would drive it.
+(tests/frontend/viewer/headless.py) whose GUI is driven from Python as its callbacks would drive it;
+and a private viser server (``server``) for the tests that draw on a scene of their own.
 """
 
 import pytest
+import viser
 from fastapi.testclient import TestClient
 
 from backend.api.app import create_app
@@ -39,3 +41,11 @@ def browsers(service):
     yield open_view
     for browser in opened:
         browser.close()
+
+
+@pytest.fixture
+def server():
+    """A private viser server on a free port, its scene empty: for drawing without the service."""
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    yield server
+    server.stop()

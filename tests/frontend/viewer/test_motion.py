@@ -1,107 +1,19 @@
-"""The view's motion sources agree with the simulator's map, jump for jump."""
+"""Sampled motion (frontend/viewer/motion.py): a clip's pose at any instant, interpolated within a
+phase and clamped to its ends, one instant or many at once; tracker data without legs."""
 
 import math
 
 import numpy as np
 import pytest
-from numpy.testing import assert_allclose
 
-from frontend.viewer.motion import Controls, PathClip, SimulatedClimb, model_jump
-from sim_core import ControlSchedule, LegControl, get_preset, iterate_map
-from sim_core.climb import FLOOR, ClimbEnd, start_height
-from sim_core.walls import Wall, wall_of
+from frontend.viewer.motion import UNKNOWN_PHASE, PathClip
+from frontend.viewer.simulated_climb import Controls, SimulatedClimb
+from sim_core import LegControl, get_preset
+from sim_core.walls import Wall
 
 ROBOT = get_preset("paper")
 PERIOD_1 = LegControl.from_degrees(30, 0.90)
 START = (-0.9339, -0.1661)
-RTOL_MAP = 1e-9  # the view and the map run the same kernel: only sampling differs, not states
-
-
-def _climb(left=PERIOD_1, right=PERIOD_1) -> SimulatedClimb:
-    return SimulatedClimb(Controls(left, right, ROBOT), START)
-
-
-@pytest.mark.parametrize("right", [PERIOD_1, LegControl.from_degrees(30, 0.87)])
-def test_simulated_climb_follows_the_map(right):
-    climb = _climb(PERIOD_1, right)
-    climb.pose_at(6.0)
-    jumps = len(climb.plans) - 1
-    orbit = iterate_map(ROBOT.to_model(), ControlSchedule.of(PERIOD_1, right), START, jumps)
-    assert_allclose([plan.state for plan in climb.plans], orbit.states[: jumps + 1], rtol=RTOL_MAP, atol=1e-12)
-    rises = np.array([plan.rise for plan in climb.plans[:jumps]]) / ROBOT.leg_length
-    assert_allclose(rises, orbit.rises[:jumps], rtol=RTOL_MAP, err_msg="height gain per jump [l0]")
-
-
-def test_jumps_alternate_walls_and_feet_sit_on_them():
-    climb = _climb()
-    climb.pose_at(4.0)
-    half = 0.5 * ROBOT.wall_distance
-    for k, plan in enumerate(climb.plans):
-        assert plan.wall is wall_of(k)
-        assert plan.clip.foot_x[0] == pytest.approx(plan.wall * half), f"jump {k} foot on its wall"
-    first = climb.plans[0].clip
-    assert first.y[0] == pytest.approx(start_height(PERIOD_1, ROBOT)), "the first foot touches at the floor"
-    assert first.foot_y[0] == pytest.approx(FLOOR, abs=1e-12)
-
-
-def test_the_body_moves_continuously_across_touchdowns():
-    climb = _climb()
-    times = np.arange(0.0, 5.0, 1 / 240)
-    body = np.array([(pose.x, pose.y) for pose in map(climb.pose_at, times)])
-    step = np.hypot(*np.diff(body, axis=0).T)
-    assert step.max() < 0.02, "no jumps in the drawn position between frames [m]"
-
-
-def test_a_control_change_shows_from_the_next_touchdown():
-    climb = _climb()
-    first = climb.plans[0]
-    during_stance = 0.5 * (first.clip.start + first.liftoff_time)
-    climb.pose_at(during_stance)
-    deeper = LegControl.from_degrees(30, 0.86)
-    climb.set_controls(Controls(deeper, deeper, ROBOT))
-    climb.pose_at(first.clip.end - 1e-6)
-    assert climb.plans[0].leg == PERIOD_1, "the stance under way keeps its controls"
-    assert climb.plans[0].next_leg == deeper, "the next leg is read at lift-off"
-    assert_allclose(climb.plans[0].clip.x[:10], first.clip.x[:10], err_msg="same stance")
-    climb.pose_at(climb.plans[0].clip.end + 0.01)
-    assert climb.plans[1].leg == deeper
-
-
-def test_a_change_after_liftoff_waits_for_the_jump_after():
-    climb = _climb()
-    first = climb.plans[0]
-    climb.pose_at(first.liftoff_time + 0.01)
-    deeper = LegControl.from_degrees(30, 0.86)
-    climb.set_controls(Controls(deeper, deeper, ROBOT))
-    climb.pose_at(climb.plans[0].clip.end + 0.01)
-    assert climb.plans[1].leg == PERIOD_1, "the leg in flight was set at lift-off"
-    assert climb.plans[1].next_leg == deeper
-
-
-def test_a_failing_climb_stops_and_says_why():
-    weak = LegControl.from_degrees(30, 0.985)  # too little energy to reach the other wall
-    climb = _climb(weak, weak)
-    pose = climb.pose_at(60.0)
-    assert climb.ended
-    assert climb.current.failure is not None
-    assert climb.pose_at(61.0) == pose, "the pose holds after the failure"
-
-
-def test_a_descending_climb_stops_at_the_floor_and_names_it():
-    weak = LegControl.from_degrees(30, 0.99)  # beyond jumping in place: the gait descends
-    climb = _climb(weak, weak)
-    pose = climb.pose_at(120.0)
-    assert climb.ended and climb.current.failure is ClimbEnd.FLOOR
-    assert len(climb.plans) > 1 and all(plan.rise < 0 for plan in climb.plans[:-1]), "it descended"
-    assert pose.y == pytest.approx(FLOOR), "it stops where the body meets the floor"
-    assert min(plan.clip.y.min() for plan in climb.plans) >= FLOOR, "never below it"
-
-
-def test_model_jump_mirrors_on_the_right_wall():
-    left = model_jump(ROBOT, START, PERIOD_1, PERIOD_1, wall=Wall.LEFT, start_time=0.0, start_height=0.2)
-    right = model_jump(ROBOT, START, PERIOD_1, PERIOD_1, wall=Wall.RIGHT, start_time=0.0, start_height=0.2)
-    assert_allclose(right.clip.x, -left.clip.x)
-    assert_allclose(right.clip.y, left.clip.y)
 
 
 def test_path_clip_interpolates_and_clamps():
@@ -114,7 +26,7 @@ def test_path_clip_interpolates_and_clamps():
 
 
 def test_a_clip_sampled_at_many_times_is_its_pose_at_each():
-    climb = _climb(PERIOD_1, LegControl.from_degrees(30, 0.87))
+    climb = SimulatedClimb(Controls(PERIOD_1, LegControl.from_degrees(30, 0.87), ROBOT), START)
     climb.pose_at(3.0)
     clip = climb.plans[2].clip  # a jump: stance then flight, the phases not interpolated across
     times = np.r_[clip.start - 0.1, np.linspace(clip.start, clip.end, 97), clip.time[5], clip.end + 0.1]
@@ -126,3 +38,19 @@ def test_a_clip_sampled_at_many_times_is_its_pose_at_each():
         assert (sampled.phase[k], sampled.leg_wall[k], sampled.jump[k]) == (pose.phase, pose.leg_wall, pose.jump)
     body = PathClip.from_body([0.0, 1.0], [0.0, 1.0], [0.0, 2.0]).sampled_at([0.25, 3.0])
     assert body.y.tolist() == [0.5, 2.0] and np.isnan(body.zeta).all()
+
+
+def test_tracker_frames_are_a_clip_of_the_body_alone():
+    clip = PathClip.from_body([0.0, 0.5, 1.0], [-0.1, 0.0, 0.1], [0.2, 0.3, 0.4], jump=[0, 0, 1])
+    assert (clip.phase == UNKNOWN_PHASE).all() and np.isnan(clip.foot_x).all()
+    assert clip.leg_wall.tolist() == [Wall.RIGHT, Wall.LEFT, Wall.LEFT], "the leg drawn reaches across the chute"
+    assert clip.pose_at(0.75).jump == 0 and clip.pose_at(1.0).jump == 1
+    with pytest.raises(ValueError, match="at least one sample"):
+        PathClip.from_body([], [], [])
+
+
+def test_the_trail_since_an_instant_starts_at_the_sample_before_it():
+    clip = PathClip.from_body([0.0, 1.0, 2.0, 3.0], [0.0, 0.1, 0.2, 0.3], [0.0, 1.0, 2.0, 3.0])
+    assert clip.body_until(2.5, since=1.5).tolist() == [[0.1, 1.0], [0.2, 2.0]], "from the sample at 1 s"
+    assert clip.body_until(2.0).tolist() == [[0.0, 0.0], [0.1, 1.0], [0.2, 2.0]], "from the start"
+    assert (clip.start, clip.end) == (0.0, 3.0)

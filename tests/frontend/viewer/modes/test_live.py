@@ -1,6 +1,7 @@
 """Live mode (frontend/viewer/modes/live.py): the robot as everyone who chooses it sees it, the
 model's ghost beside it (the paper's or a calibration), and its trail: bounded, sent a piece at a
-time (``StreamedTrail``), and drawn afresh at each run's start.
+time (``StreamedTrail``, tested on its own in tests/frontend/viewer/test_node_rings.py), and drawn
+afresh at each run's start.
 
 The first tests run the service with a virtual robot and headless browsers (conftest.py).
 
@@ -18,7 +19,6 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-import pytest
 import viser
 
 from backend.robot.live_run import RunSnapshot
@@ -26,7 +26,8 @@ from backend.robot.touchdown import Touchdown
 from backend.robot.tracker import Calibration, Pose, PoseHistory
 from frontend.viewer.geometry import polyline_segments
 from frontend.viewer.modes.live import LiveMode
-from frontend.viewer.scene import LIVE_TRAIL_PIECES, PIECE_POINTS, ChuteScene, StreamedTrail
+from frontend.viewer.node_rings import PIECE_POINTS
+from frontend.viewer.scene import LIVE_TRAIL_PIECES, ChuteScene
 from sim_core import get_preset
 from sim_core.walls import Wall
 from tests.frontend.viewer.test_share import SceneTree, decode_recording
@@ -206,13 +207,6 @@ def test_the_live_ghost_can_predict_with_a_calibrated_model(service, browsers):
         robot.stop()
 
 
-@pytest.fixture
-def server():
-    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
-    yield server
-    server.stop()
-
-
 def test_the_live_trail_is_bounded_sent_a_piece_at_a_time_and_afresh_at_each_run(server):
     live = Live(server)
     first = live.run(30.0, start_height=0.1)  # 3000 tracker frames: more than the trail keeps
@@ -268,26 +262,3 @@ def test_a_view_that_first_sees_a_run_under_way_draws_it_from_its_first_frame(se
     live.frame()
     scene, _ = live.recorded()[-1]
     assert trail_drawn(scene) == segments_of(path), "the run's own frames, from its first: none from before it"
-
-
-@pytest.mark.parametrize("chunk", [1, 2, 7, PIECE_POINTS - 1, PIECE_POINTS, 100, 5000])
-def test_a_streamed_trail_draws_the_path_however_it_arrives(server, chunk):
-    """Points added one at a time or thousands at once: the same unbroken path, its newest part."""
-    trail = StreamedTrail(server.scene, "/chute/trail/live/", 4, (0, 0, 0), 0.003)
-    path = climb(np.arange(0.0, 7.0, 0.01), 0.1)  # 700 points
-    for start in range(0, len(path), chunk):
-        trail.extend(path[start : start + chunk])
-    shown = trail_drawn(browser_scene(server))
-    assert shown == segments_of(path[-(len(shown) + 1) :])
-    assert 4 * (PIECE_POINTS - 1) <= len(shown) < 5 * (PIECE_POINTS - 1)
-    trail.clear()
-    trail.extend(path[:3])
-    assert trail_drawn(browser_scene(server)) == segments_of(path[:3]), "cleared: the new path alone"
-
-
-def browser_scene(server: viser.ViserServer) -> dict:
-    """The scene a browser that connected now would get."""
-    tree = SceneTree()
-    for _t, message in decode_recording(server.get_scene_serializer().serialize())["messages"]:
-        tree.apply(message)
-    return _copy(tree)

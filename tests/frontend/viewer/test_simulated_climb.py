@@ -1,0 +1,120 @@
+"""The model's motion for the view (frontend/viewer/simulated_climb.py) agrees with the simulator's
+map, jump for jump: the simulated climb's states and rises, its walls and feet, controls read at
+touchdown and lift-off as the robot reads them, and its ends (a failing jump, the floor)."""
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from frontend.viewer.simulated_climb import Controls, SimulatedClimb, model_jump
+from sim_core import ControlSchedule, LegControl, get_preset, iterate_map
+from sim_core.climb import FLOOR, ClimbEnd, start_height
+from sim_core.walls import Wall, wall_of
+
+ROBOT = get_preset("paper")
+PERIOD_1 = LegControl.from_degrees(30, 0.90)
+START = (-0.9339, -0.1661)
+RTOL_MAP = 1e-9  # the view and the map run the same kernel: only sampling differs, not states
+
+
+def _climb(left=PERIOD_1, right=PERIOD_1) -> SimulatedClimb:
+    return SimulatedClimb(Controls(left, right, ROBOT), START)
+
+
+@pytest.mark.parametrize("right", [PERIOD_1, LegControl.from_degrees(30, 0.87)])
+def test_simulated_climb_follows_the_map(right):
+    climb = _climb(PERIOD_1, right)
+    climb.pose_at(6.0)
+    jumps = len(climb.plans) - 1
+    orbit = iterate_map(ROBOT.to_model(), ControlSchedule.of(PERIOD_1, right), START, jumps)
+    assert_allclose([plan.state for plan in climb.plans], orbit.states[: jumps + 1], rtol=RTOL_MAP, atol=1e-12)
+    rises = np.array([plan.rise for plan in climb.plans[:jumps]]) / ROBOT.leg_length
+    assert_allclose(rises, orbit.rises[:jumps], rtol=RTOL_MAP, err_msg="height gain per jump [l0]")
+
+
+def test_jumps_alternate_walls_and_feet_sit_on_them():
+    climb = _climb()
+    climb.pose_at(4.0)
+    half = 0.5 * ROBOT.wall_distance
+    for k, plan in enumerate(climb.plans):
+        assert plan.wall is wall_of(k)
+        assert plan.clip.foot_x[0] == pytest.approx(plan.wall * half), f"jump {k} foot on its wall"
+    first = climb.plans[0].clip
+    assert first.y[0] == pytest.approx(start_height(PERIOD_1, ROBOT)), "the first foot touches at the floor"
+    assert first.foot_y[0] == pytest.approx(FLOOR, abs=1e-12)
+
+
+def test_the_body_moves_continuously_across_touchdowns():
+    climb = _climb()
+    times = np.arange(0.0, 5.0, 1 / 240)
+    body = np.array([(pose.x, pose.y) for pose in map(climb.pose_at, times)])
+    step = np.hypot(*np.diff(body, axis=0).T)
+    assert step.max() < 0.02, "no jumps in the drawn position between frames [m]"
+
+
+def test_a_control_change_shows_from_the_next_touchdown():
+    climb = _climb()
+    first = climb.plans[0]
+    during_stance = 0.5 * (first.clip.start + first.liftoff_time)
+    climb.pose_at(during_stance)
+    deeper = LegControl.from_degrees(30, 0.86)
+    climb.set_controls(Controls(deeper, deeper, ROBOT))
+    climb.pose_at(first.clip.end - 1e-6)
+    assert climb.plans[0].leg == PERIOD_1, "the stance under way keeps its controls"
+    assert climb.plans[0].next_leg == deeper, "the next leg is read at lift-off"
+    assert_allclose(climb.plans[0].clip.x[:10], first.clip.x[:10], err_msg="same stance")
+    climb.pose_at(climb.plans[0].clip.end + 0.01)
+    assert climb.plans[1].leg == deeper
+
+
+def test_a_change_after_liftoff_waits_for_the_jump_after():
+    climb = _climb()
+    first = climb.plans[0]
+    climb.pose_at(first.liftoff_time + 0.01)
+    deeper = LegControl.from_degrees(30, 0.86)
+    climb.set_controls(Controls(deeper, deeper, ROBOT))
+    climb.pose_at(climb.plans[0].clip.end + 0.01)
+    assert climb.plans[1].leg == PERIOD_1, "the leg in flight was set at lift-off"
+    assert climb.plans[1].next_leg == deeper
+
+
+def test_a_failing_climb_stops_and_says_why():
+    weak = LegControl.from_degrees(30, 0.985)  # too little energy to reach the other wall
+    climb = _climb(weak, weak)
+    pose = climb.pose_at(60.0)
+    assert climb.ended
+    assert climb.current.failure is not None
+    assert climb.pose_at(61.0) == pose, "the pose holds after the failure"
+
+
+def test_a_descending_climb_stops_at_the_floor_and_names_it():
+    weak = LegControl.from_degrees(30, 0.99)  # beyond jumping in place: the gait descends
+    climb = _climb(weak, weak)
+    pose = climb.pose_at(120.0)
+    assert climb.ended and climb.current.failure is ClimbEnd.FLOOR
+    assert len(climb.plans) > 1 and all(plan.rise < 0 for plan in climb.plans[:-1]), "it descended"
+    assert pose.y == pytest.approx(FLOOR), "it stops where the body meets the floor"
+    assert min(plan.clip.y.min() for plan in climb.plans) >= FLOOR, "never below it"
+
+
+def test_model_jump_mirrors_on_the_right_wall():
+    left = model_jump(ROBOT, START, PERIOD_1, PERIOD_1, wall=Wall.LEFT, start_time=0.0, start_height=0.2)
+    right = model_jump(ROBOT, START, PERIOD_1, PERIOD_1, wall=Wall.RIGHT, start_time=0.0, start_height=0.2)
+    assert_allclose(right.clip.x, -left.clip.x)
+    assert_allclose(right.clip.y, left.clip.y)
+
+
+def test_each_jump_starts_where_and_when_the_one_before_ends_and_the_last_where_it_stopped():
+    climb = _climb()
+    climb.pose_at(3.0)
+    for plan, after in zip(climb.plans, climb.plans[1:], strict=False):
+        gap = after.clip.start - plan.clip.end  # the touchdown falls between the last sample and the next
+        assert 0.0 < gap < 0.01, f"jump {after.jump.start.jump} starts when the one before touches down"
+        assert plan.next_height == pytest.approx(after.clip.y[0]), "at the body height its jump predicted"
+    weak = LegControl.from_degrees(30, 0.99)  # it descends to the floor
+    ended = _climb(weak, weak)
+    ended.pose_at(120.0)
+    assert ended.current.next_height == pytest.approx(FLOOR), "after the end: where the body stopped"
+    deeper = LegControl.from_degrees(30, 0.86)
+    controls = Controls(PERIOD_1, deeper, ROBOT)
+    assert (controls.leg_for(Wall.LEFT), controls.leg_for(Wall.RIGHT)) == (PERIOD_1, deeper)
