@@ -40,7 +40,7 @@ from sim_core.presets import PRESETS, get_preset
 from sim_core.touchdown_series import TouchdownSeries, finite_rms, pitch_at
 from sim_core.walls import Wall
 
-if TYPE_CHECKING:  # the kernels load in compute workers, not in the service (tests/backend/api/test_startup.py)
+if TYPE_CHECKING:  # the kernels load in compute workers, not in the service (tests/backend/api/test_app.py)
     from sim_core.calibration import CalibrationFit
 
 CALIBRATED_KINDS = ("robot", "replay")

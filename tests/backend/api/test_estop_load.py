@@ -5,7 +5,7 @@ coming back to back — as in the lab when a study runs and the panel is busy: e
 (in the service's worker processes). ``POST /api/v1/robot/estop``, without a token, must still be
 answered and acknowledged by the robot. TestClient would run the app in this process behind its
 own portal; a real server puts uvicorn's one event loop, its sockets and the service's GIL in the
-way, as in the lab. (tests/backend/api/test_robot_api.py holds every request thread inside a
+way, as in the lab. (tests/backend/api/routes/test_robot.py holds every request thread inside a
 route instead, which costs the service nothing; here they compute.)
 
 scripts/bench_estop_api.py measures the latency in these conditions.

@@ -22,7 +22,7 @@ _SETTINGS = Settings.from_environment(_DATA)
 migrate(make_engine(_SETTINGS.database_url))
 _TOKEN, _ = api_token(_DATA)
 # Jobs are stored but not run here (no runner), so fuzzed specs cost no compute.
-# The robot's endpoints open links to real devices and sockets: tests/backend/api/test_robot_api.py
+# The robot's endpoints open links to real devices and sockets: tests/backend/api/routes/test_robot.py
 # drives them against the virtual robot instead of fuzzing them. Without the 3D view (it is the
 # frontend's, started by `parkour serve`) its endpoints answer 503 by design;
 # tests/frontend/viewer/test_view.py drives them with a real view.

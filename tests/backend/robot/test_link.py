@@ -6,7 +6,6 @@ import time
 
 import pytest
 
-from backend.robot.firmware import Firmware
 from backend.robot.link import HEARTBEAT_PERIOD, WRITE_TIMEOUT, EstopLatched, LinkError, LinkState, RobotLink
 from backend.robot.messages import Fault, Kind, Leg, RobotState
 from backend.robot.virtual import VirtualRobot
@@ -101,21 +100,6 @@ def test_killing_the_robot_is_a_lost_link(robot):
 def test_unreachable_robot_is_a_clear_error():
     with pytest.raises(LinkError, match="cannot open"):
         RobotLink("socket://127.0.0.1:9").connect(timeout=0.5)
-
-
-def test_firmware_rules_without_a_network():
-    firmware = Firmware(heartbeat_timeout=0.5)
-    firmware.receive(
-        __import__("backend.robot.messages", fromlist=["Command"]).Command(
-            1, __import__("backend.robot.messages", fromlist=["Kind"]).Kind.ARM
-        ),
-        0.0,
-    )
-    assert firmware.state.name == "ARMED"
-    firmware.tick(0.4)
-    assert firmware.state.name == "ARMED"
-    firmware.tick(0.6)
-    assert firmware.state.name == "DISARMED" and firmware.faults & Fault.HEARTBEAT_LOST
 
 
 @pytest.fixture

@@ -1,6 +1,6 @@
 """The robot service called directly, against the virtual robot: connect, a short live run, replay.
 
-Through the API, tests/backend/api/test_robot_api.py covers e-stop, a lost link and reconnects.
+Through the API, tests/backend/api/routes/test_robot.py covers e-stop, a lost link and reconnects.
 """
 
 import asyncio

@@ -1,10 +1,12 @@
-"""Live runs through the API against the virtual robot: recorded like simulated runs, safe to stop."""
+"""The robot's routes (backend/api/routes/robot.py) against the virtual robot: the token for every call
+but the e-stop, live runs recorded like simulated runs and safe to stop, the live view's stream."""
 
 import socket
 import threading
 import time
 
 import pytest
+from starlette.websockets import WebSocketDisconnect
 
 from backend.api.app import REQUEST_THREADS
 from backend.robot.messages import RobotState
@@ -269,6 +271,18 @@ def test_live_state_streams_over_websocket(client, auth, connected):
     assert len(heights) > 20 and max(heights) > min(heights) + 0.2, "the body climbs on the live view"
     assert touchdowns >= 3
     _finish(client)
+
+
+@pytest.mark.parametrize("rate", ["0", "51", "nan", "fast"])
+def test_the_live_views_rate_is_bounded(client, rate):
+    with pytest.raises(WebSocketDisconnect), client.websocket_connect(f"/api/v1/robot/live?rate={rate}") as live:
+        live.receive_json()
+
+
+def test_the_live_view_streams_without_a_robot(client):
+    with client.websocket_connect("/api/v1/robot/live?rate=50") as live:
+        first, second = live.receive_json(), live.receive_json()
+    assert first["state"] == second["state"] == "disconnected" and first["tracker"] is None
 
 
 def test_the_link_comes_back_after_the_robot_restarts(client, auth, connected):
