@@ -1,11 +1,11 @@
-"""``parkour reproduce``: every figure writes its files, and the paper's claims hold."""
+"""Reproducing the paper (experiments/reproduce.py): every figure writes its files and the report,
+and the paper's claims hold. The command over it is tested in tests/cli/test_reproduce.py; each
+figure's study beside it (tests/experiments/test_fig7.py ...)."""
 
 import json
 
 import pytest
-from typer.testing import CliRunner
 
-from cli.app import app
 from experiments.reproduce import FIGURES, figure_module, figure_names, reproduce
 from sim_core import ParameterError, get_preset
 
@@ -43,12 +43,3 @@ def test_full_reproduction_agrees_with_the_paper(tmp_path):
         claims = json.loads((tmp_path / f"{name}.json").read_text())["claims"]
         failed = [claim for claim in claims if claim["agrees"] is False]
         assert not failed, (name, failed)
-
-
-def test_reproduce_cli(tmp_path):
-    result = CliRunner().invoke(app, ["reproduce", "fig12", "--quick", "--out", str(tmp_path), "--json"])
-    assert result.exit_code == 0, result.output
-    payload = json.loads(result.stdout)
-    assert payload["figures"] == ["fig12"] and str(tmp_path / "report.md") in payload["files"]
-    bad = CliRunner().invoke(app, ["reproduce", "fig13", "--out", str(tmp_path)])
-    assert bad.exit_code == 2 and bad.stderr.startswith("error: figure:")
