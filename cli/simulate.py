@@ -90,7 +90,7 @@ def trajectory_command(
         raise ParameterError("out", f"must end in .csv or .json, got {out.name!r}")
     schedule = parse_controls(controls)
     if state is None:
-        from sim_core.fixed_points import gait_of
+        from sim_core.gait_search import gait_of
 
         gait = gait_of(setup.model, schedule)
         state = tuple(gait.state.tolist())

@@ -15,7 +15,7 @@ from experiments.report import Claim, new_figure
 from sim_core.chunks import ChunkMap, Progress, in_process
 from sim_core.closed_loop import ClosedLoopRun, closed_loop_climb
 from sim_core.controls import ControlSchedule, LegControl
-from sim_core.fixed_points import gait_of
+from sim_core.gait_search import gait_of
 from sim_core.height_controller import HeightController
 from sim_core.noise import NO_NOISE, NoiseModel
 from sim_core.params import ModelParams, PhysicalParams

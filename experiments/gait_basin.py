@@ -11,7 +11,7 @@ from sim_core.basin import Basin, check_convergence_test, compute_basin
 from sim_core.basin_grid import DEFAULT_JUMPS, DEFAULT_TOLERANCE, BasinGrid
 from sim_core.chunks import ChunkMap, Progress, in_process
 from sim_core.controls import ControlSchedule
-from sim_core.fixed_points import gait_of
+from sim_core.gait_search import gait_of
 from sim_core.params import ModelParams
 
 _PLACEHOLDER_WINDOW = ((-2.0, -1.0), (-1.0, 1.0))  # stands in for a default range while the spec is checked
@@ -31,7 +31,7 @@ def gait_basin(
     chunk_map: ChunkMap = in_process,
     progress: Progress | None = None,
 ) -> Basin:
-    """The basin of the gait of ``schedule`` (:func:`sim_core.fixed_points.gait_of`: from ``guess``,
+    """The basin of the gait of ``schedule`` (:func:`sim_core.gait_search.gait_of`: from ``guess``,
     else a grid search) on ``grid`` x ``grid`` cells; the answer holds the gait (``.gait``) and the
     window run (``.grid``).
 

@@ -2,7 +2,7 @@
 
 Per gait the robot was run at, the robot's jumps to failure come from its runs: a run that ended
 in a fall failed after its jumps; one stopped first (its jumps done, a person's stop) is censored —
-it would have gone on. The model's come from MJTF trials (:func:`sim_core.mjtf.run_trials`) of the
+it would have gone on. The model's come from MJTF trials (:func:`sim_core.mjtf_trials.run_trials`) of the
 calibrated model, its legs' offsets applied to the commanded gait, with the noise the calibration
 estimated from the same runs; trials reaching ``cap`` are censored alike.
 
@@ -81,7 +81,7 @@ def simulated(
     """MJTF trials of the gait commanded ``legs`` ((psi0_deg, zeta0) left, right): both legs carry
     the left leg's offset in the schedule, the right leg the difference as the noise's asymmetry."""
     from sim_core import gait_of
-    from sim_core.mjtf import run_trials
+    from sim_core.mjtf_trials import run_trials
     from sim_core.presets import START_GUESS
 
     left = LegOffsets(psi0_offset_deg=(offsets.psi0_offset_deg[0],) * 2, zeta0_offset=(offsets.zeta0_offset[0],) * 2)

@@ -5,10 +5,11 @@ Data flows parameters -> simulate -> analyse:
 - :mod:`sim_core.params`, :mod:`sim_core.presets`, :mod:`sim_core.controls` — what to simulate;
 - :mod:`sim_core.integrate`, :mod:`sim_core.stride` — compiled kernels (stance, one jump, orbits);
 - :mod:`sim_core.poincare`, :mod:`sim_core.trajectory` — the validated map and full paths;
-- :mod:`sim_core.fixed_points` — periodic gaits, their stability, a gait search, and
-  :func:`~sim_core.fixed_points.gait_of`, the gait of a control schedule;
+- :mod:`sim_core.fixed_points`, :mod:`sim_core.gait_search` — periodic gaits and their stability,
+  a gait search, and :func:`~sim_core.gait_search.gait_of`, the gait of a control schedule;
 - :mod:`sim_core.walls`, :mod:`sim_core.climb` — left and right, and the climb jump after jump
-  (the sequencer the 3D view and the virtual robot drive, with the noise and the chute's floor);
+  (the sequencer the 3D view and the virtual robot drive, with the noise and the chute's floor),
+  its records in :mod:`sim_core.climb_records`;
 - :mod:`sim_core.basin`, :mod:`sim_core.sweep`, :mod:`sim_core.atlas`, :mod:`sim_core.mjtf`,
   :mod:`sim_core.closed_loop` (with :mod:`sim_core.noise`) — the lab's studies (docs/analyses.md),
   split into chunks by :mod:`sim_core.chunks`;
@@ -25,8 +26,8 @@ import importlib
 
 # Public name -> the module that defines it.
 _EXPORTS = {
-    "ClimbEnd": "climb",
-    "ClimbSetup": "climb",
+    "ClimbEnd": "climb_records",
+    "ClimbSetup": "climb_records",
     "ControlSchedule": "controls",
     "LegControl": "controls",
     "Failure": "failures",
@@ -37,8 +38,8 @@ _EXPORTS = {
     "find_fixed_point": "fixed_points",
     "map_jacobian": "fixed_points",
     "minimal_period": "fixed_points",
-    "search_gaits": "fixed_points",
-    "gait_of": "fixed_points",
+    "search_gaits": "gait_search",
+    "gait_of": "gait_search",
     "NoGaitFound": "errors",
     "ModelParams": "params",
     "PhysicalParams": "params",

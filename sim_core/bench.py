@@ -21,7 +21,7 @@ import numpy as np
 from sim_core.basin import BasinGrid, compute_basin
 from sim_core.controls import ControlSchedule
 from sim_core.failures import OK
-from sim_core.fixed_points import gait_of
+from sim_core.gait_search import gait_of
 from sim_core.poincare import iterate_map_batch
 from sim_core.presets import PAPER_GAITS, START_GUESS, get_preset
 from sim_core.reference import reference_jumps

@@ -188,7 +188,7 @@ def pid_step(error, previous_error, integral, zeta0_hover, kp, ki, kd, zeta0_min
     return command, integral if pushing_out else integral + error
 
 
-# Flat scalar arguments, in mjtf.trial's order: repeated on purpose (see there).
+# Flat scalar arguments, in mjtf_trials.trial's order: repeated on purpose (see there).
 @kernel
 def pid_loop(
     xdot,

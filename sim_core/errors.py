@@ -33,7 +33,7 @@ class FixedPointNotFound(RuntimeError):
 
 
 class NoGaitFound(FixedPointNotFound):
-    """A grid search found no gait at all (:func:`sim_core.fixed_points.gait_of` without a usable guess).
+    """A grid search found no gait at all (:func:`sim_core.gait_search.gait_of` without a usable guess).
 
     Attributes:
         schedule: the controls searched.

@@ -33,7 +33,7 @@ class TrialChunk:
     seeds: np.ndarray
 
     def arguments(self, model: ModelParams, levels: Sequence, noise: NoiseModel, cap: int) -> tuple:
-        """:func:`sim_core.mjtf.run_trials`' arguments for this chunk; ``levels``: the study's
+        """:func:`sim_core.mjtf_trials.run_trials`' arguments for this chunk; ``levels``: the study's
         :class:`~sim_core.mjtf.LevelStart` (schedule and start state of each)."""
         start = levels[self.level]
         return model, start.schedule, start.start, noise, self.seeds, cap

@@ -23,7 +23,8 @@ from sim_core.basin import NOT_CONVERGED, converge_states
 from sim_core.basin_grid import DEFAULT_JUMPS, DEFAULT_TOLERANCE, BasinGrid
 from sim_core.chunks import ChunkMap, Progress, in_process
 from sim_core.controls import ControlSchedule, LegControl
-from sim_core.fixed_points import FixedPoint, FixedPointNotFound, find_fixed_point, gait_of
+from sim_core.fixed_points import FixedPoint, FixedPointNotFound, find_fixed_point
+from sim_core.gait_search import gait_of
 from sim_core.params import ModelParams
 from sim_core.validation import ParameterError, check_range
 

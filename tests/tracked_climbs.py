@@ -11,7 +11,8 @@ import numpy as np
 
 from backend.robot.touchdown import Touchdown, detect_touchdowns
 from sim_core import ControlSchedule, LegControl, PhysicalParams, gait_of, get_preset
-from sim_core.climb import ClimbSetup, simulate_climb
+from sim_core.climb import simulate_climb
+from sim_core.climb_records import ClimbSetup
 from sim_core.controls import LegOffsets
 from sim_core.errors import FixedPointNotFound
 from sim_core.noise import NoiseModel

@@ -10,7 +10,7 @@ dropped frames, as PKT1 datagrams or, with ``tracker_protocol="natnet"``, as the
 NatNet frames (:mod:`backend.robot.natnet_frame`: one rigid body, the table plane its x–y plane, the
 pitch its rotation about z). Each stance is streamed before the next leg is read, as the real robot positions
 that leg during the stance. The climb ends when a jump fails (slip, no flight, ...) or the body
-reaches the chute's floor (:data:`sim_core.climb.FLOOR`, where the first foot touches): the
+reaches the chute's floor (:data:`sim_core.climb_records.FLOOR`, where the first foot touches): the
 robot falls and reports it, and :attr:`Climber.end` says why.
 """
 
@@ -28,7 +28,7 @@ from backend.robot.natnet import parse_version
 from backend.robot.natnet_frame import RigidBody, encode_frame, quaternion_about_z
 from backend.robot.tracker import Pose, encode_datagram
 from sim_core import ControlSchedule, LegControl, PhysicalParams, climb, gait_of, get_preset
-from sim_core.climb import ClimbSetup, End, Samples
+from sim_core.climb_records import ClimbSetup, End, Samples
 from sim_core.controls import NO_OFFSETS, LegOffsets
 from sim_core.errors import FixedPointNotFound, ParameterError
 from sim_core.noise import NoiseModel

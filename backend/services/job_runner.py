@@ -129,7 +129,8 @@ class JobRunner:
 
     def _run_mjtf(self, job_id: int, spec: MJTFSpec) -> None:
         """The study's trials not stored yet, chunk by chunk as sim_core plans them."""
-        from sim_core.mjtf import level_starts, run_trials  # the kernels load with the first job (simulation.py)
+        from sim_core.mjtf import level_starts  # the kernels load with the first job (simulation.py)
+        from sim_core.mjtf_trials import run_trials
 
         model, noise = model_params(spec.model), spec.noise.model()
         guess = None if spec.guess is None else (spec.guess.xdot, spec.guess.ydot)

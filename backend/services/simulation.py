@@ -69,7 +69,7 @@ def warm_up() -> None:
     """Load the kernels a first request needs (from numba's cache, or compiled once) and scipy's
     solver: one short map, path and gait, off the request path."""
     with KERNEL_LOCK:
-        from sim_core.fixed_points import gait_of
+        from sim_core.gait_search import gait_of
         from sim_core.trajectory import simulate_trajectory
 
         model, schedule = get_preset("paper").to_model(), ControlSchedule.from_degrees([(30.0, 0.9)])
@@ -124,9 +124,9 @@ def fixed_point(body: FixedPointIn) -> dict:
 
 
 def _gait_of(model: ModelParams, schedule: ControlSchedule, period: int | None, guess) -> FixedPoint:
-    """:func:`sim_core.fixed_points.gait_of` for a request. ``guess`` is the request's state
+    """:func:`sim_core.gait_search.gait_of` for a request. ``guess`` is the request's state
     (``xdot``, ``ydot``) or None."""
-    from sim_core.fixed_points import gait_of
+    from sim_core.gait_search import gait_of
 
     with _no_gait_is_a_parameter_error():
         return gait_of(model, schedule, period, None if guess is None else (guess.xdot, guess.ydot))
@@ -154,7 +154,7 @@ def run_study_here(spec) -> dict:
 
 def run_study(spec, chunk_map, progress) -> dict:
     """A sweep, basin or gait-search job's computation; returns its JSON result."""
-    from sim_core.fixed_points import search_gaits
+    from sim_core.gait_search import search_gaits
     from sim_core.sweep import energy_sweep, zeta0_values
 
     model = model_params(spec.model)
@@ -233,7 +233,7 @@ def simulate_run(body: RunCreate) -> RunRecord:
 
 def _gait_near(model, schedule, start) -> dict:
     """The period-m gait nearest the start state (m: the schedule length), or why there is none."""
-    from sim_core.fixed_points import gait_of
+    from sim_core.gait_search import gait_of
 
     try:
         with KERNEL_LOCK:

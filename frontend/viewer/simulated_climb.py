@@ -21,14 +21,14 @@ import numpy as np
 
 from frontend.viewer.motion import PathClip, Pose
 from sim_core import LegControl, PhysicalParams, climb
-from sim_core.climb import ClimbSetup, End, Jump, JumpStart, NextLeg, Samples
+from sim_core.climb_records import ClimbSetup, End, Jump, JumpStart, NextLeg, Samples
 from sim_core.trajectory import STANCE
 from sim_core.walls import Wall
 
 
 @dataclass(frozen=True)
 class JumpPlan:
-    """One simulated jump (:class:`sim_core.climb.Jump`) and its clip, for drawing.
+    """One simulated jump (:class:`sim_core.climb_records.Jump`) and its clip, for drawing.
 
     Attributes:
         jump: the sequencer's jump: its touchdown, the leg in flight, how it ended.

@@ -11,7 +11,7 @@ from sim_core.basin import compute_basin
 from sim_core.basin_grid import BasinGrid
 from sim_core.controls import ControlSchedule
 from sim_core.errors import NoGaitFound, ParameterError
-from sim_core.fixed_points import gait_of
+from sim_core.gait_search import gait_of
 from sim_core.presets import START_GUESS, get_preset
 
 MODEL = get_preset("paper").to_model()

@@ -1,4 +1,5 @@
-"""The climb sequencer (sim_core.climb): walls and legs, the next leg at lift-off, noise, the floor."""
+"""The climb sequencer (sim_core.climb): walls and legs, the next leg at lift-off, noise, the floor
+(its records: test_climb_records.py)."""
 
 import dataclasses
 import math
@@ -9,10 +10,6 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from sim_core import ControlSchedule, LegControl, get_preset, simulate_trajectory
 from sim_core.climb import (
-    FLOOR,
-    ClimbEnd,
-    ClimbSetup,
-    NextLeg,
     jump,
     launch,
     read_next_leg,
@@ -22,6 +19,7 @@ from sim_core.climb import (
     start_height,
     touchdown_after,
 )
+from sim_core.climb_records import FLOOR, ClimbEnd, ClimbSetup, NextLeg
 from sim_core.failures import Failure
 from sim_core.noise import NoiseModel
 from sim_core.noise_rules import NoiseSampler
@@ -116,7 +114,6 @@ def test_a_descending_climb_ends_at_the_floor():
     assert all(j.rise < 0 for j in jumps[:-1]), "it descends"
     last = jumps[-1]
     assert last.end is ClimbEnd.FLOOR and len(jumps) < 100
-    assert (last.end.code, last.end.message) == ("floor", "the body reached the chute's floor")
     y = np.concatenate([j.samples.y for j in jumps])
     assert y.min() >= FLOOR, "no sample below the floor"
     assert last.samples.y[-1] == FLOOR, "the last sample is where the body meets the floor"

@@ -1,8 +1,8 @@
-"""MJTF Monte-Carlo: seeded and worker-independent, noise-free runs survive, Fig. 11's trend."""
+"""MJTF Monte-Carlo studies: seeded and chunk-independent, noise-free runs survive, Fig. 11's trend
+(the compiled trials: test_mjtf_trials.py)."""
 
 import math
 
-import numba
 import numpy as np
 import pytest
 
@@ -21,15 +21,12 @@ def _study(paper, **options):
     return mjtf_study(paper, PSI0, zeta0s, **settings)
 
 
-def test_same_seed_same_numbers_on_any_number_of_threads(paper):
-    threads = numba.get_num_threads()
+def test_same_seed_same_numbers_however_the_trials_are_chunked(paper):
+    """Each trial's seed is fixed by (seed, level, index): the chunks do not change the numbers
+    (the threads neither: test_mjtf_trials.py)."""
     first = _study(paper)
-    numba.set_num_threads(1)
-    try:
-        single = _study(paper)
-    finally:
-        numba.set_num_threads(threads)
-    for a, b in zip(first.levels, single.levels, strict=True):
+    split = _study(paper, chunk_trials=5)
+    for a, b in zip(first.levels, split.levels, strict=True):
         np.testing.assert_array_equal(a.jumps, b.jumps)
         np.testing.assert_array_equal(a.status, b.status)
     other_seed = _study(paper, seed=8)

@@ -7,7 +7,7 @@ from __future__ import annotations
 from frontend.viewer.simulated_climb import Controls
 from sim_core import ControlSchedule, FixedPoint
 from sim_core.errors import NoGaitFound
-from sim_core.fixed_points import gait_of
+from sim_core.gait_search import gait_of
 from sim_core.presets import PAPER_GAITS, START_GUESS
 
 

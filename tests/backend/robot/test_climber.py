@@ -18,7 +18,7 @@ from backend.robot.touchdown import detect_touchdowns, height_gains
 from backend.robot.tracker import UdpPoseSource, decode_datagram
 from backend.robot.virtual import VirtualRobot
 from sim_core import ClimbEnd, ControlSchedule, LegControl, PhysicalParams, get_preset, iterate_map
-from sim_core.climb import FLOOR
+from sim_core.climb_records import FLOOR
 from sim_core.controls import LegOffsets
 from sim_core.errors import ParameterError
 from sim_core.noise import NO_NOISE, NoiseModel

@@ -8,7 +8,8 @@ from numpy.testing import assert_allclose
 
 from frontend.viewer.simulated_climb import Controls, SimulatedClimb, model_jump
 from sim_core import ControlSchedule, LegControl, get_preset, iterate_map
-from sim_core.climb import FLOOR, ClimbEnd, start_height
+from sim_core.climb import start_height
+from sim_core.climb_records import FLOOR, ClimbEnd
 from sim_core.walls import Wall, wall_of
 
 ROBOT = get_preset("paper")

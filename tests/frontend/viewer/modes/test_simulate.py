@@ -5,7 +5,7 @@ readout, and a climb that ends at the floor."""
 import pytest
 
 from frontend.viewer.modes.gait_search import GAIT_PRESETS
-from sim_core.climb import ClimbEnd
+from sim_core.climb_records import ClimbEnd
 from tests.frontend.viewer.view_service import wait_for
 
 
