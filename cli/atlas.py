@@ -8,7 +8,16 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from cli.options import JsonOption, ModelSetup, SchedulerOption, handles_errors, note, print_json, with_model
+from cli.options import (
+    JsonOption,
+    ModelSetup,
+    SchedulerOption,
+    handles_errors,
+    note,
+    option_named,
+    print_json,
+    with_model,
+)
 from cli.studies import run_study
 from sim_core.controls import ControlSchedule
 from sim_core.errors import ParameterError
@@ -49,13 +58,15 @@ def atlas_command(
     rows_count, columns_count = grid
     if plot is not None and plot.suffix not in (".png", ".svg"):
         raise ParameterError("plot", f"must end in .png or .svg, got {plot.name!r}")
-    columns = zeta0_values(*zeta0_range, columns_count)
+    with option_named("--grid COLUMNS", "steps"):
+        columns = zeta0_values(*zeta0_range, columns_count)
     if pair is None:
         rows = _degrees_values("psi0_range", psi0_range, rows_count)
         schedules = [ControlSchedule.from_degrees([(psi0, zeta0)]) for psi0 in rows for zeta0 in columns]
         labels = ("psi0 [deg]", "zeta0 [l0]")
     else:
-        rows = zeta0_values(*zeta0_range, rows_count)
+        with option_named("--grid ROWS", "steps"):
+            rows = zeta0_values(*zeta0_range, rows_count)
         schedules = [
             ControlSchedule.from_degrees([(pair[0], zeta0_left), (pair[1], zeta0_right)])
             for zeta0_left in rows
@@ -93,6 +104,8 @@ def atlas_command(
 
 def _degrees_values(field: str, interval: tuple[float, float], count: int) -> np.ndarray:
     low, high = (check_range(field, value, 0.0, 90.0) for value in interval)
-    if not low < high or not 2 <= count <= 1000:
-        raise ParameterError(field, f"needs low < high and 2 to 1000 values, got [{low:g}, {high:g}] x {count}")
+    if not low < high:
+        raise ParameterError(field, f"must be a non-empty interval with low < high, got [{low:g}, {high:g}]")
+    if not 2 <= count <= 1000:
+        raise ParameterError("--grid ROWS", f"must be an integer in [2, 1000], got {count}")
     return np.linspace(low, high, count)

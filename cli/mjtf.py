@@ -13,6 +13,7 @@ from cli.options import (
     SchedulerOption,
     SeedOption,
     handles_errors,
+    option_named,
     print_json,
     with_model,
     with_noise,
@@ -49,7 +50,8 @@ def mjtf_command(
     from sim_core.mjtf import CAPPED, check_trials, mjtf_study
     from sim_core.sweep import zeta0_values
 
-    zeta0s = zeta0_values(*zeta0_range, levels)
+    with option_named("--levels", "steps"):
+        zeta0s = zeta0_values(*zeta0_range, levels)
     check_trials(trials, cap)
     study = over_zeta0(
         mjtf_study,

@@ -200,6 +200,19 @@ def _with_options(command: Callable, name: str, options: list[inspect.Parameter]
     return wrapper
 
 
+@contextmanager
+def option_named(option: str, *fields: str) -> Iterator[None]:
+    """A ParameterError about one of ``fields`` (a library's name for it) said about the user's
+    ``option`` instead: ``parkour mjtf --levels 1`` is told "--levels: must be …", not "steps:
+    …", which names no option of the command."""
+    try:
+        yield
+    except ParameterError as error:
+        if error.field not in fields:
+            raise
+        raise ParameterError(option, error.message) from None
+
+
 def handles_errors(command: Callable) -> Callable:
     """Turn errors the user can fix into one line on stderr and exit code 2."""
 

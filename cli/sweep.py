@@ -12,6 +12,7 @@ from cli.options import (
     ModelSetup,
     SchedulerOption,
     handles_errors,
+    option_named,
     print_json,
     with_model,
 )
@@ -49,7 +50,8 @@ def sweep_command(
 
     zeta0s = zeta0_values(*zeta0_range, steps)
     fixed = fixed_leg_of(fixed_leg)
-    grid = None if basin_grid == 0 else BasinGrid(*DEFAULT_BASIN_WINDOW, basin_grid)
+    with option_named("--basin-grid", "grid"):
+        grid = None if basin_grid == 0 else BasinGrid(*DEFAULT_BASIN_WINDOW, basin_grid)
     check_convergence_test(basin_jumps, DEFAULT_TOLERANCE)
     sweep = over_zeta0(
         energy_sweep,
