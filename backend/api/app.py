@@ -110,8 +110,10 @@ def create_app(
         docs_url=None,  # served by routes/site.py from local assets: the lab has no internet at run time
         redoc_url=None,
     )
-    app.mount("/static/swagger", StaticFiles(directory=site.SWAGGER_ASSETS), name="swagger")
-    app.mount("/panel", StaticFiles(directory=PANEL_DIR, html=True), name="panel")
+    # Static assets go compressed to a browser that takes gzip (Plotly, the largest, from a copy
+    # compressed once: routes/site.py); the API's responses and its event streams do not pass here.
+    app.mount("/static/swagger", site.compressed(StaticFiles(directory=site.SWAGGER_ASSETS)), name="swagger")
+    app.mount("/panel", site.compressed(StaticFiles(directory=PANEL_DIR, html=True)), name="panel")
     app.state.settings = settings
     app.state.sessions = sessions
     app.state.database = Database(sessions)

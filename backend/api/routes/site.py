@@ -1,16 +1,28 @@
-"""The service itself: health, the panel's entry, local copies of Plotly and the API docs."""
+"""The service itself: health, the panel's entry, local copies of Plotly and the API docs.
+
+Static assets go gzip-compressed to a browser that takes it: Plotly (4.8 MB, 1.4 MB compressed)
+from a copy compressed once, at its first request; the panel's and the docs' files through
+:func:`compressed` (Starlette's GZipMiddleware around their mounts only, so no API response or
+event stream is buffered or compressed).
+"""
 
 from __future__ import annotations
 
+import functools
+import gzip
+import hashlib
 import html
 import json
 from pathlib import Path
 
+import anyio.to_thread
 import fastapi_offline
 import plotly
 from fastapi import APIRouter, Request
 from fastapi.openapi.docs import swagger_ui_default_parameters
 from fastapi.responses import FileResponse, HTMLResponse, RedirectResponse, Response
+from starlette.middleware.gzip import GZipMiddleware
+from starlette.types import ASGIApp
 
 from backend import schemas
 from backend.api.deps import AUTHORIZED, Db
@@ -28,9 +40,46 @@ def index() -> RedirectResponse:
     return RedirectResponse("/panel/")
 
 
+COMPRESS_FROM_BYTES = 1024  # smaller files go as they are: gzip saves too little on them
+VARY = {"Vary": "Accept-Encoding"}  # a cache keeps the compressed and the plain answer apart
+
+
+def compressed(app: ASGIApp) -> ASGIApp:
+    """Static files ``app`` (a mount) answering gzip to a browser that takes it."""
+    return GZipMiddleware(app, minimum_size=COMPRESS_FROM_BYTES, compresslevel=6)
+
+
+def takes_gzip(accept_encoding: str | None) -> bool:
+    """Whether an ``Accept-Encoding`` header takes gzip (``gzip`` or ``*``, not at q=0)."""
+    for part in (accept_encoding or "").lower().split(","):
+        coding, *params = (piece.strip() for piece in part.split(";"))
+        if coding in ("gzip", "*"):
+            quality = next((param[2:] for param in params if param.startswith("q=")), "1")
+            try:
+                return float(quality) > 0
+            except ValueError:
+                return False
+    return False
+
+
+@functools.cache
+def _gzipped(path: Path) -> tuple[bytes, str]:
+    """``path`` compressed (at gzip's best: made once, sent many times) and its ETag."""
+    data = path.read_bytes()
+    return gzip.compress(data, compresslevel=9, mtime=0), f'"{hashlib.sha256(data).hexdigest()[:32]}-gz"'
+
+
 @router.get("/static/plotly.min.js", include_in_schema=False)
-def plotly_js() -> FileResponse:
-    return FileResponse(PLOTLY_JS, media_type="text/javascript")
+async def plotly_js(request: Request) -> Response:
+    """Plotly, compressed once and kept (a request waits for that once, in a thread), or as it
+    is to a client that does not take gzip."""
+    if not takes_gzip(request.headers.get("accept-encoding")):
+        return FileResponse(PLOTLY_JS, media_type="text/javascript", headers=VARY)
+    body, etag = await anyio.to_thread.run_sync(_gzipped, PLOTLY_JS)
+    headers = {**VARY, "ETag": etag, "Cache-Control": "no-cache"}  # revalidated: a 304 costs no bytes
+    if etag in request.headers.get("if-none-match", ""):
+        return Response(status_code=304, headers=headers)
+    return Response(body, media_type="text/javascript", headers={**headers, "Content-Encoding": "gzip"})
 
 
 # Swagger UI's page with its start-up script in a file of its own, not inline (FastAPI's
@@ -73,8 +122,14 @@ def swagger_init(request: Request) -> Response:
 
 
 @router.get("/api/v1/health", tags=["service"], response_model=schemas.Health)
-async def health(db: Db) -> schemas.Health:
-    return schemas.Health(status="ok", database=await db(ping), code_version=simulation.current_code_version())
+async def health(db: Db, request: Request) -> schemas.Health:
+    """Up, on which database; ``notices`` says what it waits for (a full disk: the writes that wait)."""
+    return schemas.Health(
+        status="ok",
+        database=await db(ping),
+        code_version=simulation.current_code_version(),
+        notices=list(request.app.state.waiting.notices()),
+    )
 
 
 @router.get("/api/v1/auth", tags=["service"], dependencies=AUTHORIZED, response_model=schemas.TokenAccepted)

@@ -95,6 +95,7 @@ def test_the_first_event_is_the_robot_now_and_the_stream_is_held_to_the_security
             headers = events.response.headers
             assert events.response.status_code == 200
             assert headers["content-type"].startswith("text/event-stream")
+            assert "content-encoding" not in headers, "not compressed (httpx takes gzip): nothing held back"
             assert headers["cache-control"] == "no-cache" and headers["x-content-type-options"] == "nosniff"
             assert "script-src 'self'" in headers["content-security-policy"]
             first = events.next()
