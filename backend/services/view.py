@@ -13,6 +13,7 @@ and :func:`commanded` (a live run's command for a leg, named by its wall).
 
 from __future__ import annotations
 
+import datetime
 import logging
 import threading
 import zlib
@@ -80,6 +81,8 @@ class StoredPath:
             source run; None when none was stored.
         touchdowns: the touchdowns found live (``time`` [s], ``wall``, ``foot_height`` [m]) of a
             robot or replay run; empty for a sim run.
+        jumps_completed, climb: how far it went: jumps done, height gained [l0] (None: not read).
+        created_at: when it was stored (UTC; None: not read).
     """
 
     run_id: int
@@ -90,6 +93,9 @@ class StoredPath:
     jumps: int
     path: dict[str, np.ndarray] | None
     touchdowns: list[dict]
+    jumps_completed: int | None = None
+    climb: float | None = None
+    created_at: datetime.datetime | None = None
 
 
 def stored_path(sessions: Callable, run_id: int) -> StoredPath:
@@ -104,7 +110,10 @@ def stored_path(sessions: Callable, run_id: int) -> StoredPath:
             raise Conflict(f"run {run_id} has no tracker frames to replay")
         path = None if source.trajectory is None else unpack_trajectory(source.trajectory)
         touchdowns = [] if run.kind == "sim" else list(run.results.get("touchdowns", []))
-        return StoredPath(run.id, run.kind, run.model, run.controls, run.start_state, run.jumps, path, touchdowns)
+        return StoredPath(
+            run.id, run.kind, run.model, run.controls, run.start_state, run.jumps, path, touchdowns,
+            jumps_completed=run.jumps_completed, climb=run.climb, created_at=run.created_at,
+        )  # fmt: skip
 
 
 def stored_path_key(sessions: Callable, run_id: int) -> tuple:

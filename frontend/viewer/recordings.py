@@ -13,6 +13,7 @@ first foot touches at the floor.
 
 from __future__ import annotations
 
+import datetime
 import math
 from dataclasses import dataclass
 
@@ -39,6 +40,7 @@ class Recording:
 
     Attributes:
         run_id, kind, label: which run, and a line that names it.
+        description: a sentence that tells what the run was (controls, jumps, climb, date), as text.
         clip: the path, time from 0 at the start of the run.
         robot: the robot it is shown at (walls, leg length, energy colours).
         legs: the left and right legs' controls (the idle leg's pose), or None for tracker data.
@@ -52,6 +54,7 @@ class Recording:
     robot: PhysicalParams
     legs: tuple[LegControl, LegControl] | None
     touchdowns: np.ndarray
+    description: str = ""
 
     @property
     def duration(self) -> float:
@@ -120,6 +123,32 @@ def _label(run: StoredPath) -> str:
     return f"run {run.run_id} ({run.kind}, {controls})"
 
 
+KIND_WORDS = {"sim": "simulated", "robot": "on the robot", "replay": "a robot run analysed again"}
+
+
+def _controls_words(controls: list) -> str:
+    """A control schedule as the panel says it: one pair for both legs, two for left and right."""
+    pairs = [f"psi0 {psi:g}°, zeta0 {zeta:g} l0" for psi, zeta in controls]
+    if len(pairs) == 1:
+        return f"both legs {pairs[0]}"
+    if len(pairs) == 2:
+        return f"left {pairs[0]}; right {pairs[1]}"
+    return "jump by jump in turn " + "; ".join(pairs)
+
+
+def describe(run: StoredPath) -> str:
+    """What run ``run`` was, in a sentence: its kind, controls, jumps, climb and date."""
+    controls = _controls_words(run.controls)
+    done = "" if run.jumps_completed is None else f", {run.jumps_completed} done"
+    parts = [f"ParkourLab run {run.run_id}, {KIND_WORDS.get(run.kind, run.kind)}", controls, f"{run.jumps} jumps{done}"]
+    if run.climb is not None:
+        parts.append(f"climb {run.climb:.3f} l0")
+    if run.created_at is not None:
+        when = run.created_at if run.created_at.tzinfo else run.created_at.replace(tzinfo=datetime.UTC)
+        parts.append(f"stored {when.astimezone(datetime.UTC):%Y-%m-%d %H:%M} UTC")
+    return ": ".join(parts[:2]) + "; " + "; ".join(parts[2:]) + "."
+
+
 def _sim_recording(run: StoredPath) -> Recording:
     paper = get_preset("paper")
     robot = PhysicalParams.from_model(
@@ -152,7 +181,7 @@ def _sim_recording(run: StoredPath) -> Recording:
     )
     stance_starts = np.flatnonzero((phase == STANCE) & np.r_[True, np.diff(jump) != 0])
     touchdowns = np.column_stack([clip.time[stance_starts], clip.leg_wall[stance_starts], clip.foot_y[stance_starts]])
-    return Recording(run.run_id, run.kind, _label(run), clip, robot, _legs(run), touchdowns)
+    return Recording(run.run_id, run.kind, _label(run), clip, robot, _legs(run), touchdowns, describe(run))
 
 
 def _tracker_recording(run: StoredPath) -> Recording:
@@ -162,4 +191,4 @@ def _tracker_recording(run: StoredPath) -> Recording:
     t0 = float(frames["time"][0])
     clip = PathClip.from_body(frames["time"] - t0, frames["x"], frames["y"])
     touchdowns = np.array([[td["time"] - t0, td["wall"], td["foot_height"]] for td in run.touchdowns]).reshape(-1, 3)
-    return Recording(run.run_id, run.kind, _label(run), clip, get_preset("paper"), None, touchdowns)
+    return Recording(run.run_id, run.kind, _label(run), clip, get_preset("paper"), None, touchdowns, describe(run))

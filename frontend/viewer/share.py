@@ -56,6 +56,16 @@ def share_html(
         return _recorded_html(recording, overlay, tuple(allowed_hosts))
 
 
+def page_text(recording: Recording, overlay: Recording | None = None) -> dict[str, str]:
+    """The file's title (what a browser's tab and a mail's attachment list show) and description
+    (its summary, shown over the scene too): the run's, as text; :func:`embed` escapes them."""
+    title = f"ParkourLab {recording.label}" + (f", ghost {overlay.label}" if overlay else "")
+    description = recording.description or f"ParkourLab {recording.label}."
+    if overlay is not None:
+        description += f" Ghost: {overlay.description or overlay.label}"
+    return {"title": title, "description": description}
+
+
 def frame_times(recording: Recording, overlay: Recording | None = None) -> np.ndarray:
     """[s] the instants the file shows: every 1/EXPORT_RATE s from 0 past the end of the longer run."""
     end = min(max(recording.duration, overlay.duration if overlay else 0.0), MAX_EXPORT_SECONDS)
@@ -75,7 +85,7 @@ def _recorded_html(recording: Recording, overlay: Recording | None, allowed_host
         out = RecordingWriter(serializer, len(times))
         record(scene, out, recording, overlay, times)
         out.finish(times, duration=len(times) / EXPORT_RATE)
-        return embed(serialize(serializer, ZSTD_LEVEL))
+        return embed(serialize(serializer, ZSTD_LEVEL), **page_text(recording, overlay))
     finally:
         server.stop()
 

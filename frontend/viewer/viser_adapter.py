@@ -18,6 +18,8 @@ test_viser_adapter.py pins the version and checks each against viser's own behav
 from __future__ import annotations
 
 import base64
+import html
+import re
 from pathlib import Path
 from typing import Any
 
@@ -218,9 +220,27 @@ def serialize(serializer, level: int) -> bytes:
     return b"".join(out)
 
 
-def embed(recording: bytes) -> str:
-    """viser's single-file client with ``recording`` inside, as ``StateSerializer.as_html`` makes it."""
+# A shared file's caption: the run's description over the scene, top left (the file opens from
+# disk, under no policy: an inline style is fine there).
+CAPTION = (
+    '<div id="parkourlab-caption" style="position:fixed;top:.5rem;left:.5rem;z-index:1000;max-width:40rem;'
+    "padding:.3rem .6rem;border-radius:4px;background:#fffd;color:#23303c;font:13px/1.35 system-ui,sans-serif;"
+    'pointer-events:none">{text}</div>'
+)
+
+
+def embed(recording: bytes, *, title: str | None = None, description: str | None = None) -> str:
+    """viser's single-file client with ``recording`` inside, as ``StateSerializer.as_html`` makes it;
+    with ``title`` and ``description`` (text, escaped here) in place of the client's own ("Viser",
+    "Viser client"), the description also shown over the scene."""
     client = CLIENT_HTML.read_text()
+    if title is not None:
+        client = re.sub(r"<title>[^<]*</title>", lambda _: f"<title>{html.escape(title)}</title>", client, count=1)
+    if description is not None:
+        meta = f'<meta name="description" content="{html.escape(description, quote=True)}" />'
+        client = re.sub(r'<meta name="description"[^>]*>', lambda _: meta, client, count=1)
+        body = client.index("<body>") + len("<body>")
+        client = client[:body] + CAPTION.format(text=html.escape(description)) + client[body:]
     data = base64.b64encode(recording).decode("ascii")
     script = f'<script>window.__VISER_EMBED_DATA__="{data}";window.__VISER_EMBED_CONFIG__={{darkMode:false}};</script>'
     head_end = client.index("</head>")
@@ -253,8 +273,9 @@ def missing(server: viser.ViserServer) -> list[str]:
         value = getattr(owner, name, _GONE)
         if value is _GONE or not isinstance(value, kind):
             gone.append(f"{type(owner).__name__}.{name}")
-    if not CLIENT_HTML.is_file() or "</head>" not in CLIENT_HTML.read_text():
-        gone.append(f"the single-file client at {CLIENT_HTML}")
+    client = CLIENT_HTML.read_text() if CLIENT_HTML.is_file() else ""
+    if not all(part in client for part in ("</head>", "<body>", "<title>", '<meta name="description"')):
+        gone.append(f"the single-file client at {CLIENT_HTML} (its head, body, title and description)")
     with_handler = getattr(serializer, "_handler", None)
     if with_handler is not None and serializer in getattr(with_handler, "_record_handles", ()):
         with_handler._record_handles.remove(serializer)

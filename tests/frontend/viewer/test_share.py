@@ -236,3 +236,41 @@ def test_a_run_longer_than_ten_minutes_is_cut_at_ten(runs):
 
 def _slowed(clip, factor):
     return type(clip)(**{name: getattr(clip, name) * (factor if name == "time" else 1) for name in clip.COLUMNS})
+
+
+# What the file says it is ------------------------------------------------------------------------
+def _head(html: str) -> tuple[str, str, str]:
+    """The file's title, its description and the caption over its scene, as written (escaped)."""
+    title = re.search(r"<title>([^<]*)</title>", html).group(1)
+    description = re.search(r'<meta name="description" content="([^"]*)"', html).group(1)
+    caption = re.search(r'<div id="parkourlab-caption"[^>]*>([^<]*)</div>', html).group(1)
+    return title, description, caption
+
+
+def test_the_file_is_titled_and_described_by_its_run(runs):
+    """It was titled "Viser" and described as "Viser client": a file mailed or kept said nothing of
+    the run. Now its title names the run and its description (shown over the scene too) says its
+    id, kind, controls, jumps, climb and date."""
+    recording = runs["sim"]
+    title, description, caption = _head(share.share_html(recording))
+    assert title == f"ParkourLab run {recording.run_id} (sim, 30°:0.87, 30°:0.9)"
+    assert description == caption
+    assert description.startswith(f"ParkourLab run {recording.run_id}, simulated: left psi0 30°, zeta0 0.87 l0;")
+    assert f"right psi0 30°, zeta0 0.9 l0; {JUMPS} jumps, " in description, description
+    assert re.search(r"; climb \d+\.\d{3} l0; stored \d{4}-\d\d-\d\d \d\d:\d\d UTC\.$", description), description
+    robot = _head(share.share_html(runs["robot"], runs["sim"]))
+    legs = "30°:0.87, 30°:0.9"
+    robot_id = runs["robot"].run_id
+    assert robot[0] == f"ParkourLab run {robot_id} (robot, {legs}), ghost run {recording.run_id} (sim, {legs})"
+    assert ", on the robot: " in robot[1] and f"Ghost: ParkourLab run {recording.run_id}, simulated" in robot[1]
+
+
+def test_the_files_title_and_description_are_text(runs):
+    markup = '</title><script>window.__xss=1</script><b a="x">'
+    odd = dataclasses.replace(runs["sim"], label=markup, description=markup)
+    html = share.share_html(odd)
+    plain = share.share_html(runs["sim"])
+    assert markup not in html and html.count("<script") == plain.count("<script"), "no element made of it"
+    title, description, caption = _head(html)
+    escaped = "&lt;/title&gt;&lt;script&gt;window.__xss=1&lt;/script&gt;&lt;b a=&quot;x&quot;&gt;"
+    assert title == f"ParkourLab {escaped}" and description == caption == escaped
