@@ -13,6 +13,7 @@ import asyncio
 import contextlib
 import functools
 import logging
+import threading
 from pathlib import Path
 
 import anyio.to_thread
@@ -27,6 +28,7 @@ from backend.services import exports, simulation
 from backend.services import runs as run_service
 from backend.services.job_runner import JobRunner
 from backend.services.robot import RobotService
+from backend.services.room import Waiting, now_or_when_room
 from backend.services.view import ViewContext, ViewFactory, ViewStarter
 from backend.settings import Settings
 from backend.store.database import ensure_reserve, make_engine, migrate, session_factory
@@ -77,7 +79,9 @@ def create_app(
     token, _ = api_token(settings.data_dir)
     owns_compute = compute is None
     compute = compute or Compute(warm_up=simulation.warm_up, reads_warm_up=functools.partial(loaded, RUN_READS))
-    runner = JobRunner(sessions, compute.jobs, dask_address=settings.dask_address)
+    waiting = Waiting()  # writes that wait for disk space: the health check lists them
+    stopping = threading.Event()
+    runner = JobRunner(sessions, compute.jobs, dask_address=settings.dask_address, waiting=waiting)
     robot_service = RobotService(sessions, latch_path=settings.data_dir / LATCH_FILE)
 
     @contextlib.asynccontextmanager
@@ -85,7 +89,12 @@ def create_app(
         anyio.to_thread.current_default_thread_limiter().total_tokens = REQUEST_THREADS
         migrate(engine)
         ensure_reserve(engine)  # the room deletes need on a full disk (store/database.py)
-        robot_service.recover()  # live runs the previous process died during: stored as interrupted, nothing re-armed
+        # Live runs the previous process died during: stored as interrupted, nothing re-armed. On a
+        # full disk that waits for space on a thread of its own: reads and DELETE must come up.
+        now_or_when_room(
+            robot_service.recover, what="storing the live runs the last stop cut short", engine=engine,
+            stopping=stopping, waiting=waiting,
+        )  # fmt: skip
         if warm_kernels:
             compute.warm()
         if run_jobs:
@@ -94,6 +103,7 @@ def create_app(
             context = ViewContext(sessions=sessions, robot_service=robot_service)
             app.state.view_starter = ViewStarter(view_factory, context).start()
         yield
+        stopping.set()
         if app.state.view_starter is not None:
             await asyncio.to_thread(app.state.view_starter.close)  # may wait for a view still starting
         robot_service.close()
@@ -123,6 +133,7 @@ def create_app(
     app.state.compute = compute
     app.state.reads = StoreReads(compute.reads, settings.database_url, RUN_READS)
     app.state.view_starter = None
+    app.state.waiting = waiting
     security.install(app, settings)  # headers, Host/Origin allow-list, token first, body limit
     errors.install(app)
     for module in ROUTERS:

@@ -91,6 +91,9 @@ class Health(BaseModel):
     status: Literal["ok"]
     database: str = Field(description="the database's dialect: sqlite or postgresql")
     code_version: str
+    notices: list[str] = Field(
+        default_factory=list, description="what the service waits for, e.g. disk space to store a job's trials"
+    )
 
 
 class TokenAccepted(BaseModel):

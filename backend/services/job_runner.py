@@ -13,8 +13,9 @@ are deterministic: they run whole through the chunk map, report progress per chu
 their result on the job when done; a restart recomputes them. Cancelling marks the job; the runner
 sees it within ``CANCEL_POLL`` and stops the worker at once (a chunk under way is dropped: its
 trials are not committed, and nothing else depends on it). On a full disk a job pauses: what it
-computed waits in memory and is committed when there is room again (tried every
-``STORAGE_RETRY``); stopped meanwhile, it stays running and the next start resumes it.
+computed waits in memory and is committed when there is room again (:mod:`backend.services.room`);
+stopped meanwhile, it stays running and the next start resumes it. The jobs a crash left unfinished
+are settled on the runner's thread too, so a full disk never holds up the service's start.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ import logging
 import queue
 import threading
 from collections.abc import Callable, Iterator
+from typing import TypeVar
 
 import numpy as np
 from sqlalchemy.orm import Session, sessionmaker
@@ -33,8 +35,9 @@ from sqlalchemy.orm import Session, sessionmaker
 from backend.repositories import jobs as stored_jobs
 from backend.schemas.jobs import JobState
 from backend.services.job_specs import MJTFSpec, decode
+from backend.services.room import Stopped, Waiting, when_room
 from backend.services.simulation import model_params, run_study, run_study_here
-from backend.store.database import StorageFull, after_storage_full
+from backend.store.database import StorageFull
 from backend.store.models import Trial, utcnow
 from backend.workers.pools import ComputePool
 from experiments.cluster import as_completed_results, chunk_map_for, dask_client
@@ -44,15 +47,11 @@ from sim_core.failures import OK, Failure
 from sim_core.mjtf_plan import TrialChunk, plan_trials
 
 log = logging.getLogger("parkourlab.jobs")
+T = TypeVar("T")
 
 CHUNK_TRIALS = 32  # tens of trials per commit: a 3 ms trial alone would drown in overhead
-STORAGE_RETRY = 5.0  # [s] between tries to store a paused job's results on a full disk
 CANCEL_POLL = 0.2  # [s] how often the runner looks for a cancel while a worker computes
 IN_FLIGHT = 4  # chunks handed to the worker ahead of the one awaited: it never idles between chunks
-
-
-class _Stopped(Exception):
-    """The runner is stopping while a job waits for disk space."""
 
 
 class JobRunner:
@@ -65,6 +64,7 @@ class JobRunner:
         *,
         chunk_trials: int = CHUNK_TRIALS,
         dask_address: str | None = None,
+        waiting: Waiting | None = None,
     ):
         self.sessions = sessions
         self.pool = pool  # the job worker: chunks run there, not in this process
@@ -73,14 +73,12 @@ class JobRunner:
         self.queue: queue.Queue[int | None] = queue.Queue()
         self.thread: threading.Thread | None = None
         self._stopping = threading.Event()  # set by stop(): a job paused on a full disk gives up its wait
+        self.waiting = waiting  # the writes waiting for disk space, which the health check lists
 
     def start(self) -> None:
-        with self.sessions() as session:
-            stored_jobs.recover_interrupted(session)  # a job running when the process died resumes from its trials
-            session.commit()
-            pending = stored_jobs.queued_ids(session)
-        for job_id in pending:
-            self.queue.put(job_id)
+        """Start the runner's thread. Jobs a crash left running or cancelling are settled there,
+        not here: on a full disk that write waits for space, and start-up (reads, DELETE: the way to
+        free space) must not wait with it."""
         self.thread = threading.Thread(target=self._loop, name="parkourlab-jobs", daemon=True)
         self.thread.start()
 
@@ -94,10 +92,16 @@ class JobRunner:
             self.thread.join(timeout)
 
     def _loop(self) -> None:
+        try:
+            unfinished = self._stored("settling the jobs left unfinished at the last stop", self._recover)
+        except Stopped:
+            return
+        for job_id in unfinished:
+            self.queue.put(job_id)
         while (job_id := self.queue.get()) is not None:
             try:
                 self.run(job_id)
-            except _Stopped:  # paused on a full disk at shutdown: still running, the next start resumes it
+            except Stopped:  # paused on a full disk at shutdown: still running, the next start resumes it
                 return
             except Exception as error:  # a job's failure is recorded; the runner goes on
                 log.exception("job %s failed", job_id)
@@ -110,6 +114,14 @@ class JobRunner:
                             utcnow(),
                         )
                         session.commit()
+
+    def _recover(self) -> list[int]:
+        """Jobs left running are queued again (they resume from their stored trials), those left
+        cancelling are cancelled; the queued jobs' ids, oldest first."""
+        with self.sessions() as session:
+            stored_jobs.recover_interrupted(session)
+            session.commit()
+            return stored_jobs.queued_ids(session)
 
     def run(self, job_id: int) -> None:
         """Run (or resume) one job to its end, committing every chunk."""
@@ -152,7 +164,8 @@ class JobRunner:
         try:
             for index, (jumps, status) in results:
                 chunk = chunks[index]
-                self._until_stored(job_id, self._commit_chunk, job_id, chunk, levels[chunk.level].zeta0, jumps, status)
+                zeta0 = levels[chunk.level].zeta0
+                self._stored(f"storing job {job_id}'s trials", self._commit_chunk, job_id, chunk, zeta0, jumps, status)
                 if self._cancelled(job_id):
                     return
         except Cancelled:
@@ -190,7 +203,7 @@ class JobRunner:
                 job.state, job.finished_at = JobState.CANCELLED, utcnow()
                 session.commit()
             return
-        self._until_stored(job_id, self._store_result, job_id, json_safe(result))
+        self._stored(f"storing job {job_id}'s result", self._store_result, job_id, json_safe(result))
 
     def _store_result(self, job_id: int, result: dict) -> None:
         with self.sessions() as session:
@@ -200,25 +213,13 @@ class JobRunner:
             job.state, job.finished_at = JobState.DONE, utcnow()
             session.commit()
 
-    def _until_stored(self, job_id: int, write: Callable, *args) -> None:
-        """``write(*args)`` (one transaction), again every STORAGE_RETRY while the disk is full: the
+    def _stored(self, what: str, write: Callable[..., T], *args) -> T:
+        """``write(*args)`` (one transaction), again every few seconds while the disk is full: the
         job pauses with what it computed in memory, and goes on when space returns."""
-        paused = False
-        while True:
-            try:
-                write(*args)
-            except StorageFull:
-                after_storage_full(self.sessions.kw["bind"])
-                if not paused:
-                    log.warning("job %s paused: the disk holding the database is full; it goes on when there is room",
-                                job_id)  # fmt: skip
-                    paused = True
-                if self._stopping.wait(STORAGE_RETRY):
-                    raise _Stopped from None
-                continue
-            if paused:
-                log.warning("job %s goes on: its results fit again", job_id)
-            return
+        engine = self.sessions.kw["bind"]
+        return when_room(
+            functools.partial(write, *args), what=what, engine=engine, stopping=self._stopping, waiting=self.waiting
+        )
 
     def _execute(
         self, job_id: int, function: Callable, arguments: list[tuple]

@@ -167,7 +167,16 @@ def schema_revision(engine: Engine) -> str | None:
 
 def migrate(engine: Engine, revision: str = "head") -> None:
     """Upgrade the schema to ``revision`` (default: the newest)."""
-    if revision == "head" and schema_revision(engine) == SCHEMA_HEAD:
+    try:
+        current = schema_revision(engine)
+    except OperationalError:
+        # A clean stop removed the WAL and its shared-memory file; on a full disk SQLite cannot make
+        # them again, so the database would not even open. The reserve deletes need makes room.
+        database = database_file(engine)
+        if database is None or free_bytes(database.parent) >= JOURNAL_SIZE_LIMIT or not release_reserve(engine):
+            raise
+        current = schema_revision(engine)
+    if revision == "head" and current == SCHEMA_HEAD:
         return
     from alembic import command
 

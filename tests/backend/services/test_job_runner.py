@@ -10,7 +10,7 @@ from sqlalchemy import delete, select, update
 
 from backend.errors import NotFound
 from backend.schemas import BasinJobCreate, GaitSearchJobCreate, LegIn, MJTFJobCreate, StateIn
-from backend.services import job_runner, jobs
+from backend.services import job_runner, jobs, room
 from backend.store.models import Job, Trial
 from sim_core import get_preset
 from sim_core.mjtf import mjtf_study
@@ -69,9 +69,9 @@ def test_a_job_left_cancelling_is_cancelled_at_start(sessions, session, runner):
     job = jobs.create_job(session, MJTFJobCreate(**SMALL))
     session.execute(update(Job).where(Job.id == job.id).values(state="cancelling"))
     session.commit()
-    runner.start()
-    stopped = job_now(sessions, job.id)
-    assert stopped.state == "cancelled" and stopped.finished_at is not None and stored_trials(session, job.id) == []
+    runner.start()  # the runner's thread settles what the last stop left (a full disk must not hold up the start)
+    stopped = wait_until(sessions, job.id, lambda now: now.state == "cancelled")
+    assert stopped.finished_at is not None and stored_trials(session, job.id) == []
 
 
 def test_cancel_a_queued_job_at_once_and_leave_a_finished_one(sessions, session, compute):
@@ -191,7 +191,7 @@ def test_a_job_pauses_on_a_full_disk_and_goes_on_when_there_is_room(sessions, se
     fail as SQLite fails on a full disk), and are committed once there is room: no trial lost."""
     from backend.store.database import StorageFull
 
-    monkeypatch.setattr(job_runner, "STORAGE_RETRY", 0.05)
+    monkeypatch.setattr(room, "STORAGE_RETRY", 0.05)
     commit, failures = job_runner.JobRunner._commit_chunk, []
 
     def full_twice(runner, *args):
