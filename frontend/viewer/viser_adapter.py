@@ -247,11 +247,27 @@ def embed(recording: bytes, *, title: str | None = None, description: str | None
     return client[:head_end] + script + client[head_end:]
 
 
+def slider_marks(handle) -> tuple[tuple[float, str | None], ...] | None:
+    """A slider's marks as (value, label) pairs (viser keeps them as its private ``_marks`` prop)."""
+    marks = getattr(handle, "_marks")  # noqa: B009 - a prop viser names private
+    return None if marks is None else tuple((mark.value, mark.label) for mark in marks)
+
+
+def set_slider_marks(handle, marks: tuple[tuple[float, str], ...]) -> None:
+    """Move a slider's marks (``add_slider(marks=...)`` sets them once; there is no public setter):
+    the change goes to the browser as any prop's does."""
+    handle._marks = tuple(_messages.GuiSliderMark(value=float(value), label=label) for value, label in marks)
+
+
 def missing(server: viser.ViserServer) -> list[str]:
     """What this module reads of viser that ``server`` (a running one) or its scene serializer
     lacks, by name; empty when everything is where it expects. Takes a recording from the server
     (and ends it)."""
     gone = []
+    if "_marks" not in getattr(_messages.GuiSliderProps, "__annotations__", {}) or not hasattr(
+        _messages, "GuiSliderMark"
+    ):
+        gone.append("GuiSliderProps._marks (GuiSliderMark)")
     for name, read in (
         ("ViserServer._websock_server", lambda: websocket_server(server)),
         ("WebsockServer._live_connections", lambda: live_connections(server)),

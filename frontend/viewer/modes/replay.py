@@ -16,6 +16,8 @@ from frontend.viewer.modes.painter import show_frame
 from frontend.viewer.recordings import Recording, load_recording
 from frontend.viewer.scene import ChuteScene
 
+MAX_RUN_ID = 2**31 - 1  # the store's largest id (backend.schemas.MAX_ID)
+TIME_STEP = 0.01  # [s] the timeline slider's step
 PLOT_SAMPLES = 400  # the replay's height plot: samples over the run (the dot moves sample by sample)
 CURSOR_PERIOD = 0.1  # [s] the plot's dot moves at most this often
 
@@ -30,12 +32,12 @@ class ReplayMode(Mode):
         self.sessions = sessions
         gui = client.gui
         with gui.add_folder("Replay", visible=False) as self.folder:
-            self.gui_run = gui.add_number("Run id", 1, min=1, step=1)
-            self.gui_overlay = gui.add_number("Overlay run id (0: none)", 0, min=0, step=1)
+            self.gui_run = self._ranged_number("Run id", 1, low=1, high=MAX_RUN_ID)
+            self.gui_overlay = self._ranged_number("Overlay run id (0: none)", 0, low=0, high=MAX_RUN_ID)
             self.gui_load = gui.add_button("Load")
-            self.gui_time = gui.add_slider("Time [s]", 0.0, 1.0, 0.01, 0.0)
+            self.gui_time = self._ranged_slider("Time [s]", 0.0, 1.0, TIME_STEP, 0.0)
             self.gui_playback = gui.add_button_group("Playback", ("Play", "Pause", "Start"))
-            self.gui_speed = gui.add_slider("speed [×]", 0.1, 4.0, 0.1, 1.0)
+            self.gui_speed = self._ranged_slider("speed [×]", 0.1, 4.0, 0.1, 1.0)
             self.gui_share = gui.add_button("Share this run (HTML)", hint="a standalone file that plays this replay")
             self.gui_readout = gui.add_markdown("Pick a run and press Load (History → “3D” does it for you).")
         self.plot = None
@@ -48,16 +50,22 @@ class ReplayMode(Mode):
         self.time = 0.0
         self._marked = (0, 0)  # touchdowns of the run and of the ghost drawn so far
         self.message = ""
+        self.end = 0.0  # [s] the timeline's end: the longer run's
+        self.speed = 1.0  # [×] the speed in use: the slider's last value in its range
+        self.input_note: str | None = None  # why a typed time or speed is not used
         self.share = None  # set by the view: run id -> standalone HTML
         self.gui_load.on_click(self._on_load)
         self.gui_time.on_update(self._on_scrub)
+        self.gui_speed.on_update(self._on_speed)
         self.gui_playback.on_click(self._on_playback)
         self.gui_share.on_click(self._on_share)
 
     def _on_load(self, _event) -> None:
         problem = self._out_of_range((self.gui_run, self.gui_overlay))
-        if problem is not None:
-            self.message = f"**Cannot replay:** {problem}"
+        if problem is not None:  # nothing loaded: the run on the timeline stays
+            self.message = f"**Cannot replay:** {problem}" + (
+                f"; still showing {self.recording.label}" if self.recording else ""
+            )
             return
         with contextlib.suppress(NotFound, Conflict):  # the readout says why
             self.load(int(self.gui_run.value), int(self.gui_overlay.value) or None)
@@ -82,12 +90,14 @@ class ReplayMode(Mode):
     def _show(self, run_id, overlay_id, recording: Recording, overlay: Recording | None) -> None:
         self.recording, self.overlay = recording, overlay
         duration = max(recording.duration, overlay.duration if overlay else 0.0)
+        self.end = round(max(duration, TIME_STEP), 2)
         with self._quietly():
             self.gui_run.value = run_id
             self.gui_overlay.value = overlay_id or 0
-            self.gui_time.max = round(max(duration, 0.01), 2)
+            self._set_range(self.gui_time, 0.0, self.end, TIME_STEP)
             self.gui_time.value = 0.0
         self.time, self.playing, self._marked = 0.0, False, (0, 0)
+        self.input_note = None
         self.scene.robot = recording.robot
         self.scene.clear_history()
         self._plot(recording, overlay)
@@ -156,9 +166,17 @@ class ReplayMode(Mode):
         if self._quiet or self.recording is None:
             return
         with self.lock:
-            self.time = self._clamped(self.gui_time, self.time)
+            self.input_note = self._out_of_range((self.gui_time, self.gui_speed))
+            if self._problem(self.gui_time) is not None:
+                return  # a time not on the timeline: the replay stays where it is
+            self.time = float(self.gui_time.value)
             self._marked = (0, 0)
             self.scene.clear_history()
+
+    def _on_speed(self, _event) -> None:
+        with self.lock:
+            self.input_note = self._out_of_range((self.gui_time, self.gui_speed))
+            self.speed = self._usable(self.gui_speed, self.speed)
 
     def _on_playback(self, event) -> None:
         with self.lock:
@@ -167,7 +185,7 @@ class ReplayMode(Mode):
     def playback(self, choice: str) -> None:
         """One of the Playback buttons: Play, Pause, Start."""
         if choice == "Play" and self.recording is not None:
-            if self.time >= self.gui_time.max:
+            if self.time >= self.end:
                 self.time = 0.0
             self.playing = True
         elif choice == "Pause":
@@ -187,8 +205,8 @@ class ReplayMode(Mode):
         if recording is None:
             return
         if self.playing:
-            self.time = min(self.time + dt * self._clamped(self.gui_speed, 1.0), float(self.gui_time.max))
-            self.playing = self.time < self.gui_time.max
+            self.time = min(self.time + dt * self.speed, self.end)
+            self.playing = self.time < self.end
             with self._quietly():
                 self.gui_time.value = round(self.time, 2)
         self._marked = show_frame(self.scene, recording, self.overlay, self.time, self._marked)
@@ -198,4 +216,5 @@ class ReplayMode(Mode):
         if self.recording is None:
             return self.message or "Pick a run and press Load."
         pose = self.recording.clip.pose_at(self.time)
-        return f"{self.message}  \nt = {self.time:.2f} s · height {pose.y:.3f} m · {updates_per_s:.0f} updates/s"
+        typed = f"  \n**Not used:** {self.input_note}" if self.input_note else ""
+        return f"{self.message}{typed}  \nt = {self.time:.2f} s · height {pose.y:.3f} m · {updates_per_s:.0f} updates/s"

@@ -39,27 +39,32 @@ class SimulateMode(Mode):
             self.gui_symmetric = gui.add_checkbox(
                 "Symmetric (R = L)", initial_value=True, hint="both legs use the left leg's controls"
             )
-            self.gui_psi0_left = gui.add_slider("psi0 L [°]", 15.0, 60.0, 0.5, left[0])
-            self.gui_zeta0_left = gui.add_slider("zeta0 L [l0]", 0.80, 0.99, 0.0005, left[1])
-            self.gui_psi0_right = gui.add_slider("psi0 R [°]", 15.0, 60.0, 0.5, right[0], disabled=True)
-            self.gui_zeta0_right = gui.add_slider("zeta0 R [l0]", 0.80, 0.99, 0.0005, right[1], disabled=True)
-            self.gui_gravity = gui.add_slider(
+            self.gui_psi0_left = self._ranged_slider("psi0 L [°]", 15.0, 60.0, 0.5, left[0])
+            self.gui_zeta0_left = self._ranged_slider("zeta0 L [l0]", 0.80, 0.99, 0.0005, left[1])
+            self.gui_psi0_right = self._ranged_slider("psi0 R [°]", 15.0, 60.0, 0.5, right[0], disabled=True)
+            self.gui_zeta0_right = self._ranged_slider("zeta0 R [l0]", 0.80, 0.99, 0.0005, right[1], disabled=True)
+            self.gui_gravity = self._ranged_slider(
                 "gravity [m/s²]", 0.3, 9.81, 0.01, robot.gravity, hint="the air table's tilt"
             )
-            self.gui_damping = gui.add_slider("damping [N·s/m]", 0.0, 3.0, 0.05, robot.c_zeta, hint="leg and pivot")
+            self.gui_damping = self._ranged_slider(
+                "damping [N·s/m]", 0.0, 3.0, 0.05, robot.c_zeta, hint="leg and pivot"
+            )
             self.gui_playback = gui.add_button_group("Playback", ("Play", "Pause", "Step jump", "Restart"))
-            self.gui_speed = gui.add_slider("speed [×]", 0.1, 4.0, 0.1, 1.0)
+            self.gui_speed = self._ranged_slider("speed [×]", 0.1, 4.0, 0.1, 1.0)
             self.gui_readout = gui.add_markdown("")
         self._control_handles = (self.gui_psi0_left, self.gui_zeta0_left, self.gui_psi0_right,
                                  self.gui_zeta0_right, self.gui_gravity, self.gui_damping)  # fmt: skip
         for handle in self._control_handles:
             handle.on_update(self._on_control)
+        self.speed = 1.0  # [×] the speed in use: the slider's last value in its range
+        self.gui_speed.on_update(self._on_speed)
         self.gui_symmetric.on_update(self._on_control)
         self.gui_preset.on_update(self._on_preset)
         self.gui_playback.on_click(self._on_playback)
         self.playing = True
         self.time = 0.0
-        self.input_note: str | None = None  # why what was typed is not in use (half-typed, out of range)
+        self.input_note: str | None = None  # why what was typed is not used (half-typed, out of range)
+        self.speed_note: str | None = None
         self.applied = self.controls()  # the controls in use: the sliders' last usable values
         self.gait: FixedPoint | None = None
         self.gait_note = "searching…"
@@ -120,6 +125,11 @@ class SimulateMode(Mode):
         self.climb.set_controls(self.applied)
         self._find_gait(restart=restart)
 
+    def _on_speed(self, _event) -> None:
+        with self.lock:
+            self.speed_note = self._out_of_range((self.gui_speed,))
+            self.speed = self._usable(self.gui_speed, self.speed)
+
     def _on_playback(self, event) -> None:
         with self.lock:
             self.playback(event.target.value)
@@ -177,7 +187,7 @@ class SimulateMode(Mode):
     # Per frame ----------------------------------------------------------------------------------
     def frame(self, dt: float) -> None:
         if self.playing:
-            self.time += dt * self._clamped(self.gui_speed, 1.0)
+            self.time += dt * self.speed
         pose = self.climb.pose_at(self.time)
         plans = self.climb.plans
         for k in range(self._shown, pose.jump + 1):
@@ -203,7 +213,8 @@ class SimulateMode(Mode):
         failed = plan.failure is not None and t >= plan.clip.end
         failure = f"**{plan.failure.code}** at jump {pose.jump + 1}: {plan.failure.message}" if failed else "none"
         robot = self.climb.controls.robot
-        typed = f"**Not in use yet:** {self.input_note}  \n" if self.input_note else ""
+        notes = [note for note in (self.input_note, self.speed_note) if note]
+        typed = f"**Not used:** {'; '.join(notes)} (the climb goes on as before)  \n" if notes else ""
         return typed + (
             f"**Jump** {pose.jump + 1} · **height** {pose.y:.3f} m · **climb/jump** {last}  \n"
             f"**Failure:** {failure}  \n"

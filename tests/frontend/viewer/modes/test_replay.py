@@ -5,6 +5,7 @@ use. The frame it draws is held equal to the shared file's in tests/frontend/vie
 
 import numpy as np
 
+from frontend.viewer.viser_adapter import slider_marks
 from tests.frontend.viewer.view_service import RUN, wait_for
 
 
@@ -61,4 +62,57 @@ def test_a_half_typed_run_id_is_named_in_the_readout(browsers):
     replay = session.modes["replay"]
     replay.gui_run.value = 0
     replay._on_load(None)
-    assert "Run id must be at least 1" in replay.readout(60.0)
+    assert "Run id must be a whole number from 1 to 2147483647, got 0" in replay.readout(60.0)
+
+
+def test_a_run_id_out_of_range_is_refused_not_held_to_1(service, browsers):
+    """Run id -1 loaded run 1: the box had min 1, and the browser holds a number box to its ends
+    when it loses focus. Now it has no ends there: -1 comes as typed, Load refuses it in the
+    readout, naming the field and its range, and the run on the timeline stays."""
+    client, auth, _view = service
+    browser, session = browsers()
+    replay = session.modes["replay"]
+    assert (replay.gui_run.min, replay.gui_overlay.min) == (None, None), "the browser changes nothing typed"
+    run = client.post("/api/v1/runs", json=RUN, headers=auth).json()
+    replay.load(run["id"])
+    browser.set_gui("Run id", -1)
+    wait_for(lambda: replay.gui_run.value == -1)
+    replay._on_load(None)  # Load
+    readout = replay.readout(60.0)
+    assert "**Cannot replay:** Run id must be a whole number from 1 to 2147483647, got -1" in readout, readout
+    assert replay.recording.run_id == run["id"] and f"still showing run {run['id']}" in readout
+    browser.set_gui("Overlay run id (0: none)", -3)
+    browser.set_gui("Run id", run["id"])
+    wait_for(lambda: replay.gui_overlay.value == -3 and replay.gui_run.value == run["id"])
+    replay._on_load(None)
+    assert "Overlay run id (0: none) must be a whole number from 0 to 2147483647, got -3" in replay.readout(60.0)
+
+
+def test_a_time_or_speed_typed_past_its_slider_is_refused(service, browsers):
+    """The timeline and the speed are sliders: a value typed past an end reaches the service as the
+    browser holds it (one step past the range), and is not used: the replay stays at its time and
+    speed, and the readout names the slider, its range and what was typed."""
+    client, auth, _view = service
+    browser, session = browsers()
+    replay = session.modes["replay"]
+    replay.load(client.post("/api/v1/runs", json=RUN, headers=auth).json()["id"])
+    end = replay.end
+    assert (replay.gui_time.min, replay.gui_time.max) == (-0.01, round(end + 0.01, 2))
+    assert slider_marks(replay.gui_time) == ((0.0, "0"), (end, f"{end:g}")), "the marks move with the run"
+    browser.set_gui("Time [s]", 999.0)  # as typed
+    wait_for(lambda: "got 999" in (replay.input_note or ""))
+    browser.set_gui("Time [s]", replay.gui_time.max)  # as the browser holds it when the box loses focus
+    wait_for(lambda: replay.gui_time.value == replay.gui_time.max)
+    assert replay.time == 0.0, "the replay did not move to the end"
+    assert f"Time [s] must be 0 to {end:g}, got 999" in replay.readout(60.0)
+    browser.set_gui("Time [s]", 1.0)
+    wait_for(lambda: replay.time == 1.0)
+    browser.set_gui("speed [×]", 10.0)
+    wait_for(lambda: "got 10" in (replay.input_note or ""))
+    browser.set_gui("speed [×]", 4.1)
+    wait_for(lambda: replay.gui_speed.value == 4.1)
+    assert replay.speed == 1.0 and "speed [×] must be 0.1 to 4, got 10" in replay.readout(60.0)
+    replay.playback("Play")
+    with session.lock:
+        replay.frame(0.5)
+    assert replay.time == 1.5, "played at the speed in use"

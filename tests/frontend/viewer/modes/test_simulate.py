@@ -5,6 +5,7 @@ readout, and a climb that ends at the floor."""
 import pytest
 
 from frontend.viewer.modes.gait_search import GAIT_PRESETS
+from frontend.viewer.viser_adapter import slider_marks
 from sim_core.climb_records import ClimbEnd
 from tests.frontend.viewer.view_service import wait_for
 
@@ -37,12 +38,44 @@ def test_half_typed_values_never_reach_the_simulator(browsers):
         handle.value = typed  # what a number box sends on the way to a whole value
         assert simulate.climb.controls == in_use, handle.label
         assert handle.label in simulate.input_note and "must be" in simulate.input_note
-        assert "**Not in use yet:**" in simulate.readout(60.0)
+        assert "**Not used:**" in simulate.readout(60.0)
         handle.value = whole  # typed to the end
         assert simulate.input_note is None and simulate.climb.controls == in_use
     simulate.gui_speed.value, before = -3.0, simulate.time
     simulate.frame(0.1)
-    assert simulate.time > before, "a half-typed speed plays at the slowest, never backwards"
+    assert simulate.time > before, "a half-typed speed leaves the speed in use, never backwards"
+
+
+def test_a_value_typed_past_a_sliders_end_is_refused_not_held_to_the_end(browsers):
+    """psi0 80 typed in its box became 60 and was used: the browser holds a slider's box to the
+    slider's ends when it loses focus. Now the slider reaches one step past the range (its marks
+    at 15 and 60), so what comes is 60.5: not used, and the readout names the slider, its range
+    and what was typed; a value in range is used at once."""
+    browser, session = browsers()
+    simulate = session.modes["simulate"]
+    wait_for(lambda: simulate.gait_note != "searching…")
+    in_use = simulate.climb.controls
+    psi0 = simulate.gui_psi0_left
+    assert (psi0.min, psi0.max, slider_marks(psi0)) == (14.5, 60.5, ((15.0, "15"), (60.0, "60")))
+    browser.set_gui("psi0 L [°]", 80.0)  # typed
+    wait_for(lambda: "got 80" in (simulate.input_note or ""))
+    browser.set_gui("psi0 L [°]", psi0.max)  # the box left: the browser holds it to the slider's end
+    wait_for(lambda: psi0.value == psi0.max)
+    assert simulate.climb.controls == in_use, "60 is not used in place of 80"
+    readout = simulate.readout(60.0)
+    assert "**Not used:** psi0 L [°] must be 15 to 60, got 80" in readout, readout
+    browser.set_gui("psi0 L [°]", 5.0)
+    wait_for(lambda: "got 5" in (simulate.input_note or ""))
+    browser.set_gui("psi0 L [°]", psi0.min)
+    wait_for(lambda: psi0.value == psi0.min)
+    assert simulate.climb.controls == in_use and "psi0 L [°] must be 15 to 60, got 5" in simulate.readout(60.0)
+    # (Replay mode's speed slider has the same label: this one is set as its callback would be.)
+    simulate.gui_speed.value = 9.0
+    simulate.gui_speed.value = simulate.gui_speed.max
+    assert simulate.speed == 1.0 and "speed [×] must be 0.1 to 4, got 9" in simulate.readout(60.0)
+    browser.set_gui("psi0 L [°]", 40.0)
+    wait_for(lambda: simulate.climb.controls.left.psi0_deg == pytest.approx(40.0))
+    assert "psi0 L" not in simulate.readout(60.0)
 
 
 def test_simulate_mode_stops_a_descending_climb_at_the_floor_and_says_so(browsers):
