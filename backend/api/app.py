@@ -20,7 +20,7 @@ import anyio.to_thread
 from fastapi import FastAPI
 from fastapi.staticfiles import StaticFiles
 
-from backend.api import errors, security
+from backend.api import errors, security, statuses
 from backend.api.deps import Database
 from backend.api.routes import calibrations, experiments, jobs, robot, runs, sim, site, view
 from backend.api.token_file import api_token
@@ -138,4 +138,5 @@ def create_app(
     errors.install(app)
     for module in ROUTERS:
         app.include_router(module.router)
+    statuses.install(app)  # the statuses each operation answers, in the OpenAPI document
     return app
