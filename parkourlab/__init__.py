@@ -16,6 +16,7 @@ from parkourlab.errors import (
     JobTimeout,
     NotFound,
     ParkourError,
+    QueueFull,
     ServiceUnreachable,
     Unauthorized,
 )
@@ -30,6 +31,7 @@ __all__ = [
     "JobTimeout",
     "NotFound",
     "ParkourError",
+    "QueueFull",
     "ServiceUnreachable",
     "Unauthorized",
 ]

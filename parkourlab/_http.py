@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import ipaddress
 import os
+import re
+import socket
 from collections.abc import Iterator, Mapping
 from datetime import date, datetime
 from enum import Enum
@@ -78,9 +80,11 @@ def query(params: Mapping[str, Any]) -> dict[str, Any]:
 class Http:
     """A sync HTTP session on one service: ``call`` for JSON, ``download`` for files."""
 
-    def __init__(self, url: str, token: str | None, timeout: float, transport: httpx.BaseTransport | None) -> None:
+    def __init__(
+        self, url: str, token: str | None, timeout: float, transport: httpx.BaseTransport | None, name: str
+    ) -> None:
         self.url, self.token = url, token
-        headers = {"Authorization": f"Bearer {token}"} if token else {}
+        headers = {"X-Parkour-Client": name} | ({"Authorization": f"Bearer {token}"} if token else {})
         self.client = httpx.Client(base_url=url, headers=headers, timeout=timeout, transport=transport)
 
     def close(self) -> None:
@@ -154,3 +158,10 @@ class Http:
             hint = FieldError(field="", message=NO_TOKEN)
             error = Unauthorized(error.status, error.detail, [*error.errors, hint], request)
         return error
+
+
+def client_name(name: str | None) -> str:
+    """Who this client is to the service (``X-Parkour-Client``: the job queue's share is per client):
+    ``name``, else ``python@<this host>``; characters the header refuses become ``-``."""
+    chosen = name or f"python@{socket.gethostname()}"
+    return re.sub(r"[^\w.:@/-]", "-", chosen)[:64] or "python"

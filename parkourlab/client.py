@@ -24,7 +24,7 @@ from typing import Any, Literal, Unpack
 import httpx
 
 from parkourlab import frames
-from parkourlab._http import Http, find_token, service_url
+from parkourlab._http import Http, client_name, find_token, service_url
 from parkourlab.bodies import Leg, State, legs, mapping, present, state
 from parkourlab.jobs import JobCalls
 from parkourlab.types import RUN_FILTERS, Experiment, Page, Run, RunDetail, RunFilters
@@ -46,6 +46,8 @@ class Client(JobCalls):
         ``$PARKOUR_API_TOKEN``, else — for a service on this machine only — the ``api_token`` file
         in ``$PARKOUR_DATA_DIR`` or ``./data``, as ``parkour serve`` writes it. Reads need none.
     timeout: [s] for each HTTP request (not for :meth:`wait`, which has its own).
+    name: who this client is to the service (the job queue gives each client a share); default
+        ``python@<host>``.
     transport: an ``httpx`` transport to use instead of the network (tests).
 
     Use it as a context manager, or call :meth:`close`, to close its connections.
@@ -58,9 +60,10 @@ class Client(JobCalls):
         token: str | None = None,
         timeout: float = 60.0,
         transport: httpx.BaseTransport | None = None,
+        name: str | None = None,
     ) -> None:
         self.url = service_url(url)
-        self._http = Http(self.url, token or find_token(self.url), timeout, transport)
+        self._http = Http(self.url, token or find_token(self.url), timeout, transport, client_name(name))
 
     def __enter__(self) -> Client:
         return self

@@ -74,6 +74,11 @@ class Conflict(ApiError):
     """409: the request clashes with what is stored (e.g. deleting an experiment that still has runs)."""
 
 
+class QueueFull(ApiError):
+    """429: the job queue holds its budget of work, or this client its share of it; the message
+    says what is queued. Wait for jobs to finish (or cancel some) and submit again."""
+
+
 class InvalidRequest(ApiError, ValueError):
     """422: a field out of its range or of the wrong type; ``errors`` names each field and the
     API's message, with the bound it broke."""
@@ -107,11 +112,14 @@ _REASONS = {
     409: "conflict",
     413: "request too large",
     422: "invalid request",
+    429: "job queue full",
     500: "service error",
     503: "service unavailable",
     507: "storage full",
 }
-_CLASSES: dict[int, type[ApiError]] = {401: Unauthorized, 404: NotFound, 409: Conflict, 422: InvalidRequest}
+_CLASSES: dict[int, type[ApiError]] = {
+    401: Unauthorized, 404: NotFound, 409: Conflict, 422: InvalidRequest, 429: QueueFull,
+}  # fmt: skip
 _LOCATIONS = ("body", "query", "path", "header")
 
 

@@ -2,11 +2,21 @@
 
 import pytest
 
-from parkourlab.errors import ApiError, Conflict, InvalidRequest, NotFound, Unauthorized, error_for, field_name
+from parkourlab.errors import (
+    ApiError,
+    Conflict,
+    InvalidRequest,
+    NotFound,
+    QueueFull,
+    Unauthorized,
+    error_for,
+    field_name,
+)
 
 
 @pytest.mark.parametrize(
-    ("status", "kind"), [(401, Unauthorized), (404, NotFound), (409, Conflict), (422, InvalidRequest), (503, ApiError)]
+    ("status", "kind"),
+    [(401, Unauthorized), (404, NotFound), (409, Conflict), (422, InvalidRequest), (429, QueueFull), (503, ApiError)],
 )
 def test_each_status_its_exception(status, kind):
     error = error_for(status, {"detail": "why"}, "GET /api/v1/x")

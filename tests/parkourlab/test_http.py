@@ -4,7 +4,7 @@ from datetime import UTC, datetime
 
 import pytest
 
-from parkourlab._http import find_token, is_loopback, query, service_url
+from parkourlab._http import client_name, find_token, is_loopback, query, service_url
 
 
 @pytest.fixture
@@ -53,3 +53,15 @@ def test_query_parameters():
     when = datetime(2026, 12, 3, tzinfo=UTC)
     got = query({"tag": "a", "cursor": None, "created_after": when, "only_differences": False, "ids": [1, 2]})
     assert got == {"tag": "a", "created_after": "2026-12-03T00:00:00+00:00", "only_differences": "false", "ids": [1, 2]}
+
+
+@pytest.mark.parametrize(
+    ("name", "sent"),
+    [("batch-trials", "batch-trials"), ("lab pc <1>", "lab-pc--1-"), ("x" * 80, "x" * 64)],
+)
+def test_the_client_names_itself_as_the_header_allows(name, sent):
+    assert client_name(name) == sent
+
+
+def test_by_default_the_client_is_python_at_this_host():
+    assert client_name(None).startswith("python@")
