@@ -1,6 +1,7 @@
 """The shapes of what the API answers, as the client hands them on: plain dicts (JSON as it
 came), typed for editors and type checkers. The service's OpenAPI document (``/openapi.json``)
-is the reference; these name the fields a script reads most. Nothing is checked at run time."""
+is the reference; each of these names every field of its answer, held to the API's response
+models by tests/parkourlab/test_types.py. Nothing is checked at run time."""
 
 from __future__ import annotations
 
@@ -10,22 +11,27 @@ from typing import Any, Generic, Literal, TypedDict, TypeVar
 T = TypeVar("T")
 RunKind = Literal["sim", "robot", "replay"]
 RunStatus = Literal["done", "failed", "running", "interrupted"]
+RunLoop = Literal["open", "closed"]
 JobState = Literal["queued", "running", "cancelling", "cancelled", "done", "failed"]
 FINAL_JOB_STATES: frozenset[str] = frozenset({"done", "cancelled", "failed"})
 
 
 class Page(TypedDict, Generic[T]):
     """One page of a list: its ``items`` and ``next_cursor`` (None on the last page). Sorted by id,
-    pass it back as ``cursor``; sorted by another field, as ``offset``. The API gives no total."""
+    pass it back as ``cursor``; sorted by another field, as ``offset``. ``total``: how many items
+    match over every page, where the list counts them (None: not counted)."""
 
     items: list[T]
     next_cursor: int | None
+    total: int | None
 
 
 class Run(TypedDict):
     """A run as listed. ``model``: the nondimensional model (alpha, d_hat, c_zeta, c_psi, mu;
     docs/model.md §1); ``controls``: ``[psi0 [deg], zeta0 [l0]]`` per leg of the schedule;
-    ``start_state``: ``[xdot, ydot]`` [sqrt(g l0)]; ``climb`` [l0]; ``duration_s`` [s]."""
+    ``start_state``: ``[xdot, ydot]`` [sqrt(g l0)]; ``climb`` [l0]; ``duration_s`` [s]. A robot run
+    also has its ``end_reason`` (as recorded) and ``touchdowns``; a closed loop (``loop``) its
+    ``controller`` and ``target`` height [m]; None where they do not apply."""
 
     id: int
     experiment_id: int | None
@@ -44,6 +50,11 @@ class Run(TypedDict):
     tags: list[str]
     notes: str
     has_trajectory: bool
+    end_reason: str | None
+    loop: RunLoop
+    controller: str | None
+    target: float | None
+    touchdowns: int | None
 
 
 class RunDetail(Run):
@@ -67,7 +78,9 @@ class Experiment(TypedDict):
 
 class Job(TypedDict):
     """A batch job. ``completed`` of ``total`` units (trials for MJTF) are done; ``progress`` is
-    their ratio in [0, 1]; ``spec`` is the job's body with the service's defaults filled in."""
+    their ratio in [0, 1]; ``spec`` is the job's body with the service's defaults filled in.
+    ``submitted_by``: who submitted it (its client's name, else its address); ``queue_position``
+    (1: next) and ``eta_s`` [s], until it ends at the latest: None once it is final."""
 
     id: int
     experiment_id: int | None
@@ -81,6 +94,9 @@ class Job(TypedDict):
     created_at: str
     started_at: str | None
     finished_at: str | None
+    submitted_by: str | None
+    queue_position: int | None
+    eta_s: float | None
 
 
 class MJTFLevel(TypedDict):
@@ -108,13 +124,19 @@ class JobResults(TypedDict):
 
 class RunFilters(TypedDict, total=False):
     """The filters every run query takes (list, export, aggregate, frame). Ranges are inclusive:
-    zeta0 [l0] in [0, 1], psi0 [deg] in [0, 90] (the first leg's); datetimes or ISO 8601 text."""
+    zeta0 [l0] in [0, 1], psi0 [deg] in [0, 90] (the first leg's); datetimes or ISO 8601 text.
+    ``end_reason``: as recorded, or its kind (``error`` matches ``error: …``); ``q``: text in the
+    notes or a tag (any case)."""
 
     experiment_id: int
     kind: RunKind
     status: RunStatus
     tag: str
     failure_code: str
+    end_reason: str
+    loop: RunLoop
+    controller: str
+    q: str
     zeta0_min: float
     zeta0_max: float
     psi0_min: float

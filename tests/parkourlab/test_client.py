@@ -1,10 +1,10 @@
-"""The Python client against the real service: ``parkour serve`` in a subprocess on a free port
-with a fresh SQLite data directory, started once for the module (tests/helpers.py).
+"""parkourlab/client.py against the real service (tests/parkourlab/conftest.py: ``parkour serve`` in a
+subprocess on a free port with a fresh SQLite data directory, started once for the session).
 
 Covered: paging through more runs than a page holds (keyset and offset sorts), filters, edits,
-job submit + wait + results, a wait that times out and a cancelled job, the error types with the
-API's status and field messages (422, 401, 404, 409, connection refused), exports to files, and
-DataFrames when pandas is installed."""
+experiments, the error types with the API's status and field messages (422, 401, 404, 409,
+connection refused), exports to files, and that importing the client loads none of the project.
+Jobs: test_jobs.py; DataFrames: test_frames.py."""
 
 from __future__ import annotations
 
@@ -20,56 +20,14 @@ from parkourlab import (
     Client,
     Conflict,
     InvalidRequest,
-    JobFailed,
-    JobTimeout,
     NotFound,
     ServiceUnreachable,
     Unauthorized,
 )
-from tests.helpers import free_port, start_service, stop_processes
+from tests.helpers import free_port
+from tests.parkourlab.conftest import START, ZETA0S
 
-START = (-0.93, -0.17)  # section state (xdot, ydot) [sqrt(g l0)] near the paper's period-1 gait
-ZETA0S = [0.84, 0.85, 0.86, 0.87, 0.88, 0.89, 0.9]  # seven runs: more than two pages of three
 PAGE = 3
-QUICK_MJTF = {"trials": 4, "cap": 30, "seed": 1}  # 2 levels x 4 trials of at most 30 jumps: a second or two
-# An MJTF job that takes minutes: waited on briefly, then cancelled.
-LONG_MJTF = {"zeta0s": [0.86, 0.88, 0.9], "trials": 4096, "cap": 1000, "seed": 2}
-WAIT_TIMEOUT = 120.0  # [s] for a quick job on a slow, shared machine
-
-
-@pytest.fixture(scope="module")
-def service(tmp_path_factory):
-    """``(url, token)`` of a running service with an empty store."""
-    data_dir, port = tmp_path_factory.mktemp("client") / "data", free_port()
-    process = start_service(data_dir, port, "--no-view")
-    try:
-        yield f"http://127.0.0.1:{port}", (data_dir / "api_token").read_text().strip()
-    finally:
-        stop_processes(process)
-
-
-@pytest.fixture(scope="module")
-def client(service):
-    url, token = service
-    with Client(url, token=token) as client:
-        yield client
-
-
-@pytest.fixture(scope="module")
-def paging_runs(client) -> list[dict]:
-    """Seven runs tagged ``paging`` (one per zeta0 of ZETA0S) in an experiment of their own."""
-    experiment = client.create_experiment("paging", description="client tests")
-    return [
-        client.create_run([(30, zeta0)], START, jumps=5, tags=["paging"], experiment_id=experiment["id"])
-        for zeta0 in ZETA0S
-    ]
-
-
-@pytest.fixture(scope="module")
-def quick_job(client) -> dict:
-    """A small MJTF job, waited for until done."""
-    job = client.submit_mjtf([0.88, 0.9], **QUICK_MJTF)
-    return client.wait(job, timeout=WAIT_TIMEOUT, progress=True)
 
 
 def test_runs_yields_every_page(client, paging_runs):
@@ -126,28 +84,6 @@ def test_experiments(client, paging_runs):
     with pytest.raises(Conflict) as refused:
         client.delete_experiment(experiment_id)
     assert refused.value.status == 409 and "runs" in str(refused.value)
-
-
-def test_job_submit_wait_results(client, quick_job):
-    assert quick_job["state"] == "done" and quick_job["completed"] == quick_job["total"] == 8
-    results = client.results(quick_job)
-    assert not results["partial"]
-    assert [(level["zeta0"], level["trials"]) for level in results["levels"]] == [(0.88, 4), (0.9, 4)]
-    assert quick_job["id"] in [job["id"] for job in client.jobs(state="done")]
-
-
-def test_wait_times_out_and_a_cancelled_job_fails(client, quick_job):
-    job = client.submit_job("mjtf", **LONG_MJTF)
-    try:
-        with pytest.raises(JobTimeout) as late:
-            client.wait(job, timeout=0.3, poll_interval=0.1)
-        assert late.value.job["id"] == job["id"] and isinstance(late.value, TimeoutError)
-    finally:
-        client.cancel(job)
-    cancelled = client.wait(job, timeout=WAIT_TIMEOUT, poll_interval=0.1, check=False)
-    assert cancelled["state"] == "cancelled"
-    with pytest.raises(JobFailed, match="cancelled"):
-        client.wait(job, timeout=WAIT_TIMEOUT)
 
 
 def test_invalid_request_names_the_field_and_its_range(client):
@@ -213,21 +149,6 @@ def test_exports_to_files(client, paging_runs, tmp_path):
     with pytest.raises(Conflict, match="only robot and replay runs"):
         client.export_mcap(paging_runs[0]["id"], target)
     assert list(tmp_path.glob("sim.mcap*")) == [], "a refused download leaves no file"
-
-
-def test_frames_with_pandas(client, paging_runs, quick_job):
-    pytest.importorskip("pandas")
-    frame = client.runs_frame(tag="paging")
-    assert sorted(frame.index) == sorted(run["id"] for run in paging_runs)
-    assert sorted(frame["leg0.zeta0"]) == ZETA0S and str(frame["created_at"].dtype).startswith("datetime64")
-    levels = client.results_frame(quick_job)
-    assert list(levels["zeta0"]) == [0.88, 0.9] and list(levels["trials"]) == [4, 4]
-
-
-def test_frames_without_pandas_say_so(client, monkeypatch):
-    monkeypatch.setitem(sys.modules, "pandas", None)  # import pandas now fails
-    with pytest.raises(ImportError, match="pip install pandas"):
-        client.runs_frame(tag="paging")
 
 
 def test_the_client_closes_its_connections(service):
