@@ -1,14 +1,18 @@
 """A robot or replay run as an MCAP recording (https://mcap.dev), which Foxglove and Rerun open.
 
-Channels (topics, schemas and units: :mod:`backend.services.mcap_schemas`), JSON messages:
+JSON channels (topics, schemas and units: :mod:`backend.services.mcap_schemas`):
 
-- ``/tracker/pose`` and ``/tracker/pose_in_frame`` (Foxglove's ``foxglove.PoseInFrame``): one
-  message per tracker frame;
+- ``/tracker/pose``: one message per tracker frame;
 - ``/touchdowns``: one per detected touchdown, with the controls it was made with;
 - ``/commands``, ``/telemetry``, ``/robot/link``: what the PC sent, what the robot reported, the
   link's state changes;
 - ``/model/prediction``: the model's prediction of each touchdown from the first (none with fewer
   than two touchdowns).
+
+Beside them, the same poses and numbers in the formats Foxglove and Rerun draw as they open the
+file (:mod:`backend.services.mcap_visuals`): the body as Foxglove's ``PoseInFrame``,
+``FrameTransform`` and ``PointCloud`` in protobuf, and the height and touchdown series as ROS 2
+number arrays, which Rerun plots.
 
 Timestamps (log time = publish time, UTC nanoseconds since the Unix epoch): a tracker-clock time
 ``t`` (frames, touchdowns, predictions) is placed at the run's start (``created_at``) plus ``t``
@@ -46,17 +50,18 @@ from experiments.manifest import json_safe
 
 EXPORTED_KINDS = ("robot", "replay")
 METADATA_NAME = "parkourlab.run"
-POSE_FRAME = "chute"
 NS_PER_S = 1_000_000_000
 
 
 @dataclass(frozen=True)
 class Recording:
-    """What a run's MCAP holds before it is written: each topic's messages as (log time [ns], JSON
-    dict), in the order they happened, and the run's metadata (:func:`_metadata`)."""
+    """What a run's MCAP holds before it is written: each topic's messages as (log time [ns],
+    message), in the order they happened — a JSON dict on the channels of
+    :mod:`~backend.services.mcap_schemas`, a protobuf message or a float on those of
+    :mod:`~backend.services.mcap_visuals` — and the run's metadata (:func:`_metadata`)."""
 
     run_id: int
-    messages: dict[str, list[tuple[int, dict]]]
+    messages: dict[str, list[tuple[int, object]]]
     metadata: dict[str, str]
 
     def counts(self) -> dict[str, int]:
@@ -73,6 +78,8 @@ def export_run(session: Session, run_id: int, stream: BinaryIO) -> dict[str, int
 
 def recording_of(session: Session, run_id: int) -> Recording:
     """The recording of a robot run that has ended, or of a replay whose source run is stored."""
+    from backend.services import mcap_visuals  # protobuf and Foxglove's schemas: loaded by exports only
+
     run = stored_runs.get_run(session, run_id)
     if run.kind not in EXPORTED_KINDS:
         raise Conflict(f"run {run_id} is a {run.kind} run: only robot and replay runs are recordings (MCAP);"
@@ -103,7 +110,6 @@ def recording_of(session: Session, run_id: int) -> Recording:
     poses = [(at(frame["tracker_time"]), frame) for frame in _poses(frames)]
     messages = {
         "/tracker/pose": poses,
-        "/tracker/pose_in_frame": [(time, _pose_in_frame(time, pose)) for time, pose in poses],
         "/touchdowns": [
             (at(td["time"]), _touchdown(td, controls[k] if k < len(controls) else None, rises))
             for k, td in enumerate(touchdowns)
@@ -116,30 +122,37 @@ def recording_of(session: Session, run_id: int) -> Recording:
         ],
         "/robot/link": _unix_timed(source.results.get("transitions", [])),
     }
-    return Recording(run.id, messages, _metadata(run, source))
+    return Recording(run.id, messages | mcap_visuals.drawn(messages), _metadata(run, source))
 
 
 def write_recording(recording: Recording, stream: BinaryIO) -> None:
     """The recording as MCAP on ``stream``: a schema and channel per topic (even one without
-    messages), the metadata record, then every message in log-time order."""
+    messages; the JSON channels first), the metadata record, then every message in log-time order."""
     from mcap.writer import Writer  # the exports load it, not the service's start
+
+    from backend.services import mcap_visuals
 
     writer = Writer(stream)
     writer.start(profile="", library="parkourlab")
-    channel_ids = {}
+    channels = {}
     for topic, schema in CHANNELS.items():
         schema_id = writer.register_schema(schema["title"], "jsonschema", json.dumps(schema).encode())
-        channel_ids[topic] = writer.register_channel(topic, "json", schema_id)
+        channels[topic] = (writer.register_channel(topic, "json", schema_id), _json)
+    channels |= mcap_visuals.register(writer)
     writer.add_metadata(METADATA_NAME, recording.metadata)
     timed = sorted(
-        ((time, topic, sequence, message) for topic in CHANNELS
+        ((time, topic, sequence, message) for topic in channels
          for sequence, (time, message) in enumerate(recording.messages[topic])),
         key=lambda item: item[0],
     )  # fmt: skip
     for time, topic, sequence, message in timed:
-        data = json.dumps(json_safe(message), allow_nan=False, separators=(",", ":")).encode()
-        writer.add_message(channel_ids[topic], log_time=time, data=data, publish_time=time, sequence=sequence)
+        channel_id, encode = channels[topic]
+        writer.add_message(channel_id, log_time=time, data=encode(message), publish_time=time, sequence=sequence)
     writer.finish()
+
+
+def _json(message: object) -> bytes:
+    return json.dumps(json_safe(message), allow_nan=False, separators=(",", ":")).encode()
 
 
 def _poses(frames: dict | None) -> Iterator[dict]:
@@ -149,20 +162,6 @@ def _poses(frames: dict | None) -> Iterator[dict]:
     pitches = frames["pitch"].tolist() if "pitch" in frames else [math.nan] * len(times)
     for t, x, y, pitch in zip(times, xs, ys, pitches, strict=True):
         yield {"tracker_time": t, "x": x, "y": y, "pitch": pitch if math.isfinite(pitch) else None}
-
-
-def _pose_in_frame(time_ns: int, pose: dict) -> dict:
-    """A tracker pose as ``foxglove.PoseInFrame`` in frame ``chute`` (x across, z up): a
-    counter-clockwise pitch seen with x right and up up is a turn about -y."""
-    half = 0.5 * (pose["pitch"] or 0.0)
-    return {
-        "timestamp": {"sec": time_ns // NS_PER_S, "nsec": time_ns % NS_PER_S},
-        "frame_id": POSE_FRAME,
-        "pose": {
-            "position": {"x": pose["x"], "y": 0.0, "z": pose["y"]},
-            "orientation": {"x": 0.0, "y": -math.sin(half), "z": 0.0, "w": math.cos(half)},
-        },
-    }
 
 
 def _touchdown(stored: dict, control: dict | None, rises: list) -> dict:

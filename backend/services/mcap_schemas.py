@@ -1,7 +1,8 @@
-"""The channels of a run's MCAP recording (:mod:`backend.services.mcap_export`): topic, schema
-name and JSON Schema of each, in the order they are registered.
+"""The JSON channels of a run's MCAP recording (:mod:`backend.services.mcap_export`): topic,
+schema name and JSON Schema of each, in the order they are registered (the channels drawn in
+Foxglove's and Rerun's own formats are :mod:`backend.services.mcap_visuals`).
 
-Every channel's messages are JSON (``message_encoding="json"``) and its schema a JSON Schema
+These channels' messages are JSON (``message_encoding="json"``) and their schemas JSON Schemas
 (``encoding="jsonschema"``), so Foxglove, Rerun and the ``mcap`` tools read them without code of
 ours. Units: SI (metres, seconds, radians) unless a name says degrees (``_deg``) or the field
 says nondimensional (section states in sqrt(g l0), height gains in l0). Times inside a message
@@ -49,29 +50,6 @@ TRACKER_POSE = _object(
         "x": {**NUMBER, "description": "[m] across the chute, from its centre line"},
         "y": {**NUMBER, "description": "[m] up"},
         "pitch": {**NUMBER_OR_NULL, "description": "[rad] counter-clockwise (x right, y up); null if untracked"},
-    },
-)
-
-_TIME = {
-    "type": "object",
-    "properties": {"sec": {**INTEGER, "minimum": 0}, "nsec": {**INTEGER, "minimum": 0, "maximum": 999_999_999}},
-    "required": ["sec", "nsec"],
-}
-_VECTOR3 = {"type": "object", "properties": {k: NUMBER for k in "xyz"}, "required": list("xyz")}
-_QUATERNION = {"type": "object", "properties": {k: NUMBER for k in "xyzw"}, "required": list("xyzw")}
-# Foxglove's own schema name and shape (foxglove-sdk schemas/jsonschema/PoseInFrame.json): its 3D
-# panel draws it. Frame "chute": x across the chute, z up (the wall's y), y into the wall plane.
-POSE_IN_FRAME = _object(
-    "foxglove.PoseInFrame",
-    "The tracked body as Foxglove's PoseInFrame, frame 'chute': x across the chute [m], z up [m], y = 0",
-    {
-        "timestamp": _TIME,
-        "frame_id": STRING,
-        "pose": {
-            "type": "object",
-            "properties": {"position": _VECTOR3, "orientation": _QUATERNION},
-            "required": ["position", "orientation"],
-        },
     },
 )
 
@@ -145,7 +123,6 @@ LINK = _object(
 # topic -> schema, in the order the channels are registered.
 CHANNELS: dict[str, dict] = {
     "/tracker/pose": TRACKER_POSE,
-    "/tracker/pose_in_frame": POSE_IN_FRAME,
     "/touchdowns": TOUCHDOWN,
     "/commands": COMMAND,
     "/telemetry": TELEMETRY,

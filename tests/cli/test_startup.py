@@ -11,9 +11,9 @@ import sys
 import pytest
 
 # Loaded only when a command runs: the kernels, the optimiser, the store, the service, the cluster,
-# plotting, the 3D view and the MCAP writer.
+# plotting, the 3D view and the MCAP writer with its protobuf schemas.
 HEAVY = ("numba", "scipy", "sqlalchemy", "alembic", "dask", "distributed", "matplotlib", "viser", "fastapi", "uvicorn",
-         "mcap")  # fmt: skip
+         "mcap", "google.protobuf", "foxglove_schemas_protobuf")  # fmt: skip
 COMMANDS = ("map", "trajectory", "fixed-point", "gaits", "basin", "sweep", "mjtf", "pid", "atlas", "reproduce")
 COMMANDS += ("robot-sim", "export", "bench", "serve")
 

@@ -1,4 +1,5 @@
-"""Robot and replay runs as MCAP recordings, read back with the mcap reader (backend/services/mcap_export.py)."""
+"""Robot and replay runs as MCAP recordings, read back with the mcap reader (backend/services/mcap_export.py).
+The channels drawn in Foxglove's and Rerun's formats are read in test_mcap_visuals.py."""
 
 import datetime
 import io
@@ -14,6 +15,7 @@ from backend.robot.tracker import Calibration
 from backend.services import runs
 from backend.services.mcap_export import METADATA_NAME, export_run
 from backend.services.mcap_schemas import CHANNELS
+from backend.services.mcap_visuals import PROTOBUF_CHANNELS, SERIES, SERIES_SCHEMA
 from backend.services.robot_records import open_robot_run, replay_run
 from backend.services.simulation import unpack_trajectory
 from sim_core import get_preset
@@ -47,15 +49,18 @@ def check(value, schema: dict, where: str = "$") -> None:
 
 
 def read(data: bytes):
-    """(summary, metadata by name, [(topic, schema dict, log time, message dict)] in file order)."""
+    """(summary, metadata by name, [(topic, schema dict, log time, message dict)] of the JSON
+    channels in file order, [(topic, log time)] of every message in file order)."""
     reader = make_reader(io.BytesIO(data))
     summary = reader.get_summary()
     metadata = {record.name: record.metadata for record in make_reader(io.BytesIO(data)).iter_metadata()}
+    every = list(make_reader(io.BytesIO(data)).iter_messages(log_time_order=False))
     messages = [
         (channel.topic, json.loads(schema.data), message.log_time, json.loads(message.data))
-        for schema, channel, message in make_reader(io.BytesIO(data)).iter_messages(log_time_order=False)
+        for schema, channel, message in every
+        if channel.message_encoding == "json"
     ]
-    return summary, metadata, messages
+    return summary, metadata, messages, [(channel.topic, message.log_time) for _s, channel, message in every]
 
 
 def exported(session, run_id: int) -> tuple[bytes, dict]:
@@ -72,33 +77,48 @@ def utc_ns(moment: datetime.datetime) -> int:
 def test_a_robot_run_reads_back_channel_by_channel(session):
     run = run_store.get_run(session, store_robot_run(session))
     data, counts = exported(session, run.id)
-    summary, metadata, messages = read(data)
+    summary, metadata, messages, every = read(data)
 
     frames = unpack_trajectory(run.trajectory)
     results = run.results
     expected = {
         "/tracker/pose": frames["time"].size,
-        "/tracker/pose_in_frame": frames["time"].size,
         "/touchdowns": len(results["touchdowns"]),
         "/commands": len(results["commands"]),
         "/telemetry": len(results["telemetry"]),
         "/model/prediction": len(results["prediction"]["states"]),
         "/robot/link": len(results["transitions"]),
+        **dict.fromkeys(PROTOBUF_CHANNELS, frames["time"].size),
+        "/plot/height": frames["time"].size,
+        "/plot/touchdown/body_height": len(results["touchdowns"]),
+        "/plot/touchdown/foot_height": len(results["touchdowns"]),
+        "/plot/touchdown/rise": len(results["rises"]),
+        "/plot/prediction/rise": len(results["prediction"]["rises"]),
     }
-    assert expected == {"/tracker/pose": 336, "/tracker/pose_in_frame": 336, "/touchdowns": 5, "/commands": 3,
-                        "/telemetry": 6, "/model/prediction": 5, "/robot/link": 1}  # fmt: skip
+    assert expected == {"/tracker/pose": 336, "/touchdowns": 5, "/commands": 3, "/telemetry": 6,
+                        "/model/prediction": 5, "/robot/link": 1, "/tracker/pose_in_frame": 336,
+                        "/tracker/transform": 336, "/tracker/body": 336, "/plot/height": 336,
+                        "/plot/touchdown/body_height": 5, "/plot/touchdown/foot_height": 5, "/plot/touchdown/rise": 4,
+                        "/plot/prediction/rise": 4}  # fmt: skip
     assert counts == expected
     topics = {channel.id: channel.topic for channel in summary.channels.values()}
-    assert list(topics.values()) == list(CHANNELS)
+    assert list(topics.values()) == [*CHANNELS, *PROTOBUF_CHANNELS, *SERIES]
     assert {topics[i]: n for i, n in summary.statistics.channel_message_counts.items()} == expected
-    assert {topic: sum(1 for m in messages if m[0] == topic) for topic in CHANNELS} == expected
+    assert {topic: sum(1 for m in every if m[0] == topic) for topic in expected} == expected
     for channel in summary.channels.values():
         schema = summary.schemas[channel.schema_id]
-        assert (channel.message_encoding, schema.encoding) == ("json", "jsonschema")
-        assert json.loads(schema.data) == CHANNELS[channel.topic]
+        if channel.topic in CHANNELS:
+            assert (channel.message_encoding, schema.encoding) == ("json", "jsonschema")
+            assert json.loads(schema.data) == CHANNELS[channel.topic]
+        elif channel.topic in PROTOBUF_CHANNELS:
+            assert (channel.message_encoding, schema.encoding) == ("protobuf", "protobuf")
+            assert schema.name == PROTOBUF_CHANNELS[channel.topic].DESCRIPTOR.full_name
+        else:
+            assert (channel.message_encoding, schema.encoding) == ("cdr", "ros2msg")
+            assert schema.name == SERIES_SCHEMA == "std_msgs/msg/Float64MultiArray"
     for topic, schema, _time, message in messages:
         check(message, schema, topic)
-    times = [time for *_, time, _message in messages]
+    times = [time for _topic, time in every]
     assert times == sorted(times), "written in log-time order"
 
     def on(topic: str) -> list[tuple[int, dict]]:
@@ -131,30 +151,11 @@ def test_a_robot_run_reads_back_channel_by_channel(session):
     assert json.loads(about["source_run_id"]) is None and json.loads(about["tracker"])["frames"] == 336
 
 
-def test_pose_in_frame_is_foxglove_s_pose_up_on_z(session):
-    run = run_store.get_run(session, store_robot_run(session))
-    _summary, _metadata, messages = read(exported(session, run.id)[0])
-    poses = [(time, m) for topic, _s, time, m in messages if topic == "/tracker/pose"]
-    framed = [(time, m) for topic, _s, time, m in messages if topic == "/tracker/pose_in_frame"]
-    (time, pose), (framed_time, framed_pose) = poses[1], framed[1]
-    assert framed_time == time
-    assert framed_pose["timestamp"] == {"sec": time // 10**9, "nsec": time % 10**9}
-    assert framed_pose["frame_id"] == "chute"
-    assert framed_pose["pose"]["position"] == {"x": pose["x"], "y": 0.0, "z": pose["y"]}
-    orientation = framed_pose["pose"]["orientation"]
-    # A counter-clockwise pitch (x right, up up) turns the body's x axis up: +z.
-    q = (orientation["w"], orientation["x"], orientation["y"], orientation["z"])
-    x_axis = (1 - 2 * (q[2] ** 2 + q[3] ** 2), 2 * (q[1] * q[2] + q[0] * q[3]), 2 * (q[1] * q[3] - q[0] * q[2]))
-    assert x_axis == pytest.approx((math.cos(0.02), 0.0, math.sin(0.02)))
-    untracked = framed[7][1]["pose"]["orientation"]
-    assert untracked == {"x": 0.0, "y": -0.0, "z": 0.0, "w": 1.0}, "no pitch: level"
-
-
 def test_a_replay_is_its_source_s_recording_with_its_own_touchdowns(session):
     source = run_store.get_run(session, store_robot_run(session))
     replay = replay_run(session, source.id)
     data, counts = exported(session, replay.id)
-    _summary, metadata, messages = read(data)
+    _summary, metadata, messages, _every = read(data)
     assert counts["/tracker/pose"] == unpack_trajectory(source.trajectory)["time"].size
     assert counts["/touchdowns"] == len(replay.results["touchdowns"]) == 5
     assert counts["/model/prediction"] == len(replay.results["prediction"]["states"])

@@ -1,11 +1,11 @@
-"""The channels of a run's MCAP recording (backend/services/mcap_schemas.py): topics in the order
-they are registered, each with a draft 2020-12 JSON Schema the MCAP tools and Foxglove read."""
+"""The JSON channels of a run's MCAP recording (backend/services/mcap_schemas.py): topics in the
+order they are registered, each with a draft 2020-12 JSON Schema the MCAP tools and Foxglove read."""
 
 import json
 
 import pytest
 
-from backend.services.mcap_schemas import CHANNELS, POSE_IN_FRAME, SECTION_STATE, TOUCHDOWN, TRACKER_POSE
+from backend.services.mcap_schemas import CHANNELS, SECTION_STATE, TOUCHDOWN, TRACKER_POSE
 
 JSON_TYPES = {"object", "array", "string", "integer", "number", "null", "boolean"}
 DRAFT = "https://json-schema.org/draft/2020-12/schema"
@@ -25,7 +25,6 @@ def _types(schema: dict, where: str = "$"):
 def test_channels_are_registered_in_this_order():
     assert list(CHANNELS) == [
         "/tracker/pose",
-        "/tracker/pose_in_frame",
         "/touchdowns",
         "/commands",
         "/telemetry",
@@ -50,20 +49,11 @@ def test_every_type_named_is_a_json_type(topic):
     assert [(where, name) for where, name in places if name not in JSON_TYPES] == []
 
 
-def test_schema_names_are_unique_and_ours_but_foxgloves_pose():
+def test_schema_names_are_unique_and_ours():
+    """Foxglove's own schemas (the body's pose) are protobuf channels: backend/services/mcap_visuals.py."""
     titles = [schema["title"] for schema in CHANNELS.values()]
     assert len(set(titles)) == len(titles)
-    assert [title for title in titles if not title.startswith("parkourlab.")] == ["foxglove.PoseInFrame"]
-
-
-def test_the_pose_in_frame_has_foxgloves_shape():
-    """Foxglove's 3D panel draws ``foxglove.PoseInFrame`` only in its own shape."""
-    properties = POSE_IN_FRAME["properties"]
-    assert set(properties) == {"timestamp", "frame_id", "pose"}
-    assert properties["timestamp"]["required"] == ["sec", "nsec"]
-    assert properties["timestamp"]["properties"]["nsec"]["maximum"] == 999_999_999
-    pose = properties["pose"]["properties"]
-    assert pose["position"]["required"] == ["x", "y", "z"] and pose["orientation"]["required"] == ["x", "y", "z", "w"]
+    assert [title for title in titles if not title.startswith("parkourlab.")] == []
 
 
 def test_values_that_may_be_missing_are_nullable_and_the_rest_are_not():
