@@ -143,7 +143,8 @@ def body_point(time_ns: int, pose: dict) -> PointCloud:
         data=struct.pack("<3d", pose["x"], 0.0, pose["y"]),
     )  # fmt: skip
     message.timestamp.FromNanoseconds(time_ns)
-    message.pose.orientation.w = 1.0
+    message.pose.position.SetInParent()  # the identity pose, written out: the origin ...
+    message.pose.orientation.w = 1.0  # ... and no turn
     return message
 
 

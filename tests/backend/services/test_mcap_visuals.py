@@ -94,6 +94,7 @@ def test_the_body_is_foxglove_s_pose_transform_and_point_in_protobuf(run_and_rec
         fields = [(field.name, field.offset, field.type) for field in cloud.fields]
         assert fields == [("x", 0, 8), ("y", 8, 8), ("z", 16, 8)] and cloud.point_stride == 24, "float64 x, y, z"
         assert struct.unpack("<3d", cloud.data) == position, where
+        assert cloud.pose.HasField("position") and cloud.pose.orientation.w == 1.0, "the cloud at the origin"
     assert_allclose([m.pose.position.z for _, m in messages["/tracker/pose_in_frame"]], frames["y"], rtol=0)
 
 
