@@ -5,9 +5,10 @@ from __future__ import annotations
 
 import datetime
 import enum
+import math
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, Field, model_validator
+from pydantic import BaseModel, Field, ValidationInfo, field_validator
 
 from backend.schemas.common import (
     MAX_JUMPS,
@@ -53,17 +54,26 @@ class RunCreate(RunBase, Strict):
     controls: Annotated[list[LegIn], Field(min_length=1, max_length=16)]
     start: StateIn
     trajectory_rate: Annotated[float, Field(gt=0.0, le=1000.0)] | None = Field(
-        None, description="also store the sampled path, samples per sqrt(l0/g)"
+        None,
+        description=f"also store the sampled path, samples per sqrt(l0/g); rate x jumps at most {MAX_PATH_SAMPLES:,}",
+        json_schema_extra={"x-max-rate-times-jumps": MAX_PATH_SAMPLES},  # the panel thins a long run's path by it
     )
     fixed_point: bool = Field(False, description="also find the gait near the start state and store its eigenvalues")
 
-    @model_validator(mode="after")
-    def _bounded_path(self) -> RunCreate:
-        # A jump lasts about 1.5 time units: this caps a stored path near 150,000 samples.
-        if self.trajectory_rate is not None and self.trajectory_rate * self.jumps > MAX_PATH_SAMPLES:
-            samples = self.trajectory_rate * self.jumps
-            raise ValueError(f"trajectory_rate x jumps must be at most {MAX_PATH_SAMPLES:,}, got {samples:g}")
-        return self
+    @field_validator("trajectory_rate")
+    @classmethod
+    def _bounded_path(cls, rate: float | None, info: ValidationInfo) -> float | None:
+        # A jump lasts about 1.5 time units: this caps a stored path near 150,000 samples. Said
+        # in the asker's terms: the path's samples, and the jumps (or the rate) that fit.
+        jumps = info.data.get("jumps")
+        if rate is None or jumps is None or rate * jumps <= MAX_PATH_SAMPLES:
+            return rate
+        raise ValueError(
+            f"a path of {jumps:,} jumps at {rate:g} samples per sqrt(l0/g) would be about {1.5 * rate * jumps:,.0f}"
+            f" samples, more than a run keeps (rate x jumps at most {MAX_PATH_SAMPLES:,}): at this rate a path is"
+            f" kept for up to {math.floor(MAX_PATH_SAMPLES / rate):,} jumps; for {jumps:,} jumps, a rate of at most"
+            f" {math.floor(MAX_PATH_SAMPLES / jumps * 1000) / 1000:g}, or no trajectory_rate (the run without its path)"
+        )
 
 
 class RunUpdate(Strict):

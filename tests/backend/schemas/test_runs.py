@@ -63,9 +63,21 @@ def test_a_stored_path_is_capped_at_rate_times_jumps():
     at_the_cap = RUN | {"jumps": 1000, "trajectory_rate": MAX_PATH_SAMPLES / 1000}
     assert accepted(RunCreate, at_the_cap).jumps == 1000
     over = at_the_cap | {"jumps": 1001}
-    assert refused(RunCreate, over) == [()], "a limit of two fields together: the body's"
-    assert "trajectory_rate x jumps must be at most 100,000, got 100100" in refusal_messages(RunCreate, over)
+    assert refused(RunCreate, over) == [("trajectory_rate",)], "the path's rate is what is refused"
     assert accepted(RunCreate, RUN | {"jumps": MAX_JUMPS}).trajectory_rate is None, "no path: no cap"
+
+
+def test_a_path_too_long_to_keep_is_refused_in_the_askers_terms():
+    """The panel's Save run once sent 60 samples per sqrt(l0/g) for 2,000 jumps and was told
+    "trajectory_rate x jumps must be at most 100,000", a product nobody typed: the message says
+    what the path would be, how many jumps fit at that rate, and the rate (or no path) that fits."""
+    message = refusal_messages(RunCreate, RUN | {"jumps": 2000, "trajectory_rate": 60.0}).removeprefix("Value error, ")
+    assert message.startswith("a path of 2,000 jumps at 60 samples per sqrt(l0/g) would be about 180,000 samples")
+    assert "at this rate a path is kept for up to 1,666 jumps" in message, message
+    assert "for 2,000 jumps, a rate of at most 50, or no trajectory_rate" in message, message
+    assert "trajectory_rate x jumps" not in message
+    assert accepted(RunCreate, RUN | {"jumps": 2000, "trajectory_rate": 50.0}).trajectory_rate == 50.0
+    assert accepted(RunCreate, RUN | {"jumps": MAX_JUMPS, "trajectory_rate": 10.0}).jumps == MAX_JUMPS
 
 
 def test_nested_errors_name_the_leg_the_start_and_the_model():
