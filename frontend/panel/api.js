@@ -11,13 +11,19 @@ const tokenStatus = $("#token-status");
 
 // Sign-in: `parkour serve` prints the panel's address with the token in the fragment
 // (#token=…), which browsers never send to the service. Keep it and take it out of the address
-// bar (and so out of the history and of what is copied from it).
-const fromLink = new URLSearchParams(location.hash.slice(1)).get("token");
-if (fromLink) {
+// bar (and so out of the history and of what is copied from it). A link opened in a tab that
+// already shows the panel changes only the fragment (no page load): hashchange signs that tab in.
+function signInFromLink() {
+  const fromLink = new URLSearchParams(location.hash.slice(1)).get("token");
+  if (!fromLink) return false;
   localStorage.setItem(TOKEN_KEY, fromLink.trim());
   history.replaceState(null, "", location.pathname + location.search);
+  tokenInput.value = fromLink.trim();
+  return true;
 }
+signInFromLink();
 tokenInput.value = localStorage.getItem(TOKEN_KEY) || "";
+addEventListener("hashchange", () => { if (signInFromLink()) checkToken(); });
 tokenInput.addEventListener("change", () => {
   localStorage.setItem(TOKEN_KEY, tokenInput.value.trim());
   checkToken();
@@ -62,7 +68,9 @@ function explain(body, status) {
   return `HTTP ${status}`;
 }
 
-// ``fields``: {form, locations} puts a 422's errors at their fields (Fields.markApiErrors).
+// ``fields``: {form, locations, action} puts a 422's errors at their fields (Fields.markApiErrors);
+// what no field on the form takes (a gait not found, a rule across fields, a field the form
+// does not have) is said in the API's own words, after ``action`` (the button's name) or the call.
 export async function call(method, path, body, fields) {
   const headers = { "Content-Type": "application/json" };
   const token = tokenInput.value.trim();
@@ -75,11 +83,17 @@ export async function call(method, path, body, fields) {
     throw error;
   }
   const text = await response.text();
-  const data = text ? JSON.parse(text) : null;
+  let data = null;
+  try {
+    data = text ? JSON.parse(text) : null;
+  } catch {  // not the service's JSON (a proxy's page, say): its text is the reason
+    if (!response.ok) data = { detail: text.trim().slice(0, 300) || null };
+  }
   if (!response.ok && response.status === 422 && fields && data) {
-    const left = Fields.markApiErrors(fields.form, data.detail, fields.locations);
+    const { left, marked } = Fields.markApiErrors(fields.form, data.detail, fields.locations);
     const message = left.length ? left.join("; ") : "the service refused the marked field(s)";
-    say(left.length ? `${method} ${path}: ${message}` : "Fix the marked field(s): the service refused them.", "error");
+    const also = marked ? "; fix the marked field(s) too" : "";
+    say(left.length ? `${fields.action ?? `${method} ${path}`}: ${message}${also}` : "Fix the marked field(s): the service refused them.", "error");
     throw new Error(message);
   }
   if (!response.ok) {
@@ -87,7 +101,7 @@ export async function call(method, path, body, fields) {
       ? "This needs the API token: open the sign-in link parkour serve prints, or paste data/api_token into the field at the top."
       : explain(data, response.status);
     if (response.status === 401) checkToken();
-    say(`${method} ${path}: ${message}`, "error");
+    say(`${fields?.action ?? `${method} ${path}`}: ${message}`, "error");
     throw new Error(message);
   }
   return data;

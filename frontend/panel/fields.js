@@ -31,11 +31,28 @@ export const Fields = (() => {
   }
 
   const show = (value) => String(Number(value.toPrecision(6)));
+  // The largest whole number a browser holds, and so sends, exactly (2^53 - 1): a whole-number
+  // field is held to it even where the API takes more (a seed: up to 2^63 - 1).
+  const EXACT = BigInt(Number.MAX_SAFE_INTEGER);
+  const EXACT_NOTE = " (the largest whole number a browser sends exactly)";
+
+  // Why whole number ``value`` breaks ``schema`` ("" when it does not): the bounds said as the
+  // whole numbers they are, exactly (BigInt: 2^63 - 1 is no double), never rounded.
+  function wholeProblem(value, schema, u) {
+    let low = schema.minimum ?? schema.exclusiveMinimum, high = schema.maximum ?? schema.exclusiveMaximum;
+    if (low !== undefined) low = schema.minimum !== undefined ? BigInt(Math.ceil(low)) : BigInt(Math.floor(low)) + 1n;
+    if (high !== undefined) high = schema.maximum !== undefined ? BigInt(Math.floor(high)) : BigInt(Math.ceil(high)) - 1n;
+    const capped = high === undefined || high > EXACT;
+    if (capped) high = EXACT;
+    if (low === undefined || low < -EXACT) low = -EXACT;
+    if (BigInt(value) >= low && BigInt(value) <= high) return "";
+    return `must be at least ${low} and at most ${high}${u}${capped ? EXACT_NOTE : ""}`;
+  }
 
   // Why ``value`` breaks ``schema`` ("" when it does not), in words, with the field's unit.
   function problem(value, schema, unit) {
     const u = unit ? ` ${unit}` : "";
-    if (schema.type === "integer" && !Number.isInteger(value)) return "must be a whole number";
+    if (schema.type === "integer") return Number.isInteger(value) ? wholeProblem(value, schema, u) : "must be a whole number";
     const low = schema.minimum ?? schema.exclusiveMinimum, high = schema.maximum ?? schema.exclusiveMaximum;
     const lowOk = low === undefined || (schema.minimum !== undefined ? value >= low : value > low);
     const highOk = high === undefined || (schema.maximum !== undefined ? value <= high : value < high);
@@ -43,6 +60,14 @@ export const Fields = (() => {
     const from = low === undefined ? "" : `${schema.minimum !== undefined ? "at least" : "more than"} ${show(low)}`;
     const to = high === undefined ? "" : `${schema.maximum !== undefined ? "at most" : "less than"} ${show(high)}`;
     return `must be ${[from, to].filter(Boolean).join(" and ")}${u}`;
+  }
+
+  // The annotation ``key`` the API puts on a property, "Model.property" (e.g. RunCreate's
+  // "x-max-rate-times-jumps" on trajectory_rate), or undefined.
+  async function annotation(path, key) {
+    await ready;
+    const [model, property] = path.split(".");
+    return resolve(schemas[model])?.properties?.[property]?.[key];
   }
 
   function clear(form) {
@@ -77,12 +102,15 @@ export const Fields = (() => {
         const value = Number(text);
         if (text === "") message = field.list ? "enter numbers separated by commas" : "enter a number";
         else if (!Number.isFinite(value)) message = `"${text}" is not a number`;
-        else message = problem(value, schema, field.unit);
+        else {
+          const broken = problem(value, schema, field.unit);
+          message = broken && field.list ? `each ${broken}` : broken;  // a list's range: "each must be …"
+        }
         if (message) break;
         numbers.push(value);
       }
       if (message) {
-        mark(input, field.list ? `each ${message}` : message);
+        mark(input, message);
         first ??= input;
       } else {
         values[field.name] = field.list ? numbers : numbers[0];
@@ -96,19 +124,27 @@ export const Fields = (() => {
   }
 
   // A 422's errors put at their fields: ``locations`` maps a body location ("controls.0.zeta0")
-  // to an input's name. Returns the messages no field took.
+  // to an input's name. Returns {left: the messages no field took, in the API's words; marked:
+  // how many fields were marked}. A detail that is one sentence (a gait not found, say) names no
+  // field: it is left, whole.
   function markApiErrors(form, detail, locations) {
+    if (!Array.isArray(detail)) return { left: detail ? [String(detail)] : [], marked: 0 };
     const left = [];
-    for (const error of Array.isArray(detail) ? detail : []) {
+    let marked = 0;
+    for (const error of detail) {
       const location = (error.loc || []).filter((part) => part !== "body").join(".");
-      const input = form.elements[locations[location]];
+      const input = locations[location] === undefined ? null : form.elements[locations[location]];
       // pydantic prefixes a validator's own message with its kind ("Value error, …"): not the user's words.
       const message = String(error.msg).replace(/^(Value|Assertion) error, /, "");
-      if (input && input.getAttribute("aria-invalid") !== "true") mark(input, message);
-      else left.push(location ? `${location}: ${error.msg}` : error.msg);
+      if (input && !input.matches(":disabled") && input.getAttribute("aria-invalid") !== "true") {
+        mark(input, message);
+        marked += 1;
+      } else {
+        left.push(location ? `${location}: ${message}` : message);
+      }
     }
-    return left;
+    return { left, marked };
   }
 
-  return { ready, readFields, markApiErrors, clear };
+  return { ready, readFields, markApiErrors, clear, annotation };
 })();

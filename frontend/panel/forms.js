@@ -23,7 +23,8 @@ export const SIM_LOCATIONS = {
   "controls.0.psi0_deg": "psiL", "controls.0.zeta0": "zetaL", "controls.1.psi0_deg": "psiR", "controls.1.zeta0": "zetaR",
   "start.xdot": "xdot", "start.ydot": "ydot", "guess.xdot": "xdot", "guess.ydot": "ydot", jumps: "jumps", psi0_deg: "psiL",
 };
-export const simFields = () => ({ form: $("#sim-form"), locations: SIM_LOCATIONS });
+// ``action``: the button's name, before what the service says no field of the form takes.
+export const simFields = (action) => ({ form: $("#sim-form"), locations: SIM_LOCATIONS, action });
 
 // The checked values of ``fields`` in ``form``, or null (the bad ones are marked; the banner says so).
 export async function checked(form, fields) {

@@ -1,7 +1,8 @@
-// The Jobs tab: the job form by kind, the jobs table with live progress (event streams), results.
+// The Jobs tab: the job form by kind, the jobs table page by page with live progress (event
+// streams) and each queued job's place and estimate, results.
 import { API, $, say, call, on } from "./api.js";
 import { filedUnder, SQRT_GL0, checked, simControls } from "./forms.js";
-import { PLOT_CONFIG, layout, plotSweep, plotBasin } from "./plots.js";
+import { draw, layout, plotSweep, plotBasin } from "./plots.js";
 import { element, fillTable, attributes } from "./dom.js";
 
 const streams = new Map();
@@ -15,14 +16,37 @@ export function describeJob(job) {
   return job.kind === "basin" ? `${legs}, ${spec.grid}² start states` : legs;
 }
 
+const ordinal = (n) => `${n}${[11, 12, 13].includes(n % 100) ? "th" : ({ 1: "st", 2: "nd", 3: "rd" }[n % 10] ?? "th")}`;
+
+function duration(seconds) {
+  if (seconds < 90) return `${Math.max(1, Math.round(seconds))} s`;
+  if (seconds < 90 * 60) return `${Math.round(seconds / 60)} min`;
+  const minutes = Math.round(seconds / 60);
+  return `${Math.floor(minutes / 60)} h ${minutes % 60} min`;
+}
+
+// Where a job stands in the queue and when it should be done, as the service estimates them
+// (``queue_position``: 1 = next to run, null when not queued; ``eta_s``: seconds until it should
+// finish, or null); "" when it gives neither (an older service does not).
+export function queueWords(job) {
+  const words = [];
+  if (Number.isInteger(job.queue_position) && job.queue_position >= 1) {
+    words.push(job.queue_position === 1 ? "next to run" : `${ordinal(job.queue_position)} in the queue`);
+  }
+  if (typeof job.eta_s === "number" && Number.isFinite(job.eta_s) && job.eta_s >= 0) words.push(`done in about ${duration(job.eta_s)}`);
+  return words.join(", ");
+}
+
 function jobRow(job) {
   const progress = attributes(element("progress", null), { max: 1, value: job.progress, "aria-label": `job ${job.id} progress` });
   const state = attributes(element("td", job.state), { class: "state" });
   if (job.error) state.title = job.error;
   const cancel = ["queued", "running"].includes(job.state) ? [attributes(element("button", "Cancel"), { class: "cancel", "data-id": job.id })] : [];
+  const queue = queueWords(job);
   const row = element("tr", null,
     element("td", String(job.id)), element("td", job.kind), attributes(element("td", describeJob(job)), { class: "what" }), state,
-    attributes(element("td", null, progress, ` ${job.completed}/${job.total}`), { class: "progress" }),
+    attributes(element("td", null, progress, ` ${job.completed}/${job.total}`,
+      ...(queue ? [attributes(element("small", queue), { class: "queue" })] : [])), { class: "progress" }),
     element("td", null, attributes(element("button", "Show"), { class: "show", "data-id": job.id, "data-kind": job.kind })),
     element("td", null, ...cancel));
   row.id = `job-${job.id}`;
@@ -52,11 +76,55 @@ export function watch(job, onFinal, onProgress) {
   if (onProgress) entry.progresses.push(onProgress);
 }
 
-export async function loadJobs() {
-  const page = await call("GET", "/jobs?limit=20");
-  fillTable("#job-table", page.items.map(jobRow), "No jobs yet: schedule one above.");
-  page.items.forEach((job) => watch(job));
+// The table shows one page of jobs, newest first; Older and Newer page through all of them. The
+// API's pages are keyset pages: page k is asked with ``cursors[k]`` (null: the newest), the
+// next_cursor of the page before it. ``total`` (every job) is shown when the API counts it.
+const PAGE_SIZE = 20;
+const paging = { cursors: [null], at: 0 };
+// The page's unfinished jobs are followed by asking for the page again every REFRESH_MS while
+// the tab is shown, not by an event stream each: a browser opens at most six connections to the
+// service, and a page of queued jobs' streams would hold them all, every other call of the panel
+// waiting behind them. Streams are kept for the jobs this panel waits on (watch: a job just
+// scheduled, the Simulate tab's analyses).
+const REFRESH_MS = 2000;
+let refresh = null;
+
+function followPage(jobs) {
+  clearTimeout(refresh);
+  const unfinished = jobs.some((job) => !FINAL.includes(job.state));
+  refresh = unfinished ? setTimeout(() => { if (!$("#jobs").hidden) loadJobs().catch(() => {}); }, REFRESH_MS) : null;
 }
+
+// ``newest``: back to the first page (a job just scheduled is on it).
+export async function loadJobs({ newest = false } = {}) {
+  if (newest) Object.assign(paging, { cursors: [null], at: 0 });
+  const cursor = paging.cursors[paging.at];
+  const page = await call("GET", `/jobs?limit=${PAGE_SIZE}${cursor === null ? "" : `&cursor=${cursor}`}`);
+  paging.cursors.length = paging.at + 1;
+  if (page.next_cursor !== null && page.next_cursor !== undefined) paging.cursors.push(page.next_cursor);
+  fillTable("#job-table", page.items.map(jobRow), paging.at ? "No older jobs." : "No jobs yet: schedule one above.");
+  showPage(page.items.length, page.total);
+  followPage(page.items);
+}
+
+function showPage(count, total) {
+  const first = paging.at * PAGE_SIZE + 1, last = paging.at * PAGE_SIZE + count;
+  const counted = Number.isInteger(total) ? ` of ${total}` : "";
+  $("#jobs-range").textContent = count ? `jobs ${first}–${last}${counted}, newest first` : `no jobs here${counted ? ` (${total} in all)` : ""}`;
+  $("#jobs-newer").disabled = paging.at === 0;
+  $("#jobs-older").disabled = paging.cursors.length <= paging.at + 1;
+}
+
+on("#jobs-older", "click", () => {
+  if (paging.cursors.length <= paging.at + 1) return;
+  paging.at += 1;
+  return loadJobs();
+});
+on("#jobs-newer", "click", () => {
+  if (paging.at === 0) return;
+  paging.at -= 1;
+  return loadJobs();
+});
 
 on("#job-kind", "change", (event) => {
   for (const fieldset of document.querySelectorAll("#job-form fieldset[data-kind]")) {
@@ -103,8 +171,9 @@ on("#job-form", "submit", async (event) => {
   const spec = await jobSpec(event.target);
   if (!spec) return;
   const job = await call("POST", "/jobs", { ...spec.body, ...filedUnder(event.target) }, { form: event.target, locations: spec.locations });
-  say(`Job ${job.id} scheduled: ${describeJob(job)}.`);
-  await loadJobs();
+  say(`Job ${job.id} scheduled: ${describeJob(job)}${queueWords(job) ? ` (${queueWords(job)})` : ""}.`);
+  watch(job);  // its row live, and a word when it ends
+  await loadJobs({ newest: true });
 });
 
 on("#job-table", "click", async (event) => {
@@ -121,10 +190,10 @@ on("#job-table", "click", async (event) => {
     const missing = results.missing_zeta0s || [];
     const partial = results.partial ? ` — partial (${job.state}: ${job.completed} of ${job.total} trials${
       missing.length ? `; no trials at zeta0 ${missing.join(", ")}` : ""})` : "";
-    Plotly.react("job-plot", [{
+    draw("job-plot", [{
       x: results.levels.map((l) => l.zeta0), y: results.levels.map((l) => l.mean), mode: "lines+markers", name: "MJTF",
       error_y: { type: "data", array: results.levels.map((l) => l.std), visible: true },
-    }], layout(`Job ${id}: Mean Jumps To Failure${partial}`, "zeta0 [l0]", "jumps to failure"), PLOT_CONFIG);
+    }], layout(`Job ${id}: Mean Jumps To Failure${partial}`, "zeta0 [l0]", "jumps to failure"));
   } else if (!results.result) {
     say(`Job ${id} is ${job.state}: no result${job.error ? ` (${job.error})` : " yet"}.`, job.state === "failed" ? "error" : "ok");
   } else if (job.kind === "sweep") {

@@ -8,6 +8,13 @@ export const PLOT_CONFIG = Object.freeze({
   modeBarButtonsToRemove: Object.freeze(["sendChartToCloud", "sendDataToCloud", "editInChartStudio"]),
 });
 
+// A plot's box is hidden (index.html) until there is something to draw in it: shown, then drawn
+// (Plotly sizes a hidden box wrongly). ``target``: the box's id.
+export function draw(target, traces, plotLayout) {
+  document.getElementById(target).hidden = false;
+  return Plotly.react(target, traces, plotLayout, PLOT_CONFIG);
+}
+
 export const layout = (title, x, y, extra = {}) => ({
   title: { text: title, font: { size: 14 } }, margin: { l: 55, r: 15, t: 40, b: 45 },
   xaxis: { title: { text: x } }, yaxis: { title: { text: y } }, ...extra,
@@ -29,10 +36,10 @@ export function plotSweep(target, result, title) {
   }
   const inPlace = result.in_place_zeta0.map((z) => ({ type: "line", x0: z, x1: z, yref: "paper", y0: 0, y1: 1, line: { color: "#888", dash: "dash" } }));
   const unit = { type: "line", xref: "paper", x0: 0, x1: 1, yref: "y2", y0: 1, y1: 1, line: { color: "#d61f1f", width: 1, dash: "dot" } };
-  Plotly.react(target, traces, layout(title, "zeta0 [l0] (smaller: more energy)", "climb per jump [l0]", {
+  draw(target, traces, layout(title, "zeta0 [l0] (smaller: more energy)", "climb per jump [l0]", {
     yaxis2: { title: { text: "max |λ|, basin area" }, overlaying: "y", side: "right", range: [0, 1.15], dtick: 0.25, showgrid: false },
     shapes: [...inPlace, unit], legend: { orientation: "h", y: -0.32 }, margin: { l: 55, r: 55, t: 40, b: 105 },
-  }), PLOT_CONFIG);
+  }));
 }
 
 // Failures in the basin: one grey per kind, each named in the legend (plotly heatmaps have no
@@ -59,6 +66,6 @@ export function plotBasin(target, result, title, start) {
     colorbar: { title: { text: "jumps to<br>converge" } }, hovertemplate: "xdot %{x:.3f}, ydot %{y:.3f}: %{z} jumps<extra></extra>" });
   traces.push({ x: [result.gait.state[0]], y: [result.gait.state[1]], mode: "markers", name: `period-${result.gait.period} gait`, marker: { symbol: "x", size: 12, color: "#d61f1f" } });
   if (start) traces.push({ x: [start.xdot], y: [start.ydot], mode: "markers", name: "start", marker: { symbol: "circle-open", size: 12, color: "#111" } });
-  Plotly.react(target, traces, layout(`${title}: ${(100 * result.fraction).toFixed(1)} % converge`, "xdot at the section [sqrt(g l0)]", "ydot [sqrt(g l0)]",
-    { legend: { orientation: "h", y: -0.32 }, margin: { l: 55, r: 15, t: 40, b: 105 } }), PLOT_CONFIG);
+  draw(target, traces, layout(`${title}: ${(100 * result.fraction).toFixed(1)} % converge`, "xdot at the section [sqrt(g l0)]", "ydot [sqrt(g l0)]",
+    { legend: { orientation: "h", y: -0.32 }, margin: { l: 55, r: 15, t: 40, b: 105 } }));
 }

@@ -3,7 +3,7 @@
 import { API, $, say, call, on } from "./api.js";
 import { onRobotEvent, statusSeen } from "./events.js";
 import { filedUnder, LEG_FIELDS, SIM_LOCATIONS, checked } from "./forms.js";
-import { PLOT_CONFIG, layout } from "./plots.js";
+import { draw, layout } from "./plots.js";
 import { definitions } from "./dom.js";
 
 // Every status (GET /robot, each answer to a robot call, each live message) goes through
@@ -18,10 +18,11 @@ const clock = (epochSeconds) => new Date(epochSeconds * 1000).toLocaleTimeString
 // Who started a run, when the service says (``started_by``: absent from an older one, or null).
 const startedBy = (run) => (typeof run.started_by === "string" && run.started_by ? ` by ${run.started_by}` : "");
 
+// The "run" entry of the status: its id (the entry's name says "run" already), how it stands, …
 function describeRun(run) {
   if (!run) return "—";
-  const parts = [`${run.id !== undefined && run.id !== null ? `run ${run.id}: ` : ""}${run.active ? "running" : run.end_reason ?? "ended"}`,
-    `${run.touchdowns} touchdowns`];
+  const parts = [`${run.id !== undefined && run.id !== null ? `${run.id}: ` : ""}${run.active ? "running" : run.end_reason ?? "ended"}`,
+    `${run.touchdowns} touchdown${run.touchdowns === 1 ? "" : "s"}`];
   if (run.jumps !== undefined) parts.push(`jumps ${run.jumps}`);  // as the service counts them
   if (typeof run.started === "number") parts.push(`started ${clock(run.started)}${startedBy(run)}`);
   if (run.max_seconds !== undefined) parts.push(`time limit ${run.max_seconds} s`);
@@ -100,13 +101,13 @@ function followRun(status) {
 
 export function drawLive() {
   if ($("#robot").hidden) return;  // Plotly sizes a hidden plot wrongly; the tab redraws when shown
+  if (!plot.t.length && $("#live-plot").hidden) return;  // nothing drawn yet: the box stays hidden until a pose comes
   const start = plot.t.length ? plot.t[0] : 0;
   const shapes = plot.target === null ? [] : [{ type: "line", xref: "paper", x0: 0, x1: 1, y0: plot.target, y1: plot.target, line: { color: "#d61f1f", dash: "dash" } }];
   const run = plot.label ? ` — ${plot.label}` : "";
   // New arrays each time: Plotly.react redraws only what it sees change.
-  Plotly.react("live-plot", [{ x: plot.t.map((t) => t - start), y: plot.y.slice(), mode: "lines", name: "height" }],
-    layout(`Live height${run}${plot.target === null ? "" : ` (target ${plot.target} m, dashed)`}`, "time since the run's first pose [s]", "y [m]", { shapes }),
-    PLOT_CONFIG);
+  draw("live-plot", [{ x: plot.t.map((t) => t - start), y: plot.y.slice(), mode: "lines", name: "height" }],
+    layout(`Live height${run}${plot.target === null ? "" : ` (target ${plot.target} m, dashed)`}`, "time since the run's first pose [s]", "y [m]", { shapes }));
 }
 
 export async function refreshRobot() { showStatus(await call("GET", "/robot")); }

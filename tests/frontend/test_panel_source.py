@@ -38,9 +38,12 @@ def _calls(source: str, name: str) -> list[str]:
 def test_every_plot_gets_the_config_without_cloud_buttons():
     source = "\n".join(path.read_text() for path in sorted(PANEL.glob("*.js")))
     calls = [call for name in ("Plotly.react", "Plotly.newPlot", "Plotly.plot") for call in _calls(source, name)]
-    assert len(calls) >= 7, "the Simulate, Jobs and Robot tabs' plots"
+    # plots.js's draw(target, data, layout) shows a plot's box and passes PLOT_CONFIG (one of the calls above).
+    drawn = [call for call in _calls(source, "draw") if not call.startswith("draw(target, traces, plotLayout")]
+    assert len(calls) + len(drawn) >= 7, "the Simulate, Jobs and Robot tabs' plots"
     missing = [call.splitlines()[0] for call in calls if not re.sub(r"\s+", " ", call).endswith(", PLOT_CONFIG)")]
     assert not missing, f"every plot: Plotly.react(target, data, layout, PLOT_CONFIG): {missing}"
+    assert "return Plotly.react(target, traces, plotLayout, PLOT_CONFIG);" in source
     config = re.search(r"export const PLOT_CONFIG = Object\.freeze\(\{(.*?)\}\);", source, re.S).group(1)
     for setting in ("displaylogo: false", "showLink: false", "showSendToCloud: false", "showEditInChartStudio: false"):
         assert setting in config
