@@ -19,7 +19,8 @@ import math
 
 import numpy as np
 
-from sim_core.calibration import PARAMETERS, CalibrationFit, calibrate, vector_of
+from sim_core.calibration import calibrate
+from sim_core.calibration_fit import PARAMETERS, CalibrationFit, vector_of
 from sim_core.noise import NoiseModel
 from sim_core.touchdown_series import TouchdownSeries, pitch_at
 from sim_core.walls import Wall

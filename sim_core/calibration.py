@@ -2,7 +2,8 @@
 
 What is fitted: ``alpha``, ``c_zeta``, ``c_psi`` (nondimensional, docs/model.md §1) and each leg's
 servo offsets of psi0 [deg] and zeta0 [l0] (:class:`~sim_core.controls.LegOffsets`); ``d_hat`` and
-``mu`` stay the base model's (the chute is measured; friction only shows when a foot slips).
+``mu`` stay the base model's (the chute is measured; friction only shows when a foot slips). The
+vector, its names and the report a fit returns are :mod:`sim_core.calibration_fit`'s.
 
 From what: touchdown-to-touchdown pairs. Each measured touchdown is mapped one jump forward by
 the model (:mod:`sim_core.touchdown_model`) and compared with the next measured one on three
@@ -12,7 +13,7 @@ From what not: a run that fell (:attr:`TouchdownSeries.fell`) is cut before its 
 the touchdown its failing jump began at (:data:`~sim_core.touchdown_series.FALL_PAIRS`) carries no
 steady-state information — a jump on the edge of failing, often a long slow flight no
 linearisation holds — and on a real robot the detector may find crossings while it falls. What is
-cut is reported: :attr:`CalibrationFit.cut_at_fall`.
+cut is reported: :attr:`~sim_core.calibration_fit.CalibrationFit.cut_at_fall`.
 
 How: least squares (``scipy.optimize.least_squares``, trust region), first with each channel at a
 nominal scale, then (:data:`GLS_PASSES` times) with each pair weighted by its own covariance: the
@@ -27,7 +28,7 @@ beyond :data:`ROBUST_SCALE` sigmas, so a pair the model cannot explain pulls no 
 median-absolute-deviation screen first, then pairs whose Mahalanobis distance under the noise
 found is below :data:`OUTLIER_SIGMAS`, until the set settles — so one wild pair cannot inflate one
 sigma and let the others collapse. The pairs beyond it at the optimum are reported by run and
-touchdown: :attr:`CalibrationFit.outliers`.
+touchdown: :attr:`~sim_core.calibration_fit.CalibrationFit.outliers`.
 
 How sure: the covariance is a sandwich estimate at the optimum (:func:`_uncertainty`; neighbouring
 pairs share a touchdown), its inner inverse from an SVD; standard errors and the correlation
@@ -41,10 +42,10 @@ measurement. Pairs correlated beyond :data:`CONFOUNDED` are named as hard to tel
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
 
 import numpy as np
 
+from sim_core.calibration_fit import PARAMETERS, CalibrationFit, Outlier, split, vector_of
 from sim_core.calibration_noise import TouchdownNoise, estimate_noise, pair_covariances, whitening
 from sim_core.controls import LegOffsets
 from sim_core.params import ModelParams
@@ -52,10 +53,10 @@ from sim_core.touchdown_model import predict_pairs, sensitivities
 from sim_core.touchdown_series import CHANNEL_UNITS, CHANNELS, Pairs, TouchdownSeries, finite_rms
 from sim_core.validation import ParameterError
 
-# The fitted vector, in order: its names in the JSON, and the units the fit works in.
-PARAMETERS = ("alpha", "c_zeta", "c_psi", "psi0_offset_deg.left", "psi0_offset_deg.right",
-              "zeta0_offset.left", "zeta0_offset.right")  # fmt: skip
-TYPICAL_SCALE = np.array([10.0, 0.3, 0.3, 0.5, 0.5, 0.005, 0.005])  # steps of a comparable effect
+# Per fitted parameter, in PARAMETERS order and units: a step of comparable effect, the bounds searched.
+TYPICAL_SCALE = np.array([10.0, 0.3, 0.3, 0.5, 0.5, 0.005, 0.005])
+LOWER = np.array([1.0, 0.0, 0.0, -10.0, -10.0, -0.1, -0.1])
+UPPER = np.array([1000.0, 20.0, 20.0, 10.0, 10.0, 0.1, 0.1])
 NOMINAL_SCATTER = np.array([0.02, 0.02, 0.005])  # first-pass channel scales: xdot, ydot, rise
 GLS_PASSES = 2
 ROBUST_SCALE = 3.0  # Huber loss: residuals beyond 3 channel sigmas count linearly, not squared
@@ -69,111 +70,6 @@ FAILED_RESIDUAL = 10.0  # a pair whose predicted jump fails, in channel scales (
 IDENTIFIABLE_RCOND = 1e-6
 CONFOUNDED = 0.95  # |correlation| above which two parameters are reported as hard to tell apart
 MIN_PAIRS = 10
-LOWER = np.array([1.0, 0.0, 0.0, -10.0, -10.0, -0.1, -0.1])
-UPPER = np.array([1000.0, 20.0, 20.0, 10.0, 10.0, 0.1, 0.1])
-
-
-@dataclass(frozen=True)
-class Outlier:
-    """A touchdown pair the fit does not explain.
-
-    Attributes:
-        series: the run's position in the series given to :func:`calibrate`.
-        touchdown: index ``k + 1`` in that run of the touchdown predicted from touchdown ``k``.
-        residual: the pair's Mahalanobis distance [sigmas] under its covariance at the fit (3
-            channels); inf where the fitted model's jump fails.
-    """
-
-    series: int
-    touchdown: int
-    residual: float
-
-    def to_dict(self) -> dict:
-        return {"series": self.series, "touchdown": self.touchdown, "residual": self.residual}
-
-
-@dataclass(frozen=True)
-class CalibrationFit:
-    """A fitted model with its uncertainty.
-
-    Attributes:
-        model: the base model with the fitted ``alpha``, ``c_zeta``, ``c_psi``.
-        offsets: the fitted leg offsets.
-        stderr: standard error per name of :data:`PARAMETERS` (inf: not identifiable).
-        correlation: (7, 7) correlation matrix in :data:`PARAMETERS` order (NaN rows: unidentifiable).
-        unidentifiable: names the data do not constrain at all (a singular direction).
-        confounded: pairs ``(a, b, correlation)`` with ``|correlation| >`` :data:`CONFOUNDED`: the data
-            pin down a combination of the two better than either (e.g. the legs' zeta0 offsets,
-            whose sum sets the energy) — read their values with their standard errors.
-        touchdowns_used: pairs compared (each a touchdown the model predicted).
-        rms_before, rms_after: RMS one-jump error of the section state [sqrt(g l0)], base vs fitted.
-        channels: per channel ``{"unit", "rms_before", "rms_after"}``.
-        noise: the noise levels most likely at the fit (:class:`sim_core.calibration_noise.TouchdownNoise`).
-        failed_predictions: pairs whose predicted jump failed with the fitted model.
-        outliers: the pairs the fitted model and noise do not explain (:class:`Outlier`), in run order.
-        cut_at_fall: ``(series, touchdown)`` per run that fell: the position of the run in the
-            series given and the first of its touchdowns not predicted (docs/calibration.md, "Falls").
-        noise_pairs: the pairs the noise was estimated from (the compared ones less the outliers).
-    """
-
-    model: ModelParams
-    offsets: LegOffsets
-    stderr: dict[str, float]
-    correlation: np.ndarray
-    unidentifiable: tuple[str, ...]
-    confounded: tuple[tuple[str, str, float], ...]
-    touchdowns_used: int
-    rms_before: float
-    rms_after: float
-    channels: dict[str, dict]
-    noise: dict[str, float]
-    failed_predictions: int
-    outliers: tuple[Outlier, ...] = ()
-    cut_at_fall: tuple[tuple[int, int], ...] = ()
-    noise_pairs: int = 0
-
-    def to_dict(self) -> dict:
-        """The ``parkour calibrate --json`` contract (NaN and inf become null in JSON)."""
-        se = self.stderr
-        return {
-            "params": {
-                "alpha": self.model.alpha,
-                "c_zeta": self.model.c_zeta,
-                "c_psi": self.model.c_psi,
-                **self.offsets.to_dict(),
-            },
-            "stderr": {
-                "alpha": se["alpha"],
-                "c_zeta": se["c_zeta"],
-                "c_psi": se["c_psi"],
-                "psi0_offset_deg": [se["psi0_offset_deg.left"], se["psi0_offset_deg.right"]],
-                "zeta0_offset": [se["zeta0_offset.left"], se["zeta0_offset.right"]],
-            },
-            "parameters": list(PARAMETERS),
-            "correlation": self.correlation.tolist(),
-            "unidentifiable": list(self.unidentifiable),
-            "confounded": [list(pair) for pair in self.confounded],
-            "touchdowns_used": self.touchdowns_used,
-            "rms_residual_before": self.rms_before,
-            "rms_residual_after": self.rms_after,
-            "residuals": self.channels,
-            "noise": self.noise,
-            "failed_predictions": self.failed_predictions,
-            "outliers": [outlier.to_dict() for outlier in self.outliers],
-            "cut_at_fall": [{"series": series, "touchdown": touchdown} for series, touchdown in self.cut_at_fall],
-            "noise_pairs": self.noise_pairs,
-        }
-
-
-def vector_of(model: ModelParams, offsets: LegOffsets) -> np.ndarray:
-    return np.array([model.alpha, model.c_zeta, model.c_psi, *offsets.psi0_offset_deg, *offsets.zeta0_offset])
-
-
-def split(base: ModelParams, vector: np.ndarray) -> tuple[ModelParams, LegOffsets]:
-    model = replace(base, alpha=float(vector[0]), c_zeta=float(vector[1]), c_psi=float(vector[2]))
-    offsets = LegOffsets(psi0_offset_deg=(float(vector[3]), float(vector[4])),
-                         zeta0_offset=(float(vector[5]), float(vector[6])))  # fmt: skip
-    return model, offsets
 
 
 def predict(pairs: Pairs, model: ModelParams, offsets: LegOffsets) -> tuple[np.ndarray, int]:

@@ -13,7 +13,6 @@ from __future__ import annotations
 import re
 from collections.abc import Callable
 from dataclasses import asdict
-from typing import TYPE_CHECKING
 
 import numpy as np
 from sqlalchemy.orm import Session
@@ -33,6 +32,7 @@ from backend.services.models import resolve_model
 from backend.services.simulation import current_code_version, unpack_trajectory
 from backend.store.models import ModelPreset, Run
 from experiments.manifest import json_safe
+from sim_core.calibration_fit import CalibrationFit
 from sim_core.controls import NO_OFFSETS, LegControl, LegOffsets
 from sim_core.errors import ParameterError
 from sim_core.params import ModelParams, PhysicalParams
@@ -40,14 +40,11 @@ from sim_core.presets import PRESETS, get_preset
 from sim_core.touchdown_series import TouchdownSeries, finite_rms, pitch_at
 from sim_core.walls import Wall
 
-if TYPE_CHECKING:  # the kernels load in compute workers, not in the service (tests/backend/api/test_app.py)
-    from sim_core.calibration import CalibrationFit
-
 CALIBRATED_KINDS = ("robot", "replay")
 SELF_DISARMED = "robot disarmed (fell or timed out)"  # backend.robot.live_run's ending
 PRESET_NAME = re.compile(PRESET_PATTERN)
 MAX_RUNS = 100
-Fitter = Callable[[list[TouchdownSeries], ModelParams], "CalibrationFit"]
+Fitter = Callable[[list[TouchdownSeries], ModelParams], CalibrationFit]
 
 
 def check_preset_name(name: str) -> str:

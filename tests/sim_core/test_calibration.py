@@ -8,7 +8,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from sim_core.calibration import OUTLIER_SIGMAS, PARAMETERS, calibrate
+from sim_core.calibration import OUTLIER_SIGMAS, calibrate
+from sim_core.calibration_fit import PARAMETERS
 from sim_core.noise import NO_NOISE, NoiseModel
 from sim_core.touchdown_series import Pairs, TouchdownSeries, pitch_at
 from sim_core.validation import ParameterError
