@@ -69,6 +69,15 @@ async def run_filter(
     status_: Annotated[schemas.RunStatus | None, Query(alias="status")] = None,
     tag: Annotated[str | None, Query(max_length=64)] = None,
     failure_code: Annotated[str | None, Query(max_length=32)] = None,
+    end_reason: Annotated[
+        str | None,
+        Query(min_length=1, max_length=200, description='as recorded, or its kind: "error" matches "error: …"'),
+    ] = None,
+    loop: schemas.RunLoop | None = None,
+    controller: Annotated[str | None, Query(min_length=1, max_length=16, description='"pid"')] = None,
+    q: Annotated[
+        str | None, Query(min_length=1, max_length=200, description="text in the notes or a tag (any case)")
+    ] = None,
     zeta0_min: Annotated[float | None, Query(ge=0.0, le=1.0, allow_inf_nan=False)] = None,
     zeta0_max: Annotated[float | None, Query(ge=0.0, le=1.0, allow_inf_nan=False)] = None,
     psi0_min: Annotated[float | None, Query(ge=0.0, le=90.0, allow_inf_nan=False)] = None,
@@ -83,12 +92,16 @@ async def run_filter(
         status=status_,
         tag=tag,
         failure_code=failure_code,
+        end_reason=end_reason,
+        loop=loop,
+        controller=controller,
         zeta0_min=zeta0_min,
         zeta0_max=zeta0_max,
         psi0_min=psi0_min,
         psi0_max=psi0_max,
         created_after=created_after,
         created_before=created_before,
+        q=q.strip() or None if q is not None else None,
     )
 
 

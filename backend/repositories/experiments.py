@@ -58,3 +58,8 @@ def counted_page(
     if len(rows) > limit:
         return rows[:limit], rows[limit - 1][0].id
     return rows, None
+
+
+def count(session: Session) -> int:
+    """How many experiments there are."""
+    return session.scalar(select(func.count()).select_from(Experiment)) or 0

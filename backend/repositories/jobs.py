@@ -43,12 +43,21 @@ def newest(
     session: Session, *, state: JobState | None, limit: int, cursor: int | None, experiment_id: int | None
 ) -> tuple[list[Job], int | None]:
     """A keyset page of jobs, newest first, of one ``state`` and ``experiment_id`` where given."""
-    query = newest_first(Job, limit, cursor)
+    query = _of(newest_first(Job, limit, cursor), state, experiment_id)
+    return page(list(session.scalars(query)), limit)
+
+
+def count(session: Session, *, state: JobState | None, experiment_id: int | None) -> int:
+    """How many jobs :func:`newest` pages through."""
+    return session.scalar(_of(select(func.count()).select_from(Job), state, experiment_id)) or 0
+
+
+def _of(query, state: JobState | None, experiment_id: int | None):
     if state is not None:
         query = query.where(Job.state == state)
     if experiment_id is not None:
         query = query.where(Job.experiment_id == experiment_id)
-    return page(list(session.scalars(query)), limit)
+    return query
 
 
 def change_state(session: Session, job_id: int, was: JobState, **values) -> int:

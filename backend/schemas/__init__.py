@@ -39,6 +39,7 @@ from backend.schemas.experiments import (
     ExperimentCreate,
     ExperimentOut,
     ExperimentPage,
+    ExperimentSummary,
     ExperimentUpdate,
 )
 from backend.schemas.jobs import (
@@ -65,6 +66,7 @@ from backend.schemas.runs import (
     RunDetail,
     RunGroup,
     RunKind,
+    RunLoop,
     RunOut,
     RunPage,
     RunStatus,
@@ -96,6 +98,7 @@ __all__ = [
     "ExperimentCreate",
     "ExperimentOut",
     "ExperimentPage",
+    "ExperimentSummary",
     "ExperimentUpdate",
     "FixedPointIn",
     "FixedPointOut",
@@ -129,6 +132,7 @@ __all__ = [
     "RunDetail",
     "RunGroup",
     "RunKind",
+    "RunLoop",
     "RunOut",
     "RunPage",
     "RunStatus",

@@ -105,6 +105,7 @@ class Page(BaseModel, Generic[Item]):
 
     items: list[Item]
     next_cursor: int | None = Field(None, description="pass as ?cursor= for the next page; null at the end")
+    total: int | None = Field(None, description="how many items match, over every page (null: not counted)")
 
 
 def finite_or_none(value: float) -> float | None:

@@ -39,6 +39,11 @@ class RunStatus(enum.StrEnum):
     INTERRUPTED = "interrupted"  # a live run the service died during, kept to its last journal entry
 
 
+class RunLoop(enum.StrEnum):
+    OPEN = "open"  # the controls as given (every simulation)
+    CLOSED = "closed"  # a robot run holding a height: a controller sets zeta0 after each touchdown
+
+
 class RunBase(BaseModel):
     """What a run is asked for with and keeps: its experiment, length and labels."""
 
@@ -106,6 +111,17 @@ class RunOut(RunBase):
     tags: list[str]
     notes: str
     has_trajectory: bool
+    end_reason: str | None = Field(
+        None, description='how a robot run ended, as it recorded it: "jumps done", "stopped", "time limit", "e-stop", '
+        '"link lost", "robot disarmed (fell or timed out)", "error: …", "interrupted: …"; null for simulations',
+    )  # fmt: skip
+    loop: RunLoop = Field(RunLoop.OPEN, description="closed: a robot run holding a height (a replay: as its run)")
+    controller: str | None = Field(None, description='the closed loop\'s controller ("pid"); null when open')
+    target: float | None = Field(None, description="the height a closed loop held [m]; null when open")
+    touchdowns: int | None = Field(
+        None, description="robot and replay runs: the touchdowns recorded, which is what their jumps ask for "
+        "(jumps_completed counts the jumps between them, one fewer); null for simulations",
+    )  # fmt: skip
 
 
 class RunDetail(RunOut):
@@ -130,6 +146,11 @@ class Stats(BaseModel):
     std: float = Field(description="population standard deviation over the group")
     min: float
     max: float
+    ci95_low: float | None = Field(
+        None, description="95% confidence interval of the mean, lower end (Student's t on the sample "
+        "standard deviation); null for fewer than two runs",
+    )  # fmt: skip
+    ci95_high: float | None = Field(None, description="95% confidence interval of the mean, upper end")
 
 
 class RunGroup(BaseModel):

@@ -1,6 +1,6 @@
 """Experiments: named groups of runs with notes and tags — created, read, edited, deleted, listed
 in keyset pages (newest first), each answered as the API's :class:`~backend.schemas.ExperimentOut`
-with its run count.
+with its run count — and an experiment's page (:func:`summary`: its outcomes, endings and jobs).
 
 An edit or a delete takes the write lock first and reads the experiment fresh under it
 (:func:`backend.repositories.common.locked`). Deletes also work on a full disk
@@ -13,7 +13,13 @@ from sqlalchemy.orm import Session
 
 from backend.errors import Conflict
 from backend.repositories import experiments as stored
-from backend.schemas import ExperimentCreate, ExperimentOut, ExperimentPage, ExperimentUpdate
+from backend.repositories import jobs as stored_jobs
+from backend.repositories import runs as stored_runs
+from backend.repositories.runs import RunFilter
+from backend.schemas import ExperimentCreate, ExperimentOut, ExperimentPage, ExperimentSummary, ExperimentUpdate
+from backend.schemas.experiments import MAX_SUMMARY_JOBS
+from backend.services.jobs import public as job_out
+from backend.services.runs import aggregate
 from backend.store.database import freeing_space
 from backend.store.models import Experiment
 
@@ -26,6 +32,29 @@ def create(session: Session, body: ExperimentCreate) -> ExperimentOut:
 
 def get(session: Session, experiment_id: int) -> ExperimentOut:
     return experiment_out(stored.get(session, experiment_id), stored.run_count(session, experiment_id))
+
+
+def summary(session: Session, experiment_id: int) -> ExperimentSummary:
+    """The experiment's page: itself, its runs' outcomes (over all and by kind, with 95% intervals
+    of the means, grouped in SQL), how they ended, and its newest jobs."""
+    experiment = stored.get(session, experiment_id)
+    runs = stored.run_count(session, experiment_id)
+    its = RunFilter(experiment_id=experiment_id)
+    overall = aggregate(session, its, "experiment_id").groups
+    jobs, _next = stored_jobs.newest(
+        session, state=None, limit=MAX_SUMMARY_JOBS, cursor=None, experiment_id=experiment_id
+    )
+    return ExperimentSummary(
+        experiment=experiment_out(experiment, runs),
+        runs=runs,
+        outcomes=overall[0] if overall else None,
+        by_kind=aggregate(session, its, "kind").groups,
+        statuses=stored_runs.counts_by(session, its, "status"),
+        end_reasons=stored_runs.counts_by(session, its, "end_reason"),
+        loops=stored_runs.counts_by(session, its, "loop"),
+        jobs=[job_out(job) for job in jobs],
+        jobs_total=stored_jobs.count(session, state=None, experiment_id=experiment_id),
+    )
 
 
 def update(session: Session, experiment_id: int, body: ExperimentUpdate) -> ExperimentOut:
@@ -54,10 +83,13 @@ def delete(session: Session, experiment_id: int) -> None:
 
 
 def list_page(session: Session, *, limit: int, cursor: int | None) -> ExperimentPage:
-    """A page of experiments, newest first, with their run counts (one query) and the next cursor."""
+    """A page of experiments, newest first, with their run counts (one query), the next cursor and
+    how many there are."""
     rows, next_cursor = stored.counted_page(session, limit=limit, cursor=cursor)
     return ExperimentPage(
-        items=[experiment_out(experiment, runs) for experiment, runs in rows], next_cursor=next_cursor
+        items=[experiment_out(experiment, runs) for experiment, runs in rows],
+        next_cursor=next_cursor,
+        total=stored.count(session),
     )
 
 

@@ -32,10 +32,11 @@ from experiments.manifest import json_safe
 from sim_core.params import ModelParams
 
 RECORD_FIELDS = ("id", "experiment_id", "kind", "status", "created_at", "duration_s", "code_version", "tags", "notes",
-                 "jumps", "jumps_completed", "failure_code", "climb", "start_xdot", "start_ydot")  # fmt: skip
+                 "jumps", "jumps_completed", "failure_code", "climb", "start_xdot", "start_ydot", "end_reason",
+                 "loop", "controller", "target", "touchdowns")  # fmt: skip
 MODEL_FIELDS = tuple(field.name for field in dataclasses.fields(ModelParams))
-TEXT_COLUMNS = tuple(RECORD_FIELDS.index(name) for name in ("kind", "status", "code_version", "tags", "notes",
-                                                           "failure_code"))  # fmt: skip
+TEXT_FIELDS = ("kind", "status", "code_version", "tags", "notes", "failure_code", "end_reason", "loop", "controller")
+TEXT_COLUMNS = tuple(RECORD_FIELDS.index(name) for name in TEXT_FIELDS)
 FORMULA_START = frozenset("=+-@\t\r\n")  # a spreadsheet reads a cell starting with one as a formula
 CHUNK_CHARS = 64_000  # what a streamed export yields at a time
 
@@ -53,7 +54,8 @@ def record_values(run, model: dict, controls: Sequence, start_state: Sequence, t
     decoded JSON columns."""
     values = [run.id, run.experiment_id, run.kind, run.status, run.created_at.isoformat(), run.duration_s,
               run.code_version, " ".join(tags), run.notes, run.jumps, run.jumps_completed, run.failure_code, run.climb,
-              start_state[0], start_state[1], *map(model.get, MODEL_FIELDS)]  # fmt: skip
+              start_state[0], start_state[1], run.end_reason, run.loop, run.controller, run.target, run.touchdowns,
+              *map(model.get, MODEL_FIELDS)]  # fmt: skip
     for leg in range(legs):
         values += controls[leg] if leg < len(controls) else (None, None)
     return values

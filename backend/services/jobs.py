@@ -64,7 +64,8 @@ def list_jobs(
     rows, next_cursor = stored_jobs.newest(
         session, state=state, limit=limit, cursor=cursor, experiment_id=experiment_id
     )
-    return JobPage(items=[public(row) for row in rows], next_cursor=next_cursor)
+    total = stored_jobs.count(session, state=state, experiment_id=experiment_id)
+    return JobPage(items=[public(row) for row in rows], next_cursor=next_cursor, total=total)
 
 
 def cancel_job(session: Session, job_id: int) -> JobOut:

@@ -109,6 +109,7 @@ def fold_journal(session, run_id: int, *, status: str, end_reason: str, disarm: 
     )
     for name, value in touchdown_columns(touchdowns, analysis).items():
         setattr(run, name, value)
+    stored_runs.set_outcome(run)  # its end reason and touchdowns as columns
     columns = {name: np.asarray(values, dtype=float) for name, values in frames.items()}
     run.trajectory = pack_trajectory(columns) if frames["time"] else None
     robot_runs.delete_journal(session, run_id)
@@ -183,6 +184,7 @@ def replay_run(session, run_id: int, robot=None) -> Run:
         results=json_safe(
             {
                 "source_run_id": run_id,
+                "closed_loop": source.results.get("closed_loop"),  # driven as the run it replays
                 **analysis,
                 "touchdown_controls": [[leg_for(k).psi0_deg, leg_for(k).zeta0] for k in range(len(touchdowns))],
             }

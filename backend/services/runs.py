@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import math
 
 from sqlalchemy.orm import Session
 
@@ -27,6 +26,7 @@ from backend.repositories.runs import RunFilter
 from backend.schemas import RunAggregate, RunComparison, RunCreate, RunDetail, RunOut, RunTrajectory
 from backend.services.exports import flat_record
 from backend.services.models import InSession, preset_resolved
+from backend.services.run_stats import stats
 from backend.services.simulation import simulate_run, unpack_trajectory
 from backend.store.database import freeing_space
 from backend.store.models import Run
@@ -35,8 +35,9 @@ from sim_core.errors import ParameterError
 
 SORTS = stored_runs.SORTS  # the API's sort parameter is checked against them
 MAX_COMPARE = 50
-GROUP_BY = ("zeta0", "psi0_deg", "alpha", "kind", "failure_code", "experiment_id", "tag")
-CONTINUOUS = ("zeta0", "psi0_deg", "alpha")  # grouped by exact value (at most MAX_GROUPS) or in bins
+GROUP_BY = ("zeta0", "psi0_deg", "alpha", "kind", "failure_code", "experiment_id", "tag", "status", "end_reason",
+            "loop", "controller", "target")  # fmt: skip
+CONTINUOUS = ("zeta0", "psi0_deg", "alpha", "target")  # grouped by exact value (at most MAX_GROUPS) or in bins
 MAX_GROUPS = 1000
 MAX_BINS = 1000
 # A simulated run's path is nondimensional (docs/model.md §1); a robot or replay run's is the tracker's frames.
@@ -111,9 +112,10 @@ def delete(session: Session, run_id: int) -> None:
 
 def list_runs(
     session: Session, where: RunFilter, *, limit: int, cursor: int | None, sort: str = "-id", offset: int = 0
-) -> tuple[list[dict], int | None]:
-    """A page of runs as the API lists them, and the cursor or offset of the next (None at the end):
-    see :func:`backend.repositories.runs.listed_page`. Run in the read workers (backend/workers)."""
+) -> tuple[list[dict], int | None, int]:
+    """A page of runs as the API lists them, the cursor or offset of the next (None at the end) and
+    how many match in all: see :func:`backend.repositories.runs.listed_page`. Run in the read
+    workers (backend/workers)."""
     return stored_runs.listed_page(session, where, limit=limit, cursor=cursor, sort=sort, offset=offset)
 
 
@@ -140,8 +142,9 @@ def compare(session: Session, ids: list[int], *, only_differences: bool) -> RunC
 
 
 def aggregate(session: Session, where: RunFilter, by: str, bins: int | None = None) -> RunAggregate:
-    """Groups with count and mean/std/min/max of climb and jumps completed, computed in SQL; the
-    same JSON types on every database.
+    """Groups with count and mean/std/min/max of climb and jumps completed, computed in SQL, and the
+    95% confidence interval of each mean (:mod:`backend.services.run_stats`); the same JSON types
+    on every database.
 
     A continuous parameter (:data:`CONTINUOUS`) groups by its exact values, at most
     :data:`MAX_GROUPS` of them, or with ``bins`` into that many equal bins between the smallest
@@ -172,14 +175,9 @@ def _groups(session: Session, where: RunFilter, by: str, bins: int | None) -> li
             group |= {"key": low + (row["key"] + 0.5) * width, "low": low + row["key"] * width,
                       "high": low + (row["key"] + 1) * width}  # fmt: skip
         for name in ("climb", "jumps_completed"):
-            mean = row[f"{name}_mean"]
-            variance = max(row[f"{name}_mean_square"] - mean * mean, 0.0)
-            group[name] = {
-                "mean": mean,
-                "std": math.sqrt(variance),  # population std over the group
-                "min": row[f"{name}_min"],
-                "max": row[f"{name}_max"],
-            }
+            group[name] = stats(
+                row["runs"], row[f"{name}_mean"], row[f"{name}_mean_square"], row[f"{name}_min"], row[f"{name}_max"]
+            )
         groups.append(group)
     return groups
 
@@ -213,4 +211,9 @@ def _fields(run: Run) -> dict:
         "tags": run.tags,
         "notes": run.notes,
         "has_trajectory": run.has_trajectory,
+        "end_reason": run.end_reason,
+        "loop": run.loop,
+        "controller": run.controller,
+        "target": run.target,
+        "touchdowns": run.touchdowns,
     }

@@ -16,7 +16,9 @@ assembles it): the workers import no service.
 
 A worker reads through its own connection, so it sees what was committed before the request
 came (a run just stored is listed); the page is the same JSON the route would encode itself
-(:data:`PAGE` is its response model).
+(:data:`PAGE` is its response model). The page's ``total`` is counted once per filter while the
+store is unchanged: a worker's connection keeps its counts until anything is committed
+(``repositories.runs.matching_count``).
 """
 
 from __future__ import annotations
@@ -44,15 +46,15 @@ class RunReads:
     """The functions the reads run, the services' own (module-level: they travel to the workers by name).
 
     Attributes:
-        list_runs: ``(session, where, *, limit, cursor, sort, offset) -> (rows, next_cursor)``, a page
-            of runs (``backend.services.runs.list_runs``); run in a worker.
+        list_runs: ``(session, where, *, limit, cursor, sort, offset) -> (rows, next_cursor, total)``,
+            a page of runs and how many match (``backend.services.runs.list_runs``); run in a worker.
         plan_export: ``(session, where, format_) -> plan``; run in a worker.
         export_part: ``(session, where, plan, part) -> str``, one part's text; run in a worker.
         export_head, export_tail: ``(plan) -> str``, the text before and after the parts; run here.
         joined: ``(plan, text, follows) -> str``, a part's text as it goes out after the ones before.
     """
 
-    list_runs: Callable[..., tuple[list, int | None]]
+    list_runs: Callable[..., tuple[list, int | None, int]]
     plan_export: Callable[..., Any]
     export_part: Callable[..., str]
     export_head: Callable[[Any], str]
@@ -121,8 +123,8 @@ def runs_page_json(
     session: Session, list_runs: Callable, where, limit: int, cursor: int | None, sort: str, offset: int
 ) -> bytes:
     """In a worker: the page ``list_runs`` reads, encoded (:meth:`StoreReads.runs_page`)."""
-    rows, next_cursor = list_runs(session, where, limit=limit, cursor=cursor, sort=sort, offset=offset)
-    return PAGE.dump_json(PAGE.validate_python({"items": rows, "next_cursor": next_cursor}))
+    rows, next_cursor, total = list_runs(session, where, limit=limit, cursor=cursor, sort=sort, offset=offset)
+    return PAGE.dump_json(PAGE.validate_python({"items": rows, "next_cursor": next_cursor, "total": total}))
 
 
 def _in_session(work, database_url: str, *args):

@@ -35,12 +35,16 @@ async def list_runs(
     where: RunQuery,
     limit: PageLimit = 50,
     cursor: Cursor = None,
-    sort: Annotated[str, Query(pattern=f"^({'|'.join(service.SORTS)})$", description="-climb: best first")] = "-id",
-    offset: Annotated[int, Query(ge=0, le=10_000_000, description="for sorts other than id")] = 0,
+    sort: Annotated[
+        str, Query(pattern=f"^({'|'.join(service.SORTS)})$", description="a column; -climb: best first")
+    ] = "-id",
+    offset: Annotated[int, Query(ge=0, le=10_000_000, description="runs to skip (without a cursor)")] = 0,
 ) -> Response:
-    """Runs matching the filters. Sorted by id, ``next_cursor`` pages by keyset; sorted by another
-    field, pass ``next_cursor`` back as ``offset``. Read and encoded in a worker process
-    (backend/workers/store_reads.py): the service's own process only forwards the page."""
+    """Runs matching the filters, with ``total``, how many match in all. Sorted by id,
+    ``next_cursor`` pages by keyset; sorted by another field, pass ``next_cursor`` back as
+    ``offset``; any page can be asked for by ``offset``. Ties on the sorted field are in id order.
+    Read and encoded in a worker process (backend/workers/store_reads.py): the service's own
+    process only forwards the page."""
     page = await reads.runs_page(where, limit=limit, cursor=cursor, sort=sort, offset=offset)
     return Response(page, media_type="application/json")
 

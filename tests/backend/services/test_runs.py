@@ -25,7 +25,7 @@ def _all_pages(fetch, limit: int) -> list[list[int]]:
     """Follow ``next_cursor`` from the first page to the last: the ids of each page."""
     pages, cursor = [], None
     while True:
-        rows, cursor = fetch(limit=limit, cursor=cursor)
+        rows, cursor, _total = fetch(limit=limit, cursor=cursor)
         pages.append(_ids(rows))
         if cursor is None:
             return pages
@@ -51,7 +51,7 @@ def test_a_physical_failure_is_a_done_run_with_its_code(make_run):
 def test_a_run_in_a_missing_experiment_is_not_stored(session, make_run):
     with pytest.raises(NotFound, match="experiment 999"):
         make_run(experiment_id=999)
-    assert runs.list_runs(session, RunFilter(), limit=10, cursor=None) == ([], None)
+    assert runs.list_runs(session, RunFilter(), limit=10, cursor=None) == ([], None, 0)
 
 
 def test_update_and_delete_a_run(session, make_run):
@@ -127,20 +127,21 @@ def test_an_edit_waits_for_the_write_lock_and_reads_after_it(sessions, make_run)
 )
 def test_filters_select_runs(session, stored_runs, where, expected):
     _, stored = stored_runs
-    rows, cursor = runs.list_runs(session, where, limit=50, cursor=None)
+    rows, cursor, total = runs.list_runs(session, where, limit=50, cursor=None)
     assert sorted(_ids(rows)) == sorted(stored[key].id for key in expected) and cursor is None
+    assert total == len(expected)
 
 
 def test_filter_by_experiment_and_creation_time(session, stored_runs):
     experiment, stored = stored_runs
-    rows, _ = runs.list_runs(session, RunFilter(experiment_id=experiment.id), limit=50, cursor=None)
+    rows, _, _ = runs.list_runs(session, RunFilter(experiment_id=experiment.id), limit=50, cursor=None)
     assert _ids(rows) == [stored[0.9].id]
     after = stored[0.92].created_at
-    rows, _ = runs.list_runs(session, RunFilter(created_after=after), limit=50, cursor=None)
+    rows, _, _ = runs.list_runs(session, RunFilter(created_after=after), limit=50, cursor=None)
     assert set(_ids(rows)) >= {stored[0.92].id, stored[0.94].id, stored["slip"].id} and stored[0.86].id not in _ids(
         rows
     )
-    rows, _ = runs.list_runs(session, RunFilter(created_before=after), limit=50, cursor=None)
+    rows, _, _ = runs.list_runs(session, RunFilter(created_before=after), limit=50, cursor=None)
     assert stored[0.92].id not in _ids(rows), "created_before is exclusive"
 
 
@@ -154,12 +155,12 @@ def test_keyset_pages_cover_every_run_once(session, stored_runs):
 
 
 def test_other_orders_page_by_offset(session, stored_runs):
-    first, next_offset = runs.list_runs(session, RunFilter(), limit=4, cursor=None, sort="-climb")
+    first, next_offset, total = runs.list_runs(session, RunFilter(), limit=4, cursor=None, sort="-climb")
     climbs = [run["climb"] for run in first]
-    assert climbs == sorted(climbs, reverse=True) and next_offset == 4
-    rest, end = runs.list_runs(session, RunFilter(), limit=4, cursor=None, sort="-climb", offset=next_offset)
+    assert climbs == sorted(climbs, reverse=True) and next_offset == 4 and total == 6
+    rest, end, _ = runs.list_runs(session, RunFilter(), limit=4, cursor=None, sort="-climb", offset=next_offset)
     assert len(rest) == 2 and end is None and max(run["climb"] for run in rest) <= climbs[-1]
-    by_zeta0, _ = runs.list_runs(session, RunFilter(psi0_max=45.0), limit=10, cursor=None, sort="zeta0")
+    by_zeta0, _, _ = runs.list_runs(session, RunFilter(psi0_max=45.0), limit=10, cursor=None, sort="zeta0")
     assert [run["controls"][0][1] for run in by_zeta0] == [0.86, 0.88, 0.9, 0.92, 0.94]
 
 
@@ -188,6 +189,11 @@ def test_aggregate_groups_by_a_column_and_by_tag(session, stored_runs):
     assert climbed["mean"] == pytest.approx(mean, rel=1e-12)
     assert climbed["std"] == pytest.approx(math.sqrt(sum((c - mean) ** 2 for c in climbs) / 5), rel=1e-6)
     assert (climbed["min"], climbed["max"]) == (min(climbs), max(climbs))
-    assert by_key["slip"]["jumps_completed"] == {"mean": 0.0, "std": 0.0, "min": 0, "max": 0}
+    assert by_key["slip"]["jumps_completed"] == {
+        "mean": 0.0, "std": 0.0, "min": 0, "max": 0, "ci95_low": None, "ci95_high": None}  # fmt: skip
+    # The mean's 95% interval: Student's t with 4 degrees of freedom on the sample std.
+    half_width = 2.7764 * math.sqrt(sum((c - mean) ** 2 for c in climbs) / 4) / math.sqrt(5)
+    interval = (climbed["ci95_low"], climbed["ci95_high"])
+    assert interval == pytest.approx((mean - half_width, mean + half_width), rel=1e-9)
     tagged = runs.aggregate(session, RunFilter(psi0_max=45.0), "tag").model_dump()["groups"]
     assert [(group["key"], group["runs"]) for group in tagged] == [("middle", 1)]

@@ -58,3 +58,47 @@ def test_runs_stored_before_notes_get_empty_notes(empty_database_url):
     )
     row = _row_after_upgrade(empty_database_url, "0003", insert, "SELECT code_version, climb, notes FROM runs")
     assert row == ("old", 1.2, "")
+
+
+RUN_COLUMNS = (
+    "INSERT INTO runs (id, kind, status, created_at, duration_s, code_version, model, controls, start_state, jumps, "
+    "alpha, psi0_deg, zeta0, jumps_completed, climb, results) VALUES "
+)
+OLD_RUN = "({id}, '{kind}', '{status}', '2026-01-01 00:00:00', 0.1, 'old', '{{}}', '[[30, 0.9]]', '[-0.9, -0.2]', 15, "
+OLD_RUN += "77.6, 30, 0.9, 14, 1.2, '{results}')"
+CLOSED = '{"target_m": 0.55, "kp": 0.04, "ki": 0.0, "kd": 0.02, "zeta0_min": 0.8, "zeta0_max": 0.98}'
+OLD_RUNS = [
+    dict(id=1, kind="sim", status="done", results='{"rises": [0.3], "failure": null}'),
+    dict(id=2, kind="robot", status="failed",
+         results=f'{{"end_reason": "e-stop", "closed_loop": {CLOSED}, "touchdowns": [{{}}, {{}}, {{}}]}}'),
+    dict(id=3, kind="robot", status="done",
+         results='{"end_reason": "jumps done", "closed_loop": null, "touchdowns": []}'),
+    dict(id=4, kind="replay", status="done", results='{"source_run_id": 2, "touchdowns": [{}, {}]}'),
+    dict(id=5, kind="replay", status="done", results='{"source_run_id": 99, "touchdowns": [{}]}'),  # source deleted
+    dict(id=6, kind="robot", status="running", results='{"end_reason": null, "closed_loop": null}'),
+]  # fmt: skip
+
+
+def test_runs_stored_before_0008_get_their_outcome_columns(empty_database_url):
+    """Migration 0008 copies how each stored run ended and was driven from its results: a robot
+    run's end reason and closed loop, a replay's loop from the run it replays, the touchdowns."""
+    engine = make_engine(empty_database_url)
+    migrate(engine, "0007")
+    with engine.begin() as connection:
+        connection.exec_driver_sql(RUN_COLUMNS + ", ".join(OLD_RUN.format(**run) for run in OLD_RUNS))
+    migrate(engine)
+    try:
+        with engine.connect() as connection:
+            rows = connection.exec_driver_sql(
+                "SELECT id, end_reason, loop, controller, target, touchdowns FROM runs ORDER BY id"
+            ).all()
+    finally:
+        engine.dispose()
+    assert [tuple(row) for row in rows] == [
+        (1, None, "open", None, None, None),
+        (2, "e-stop", "closed", "pid", 0.55, 3),
+        (3, "jumps done", "open", None, None, 0),
+        (4, None, "closed", "pid", 0.55, 2),
+        (5, None, "open", None, None, 1),
+        (6, None, "open", None, None, 0),
+    ]

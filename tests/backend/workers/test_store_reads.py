@@ -1,5 +1,6 @@
 """The run list's pages read in worker processes (backend/workers/store_reads.py): the same page
-the records service lists, as the API's JSON, seeing what was just stored; a worker keeps few engines."""
+the records service lists, as the API's JSON, seeing what was just stored (its total too); a worker
+keeps few engines."""
 
 import asyncio
 import functools
@@ -26,13 +27,15 @@ def test_a_page_read_in_a_worker_is_the_records_page_as_the_api_encodes_it(tmp_p
         where = RunFilter(zeta0_min=0.87)
         page = asyncio.run(reads.runs_page(where, limit=1, cursor=None, sort="-id", offset=0))
         with sessions() as session:
-            rows, next_cursor = records.list_runs(session, where, limit=1, cursor=None)
-            expected = RunPage.model_validate({"items": rows, "next_cursor": next_cursor}).model_dump(mode="json")
-        assert json.loads(page) == expected and expected["next_cursor"] is not None
+            rows, next_cursor, total = records.list_runs(session, where, limit=1, cursor=None)
+            expected = RunPage.model_validate({"items": rows, "next_cursor": next_cursor, "total": total})
+            expected = expected.model_dump(mode="json")
+        assert json.loads(page) == expected and expected["next_cursor"] is not None and expected["total"] == 2
         assert expected["items"][0]["tags"] == ["a", "b"]
         make_run(zeta0=0.95)  # stored after the worker opened its connection: the next page sees it
         newest = json.loads(asyncio.run(reads.runs_page(where, limit=1, cursor=None, sort="-id", offset=0)))
         assert newest["items"][0]["controls"][0][1] == 0.95
+        assert newest["total"] == 3, "the total counted before is not kept past a change"
     finally:
         pool.close()
 
@@ -51,7 +54,7 @@ def test_a_worker_keeps_a_few_stores_open_and_lets_the_oldest_go(tmp_path, monke
                 store_reads.runs_page_json, urls[-1], records.list_runs, RunFilter(), 10, None, "-id", 0
             )
         )
-        assert page == {"items": [], "next_cursor": None}
+        assert page == {"items": [], "next_cursor": None, "total": 0}
     assert list(store_reads._stores) == urls[-store_reads.STORES_KEPT :]
     store_reads._in_session(
         store_reads.runs_page_json, urls[-store_reads.STORES_KEPT], records.list_runs, RunFilter(), 10, None, "-id", 0

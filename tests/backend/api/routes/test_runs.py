@@ -217,3 +217,113 @@ def test_more_distinct_values_than_groups_allowed_ask_for_bins(client, auth, mon
     response = client.get("/api/v1/runs/aggregate", params={"by": "zeta0"})
     assert response.status_code == 422 and "ask for bins" in response.text
     assert client.get("/api/v1/runs/aggregate", params={"by": "zeta0", "bins": 1}).json()["groups"][0]["runs"] == 3
+
+
+def _robot_run(client, *, end_reason: str, status: str = "failed", target_m: float | None = None, tags=()) -> int:
+    """A robot run that ended as ``end_reason`` says, stored as a live run stores one (no frames)."""
+    from backend.robot.tracker import Calibration
+    from backend.schemas import ClosedLoopIn, LegIn, RobotRunCreate
+    from backend.services.robot_records import fold_journal, open_robot_run
+    from sim_core import get_preset
+
+    closed_loop = None if target_m is None else ClosedLoopIn(target_m=target_m)
+    legs = [LegIn(psi0_deg=35, zeta0=0.9)] * 2
+    request = RobotRunCreate(controls=legs, jumps=15, closed_loop=closed_loop, tags=list(tags))
+    with client.app.state.sessions() as session:
+        run_id = open_robot_run(session, request, get_preset("paper"), Calibration())
+        fold_journal(session, run_id, status=status, end_reason=end_reason, disarm="disarmed")
+    return run_id
+
+
+def _listed(client, **params) -> list[int]:
+    return [run["id"] for run in client.get("/api/v1/runs", params=params | {"limit": 500}).json()["items"]]
+
+
+def test_a_page_says_how_many_runs_match_and_any_page_can_be_asked_for(client, auth):
+    ids = [client.post("/api/v1/runs", json=RUN | {"tags": [f"t{k % 2}"]}, headers=auth).json()["id"] for k in range(7)]
+    first = client.get("/api/v1/runs", params={"limit": 3}).json()
+    assert first["total"] == 7 and [run["id"] for run in first["items"]] == ids[::-1][:3]
+    third = client.get("/api/v1/runs", params={"limit": 3, "offset": 6}).json()
+    assert (third["total"], [run["id"] for run in third["items"]], third["next_cursor"]) == (7, [ids[0]], None)
+    climb = client.get("/api/v1/runs", params={"limit": 3, "offset": 3, "sort": "climb", "tag": "t0"}).json()
+    assert (climb["total"], len(climb["items"]), climb["next_cursor"]) == (4, 1, None)
+    assert client.get("/api/v1/runs", params={"tag": "none"}).json() == {"items": [], "next_cursor": None, "total": 0}
+    client.delete(f"/api/v1/runs/{ids[0]}", headers=auth)
+    assert client.get("/api/v1/runs", params={"limit": 3}).json()["total"] == 6, "a deleted run is not counted"
+    for listed in ("/api/v1/experiments", "/api/v1/jobs"):
+        page = client.get(listed).json()
+        assert page["total"] == len(page["items"]) == 0 and page["next_cursor"] is None
+
+
+def test_runs_say_how_they_ended_and_were_driven_and_filter_and_sort_by_it(client, auth):
+    """A robot run's end reason, loop, controller, target and touchdowns: listed, filtered (an
+    end reason as recorded or by its kind, "error" for "error: …"), sorted, compared, exported."""
+    sim = client.post("/api/v1/runs", json=RUN, headers=auth).json()
+    assert (sim["end_reason"], sim["loop"], sim["controller"], sim["target"], sim["touchdowns"]) == (
+        None, "open", None, None, None)  # fmt: skip
+    estop = _robot_run(client, end_reason="e-stop", target_m=0.55)
+    fell_reason = "robot disarmed (fell or timed out)"
+    fell = _robot_run(client, end_reason=fell_reason)
+    error = _robot_run(client, end_reason="error: the link write timed out", target_m=0.4)
+    done = _robot_run(client, end_reason="jumps done", status="done")
+    listed = {run["id"]: run for run in client.get("/api/v1/runs").json()["items"]}
+    assert {key: listed[estop][key] for key in ("status", "end_reason", "loop", "controller", "target")} == {
+        "status": "failed", "end_reason": "e-stop", "loop": "closed", "controller": "pid", "target": 0.55}  # fmt: skip
+    assert listed[done]["touchdowns"] == 0 and listed[done]["loop"] == "open"
+    assert _listed(client, end_reason="e-stop") == [estop]
+    assert _listed(client, end_reason="error") == [error], "a kind of end reason"
+    assert _listed(client, end_reason="error: the link write timed out") == [error]
+    assert _listed(client, end_reason="err") == []
+    assert _listed(client, loop="closed") == [error, estop]
+    assert _listed(client, controller="pid", status="failed") == [error, estop]
+    assert _listed(client, status="done", kind="robot") == [done]
+    assert _listed(client, sort="target") == [sim["id"], fell, done, error, estop], "nulls first, ties by id"
+    assert _listed(client, sort="-target") == [estop, error, done, fell, sim["id"]]
+    assert _listed(client, sort="end_reason", kind="robot") == [estop, error, done, fell]
+    assert client.get("/api/v1/runs", params={"loop": "sideways"}).status_code == 422
+    compared = client.get("/api/v1/runs/compare", params={"ids": [estop, done]}).json()
+    assert {"end_reason", "loop", "controller", "target", "status"} <= set(compared["differing"])
+    rows = list(csv.DictReader(io.StringIO(client.get("/api/v1/runs/export", params={"format": "csv"}).text)))
+    by_id = {int(row["id"]): row for row in rows}
+    assert (by_id[estop]["end_reason"], by_id[estop]["loop"], by_id[estop]["target"]) == ("e-stop", "closed", "0.55")
+    assert by_id[estop]["controller"] == "pid" and by_id[sim["id"]]["loop"] == "open"
+    as_json = {row["id"]: row for row in client.get("/api/v1/runs/export", params={"format": "json"}).json()}
+    assert as_json[fell]["end_reason"] == fell_reason and as_json[fell]["target"] is None
+    by_ending = client.get("/api/v1/runs/aggregate", params={"by": "end_reason", "kind": "robot"}).json()["groups"]
+    assert {group["key"]: group["runs"] for group in by_ending} == {"e-stop": 1, "error: the link write timed out": 1,
+                                                                    "jumps done": 1, fell_reason: 1}  # fmt: skip
+
+
+def test_a_robot_run_counts_its_touchdowns_as_its_jumps(client, auth):
+    """A robot run asked for 5 jumps records 5 touchdowns; jumps_completed counts the 4 measured between them."""
+    with client.app.state.sessions() as session:
+        robot_run = store_robot_run(session)
+    run = client.get(f"/api/v1/runs/{robot_run}").json()
+    assert (run["jumps"], run["touchdowns"], run["jumps_completed"]) == (5, 5, 4)
+    replay = client.post(f"/api/v1/runs/{robot_run}/replay", headers=auth).json()
+    assert (replay["touchdowns"], replay["loop"], replay["end_reason"]) == (5, "open", None)
+
+
+def test_search_finds_text_in_notes_and_tags_in_any_case(client, auth):
+    runs = [client.post("/api/v1/runs", json=RUN | {"tags": tags}, headers=auth).json()["id"]
+            for tags in (["wet-wall"], ["dry"], ["dry"])]  # fmt: skip
+    client.patch(f"/api/v1/runs/{runs[1]}", json={"notes": "Left foot SLIPPED on a WET patch"}, headers=auth)
+    client.patch(f"/api/v1/runs/{runs[2]}", json={"notes": "50% humidity_high"}, headers=auth)
+    assert _listed(client, q="wet") == [runs[1], runs[0]]
+    assert _listed(client, q="Slipped") == [runs[1]]
+    assert _listed(client, q="50%") == [runs[2]] and _listed(client, q="%") == [runs[2]], "% is a character"
+    assert _listed(client, q="y_h") == [runs[2]] and _listed(client, q="y_") == [runs[2]], "_ is a character"
+    assert client.get("/api/v1/runs", params={"q": "wet", "limit": 1}).json()["total"] == 2
+    assert _listed(client, q="  ") == _listed(client), "blank: no search"
+    assert client.get("/api/v1/runs", params={"q": "x" * 201}).status_code == 422
+
+
+def test_the_aggregate_gives_each_means_95_percent_interval(client, auth):
+    for zeta0 in (0.88, 0.88, 0.88, 0.92):
+        start = {"xdot": -0.93, "ydot": -0.2 + zeta0 / 100}
+        body = RUN | {"controls": [{"psi0_deg": 30, "zeta0": zeta0}], "start": start}
+        client.post("/api/v1/runs", json=body, headers=auth)
+    groups = client.get("/api/v1/runs/aggregate", params={"by": "zeta0"}).json()["groups"]
+    three = groups[0]["climb"]
+    assert three["ci95_low"] <= three["mean"] <= three["ci95_high"]
+    assert groups[1]["climb"]["ci95_low"] is None, "one run: no interval"
