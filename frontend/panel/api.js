@@ -72,7 +72,8 @@ function explain(body, status) {
 // what no field on the form takes (a gait not found, a rule across fields, a field the form
 // does not have) is said in the API's own words, after ``action`` (the button's name) or the call.
 export async function call(method, path, body, fields) {
-  const headers = { "Content-Type": "application/json" };
+  // "panel": the job queue keeps each client a share (docs/service.md), so a script cannot crowd it out.
+  const headers = { "Content-Type": "application/json", "X-Parkour-Client": "panel" };
   const token = tokenInput.value.trim();
   if (token) headers.Authorization = `Bearer ${token}`;
   let response;

@@ -243,3 +243,17 @@ def test_the_jobs_tab_pages_through_every_job_and_says_where_a_queued_one_stands
     with page.expect_request(lambda request: "/api/v1/jobs?limit=20" in request.url, timeout=5_000):
         pass
     assert not streams, "no event stream per listed job"
+    page.unroute_all(behavior="ignoreErrors")  # a refresh still in the handler must not outlive the test
+
+
+def test_the_panel_submits_jobs_as_panel_for_the_queues_share(page, service):
+    """The job queue keeps each client a share (docs/service.md): the panel names itself, so a script
+    on the same machine (the same address) cannot crowd it out."""
+    base, _token = service
+    page.click("nav [data-tab=jobs]")
+    page.fill("input[name=trials]", "2")
+    page.fill("input[name=cap]", "20")
+    page.click("#submit-job")
+    _until(page, "document.querySelector('#job-table tbody tr .state') !== null")
+    newest = httpx.get(f"{base}/api/v1/jobs?limit=1").json()["items"][0]
+    assert newest["submitted_by"] == "panel"
