@@ -1,43 +1,95 @@
-// The History tab: runs (filter, sort, pages), experiments, tags and notes, compare, 3D.
+// The History tab: every run, a page at a time from the service (filters, search, sort by any
+// column, page size; "runs 51–100 of 1,234"), a compare basket that outlives pages and filters
+// (basket.js), columns to show, tags and notes, Compare, 3D, exports; the experiments and an
+// experiment's page (experiment.js) and runs grouped by a parameter (aggregate.js). The whole
+// view is in the address bar (history_view.js). Every value reaches the page as text (dom.js).
 import { API, $, say, call, on } from "./api.js";
 import { selectTab } from "./tabs.js";
-import { describeJob } from "./jobs.js";
 import { element, fillTable, attributes } from "./dom.js";
 import { VIEWER } from "./view.js";
+import { FILTERS, COLUMNS, readView, showView } from "./history_view.js";
+import { addRun, removeRun, refreshRun, inBasket, basketIds, basketRuns, onBasketChange, restoreBasket } from "./basket.js";
+import { loadExperiments, onExperimentRuns, showExperiment, closeExperiment } from "./experiment.js";
+import { GROUP_BY, showAggregate, hideAggregate } from "./aggregate.js";
+import { cell, controlsText, endingBadge, jumpsCell, statusCell, targetText } from "./run_cells.js";
+import "./compare.js";
 
-function runQuery() {
-  const form = new FormData($("#history-form"));
-  const params = new URLSearchParams();
-  for (const name of ["experiment_id", "kind", "tag"]) if (form.get(name)) params.set(name, form.get(name));
-  return params;
+export { loadExperiments };
+// A robot or replay run that has ended downloads as an MCAP recording (Foxglove, Rerun open it),
+// and shows its touchdowns beside the model's predictions (touchdowns.js).
+export const RECORDED_KINDS = ["robot", "replay"];
+// The runs in the basket (Compare, 3D's ghost, Calibrate: calibration.js), as last listed.
+export const selectedRuns = () => basketRuns();
+
+const SORTS = [["-id", "newest"], ["id", "oldest"], ["-climb", "best climb"], ["climb", "least climb"],
+  ["zeta0", "zeta0 ↑"], ["-zeta0", "zeta0 ↓"], ["psi0_deg", "psi0 ↑"], ["-psi0_deg", "psi0 ↓"],
+  ["-jumps_completed", "most jumps"], ["jumps_completed", "fewest jumps"], ["-duration_s", "longest"], ["duration_s", "shortest"],
+  ["-created_at", "created ↓"], ["created_at", "created ↑"], ["kind", "kind"], ["status", "status"], ["end_reason", "ending"],
+  ["loop", "loop"], ["controller", "controller"], ["-target", "target ↓"], ["target", "target ↑"], ["failure_code", "failure"]];
+const COLUMN_WORDS = { kind: "kind", status: "status", ending: "ending", loop: "loop", controller: "controller", target: "target",
+  controls: "controls", jumps: "jumps", climb: "climb", failure: "failure", tags: "tags", notes: "notes", created: "created" };
+const view = readView();  // what the tab shows; the form holds the filters, sort and page size
+const shownRuns = new Map();  // id -> the run as last listed: what the editor and the basket start from
+const form = () => $("#history-form");
+
+$("#history-form select[name=sort]").replaceChildren(...SORTS.map(([value, words]) => new Option(words, value)));
+$("#aggregate-by").replaceChildren(...Object.entries(GROUP_BY).map(([value, words]) => new Option(words, value)));
+$("#run-column-choices").replaceChildren(...COLUMNS.map((name) => element("label", null,
+  attributes(element("input", null), { type: "checkbox", name, checked: "" }), ` ${COLUMN_WORDS[name]}`)));
+for (const header of document.querySelectorAll("#run-table th[data-sort]")) {  // a header sorts by its column
+  header.replaceChildren(attributes(element("button", header.textContent), { type: "button", class: "sort-by", "data-sort": header.dataset.sort,
+    title: `sort by ${header.textContent}; again: the other way` }));
 }
 
-const shownRuns = new Map();  // id -> the run as last listed: what the editor starts from
-// The runs ticked in the table (compare, 3D's ghost, calibrate), as last listed.
-export const selectedRuns = () => [...document.querySelectorAll("#run-table input:checked")]
-  .map((box) => shownRuns.get(Number(box.value))).filter(Boolean);
+function formToView() {
+  const values = new FormData(form());
+  view.filters = {};
+  for (const name of FILTERS) if (String(values.get(name) ?? "").trim()) view.filters[name] = String(values.get(name)).trim();
+  view.sort = String(values.get("sort"));
+  view.size = Number(values.get("size"));
+}
+
+function viewToForm() {
+  const fields = form().elements;
+  for (const name of FILTERS) {
+    const field = fields[name], value = view.filters[name] ?? "";
+    if (field.tagName === "SELECT" && value && ![...field.options].some((option) => option.value === value)) {
+      field.append(new Option(value, value));  // e.g. an experiment before the list of them has loaded
+    }
+    field.value = value;
+  }
+  if (!SORTS.some(([value]) => value === view.sort)) view.sort = "-id";
+  fields.sort.value = view.sort;
+  fields.size.value = String(view.size);
+}
+
+const filterQuery = () => new URLSearchParams(view.filters);
 
 function runRow(run) {
-  const controls = run.controls.map((c) => `${c[0]}°/${c[1]}`).join(", ");
-  const select = attributes(element("input", null), { type: "checkbox", value: run.id, "aria-label": `select run ${run.id}` });
-  const notes = attributes(element("td", run.notes.length > 60 ? `${run.notes.slice(0, 60)}…` : run.notes), { class: "notes", title: run.notes });
+  const tick = attributes(element("input", null), { type: "checkbox", value: run.id, "aria-label": `run ${run.id} in the compare basket` });
+  tick.checked = inBasket(run.id);
+  const notes = attributes(element("td", run.notes.length > 60 ? `${run.notes.slice(0, 60)}…` : run.notes), { class: "notes col-notes", title: run.notes });
   const actions = attributes(element("td", null,
     attributes(element("button", "edit"), { type: "button", class: "edit-run", "data-run": run.id, "aria-label": `edit the tags and notes of run ${run.id}` }), " ",
     attributes(element("button", "3D"), { type: "button", class: "open-3d", "data-run": run.id, "aria-label": `open run ${run.id} in the 3D view` }), " ",
     attributes(element("a", "share"), { href: `${API}/runs/${run.id}/share.html`, download: "", "aria-label": `share run ${run.id} as a standalone HTML file` }),
     ...recordingLink(run)),
   { class: "actions" });
-  const row = element("tr", null, element("td", null, select), element("td", String(run.id)), element("td", run.kind),
-    element("td", controls), element("td", `${run.jumps_completed}/${run.jumps}`), element("td", run.climb.toFixed(3)),
-    element("td", run.failure_code ?? ""), attributes(element("td", run.tags.join(" ")), { class: "tags" }), notes,
-    element("td", new Date(run.created_at).toLocaleString()), actions);
+  const row = element("tr", null, element("td", null, tick), element("td", String(run.id)), cell("kind", run.kind), statusCell(run),
+    cell("ending", null, endingBadge(run.end_reason)), cell("loop", run.loop), cell("controller", run.controller ?? "—"),
+    cell("target", targetText(run)), cell("controls", controlsText(run)), jumpsCell(run), cell("climb", run.climb.toFixed(3)),
+    cell("failure", run.failure_code ?? ""), attributes(element("td", run.tags.join(" ")), { class: "tags col-tags" }), notes,
+    created(run.created_at), actions);
   row.id = `run-${run.id}`;
   return row;
 }
 
-// A robot or replay run that has ended downloads as an MCAP recording (Foxglove, Rerun open it),
-// and shows its touchdowns beside the model's predictions (touchdowns.js).
-export const RECORDED_KINDS = ["robot", "replay"];
+function created(at) {
+  const moment = new Date(at);
+  return attributes(cell("created", moment.toLocaleString(undefined, { dateStyle: "short", timeStyle: "short" })),
+    { title: moment.toLocaleString() });
+}
+
 function recordingLink(run) {
   if (!RECORDED_KINDS.includes(run.kind) || run.status === "running") return [];
   return [" ", attributes(element("a", "MCAP"), { href: `${API}/runs/${run.id}/export.mcap`, download: "", class: "export-mcap",
@@ -49,66 +101,137 @@ function recordingLink(run) {
 let listing = 0;  // the newest listing asked for: an older answer arriving later is not shown
 export async function loadRuns() {
   const asked = ++listing;
-  const params = runQuery();
-  const sort = new FormData($("#history-form")).get("sort");
-  const page = await call("GET", `/runs?limit=100&sort=${sort}&${params}`);
+  formToView();
+  const offset = (view.page - 1) * view.size;
+  const page = await call("GET", `/runs?limit=${view.size}&offset=${offset}&sort=${encodeURIComponent(view.sort)}&${filterQuery()}`);
   if (asked !== listing) return;  // the tab's first listing answered after the filter's
-  $("#export-csv").href = `${API}/runs/export?format=csv&${params}`;
-  $("#export-json").href = `${API}/runs/export?format=json&${params}`;
+  if (!page.items.length && page.total > 0 && offset >= page.total) {  // past the end (fewer runs match now)
+    view.page = Math.ceil(page.total / view.size);
+    return loadRuns();
+  }
+  $("#export-csv").href = `${API}/runs/export?format=csv&${filterQuery()}`;
+  $("#export-json").href = `${API}/runs/export?format=json&${filterQuery()}`;
   shownRuns.clear();
   page.items.forEach((run) => shownRuns.set(run.id, run));
   fillTable("#run-table", page.items.map(runRow), "No runs match these filters.");
+  showPager(page.items.length, page.total);
+  showSort();
+  remember();
+  if (view.by) await showAggregate(filterQuery(), view.by, view.bins);
 }
 
-on("#history-form", "submit", (event) => { event.preventDefault(); loadRuns(); });
-on("#history-form select[name=sort]", "change", () => loadRuns());  // a new order applies at once
+function showPager(count, total) {
+  const first = (view.page - 1) * view.size + 1;
+  const pages = Math.max(1, Math.ceil(total / view.size));
+  $("#runs-range").textContent = count
+    ? `runs ${first.toLocaleString()}–${(first + count - 1).toLocaleString()} of ${total.toLocaleString()} (page ${view.page} of ${pages.toLocaleString()})`
+    : "no runs match";
+  $("#runs-first").disabled = $("#runs-prev").disabled = view.page <= 1;
+  $("#runs-next").disabled = $("#runs-last").disabled = view.page >= pages;
+  $("#run-pager").dataset.pages = String(pages);
+}
 
-// Experiments group runs (and jobs) under a name; picking one filters the runs below.
-export async function loadExperiments() {
-  const page = await call("GET", "/experiments?limit=100");
-  const filter = $("#experiment-filter");
-  const chosen = filter.value;
-  filter.replaceChildren(new Option("any", ""), ...page.items.map((e) => new Option(`${e.id}: ${e.name}`, String(e.id))));
-  filter.value = page.items.some((e) => String(e.id) === chosen) ? chosen : "";
-  for (const choice of document.querySelectorAll("select.experiment-choice")) {
-    const kept = choice.value;
-    choice.replaceChildren(new Option("none", ""), ...page.items.map((e) => new Option(`${e.id}: ${e.name}`, String(e.id))));
-    choice.value = page.items.some((e) => String(e.id) === kept) ? kept : "";
+function showSort() {
+  for (const header of document.querySelectorAll("#run-table th[data-sort]")) {
+    const name = header.dataset.sort;
+    header.setAttribute("aria-sort", view.sort === name ? "ascending" : view.sort === `-${name}` ? "descending" : "none");
   }
-  fillTable("#experiment-table", page.items.map((experiment) => element("tr", null,
-    element("td", String(experiment.id)),
-    element("td", null, attributes(element("button", experiment.name), { type: "button", class: "show-experiment", "data-experiment": experiment.id })),
-    attributes(element("td", experiment.description), { class: "description" }), element("td", String(experiment.runs)),
-    attributes(element("td", experiment.tags.join(" ")), { class: "tags" }), element("td", new Date(experiment.created_at).toLocaleString()))),
-    "No experiments yet: name one above.");
 }
 
-loadExperiments().catch(() => {});  // the forms' "in experiment" choices, from the start
+// The view in the address bar and in the "Link to this view".
+function remember() {
+  view.basket = basketIds();
+  $("#history-link").href = showView(view);
+}
 
-on("#experiment-table", "click", async (event) => {
-  const button = event.target.closest("button.show-experiment");
+function again(page = 1) {
+  view.page = page;
+  return loadRuns();
+}
+
+on("#history-form", "submit", (event) => { event.preventDefault(); return again(); });
+for (const name of ["experiment_id", "kind", "status", "end_reason", "loop", "controller", "sort", "size"]) {
+  on(`#history-form select[name=${name}]`, "change", () => again());  // a choice applies at once
+}
+on("#runs-first", "click", () => again(1));
+on("#runs-prev", "click", () => again(Math.max(1, view.page - 1)));
+on("#runs-next", "click", () => again(view.page + 1));
+on("#runs-last", "click", () => again(Number($("#run-pager").dataset.pages || 1)));
+on("#run-table thead", "click", (event) => {
+  const button = event.target.closest("button.sort-by");
   if (!button) return;
-  $("#experiment-filter").value = button.dataset.experiment;
-  await Promise.all([loadRuns(), showExperimentJobs(button.dataset.experiment, button.textContent)]);
+  const name = button.dataset.sort;
+  form().elements.sort.value = view.sort === `-${name}` ? name : `-${name}`;
+  return again();
 });
 
-// An experiment's jobs, under the experiments (its runs are the runs list, filtered to it).
-async function showExperimentJobs(id, name) {
-  const page = await call("GET", `/jobs?limit=100&experiment_id=${id}`);
-  const table = $("#experiment-jobs");
-  table.querySelector("caption").textContent = `Jobs in experiment ${id}: ${name}`;
-  fillTable("#experiment-jobs", page.items.map((job) => element("tr", null, element("td", String(job.id)), element("td", job.kind),
-    element("td", describeJob(job)), element("td", job.state))), "No jobs in this experiment.");
-  table.hidden = false;
+// The basket: a tick puts the run in (or takes it out); it stays there across pages and filters.
+on("#run-table tbody", "change", (event) => {
+  const box = event.target.closest("input[type=checkbox]");
+  if (!box) return;
+  const run = shownRuns.get(Number(box.value));
+  if (box.checked && !addRun(run)) box.checked = false;
+  if (!box.checked) removeRun(run.id);
+});
+onBasketChange(() => {
+  for (const box of document.querySelectorAll("#run-table tbody input[type=checkbox]")) box.checked = inBasket(Number(box.value));
+  if (!$("#history").hidden) remember();
+});
+
+// Columns: each can be hidden (the table's hide-NAME class), and the choice is part of the view.
+function showColumns() {
+  const table = $("#run-table");
+  for (const name of COLUMNS) table.classList.toggle(`hide-${name}`, view.hide.includes(name));
+  for (const box of document.querySelectorAll("#run-column-choices input")) box.checked = !view.hide.includes(box.name);
+}
+on("#run-column-choices", "change", () => {
+  view.hide = [...document.querySelectorAll("#run-column-choices input")].filter((box) => !box.checked).map((box) => box.name);
+  showColumns();
+  remember();
+});
+
+// Experiments: a name opens its page and lists its runs; Close lists every run again.
+onExperimentRuns((id) => {
+  form().elements.experiment_id.value = id ?? "";
+  return again();
+});
+
+// Runs grouped by a parameter, over the runs the filters select (aggregate.js).
+on("#group-runs", "click", () => {
+  $("#aggregate-box").hidden = false;
+  $("#aggregate-box").scrollIntoView({ block: "nearest" });
+});
+on("#aggregate-form", "submit", async (event) => {
+  event.preventDefault();
+  view.by = $("#aggregate-by").value;
+  view.bins = String(new FormData(event.target).get("bins") || "").trim();
+  remember();
+  await showAggregate(filterQuery(), view.by, view.bins);
+});
+on("#aggregate-close", "click", () => {
+  view.by = view.bins = "";
+  hideAggregate();
+  remember();
+});
+
+// A link to a view (or a reload) shows it: History with its filters, sort, page, columns, basket.
+export async function restoreView() {
+  viewToForm();
+  showColumns();
+  if (view.by) {
+    $("#aggregate-by").value = view.by;
+    $("#aggregate-form").elements.bins.value = view.bins;
+  }
+  if (view.basket.length) restoreBasket(view.basket).catch(() => {});
+  if (view.tab !== "history") return;
+  selectTab("history");  // loads the experiments, then this page of runs (main.js)
+  if (view.filters.experiment_id) await showExperiment(view.filters.experiment_id).catch(() => closeExperiment());
 }
 
-on("#experiment-form", "submit", async (event) => {
-  event.preventDefault();
-  const form = new FormData(event.target);
-  const experiment = await call("POST", "/experiments", { name: String(form.get("name")), description: String(form.get("description")) });
-  event.target.reset();
-  await loadExperiments();
-  say(`Experiment ${experiment.id} "${experiment.name}" created; runs and jobs join it through experiment_id.`);
+// Another tab: the address bar no longer names History's view (back on History, it does again).
+on("nav[role=tablist]", "click", (event) => {
+  const tab = event.target.closest("[role=tab]");
+  if (tab && tab.dataset.tab !== "history" && location.search) history.replaceState(null, "", location.pathname);
 });
 
 // Tags and notes: the only things about a run that change after it is stored.
@@ -130,12 +253,13 @@ on("#run-editor", "close", async () => {
   const choice = editor.returnValue;
   editor.returnValue = "";
   if (choice !== "save") return;
-  const form = $("#run-editor-form").elements;
+  const fields = $("#run-editor-form").elements;
   const id = Number(editor.dataset.run);
-  const tags = form.tags.value.split(/[\s,]+/).filter(Boolean);
+  const tags = fields.tags.value.split(/[\s,]+/).filter(Boolean);
   try {
-    const run = await call("PATCH", `/runs/${id}`, { tags, notes: form.notes.value });
+    const run = await call("PATCH", `/runs/${id}`, { tags, notes: fields.notes.value });
     shownRuns.set(run.id, run);
+    refreshRun(run);
     $(`#run-${run.id}`)?.replaceWith(runRow(run));
     say(`Run ${run.id} saved.`);
   } catch (error) {
@@ -144,46 +268,13 @@ on("#run-editor", "close", async () => {
   }
 });
 
-// "3D" on a run: replay it in the 3D view (with the other selected run, if one, as a ghost).
+// "3D" on a run: replay it in the 3D view (with the basket's first other run, if any, as a ghost).
 on("#run-table", "click", async (event) => {
   const button = event.target.closest("button.open-3d");
   if (!button) return;
   const runId = Number(button.dataset.run);
-  const others = [...document.querySelectorAll("#run-table input:checked")].map((box) => Number(box.value)).filter((id) => id !== runId);
+  const others = basketIds().filter((id) => id !== runId);
   await call("POST", "/view/replay", { viewer: VIEWER, run_id: runId, overlay_run_id: others[0] ?? null });
   selectTab("view3d");
   say(`Run ${runId} is on the 3D view's timeline${others.length ? ` with run ${others[0]} as a ghost` : ""}.`);
-});
-
-// Compare in a person's terms: legs by side, dates in local time, numbers to 6 significant digits.
-const LEG_SIDES = ["left", "right"];
-const COMPARE_LABELS = { created_at: "created", duration_s: "computed in [s]", climb: "climb [l0]",
-  start_xdot: "start xdot [√(g l0)]", start_ydot: "start ydot [√(g l0)]", jumps_completed: "jumps completed",
-  failure_code: "failure", code_version: "code version", experiment_id: "experiment" };
-function compareLabel(field) {
-  if (COMPARE_LABELS[field]) return COMPARE_LABELS[field];
-  return field.replace(/^leg(\d+)\./, (_, leg) => `${LEG_SIDES[Number(leg)] ?? `leg ${leg}`} leg `).replace(/^model\./, "model ");
-}
-function compareValue(field, value) {
-  if (value === null || value === undefined || value === "") return "—";
-  if (field === "created_at") return new Date(value).toLocaleString();
-  if (typeof value === "number" && !Number.isInteger(value)) return String(Number(value.toPrecision(6)));
-  return String(value);
-}
-
-on("#compare", "click", async () => {
-  const ids = [...document.querySelectorAll("#run-table input:checked")].map((box) => box.value);
-  if (ids.length < 2) return say("Select two or more runs to compare.", "error");
-  const result = await call("GET", `/runs/compare?${ids.map((id) => `ids=${id}`).join("&")}`);
-  // Every value (notes included) goes in as text, never as markup.
-  const table = element("table", null, element("caption", "What differs"));
-  table.id = "compare-table";
-  table.append(element("tr", null, element("th", "field"), ...result.runs.map((r) => element("th", `run ${r.id}`))));
-  for (const field of result.fields.filter((f) => f !== "id")) {
-    const cells = result.runs.map((r) => element("td", compareValue(field, r[field])));
-    const row = element("tr", null, element("td", compareLabel(field)), ...cells);
-    row.className = "differs";
-    table.append(row);
-  }
-  $("#compare-out").replaceChildren(table);
 });

@@ -6,7 +6,7 @@
 // and it starts itself, so the banner does not wait for Plotly and the other tabs' modules.
 import { initTabs } from "./tabs.js";
 import { loadJobs } from "./jobs.js";
-import { loadExperiments, loadRuns } from "./history.js";
+import { loadExperiments, loadRuns, restoreView } from "./history.js";
 import { loadCalibrations } from "./calibration.js";
 import "./touchdowns.js";
 import { drawLive, refreshRobot, syncLive } from "./robot.js";
@@ -21,3 +21,4 @@ initTabs((name) => {
   syncLive();  // the live websocket is open while the Robot tab is shown
   if (name === "view3d") showView();
 });
+restoreView().catch(() => {});  // a link to a History view (?tab=history&…) opens it

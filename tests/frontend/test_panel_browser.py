@@ -386,9 +386,9 @@ def test_history_compares_and_exports(page, service):
     page.click("nav [data-tab=history]")
     # The table may still show an earlier visit's rows: wait for the reload with the saved run and these two.
     _until(page, "document.querySelectorAll('#run-table tbody tr').length >= 3")
-    boxes = page.query_selector_all("#run-table tbody input[type=checkbox]")
-    boxes[0].check()
-    boxes[1].check()
+    boxes = page.locator("#run-table tbody input[type=checkbox]")  # found again if the list is drawn again
+    boxes.nth(0).check()
+    boxes.nth(1).check()
     page.click("#compare")
     page.wait_for_selector("#compare-table")
     compared = page.inner_text("#compare-table")
@@ -1193,6 +1193,7 @@ def varied_runs(service, data_dir):
 
 def _show_runs(page, runs):
     page.click("nav [data-tab=history]")
+    page.click("#basket-clear")  # the basket outlives pages and filters: empty it of earlier tests' runs
     page.select_option("#history-form select[name=kind]", "robot")
     page.click("#history-form button[type=submit]")
     _until(page, " && ".join(f"!!document.querySelector('#run-{run}')" for run in runs))
