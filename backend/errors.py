@@ -19,3 +19,8 @@ class NotFound(LookupError):
 
 class Conflict(RuntimeError):
     """The request contradicts stored data (e.g. deleting an experiment that still has runs)."""
+
+
+class QueueFull(RuntimeError):
+    """The job queue holds its budget of work (or this client its share); the message says how much
+    is queued and what to do."""

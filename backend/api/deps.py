@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Annotated, TypeVar
 
-from fastapi import Depends, HTTPException, Query, Request, status
+from fastapi import Depends, Header, HTTPException, Query, Request, status
 from fastapi import Path as FastAPIPath
 from fastapi.concurrency import run_in_threadpool
 from sqlalchemy.orm import Session, sessionmaker
@@ -105,6 +105,20 @@ async def run_filter(
     )
 
 
+def submitted_by(
+    request: Request,
+    client: Annotated[
+        str | None,
+        Header(alias="X-Parkour-Client", pattern=schemas.CLIENT_PATTERN,
+               description="who submits (e.g. panel, a script's name): the job queue's share is per client"),
+    ] = None,
+) -> str:  # fmt: skip
+    """Who makes the request: the ``X-Parkour-Client`` header, else the client's address."""
+    if client:
+        return client
+    return request.client.host if request.client is not None else "unknown"
+
+
 async def robot_service(request: Request) -> RobotService:
     return request.app.state.robot
 
@@ -149,6 +163,7 @@ Robot = Annotated[RobotService, Depends(robot_service)]
 Runner = Annotated[JobRunner | None, Depends(job_runner)]
 QuickCompute = Annotated[ComputePool, Depends(quick_compute)]
 Reads = Annotated[StoreReads, Depends(store_reads)]
+SubmittedBy = Annotated[str, Depends(submitted_by)]
 SceneView = Annotated[object, Depends(scene_view)]  # frontend.viewer's view (the backend does not import it)
 AUTHORIZED = [Depends(require_token)]  # every mutating route's dependencies
 PageLimit = Annotated[int, Query(ge=1, le=schemas.MAX_PAGE, description="items per page")]

@@ -20,7 +20,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 
 from backend.api import security
-from backend.errors import Conflict, NotFound
+from backend.errors import Conflict, NotFound, QueueFull
 from backend.robot.link import EstopLatched, LinkError
 from backend.services.robot import RobotUnavailable
 from backend.services.robot_tracker import TrackerPortInUse
@@ -37,6 +37,7 @@ VALUE_ERROR_PREFIX = "Value error, "  # pydantic's, before the message of a vali
 STATUS_OF: dict[type[Exception], tuple[int, str]] = {
     NotFound: (status.HTTP_404_NOT_FOUND, "{}"),
     Conflict: (status.HTTP_409_CONFLICT, "{}"),
+    QueueFull: (status.HTTP_429_TOO_MANY_REQUESTS, "{}"),
     RobotUnavailable: (status.HTTP_409_CONFLICT, "{}"),
     TrackerPortInUse: (status.HTTP_409_CONFLICT, "{}"),
     EstopLatched: (status.HTTP_409_CONFLICT, "{}"),  # before LinkError, its base: the latch is no outage

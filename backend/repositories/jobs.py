@@ -84,6 +84,12 @@ def recover_interrupted(session: Session) -> None:
     )
 
 
+def unfinished(session: Session) -> list[Job]:
+    """The jobs queued, running or cancelling, oldest first (the queue, bounded by its budget)."""
+    waiting = (JobState.QUEUED, JobState.RUNNING, JobState.CANCELLING)
+    return list(session.scalars(select(Job).where(Job.state.in_(waiting)).order_by(Job.id)))
+
+
 def queued_ids(session: Session) -> list[int]:
     """The queued jobs' ids, oldest first."""
     return list(session.scalars(select(Job.id).where(Job.state == JobState.QUEUED).order_by(Job.id)))

@@ -43,7 +43,9 @@ from backend.schemas.experiments import (
     ExperimentUpdate,
 )
 from backend.schemas.jobs import (
+    CLIENT_PATTERN,
     JOB_KINDS,
+    QUEUE_BUDGET_JUMPS,
     WORK_BUDGET_JUMPS,
     BasinJobCreate,
     GaitSearchJobCreate,
@@ -78,6 +80,7 @@ from backend.schemas.sim import FixedPointIn, FixedPointOut, MapIn, MapOut, Traj
 from backend.schemas.view import VIEWER_ID_PATTERN, ViewerId, ViewOut, ViewReplay
 
 __all__ = [
+    "CLIENT_PATTERN",
     "JOB_KINDS",
     "MAX_ID",
     "MAX_JUMPS",
@@ -86,6 +89,7 @@ __all__ = [
     "MAX_PATH_SAMPLES",
     "MAX_TRIALS",
     "PRESET_PATTERN",
+    "QUEUE_BUDGET_JUMPS",
     "VIEWER_ID_PATTERN",
     "WORK_BUDGET_JUMPS",
     "BasinJobCreate",

@@ -28,6 +28,15 @@ from sim_core.noise import ASYMMETRY_LIMITS, SIGMA_LIMITS, NoiseModel
 # about an hour of the job worker on the lab's machine (1.35e5-1.6e5 jumps/s measured by
 # scripts/bench_job_rate.py on 2 cores). Larger jobs are refused with a 422 naming the limit.
 WORK_BUDGET_JUMPS = 500_000_000
+# The queue's budget: queued and running work together (each job at its worst, a running one's
+# share still to do), about eight hours of the job worker; one client (a script, the panel) may
+# hold at most CLIENT_SHARE of it, so another always finds room. Past either, a 429 says so.
+QUEUE_BUDGET_JUMPS = 8 * WORK_BUDGET_JUMPS
+CLIENT_SHARE = 0.5
+MAX_QUEUED_JOBS = 1000  # jobs waiting at once, however small
+JOB_RATE_JUMPS_PER_S = 135_000  # the job worker's rate (the low end of scripts/bench_job_rate.py): for estimates
+GAIT_SEARCH_JUMPS = 1000  # a gait search's work per guess, at most (Levenberg–Marquardt's map evaluations)
+CLIENT_PATTERN = r"^[\w.:@/-]{1,64}$"  # the X-Parkour-Client header: who submits, for the queue's fairness
 
 
 class JobState(enum.StrEnum):
@@ -78,7 +87,7 @@ class MJTFJobCreate(Strict):
 
     @model_validator(mode="after")
     def _within_budget(self) -> MJTFJobCreate:
-        return _within_budget(self, len(self.zeta0s) * self.trials * self.cap, "levels x trials x cap")
+        return _within_budget(self)
 
 
 class SweepJobCreate(Strict):
@@ -101,9 +110,7 @@ class SweepJobCreate(Strict):
             raise ValueError(f"zeta0_low must be below zeta0_high, got {self.zeta0_low:g} >= {self.zeta0_high:g}")
         if self.basin_grid == 1:
             raise ValueError("basin_grid must be 0 (no basins) or at least 2")
-        return _within_budget(
-            self, self.steps * self.basin_grid**2 * self.basin_jumps, "steps x basin_grid² x basin_jumps"
-        )
+        return _within_budget(self)
 
 
 class BasinJobCreate(Strict):
@@ -121,7 +128,7 @@ class BasinJobCreate(Strict):
 
     @model_validator(mode="after")
     def _within_budget(self) -> BasinJobCreate:
-        return _within_budget(self, self.grid**2 * self.jumps, "grid² x jumps")
+        return _within_budget(self)
 
 
 class GaitSearchJobCreate(Strict):
@@ -135,8 +142,21 @@ class GaitSearchJobCreate(Strict):
     grid: Annotated[int, Field(ge=1, le=20)] = 6
 
 
-def _within_budget(job, jumps: int, formula: str):
-    """``job`` if its worst-case work (``jumps``, counted as ``formula``) fits the budget."""
+def worst_case_jumps(job) -> tuple[int, str]:
+    """A job's work in jumps at its worst, and the formula that counts it: for a request body or a
+    stored spec alike (both have the fields this reads)."""
+    if job.kind == "mjtf":
+        return len(job.zeta0s) * job.trials * job.cap, "levels x trials x cap"
+    if job.kind == "sweep":
+        return job.steps * job.basin_grid**2 * job.basin_jumps, "steps x basin_grid² x basin_jumps"
+    if job.kind == "basin":
+        return job.grid**2 * job.jumps, "grid² x jumps"
+    return job.grid**2 * GAIT_SEARCH_JUMPS, f"grid² x {GAIT_SEARCH_JUMPS}"
+
+
+def _within_budget(job):
+    """``job`` if its worst-case work fits the budget."""
+    jumps, formula = worst_case_jumps(job)
     if jumps > WORK_BUDGET_JUMPS:
         raise ValueError(
             f"the job would take up to {jumps:.3g} jumps ({formula}), over the limit of {WORK_BUDGET_JUMPS:.3g} "
@@ -175,6 +195,11 @@ class JobOut(BaseModel):
     created_at: datetime.datetime
     started_at: datetime.datetime | None
     finished_at: datetime.datetime | None
+    submitted_by: str | None = Field(None, description="who submitted it: X-Parkour-Client, else the address")
+    queue_position: int | None = Field(None, description="1: runs next; null when not queued")
+    eta_s: float | None = Field(
+        None, description="seconds until it ends at the latest (its work and the work ahead at their worst)"
+    )
 
 
 JobPage = Page[JobOut]

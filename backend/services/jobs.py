@@ -16,9 +16,11 @@ from sqlalchemy.orm import Session
 from backend.repositories import jobs as stored_jobs
 from backend.repositories.common import locked
 from backend.schemas.jobs import JobOut, JobPage, JobResults, JobState, MJTFLevelOut
+from backend.services.job_queue import Standing, check_room, standings
 from backend.services.job_specs import decode, encode, spec_of
 from backend.services.models import with_preset_resolved
 from backend.services.simulation import current_code_version
+from backend.store.database import lock_for_write
 from backend.store.models import Experiment, Job, utcnow
 from sim_core.mjtf_plan import CAPPED, jump_statistics, no_outcomes
 
@@ -28,12 +30,15 @@ if TYPE_CHECKING:
 FINAL = frozenset({JobState.DONE, JobState.CANCELLED, JobState.FAILED})  # a job in one of these never changes again
 
 
-def create_job(session: Session, body, runner: JobRunner | None = None) -> JobOut:
-    """Store a job (any of ``schemas.JOB_KINDS``, a stored preset resolved) and hand it to ``runner``;
-    MJTF totals count trials, other kinds chunks. Its experiment is read under the write lock
-    (``locked``), so a concurrent delete of it waits for this commit (and then refuses: the
-    experiment has a job) or has removed it first (404)."""
+def create_job(session: Session, body, runner: JobRunner | None = None, *, client: str | None = None) -> JobOut:
+    """Store a job (any of ``schemas.JOB_KINDS``, a stored preset resolved) submitted by ``client``
+    and hand it to ``runner``; MJTF totals count trials, other kinds chunks. The queue's room is
+    checked under the write lock (:mod:`backend.services.job_queue`: a 429 past its budget or the
+    client's share), and its experiment read under it (``locked``), so a concurrent delete of it
+    waits for this commit (and then refuses: the experiment has a job) or has removed it first (404)."""
     body = with_preset_resolved(session, body)
+    lock_for_write(session)
+    check_room(session, body, client or "unknown")
     if body.experiment_id is not None:
         locked(session, Experiment, body.experiment_id, "experiment")
     spec = spec_of(body)  # stored as its own versioned record: job_specs.py says why
@@ -46,16 +51,18 @@ def create_job(session: Session, body, runner: JobRunner | None = None) -> JobOu
             state=JobState.QUEUED,
             total=len(spec.zeta0s) * spec.trials if spec.kind == "mjtf" else 1,
             code_version=current_code_version(),
+            submitted_by=client,
         ),
     )
     session.commit()
     if runner is not None:
         runner.submit(job.id)
-    return public(job)
+    return public(job, standings(session).get(job.id))
 
 
 def get_job(session: Session, job_id: int) -> JobOut:
-    return public(stored_jobs.get(session, job_id))
+    job = stored_jobs.get(session, job_id)
+    return public(job, standings(session).get(job_id) if job.state not in FINAL else None)
 
 
 def list_jobs(
@@ -65,7 +72,8 @@ def list_jobs(
         session, state=state, limit=limit, cursor=cursor, experiment_id=experiment_id
     )
     total = stored_jobs.count(session, state=state, experiment_id=experiment_id)
-    return JobPage(items=[public(row) for row in rows], next_cursor=next_cursor, total=total)
+    standing = standings(session) if any(row.state not in FINAL for row in rows) else {}
+    return JobPage(items=[public(row, standing.get(row.id)) for row in rows], next_cursor=next_cursor, total=total)
 
 
 def cancel_job(session: Session, job_id: int) -> JobOut:
@@ -119,8 +127,9 @@ def level_summaries(session: Session, job) -> list[dict]:
     return summaries
 
 
-def public(job: Job) -> JobOut:
-    """A job as the API gives it (its progress: the share of its work done)."""
+def public(job: Job, standing: Standing | None = None) -> JobOut:
+    """A job as the API gives it (its progress: the share of its work done; ``standing``: its place
+    in the queue and estimate, while unfinished)."""
     return JobOut(
         id=job.id,
         experiment_id=job.experiment_id,
@@ -134,4 +143,7 @@ def public(job: Job) -> JobOut:
         created_at=job.created_at,
         started_at=job.started_at,
         finished_at=job.finished_at,
+        submitted_by=job.submitted_by,
+        queue_position=None if standing is None else standing.position,
+        eta_s=None if standing is None else standing.eta_s,
     )

@@ -176,6 +176,7 @@ class Job(Base):
     updated_at: Mapped[datetime.datetime] = mapped_column(default=utcnow, onupdate=utcnow)
     started_at: Mapped[datetime.datetime | None]
     finished_at: Mapped[datetime.datetime | None]
+    submitted_by: Mapped[str | None] = mapped_column(String(64))  # the queue's fairness counts work per client
 
     trials: Mapped[list[Trial]] = relationship(back_populates="job", cascade="all, delete-orphan")
 

@@ -12,7 +12,7 @@ from fastapi.encoders import jsonable_encoder
 from fastapi.responses import StreamingResponse
 
 from backend import schemas
-from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, RecordId, Runner
+from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, RecordId, Runner, SubmittedBy
 from backend.services import jobs
 
 EVENT_POLL_S = 0.25  # progress comes from committed chunks; a quarter second is live enough
@@ -21,8 +21,10 @@ router = APIRouter(prefix="/api/v1/jobs", tags=["jobs"])
 
 
 @router.post("", status_code=202, dependencies=AUTHORIZED, response_model=schemas.JobOut)
-async def create_job(body: schemas.JobCreate, db: Db, runner: Runner) -> schemas.JobOut:
-    return await db(jobs.create_job, body, runner)
+async def create_job(body: schemas.JobCreate, db: Db, runner: Runner, client: SubmittedBy) -> schemas.JobOut:
+    """Queue a job. Past the queue's budget of work, or this client's share of it, a 429 says what
+    is queued (docs/service.md); ``queue_position`` and ``eta_s`` say where it stands."""
+    return await db(jobs.create_job, body, runner, client=client)
 
 
 @router.get("", response_model=schemas.JobPage)

@@ -144,3 +144,23 @@ def test_jobs_list_by_experiment(client, auth):
     assert [job["id"] for job in listed] == [filed]
     assert len(client.get("/api/v1/jobs").json()["items"]) == 2
     assert client.get("/api/v1/jobs", params={"experiment_id": 0}).status_code == 422
+
+
+def test_past_the_queue_budget_a_job_is_a_429_naming_it(client, auth, monkeypatch):
+    from backend.services import job_queue
+
+    monkeypatch.setattr(job_queue, "QUEUE_BUDGET_JUMPS", 100)
+    body = {"zeta0s": [0.9], "trials": 4, "cap": 100}
+    refused = client.post("/api/v1/jobs", json=body, headers=auth | {"X-Parkour-Client": "sweep-script"})
+    assert refused.status_code == 429
+    assert refused.json()["detail"].startswith("the job queue is full: this job's 400 jumps at its worst")
+    assert client.get("/api/v1/jobs").json()["items"] == []
+
+
+def test_the_submitter_is_the_client_header_else_the_address(client, auth):
+    body = {"zeta0s": [0.9], "trials": 2, "cap": 20}
+    named = client.post("/api/v1/jobs", json=body, headers=auth | {"X-Parkour-Client": "panel"}).json()
+    unnamed = client.post("/api/v1/jobs", json=body, headers=auth).json()
+    assert named["submitted_by"] == "panel" and unnamed["submitted_by"] == "testclient"
+    bad = client.post("/api/v1/jobs", json=body, headers=auth | {"X-Parkour-Client": "<script>"})
+    assert bad.status_code == 422 and bad.json()["detail"][0]["loc"] == ["header", "X-Parkour-Client"]

@@ -1,0 +1,108 @@
+"""The job queue: a budget of queued work, each client's share of it, and where each job stands.
+
+Jobs run one at a time (:mod:`backend.services.job_runner`). What is queued and running is bounded
+by :data:`~backend.schemas.jobs.QUEUE_BUDGET_JUMPS` of work, each job counted at its worst
+(:func:`~backend.schemas.jobs.worst_case_jumps`; a running one by the share it has still to do), and
+one client — a script, the panel: the ``X-Parkour-Client`` header, else its address — may hold at
+most :data:`~backend.schemas.jobs.CLIENT_SHARE` of it, so one script cannot starve the panel. A job
+past either is refused with a 429 (:class:`~backend.errors.QueueFull`) saying what is queued.
+A queued job's place is its rank among the queued jobs by id (the runner takes them oldest
+first); its estimate is the work ahead of it and its own at the job worker's rate, at the latest.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+from sqlalchemy.orm import Session
+
+from backend.errors import QueueFull
+from backend.repositories import jobs as stored_jobs
+from backend.schemas.jobs import (
+    CLIENT_SHARE,
+    JOB_RATE_JUMPS_PER_S,
+    MAX_QUEUED_JOBS,
+    QUEUE_BUDGET_JUMPS,
+    JobState,
+    worst_case_jumps,
+)
+from backend.services.job_specs import UnreadableSpec, decode
+from backend.store.models import Job
+
+
+@dataclass(frozen=True)
+class Standing:
+    """Where an unfinished job stands: ``position`` 1 runs next (None: running), ``eta_s`` the
+    seconds until it ends at the latest."""
+
+    position: int | None
+    eta_s: float
+
+
+def work_left(job: Job) -> int:
+    """The job's work still to do, in jumps at its worst: all of it while queued, the share of its
+    total not completed while running."""
+    try:
+        worst, _ = worst_case_jumps(decode(job.spec))
+    except UnreadableSpec:
+        return 0  # a spec of another version of the code: it will fail when it runs, taking no time
+    if job.state == JobState.QUEUED or not job.total:
+        return worst
+    return round(worst * max(job.total - job.completed, 0) / job.total)
+
+
+def check_room(session: Session, body, client: str) -> None:
+    """Refuse ``body`` (a job request) with :class:`QueueFull` if the queue, or ``client``'s share
+    of it, has no room for its work at its worst."""
+    unfinished = stored_jobs.unfinished(session)
+    wanted, _ = worst_case_jumps(body)
+    queued = sum(work_left(job) for job in unfinished)
+    waiting = sum(job.state == JobState.QUEUED for job in unfinished)
+    mine = sum(work_left(job) for job in unfinished if job.submitted_by == client)
+    share = int(CLIENT_SHARE * QUEUE_BUDGET_JUMPS)
+    ahead = f"{len(unfinished)} jobs unfinished, {_jumps(queued)} of work ({_hours(queued)})"
+    if waiting >= MAX_QUEUED_JOBS:
+        raise QueueFull(f"the job queue is full: {waiting} jobs wait, the most it holds; {ahead}. "
+                        "Wait for some to finish, or cancel some")  # fmt: skip
+    if queued + wanted > QUEUE_BUDGET_JUMPS:
+        raise QueueFull(
+            f"the job queue is full: this job's {_jumps(wanted)} at its worst would take the queue past its budget "
+            f"of {_jumps(QUEUE_BUDGET_JUMPS)} ({_hours(QUEUE_BUDGET_JUMPS)}); {ahead}. "
+            "Wait for jobs to finish, cancel some, or ask for less"
+        )
+    if mine + wanted > share:
+        raise QueueFull(
+            f"{client} already holds {_jumps(mine)} of queued work; with this job's {_jumps(wanted)} it would pass "
+            f"a client's share of {_jumps(share)} ({_hours(share)}), kept so others always find room. "
+            "Wait for your jobs to finish, or cancel some"
+        )
+
+
+def standings(session: Session) -> dict[int, Standing]:
+    """Every unfinished job's standing, by id (one query of the unfinished jobs)."""
+    return standings_of(stored_jobs.unfinished(session))
+
+
+def standings_of(unfinished: Iterable[Job]) -> dict[int, Standing]:
+    """:func:`standings` from the unfinished jobs, oldest first."""
+    unfinished = list(unfinished)
+    started = [job for job in unfinished if job.state != JobState.QUEUED]  # running (or cancelling)
+    ahead = sum(work_left(job) for job in started)
+    result = {job.id: Standing(None, ahead / JOB_RATE_JUMPS_PER_S) for job in started}
+    position = 0
+    for job in unfinished:
+        if job.state == JobState.QUEUED:
+            position += 1
+            ahead += work_left(job)
+            result[job.id] = Standing(position, ahead / JOB_RATE_JUMPS_PER_S)
+    return result
+
+
+def _jumps(jumps: int) -> str:
+    return f"{jumps:.3g} jumps"
+
+
+def _hours(jumps: int) -> str:
+    hours = jumps / JOB_RATE_JUMPS_PER_S / 3600
+    return f"about {hours:.1f} h of the job worker" if hours >= 1 else f"about {hours * 60:.0f} min of the job worker"
