@@ -40,7 +40,7 @@ import urllib.parse
 from pathlib import Path
 
 import httpx
-from bench_load import RUN, Connection  # scripts/ is on the path when this script runs
+from bench_load import RUN, Connection, cpu_seconds, machine_cpu_seconds  # scripts/ is on the path
 from sqlalchemy import MetaData, insert
 
 from backend.store.database import make_engine, migrate, sqlite_url
@@ -172,8 +172,22 @@ def _client_process(base: str, token: str, seconds: float, clients: int, queries
     return asyncio.run(run())
 
 
-def phase(base: str, token: str, clients: int, seconds: float, queries: list, writes: float, seed_value: int) -> dict:
-    """``clients`` clients for ``seconds``: per set of queries, p50/p95/max [ms] and requests."""
+def service_cpu(pid: int) -> tuple[float, float]:
+    """CPU seconds so far of the service's own process and of its children (the read and compute
+    workers), from /proc (Linux)."""
+    children = []
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        children += (task / "children").read_text().split()
+    return cpu_seconds(pid), sum(cpu_seconds(int(child)) for child in children)
+
+
+def phase(
+    base: str, token: str, clients: int, seconds: float, queries: list, writes: float, seed_value: int, pid: int = 0
+) -> dict:
+    """``clients`` clients for ``seconds``: per set of queries, p50/p95/max [ms] and requests, and
+    the CPU per request of the service's process, its workers and the whole machine [ms]."""
+    before = service_cpu(pid) if pid else (0.0, 0.0)
+    machine_before = machine_cpu_seconds()
     per_process = [clients // CLIENT_PROCESSES + (k < clients % CLIENT_PROCESSES) for k in range(CLIENT_PROCESSES)]
     context = multiprocessing.get_context("spawn")
     with concurrent.futures.ProcessPoolExecutor(CLIENT_PROCESSES, mp_context=context) as pool:
@@ -182,6 +196,12 @@ def phase(base: str, token: str, clients: int, seconds: float, queries: list, wr
         requests = [request for future in futures for request in future.result()]
     summary = {"requests": len(requests), "per_s": len(requests) / seconds,
                "errors": sorted({status for _, _, status in requests if status >= 400})}  # fmt: skip
+    count = max(len(requests), 1)
+    summary["machine_cpu_ms"] = 1e3 * (machine_cpu_seconds() - machine_before) / count
+    if pid:
+        after = service_cpu(pid)
+        summary["service_cpu_ms"] = 1e3 * (after[0] - before[0]) / count
+        summary["workers_cpu_ms"] = 1e3 * (after[1] - before[1]) / count
     for name in sorted({name for name, _, _ in requests}):
         times = sorted(latency for kind, latency, _ in requests if kind == name)
         summary[name] = {"count": len(times), "p50_ms": 1e3 * statistics.median(times),
@@ -243,7 +263,7 @@ def main() -> None:
             for name in sides if round_ % 2 == 0 else reversed(list(sides)):
                 _, port, queries = sides[name]
                 entry = phase(f"http://127.0.0.1:{port}", tokens[name], args.clients, args.seconds, _named(queries),
-                              args.writes, round_)  # fmt: skip
+                              args.writes, round_, processes[name].pid)  # fmt: skip
                 results["rounds"][name].append(entry)
     finally:
         for process in processes.values():
@@ -279,6 +299,12 @@ def _report(results: dict, args) -> None:
             print(f"{name:>5} {kind:>6}: p50 {p50:6.1f} ms, p95 {p95:6.1f} ms (worst round {worst:6.1f}), "
                   f"{count} requests, {statistics.median(e['per_s'] for e in entries):.0f}/s all kinds, "
                   f"errors {sorted({s for e in entries for s in e['errors']}) or 'none'}")  # fmt: skip
+    for name, entries in rounds.items():
+        cpu = {key: statistics.median(entry[key] for entry in entries)
+               for key in ("service_cpu_ms", "workers_cpu_ms", "machine_cpu_ms")}  # fmt: skip
+        print(f"{name:>5} CPU per request: service {cpu['service_cpu_ms']:.2f} ms, its workers "
+              f"{cpu['workers_cpu_ms']:.2f} ms, the whole machine {cpu['machine_cpu_ms']:.2f} ms (clients and "
+              "other programs included)")  # fmt: skip
     ratios = [new["common"]["p95_ms"] / base["common"]["p95_ms"] for new, base in zip(rounds["new"], rounds["base"],
                                                                                        strict=True)]  # fmt: skip
     print("common pages' p95, new / base, per round:", ", ".join(f"{ratio:.2f}" for ratio in ratios))

@@ -180,8 +180,9 @@ def list_cache(connection) -> ListCache | None:
 
 
 def store_stamp(connection) -> int | None:
-    """The runs' version (``store_versions``, moved by SQLite's triggers with every change of a run
-    or its tags, by any connection), or None when it cannot be relied on: on other databases, and
+    """The runs' version (``store_versions``, moved by SQLite's triggers whenever any connection adds
+    or deletes a run or a tag or changes what a list filters or sorts by — not a live run's
+    duration alone: migration 0008), or None when it cannot be relied on: on other databases, and
     while ``connection`` has a transaction open. Read before what is kept under it, so a change
     committed in between makes the next read see a new version, never an old one."""
     if connection.dialect.name != "sqlite" or connection.connection.dbapi_connection.in_transaction:

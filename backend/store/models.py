@@ -143,12 +143,12 @@ class RunTag(Base):
 
 
 class StoreVersion(Base):
-    """How often a part of the store has changed: ``runs`` counts the commits that inserted, changed
-    or deleted runs or their tags, bumped by SQLite triggers (migration 0008). The run list's read
-    workers keep the totals and orders they read while it stands still
-    (``repositories.run_filters.store_stamp``); other commits — a job's trials, a live run's
-    journal entries — leave them valid. PostgreSQL has the table but no triggers (its counts are
-    not kept)."""
+    """How often a part of the store has changed: ``runs`` counts the changes of runs and their tags
+    that a list can see — a run or tag added or deleted, a change of what lists filter or sort by —
+    bumped by SQLite triggers (migration 0008). The run list's read workers keep the totals and
+    orders they read while it stands still (``repositories.run_filters.store_stamp``); other
+    commits — a job's trials, a live run's journal entries and its duration — leave them valid.
+    PostgreSQL has the table but no triggers (its counts are not kept)."""
 
     __tablename__ = "store_versions"
 

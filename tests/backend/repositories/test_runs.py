@@ -216,6 +216,10 @@ def test_a_kept_order_serves_pages_until_a_run_changes(stored, database_url):
             writer.commit()
         assert store_stamp(reader.connection()) == stamp, "no run changed"
         assert listed_page(reader, where, limit=5, cursor=None, sort="-climb")[0] == first
+        with sessions() as writer:  # a live run's journal writer: its duration, twice a second
+            writer.execute(Run.__table__.update().where(Run.id == first[0]["id"]).values(duration_s=99.0))
+            writer.commit()
+        assert store_stamp(reader.connection()) == stamp, "a duration alone is no change a list sees"
         with sessions() as writer:
             best = add_run(writer, _record(climb=100.0))
             writer.commit()
@@ -234,3 +238,8 @@ def test_a_kept_order_serves_pages_until_a_run_changes(stored, database_url):
         assert [row["id"] for row in tagged] == [first[2]["id"]]
         listed = listed_page(reader, where, limit=5, cursor=None, sort="-climb")[0]
         assert listed[3]["tags"] == sorted([*first[2]["tags"], "late"])
+        with sessions() as writer:  # what a list filters by: the run leaves the sims
+            writer.execute(Run.__table__.update().where(Run.id == best_id).values(kind="robot"))
+            writer.commit()
+        reader.commit()
+        assert listed_page(reader, where, limit=5, cursor=None, sort="-climb")[0][0]["id"] == first[0]["id"]

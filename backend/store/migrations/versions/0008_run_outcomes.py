@@ -11,8 +11,9 @@ duration let a page sorted by one of them read an index instead of sorting every
 (besides the key) lets SQLite skip to a page deep in the list by id through a narrow index, not
 its table of wide rows.
 
-``store_versions`` holds the runs' version, which SQLite triggers move with every change of a run
-or its tags: the read workers keep a filter's total and order while it stands still.
+``store_versions`` holds the runs' version, which SQLite triggers move when a run or a tag is added
+or deleted or what a list filters or sorts by changes (not a live run's duration alone): the read
+workers keep a filter's total and order while it stands still.
 
 Revision ID: 0008
 Revises: 0007
@@ -27,8 +28,13 @@ down_revision = "0007"
 branch_labels = None
 depends_on = None
 
-# What moves the runs' version (SQLite): every change of a run or its tags.
-VERSIONED = [(table, change) for table in ("runs", "run_tags") for change in ("INSERT", "UPDATE", "DELETE")]
+# What moves the runs' version (SQLite): a run or a tag added or deleted, and a change of what a
+# list filters or sorts by — but not a live run's duration alone, which its journal writer updates
+# twice a second (a list sorted by duration places a running run by its duration when it started).
+LISTED = ("experiment_id", "kind", "status", "created_at", "failure_code", "zeta0", "psi0_deg", "jumps_completed",
+          "climb", "notes", "end_reason", "loop", "controller", "target")  # fmt: skip
+VERSIONED = [("runs", "INSERT"), ("runs", f"UPDATE OF {', '.join(LISTED)}"), ("runs", "DELETE"),
+             ("run_tags", "INSERT"), ("run_tags", "UPDATE"), ("run_tags", "DELETE")]  # fmt: skip
 NEW_INDEXES = ("end_reason", "loop", "controller", "target", "climb", "jumps_completed", "duration_s", "id")
 END_REASON_LENGTH = 200
 
@@ -53,9 +59,13 @@ def upgrade() -> None:
     if op.get_bind().dialect.name == "sqlite":
         for table, change in VERSIONED:
             op.execute(
-                f"CREATE TRIGGER {table}_{change.lower()}_bumps_runs_version AFTER {change} ON {table} "
+                f"CREATE TRIGGER {_trigger(table, change)} AFTER {change} ON {table} "
                 "BEGIN UPDATE store_versions SET version = version + 1 WHERE name = 'runs'; END"
             )
+
+
+def _trigger(table: str, change: str) -> str:
+    return f"{table}_{change.split()[0].lower()}_bumps_runs_version"
 
 
 def _backfill() -> None:
@@ -108,7 +118,7 @@ def _backfill() -> None:
 def downgrade() -> None:
     if op.get_bind().dialect.name == "sqlite":
         for table, change in VERSIONED:
-            op.execute(f"DROP TRIGGER {table}_{change.lower()}_bumps_runs_version")
+            op.execute(f"DROP TRIGGER {_trigger(table, change)}")
     op.drop_table("store_versions")
     for column in NEW_INDEXES:
         op.drop_index(f"ix_runs_{column}", table_name="runs")
