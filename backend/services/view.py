@@ -83,6 +83,8 @@ class StoredPath:
             robot or replay run; empty for a sim run.
         jumps_completed, climb: how far it went: jumps done, height gained [l0] (None: not read).
         created_at: when it was stored (UTC; None: not read).
+        status, end_reason: how it ended (a robot run's reason, e.g. "e-stop"; None: not read).
+        loop, controller, target: how it was driven ("open"/"closed", "pid", the height held [m]).
     """
 
     run_id: int
@@ -96,6 +98,11 @@ class StoredPath:
     jumps_completed: int | None = None
     climb: float | None = None
     created_at: datetime.datetime | None = None
+    status: str | None = None
+    end_reason: str | None = None
+    loop: str | None = None
+    controller: str | None = None
+    target: float | None = None
 
 
 def stored_path(sessions: Callable, run_id: int) -> StoredPath:
@@ -112,7 +119,8 @@ def stored_path(sessions: Callable, run_id: int) -> StoredPath:
         touchdowns = [] if run.kind == "sim" else list(run.results.get("touchdowns", []))
         return StoredPath(
             run.id, run.kind, run.model, run.controls, run.start_state, run.jumps, path, touchdowns,
-            jumps_completed=run.jumps_completed, climb=run.climb, created_at=run.created_at,
+            jumps_completed=run.jumps_completed, climb=run.climb, created_at=run.created_at, status=run.status,
+            end_reason=run.end_reason, loop=run.loop, controller=run.controller, target=run.target,
         )  # fmt: skip
 
 

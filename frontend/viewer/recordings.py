@@ -137,10 +137,18 @@ def _controls_words(controls: list) -> str:
 
 
 def describe(run: StoredPath) -> str:
-    """What run ``run`` was, in a sentence: its kind, controls, jumps, climb and date."""
+    """What run ``run`` was, in a sentence: its kind, controls, jumps, how it was driven and how it
+    ended (as History lists them), climb and date."""
     controls = _controls_words(run.controls)
     done = "" if run.jumps_completed is None else f", {run.jumps_completed} done"
     parts = [f"ParkourLab run {run.run_id}, {KIND_WORDS.get(run.kind, run.kind)}", controls, f"{run.jumps} jumps{done}"]
+    if run.loop == "closed":
+        target = "" if run.target is None else f", target {run.target:.3g} m"
+        parts.append(f"closed loop ({run.controller or 'pid'}{target})")
+    elif run.loop == "open" and run.kind != "sim":
+        parts.append("open loop")
+    if run.end_reason or run.status == "failed":
+        parts.append(f"ended: {run.end_reason or run.status}")
     if run.climb is not None:
         parts.append(f"climb {run.climb:.3f} l0")
     if run.created_at is not None:

@@ -48,3 +48,24 @@ def test_recordings_put_sim_runs_between_the_walls(service):
     stance_feet = recording.clip.foot_x[recording.clip.phase == 0]
     assert np.allclose(np.abs(stance_feet), half), "stance feet are on the walls"
     assert np.all(np.abs(recording.clip.x) < half)
+
+
+def _stored(**changes):
+    from backend.services.view import StoredPath
+
+    base = {"run_id": 7, "kind": "robot", "model": {}, "controls": [[35.0, 0.85], [35.0, 0.85]],
+            "start_state": [-0.9, -0.2], "jumps": 15, "path": None, "touchdowns": [], "jumps_completed": 4,
+            "climb": 1.111}  # fmt: skip
+    return StoredPath(**(base | changes))
+
+
+def test_a_share_files_description_says_how_the_run_was_driven_and_how_it_ended():
+    """History lists each run's loop, controller, target and ending; its share file says the same."""
+    from frontend.viewer.recordings import describe
+
+    stopped = describe(_stored(status="failed", end_reason="e-stop", loop="closed", controller="pid", target=0.55))
+    assert "; closed loop (pid, target 0.55 m); ended: e-stop; climb 1.111 l0." in stopped, stopped
+    open_loop = describe(_stored(status="done", end_reason="jumps done", loop="open"))
+    assert "; open loop; ended: jumps done;" in open_loop, open_loop
+    simulated = describe(_stored(kind="sim", status="done", loop="open"))
+    assert "loop" not in simulated and "ended" not in simulated, "a simulation's ending is its failure code"
