@@ -7,7 +7,7 @@ import pickle
 import pytest
 
 from backend import errors
-from backend.errors import Conflict, NotFound
+from backend.errors import Conflict, NotFound, QueueFull
 
 DOMAIN_ERRORS = [
     kind for _name, kind in inspect.getmembers(errors, inspect.isclass) if kind.__module__ == errors.__name__
@@ -31,11 +31,13 @@ def test_not_found_is_a_lookup_error_and_conflict_a_runtime_error():
 def test_each_domain_error_has_its_status_in_the_apis_table():
     from backend.api.errors import STATUS_OF  # the API's side: loaded only here
 
-    assert sorted(kind.__name__ for kind in DOMAIN_ERRORS) == ["Conflict", "NotFound"]
-    assert {kind: STATUS_OF[kind][0] for kind in DOMAIN_ERRORS} == {NotFound: 404, Conflict: 409}
+    assert sorted(kind.__name__ for kind in DOMAIN_ERRORS) == ["Conflict", "NotFound", "QueueFull"]
+    assert {kind: STATUS_OF[kind][0] for kind in DOMAIN_ERRORS} == {NotFound: 404, Conflict: 409, QueueFull: 429}
 
 
-@pytest.mark.parametrize("error", [NotFound("run", 42), Conflict("experiment 1 still has 2 runs")])
+@pytest.mark.parametrize(
+    "error", [NotFound("run", 42), Conflict("experiment 1 still has 2 runs"), QueueFull("the job queue is full")]
+)
 def test_domain_errors_cross_process_boundaries_as_made(error):
     """The store is read in worker processes: an error raised there is pickled back to the service."""
     copy = pickle.loads(pickle.dumps(error))
