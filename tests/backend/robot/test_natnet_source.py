@@ -31,7 +31,7 @@ LEGS = {Leg.LEFT: (30.0, 0.87), Leg.RIGHT: (30.0, 0.9)}
 ROBOT = get_preset("paper")
 
 
-def _until(condition, timeout=3.0):
+def _until(condition, timeout=10.0):  # a bound on waiting for the reader thread, not a timing assertion
     deadline = time.monotonic() + timeout
     while not condition():
         assert time.monotonic() < deadline, "timed out"
