@@ -110,20 +110,12 @@ def now_or_when_room(write: Callable[[], object], *, what: str, engine, stopping
             when_room(write, what=what, engine=engine, stopping=stopping, waiting=waiting)
         except Stopped:
             log.warning("%s still waits for space; the next start tries again", what)
-
-    if waiting is not None:
-        waiting.add(what)  # listed from now, not from the thread's first failure
-    thread = threading.Thread(target=_listed_until_done(retry, what, waiting), name="parkourlab-room", daemon=True)
-    thread.start()
-    return thread
-
-
-def _listed_until_done(work: Callable[[], None], what: str, waiting: Waiting | None) -> Callable[[], None]:
-    def run() -> None:
-        try:
-            work()
         finally:
             if waiting is not None:
                 waiting.discard(what)
 
-    return run
+    if waiting is not None:
+        waiting.add(what)  # listed from now, not from the thread's first failure
+    thread = threading.Thread(target=retry, name="parkourlab-room", daemon=True)
+    thread.start()
+    return thread
