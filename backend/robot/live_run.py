@@ -27,7 +27,7 @@ import numpy as np
 
 from backend.robot.link import LinkError, LinkState, RobotLink
 from backend.robot.messages import Leg
-from backend.robot.touchdown import Touchdown, detect_touchdowns
+from backend.robot.touchdown import PITCH_LOOKBACK, Touchdown, scan_touchdowns
 from backend.robot.tracker import PoseHistory
 from sim_core.controls import LegControl
 from sim_core.errors import ParameterError
@@ -151,6 +151,11 @@ class LiveRun:
         )
 
 
+def _arrays(poses) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(time, x, y, pitch)`` of tracker poses, as arrays."""
+    return tuple(np.array([getattr(p, name) for p in poses], dtype=float) for name in ("time", "x", "y", "pitch"))
+
+
 PidLaw = tuple[float, float, float, float, float, float]  # hover zeta0, kp, ki, kd, zeta0 min, max
 
 
@@ -173,6 +178,7 @@ def execute(
     commanded.update({Leg.LEFT: legs[0], Leg.RIGHT: legs[1]})
     integral, previous_error = 0.0, math.nan
     seen_poses = run.first_pose
+    scan_from = run.first_pose + 1  # the tracker's index of the first pose not yet scanned for touchdowns
 
     def send(leg: Leg, control: LegControl, why: str) -> None:
         link.set_leg(leg, control.psi0_deg, control.zeta0)
@@ -204,14 +210,16 @@ def execute(
                 time.sleep(POLL)  # nothing new to analyse
                 continue
             seen_poses = tracker.count()
-            poses = tracker.poses_from(run.first_pose)
-            if len(poses) > 1:
-                times = np.array([p.time for p in poses])
-                found = detect_touchdowns(times, np.array([p.x for p in poses]), np.array([p.y for p in poses]),
-                                          robot, leg_for, np.array([p.pitch for p in poses]))  # fmt: skip
-                while len(run.touchdown_controls) < len(found):
-                    run.touchdown_controls.append(leg_for(len(run.touchdown_controls)))
-                for touchdown in found[len(run.touchdowns) :]:
+            # Only the poses since the last scan (and the few looked back to): a new pose costs
+            # the same at the thousandth jump as at the first, and the link's thread keeps its time.
+            first, poses = tracker.numbered_from(max(run.first_pose, scan_from - 1 - PITCH_LOOKBACK))
+            if scan_from - first < len(poses):
+                times, xs, ys, pitches = _arrays(poses)
+                scan = scan_touchdowns(times, xs, ys, robot, leg_for, pitches, start=scan_from - first,
+                                       first_index=len(run.touchdowns))  # fmt: skip
+                scan_from = first + scan.resume
+                run.touchdown_controls.extend(leg_for(touchdown.index) for touchdown in scan.touchdowns)
+                for touchdown in scan.touchdowns:
                     run.record("touchdown", (touchdown, run.touchdown_controls[touchdown.index]), run.touchdowns)
                     run.publish()
                     if controller is not None:

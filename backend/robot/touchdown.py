@@ -24,6 +24,7 @@ from sim_core.params import PhysicalParams
 from sim_core.walls import Wall
 
 MIN_FIT_POSES = 4
+PITCH_LOOKBACK = 10  # poses looked back through for the newest pitch the markers gave
 
 
 @dataclass(frozen=True)
@@ -61,18 +62,46 @@ def detect_touchdowns(
     A crossing whose flight could not be fitted (fewer than ``MIN_FIT_POSES`` flight poses) is
     skipped; the stream may start and end anywhere.
     """
+    return scan_touchdowns(time, x, y, robot, leg_for, pitch).touchdowns
+
+
+@dataclass(frozen=True)
+class Scan:
+    """What :func:`scan_touchdowns` found, and where a scan of the same stream, grown since, goes on."""
+
+    touchdowns: list[Touchdown]
+    resume: int  # the next scan's ``start``: the pose where an unfinished flight began, else the end
+
+
+def scan_touchdowns(
+    time: np.ndarray,
+    x: np.ndarray,
+    y: np.ndarray,
+    robot: PhysicalParams,
+    leg_for: Callable[[int], LegControl],
+    pitch: np.ndarray | None = None,
+    *,
+    start: int = 1,
+    first_index: int = 0,
+) -> Scan:
+    """:func:`detect_touchdowns` from pose ``start`` on (the poses before it only give the pitch
+    looked back to and the centre-line crossing at ``start``), numbering touchdowns from
+    ``first_index``. A live run scans only what came since its last scan's ``resume``, so each new
+    pose costs the same however long the run has gone; the touchdowns are those one scan of the
+    whole stream finds."""
     scales = robot.scales
     half = 0.5 * robot.wall_distance
     touchdowns: list[Touchdown] = []
     flight_start = None  # index where the body crossed the centre line heading for a wall
-    for i in range(1, len(time)):
+    for i in range(max(start, 1), len(time)):
         if x[i - 1] * x[i] <= 0.0 and x[i] != x[i - 1]:
             flight_start = i
             continue
         if flight_start is None:
             continue
         wall = Wall.RIGHT if x[i] > 0 else Wall.LEFT
-        leg = leg_for(len(touchdowns))
+        number = first_index + len(touchdowns)
+        leg = leg_for(number)
         psi = leg.psi0 - wall * _pitch_at(pitch, i)  # the leg turned with the body
         line = wall * (half - leg.zeta0 * robot.leg_length * math.cos(psi))
         if wall * x[i] < wall * line:
@@ -91,7 +120,7 @@ def detect_touchdowns(
         state = (-wall * vx / scales.velocity, vy / scales.velocity)  # the flip: toward the wall is -x
         touchdowns.append(
             Touchdown(
-                index=len(touchdowns),
+                index=number,
                 time=t0 + crossing,
                 wall=wall,
                 state=state,
@@ -100,14 +129,14 @@ def detect_touchdowns(
                 poses_fitted=fit.stop - fit.start,
             )
         )
-    return touchdowns
+    return Scan(touchdowns, len(time) if flight_start is None else flight_start)
 
 
 def _pitch_at(pitch: np.ndarray | None, i: int) -> float:
     """The body's pitch at pose ``i``: its own, else the newest finite one before it, else 0."""
     if pitch is None:
         return 0.0
-    for j in range(i, max(i - 10, -1), -1):
+    for j in range(i, max(i - PITCH_LOOKBACK, -1), -1):
         if math.isfinite(pitch[j]):
             return float(pitch[j])
     return 0.0

@@ -197,8 +197,14 @@ class PoseHistory:
     def poses_from(self, index: int) -> list[Pose]:
         """Poses from the ``index``-th received on, or from the oldest still kept (no copy of the
         older ones)."""
+        return self.numbered_from(index)[1]
+
+    def numbered_from(self, index: int) -> tuple[int, list[Pose]]:
+        """:meth:`poses_from`, with the index of the first pose returned (``index``, or the oldest
+        kept's when older ones were let go)."""
         with self._lock:
-            return self._poses[max(0, index - self._released) :]
+            first = max(index, self._released)
+            return first, self._poses[first - self._released :]
 
     def poses_since(self, since: float) -> list[Pose]:
         with self._lock:

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from backend.robot.touchdown import MIN_FIT_POSES, Touchdown, detect_touchdowns, height_gains
+from backend.robot.touchdown import MIN_FIT_POSES, Touchdown, detect_touchdowns, height_gains, scan_touchdowns
 from sim_core import LegControl, get_preset
 from sim_core.walls import Wall
 
@@ -43,6 +43,30 @@ def test_touchdowns_survive_tracker_noise_and_dropped_frames(climb):
     assert len(found) == 12
     np.testing.assert_allclose([td.state for td in found], path.section_states[1:13], atol=0.03)
     np.testing.assert_allclose(height_gains(found, robot), path.rises[1:12], atol=0.02)
+
+
+@pytest.mark.parametrize("seed", [3, 4, 5])
+def test_a_stream_scanned_as_it_grows_gives_the_touchdowns_of_one_scan(climb, seed):
+    """A live run scans only the poses since its last scan's resume point (and a few before, for the
+    pitch): in chunks of any size, the touchdowns are exactly those of one scan of the whole, even
+    where the pitch is missing (NaN) for a few poses and must be looked back for."""
+    robot, schedule, _path, si = climb
+    rng = np.random.default_rng(seed)
+    x = si.x + rng.normal(0, 0.001, si.x.size)
+    pitch = rng.normal(0, np.radians(2.0), si.x.size)
+    pitch[rng.random(si.x.size) < 0.2] = np.nan
+    whole = detect_touchdowns(si.time, x, si.y, robot, lambda k: schedule[k + 1], pitch)
+    assert len(whole) >= 10
+    found, scan_from, end = [], 1, 0
+    while end < si.time.size:
+        end = min(si.time.size, end + int(rng.integers(1, 60)))
+        first = max(0, scan_from - 11)  # as the live run asks the tracker: PITCH_LOOKBACK + 1 before
+        window = slice(first, end)
+        scan = scan_touchdowns(si.time[window], x[window], si.y[window], robot, lambda k: schedule[k + 1],
+                               pitch[window], start=scan_from - first, first_index=len(found))  # fmt: skip
+        found += scan.touchdowns
+        scan_from = first + scan.resume
+    assert found == whole
 
 
 def _flight(wall: Wall, vx: float = VX, pitch: float = 0.0, samples: int = 30):

@@ -71,6 +71,30 @@ def test_a_live_run_is_stored_with_the_models_prediction(connected, session):
     assert set(frames) == {"time", "x", "y", "pitch"} and frames["time"].size == results["tracker"]["frames"] > 0
 
 
+def test_a_long_live_run_scans_only_the_poses_of_its_last_flight(connected, session, monkeypatch):
+    """Each new tracker pose costs the control loop the same at the 40th jump as at the first: it
+    scans only the poses since its last scan (it rescanned the whole run at every pose, which at a
+    few thousand poses held the interpreter long enough to starve the link's heartbeats)."""
+    from backend.robot import live_run
+
+    windows = []
+
+    def scan(time, *args, start, **kwargs):
+        windows.append((time.size, time.size - start))
+        return live_run_scan(time, *args, start=start, **kwargs)
+
+    live_run_scan = live_run.scan_touchdowns
+    monkeypatch.setattr(live_run, "scan_touchdowns", scan)
+    connected.start_run(RobotRunCreate(controls=LEGS, jumps=40))
+    status = connected.wait_run(RUN_WAIT_S * 4)
+    assert status.end_reason == "jumps done", status.end_reason
+    frames = run_store.get_run(session, status.run_id).results["tracker"]["frames"]
+    longest = max(new for _, new in windows)
+    assert frames > 1000 and longest < frames / 10, f"a scan went over {longest} of {frames} poses"
+    assert max(size for size, _ in windows) < frames / 10, "a scan looks back over one flight at most"
+    print(f"{frames} poses in {len(windows)} scans of at most {longest} poses")
+
+
 def test_a_recorded_run_replays_to_the_same_touchdowns(connected, session, make_run):
     live_id = _live_run(connected)["run"]["stored_run_id"]
     replay = replay_run(session, live_id)
@@ -254,6 +278,7 @@ def test_every_ending_disarms_the_robot(connected, virtual, session, end):
     assert run_store.get_run(session, run.run_id).results["disarm"] == "disarmed"
 
 
+@pytest.mark.realtime
 def test_an_estop_ending_leaves_the_robot_estopped(connected, virtual):
     robot, _ = virtual
     _running(connected, connected.start_run(RobotRunCreate(controls=LEGS, jumps=1000)))
