@@ -17,7 +17,7 @@ import { showView } from "./view.js";
 initTabs((name) => {
   if (name === "history") loadExperiments().then(loadRuns).then(loadCalibrations).catch(() => {});
   if (name === "jobs") loadJobs();
-  if (name === "robot") { refreshRobot().catch(() => {}); drawLive(); }
+  if (name === "robot") { refreshRobot().catch(() => {}); drawLive(true); }
   syncLive();  // the live websocket is open while the Robot tab is shown
   if (name === "view3d") showView();
 });

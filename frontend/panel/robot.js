@@ -87,7 +87,7 @@ function followRun(status) {
   } else if (key !== plot.key) {
     Object.assign(plot, { key, label, started: run ? run.started : undefined, t: [], y: [], lastTime: null, target: run && run.target_m != null ? run.target_m : (pendingTarget ?? null) });
     pendingTarget = undefined;
-    drawLive();
+    drawLive(true);
   }
   const pose = status.tracker && status.tracker.latest;
   if (run && run.active && pose && pose.time !== plot.lastTime) {
@@ -99,7 +99,26 @@ function followRun(status) {
   }
 }
 
-export function drawLive() {
+// The live plot is redrawn at most every LIVE_PLOT_MS, however fast statuses come: one Plotly
+// redraw lays the whole figure out again (axes, ticks), and at the live socket's 10 a second it
+// took all of a slow machine's main thread, so the page answered clicks seconds late.
+const LIVE_PLOT_MS = 500;
+const livePlotDrawn = { at: -Infinity, pending: null };
+
+// ``now``: draw at once (a new run's empty plot, a tab just shown), not at the next turn.
+export function drawLive(now = false) {
+  if (now) {
+    clearTimeout(livePlotDrawn.pending);
+    livePlotDrawn.pending = null;
+  } else if (livePlotDrawn.pending !== null) {
+    return;  // already due: it draws the newest data then
+  }
+  const wait = now ? 0 : livePlotDrawn.at + LIVE_PLOT_MS - performance.now();
+  if (wait > 0) {
+    livePlotDrawn.pending = setTimeout(() => { livePlotDrawn.pending = null; drawLive(); }, wait);
+    return;
+  }
+  livePlotDrawn.at = performance.now();
   if ($("#robot").hidden) return;  // Plotly sizes a hidden plot wrongly; the tab redraws when shown
   if (!plot.t.length && $("#live-plot").hidden) return;  // nothing drawn yet: the box stays hidden until a pose comes
   const start = plot.t.length ? plot.t[0] : 0;
