@@ -24,6 +24,9 @@ from backend.robot.messages import Command, Kind
 from backend.robot.virtual import VirtualRobot
 from tests.helpers import HEAVY_JOB, MAP_BODY, free_port, start_map_load, start_service, stop_map_load
 
+# A robot answering in real time (the e-stop's 150 ms acknowledgement): ./test.sh runs these alone.
+pytestmark = pytest.mark.realtime
+
 PRESSES = 5
 ESTOP_BOUND_S = 1.0  # [s] the service promises 200 ms; a generous bound for noisy machines
 PROMISE_PRESSES = 50  # enough that a missed press would show (2 in 100 were, with compute in the service's process)

@@ -108,6 +108,7 @@ def test_the_first_event_is_the_robot_now_and_the_stream_is_held_to_the_security
         assert refused.status_code == 400 and "host not allowed" in refused.json()["detail"]
 
 
+@pytest.mark.realtime
 def test_a_press_latches_in_the_stream_and_a_reset_releases_it(served, virtual):
     base, _app, auth = served
     robot, tracker_port = virtual

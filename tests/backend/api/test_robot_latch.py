@@ -41,6 +41,7 @@ def _kinds_since(rig, since: int) -> list[Kind]:
     return [getattr(message, "kind", None) for message in rig.sent[since:]]
 
 
+@pytest.mark.realtime
 def test_an_unacknowledged_estop_holds_across_an_automatic_reconnect(client, auth, deaf_robot):
     rig = deaf_robot
     assert _connect(client, auth, rig)["state"] == "armed"

@@ -58,6 +58,7 @@ def test_commands_beyond_servo_limits_are_refused_before_sending(robot, link):
     assert robot.firmware.legs[Leg.LEFT] == (30.0, 0.9), "nothing reached the robot"
 
 
+@pytest.mark.realtime
 def test_estop_latches_until_reset_and_is_fast(robot, link):
     link.arm()
     result = link.estop()
@@ -237,6 +238,7 @@ def test_a_failed_reset_keeps_repeating_the_estop(lossy):
     assert rig.state == RobotState.ESTOPPED
 
 
+@pytest.mark.realtime
 def test_a_new_connection_sends_the_latched_estop_first(lossy):
     rig, link = lossy
     link.close()
@@ -304,6 +306,7 @@ def test_transmit_status_is_not_the_robots_voice():
         rig.stop()
 
 
+@pytest.mark.realtime
 def test_the_virtual_radio_reports_every_frame_delivered(robot, link):
     link.arm()
     assert link.estop().acknowledged
@@ -329,6 +332,7 @@ def test_make_safe_disarms_whatever_the_link_believes(robot, link):
     assert link.make_safe() == LinkState.DISARMED and robot.firmware.state == RobotState.DISARMED
 
 
+@pytest.mark.realtime
 def test_make_safe_accepts_an_estopped_robot(robot, link):
     assert link.estop().acknowledged
     assert link.make_safe() == LinkState.ESTOPPED and robot.firmware.state == RobotState.ESTOPPED
