@@ -6,11 +6,7 @@ experiment's page with its outcomes and jobs, and runs grouped over seeds with 9
 Set PARKOUR_SCREENSHOTS=1 to refresh docs/screenshots/history_*.png from this run.
 """
 
-import os
 import random
-import shutil
-import time
-from pathlib import Path
 
 import httpx
 import pytest
@@ -19,15 +15,11 @@ from backend.repositories.runs import add_run
 from backend.store.database import make_engine, migrate, session_factory, sqlite_url
 from backend.store.models import Experiment
 from backend.store.run_record import RunRecord
+from tests.frontend.browser import chromium, panel, screenshot, until
 from tests.helpers import free_port, start_service
 
 pytestmark = pytest.mark.slow  # a browser and a service: ~40 s
 
-ROOT = Path(__file__).resolve().parents[2]
-CHROMIUM = os.environ.get("PARKOUR_CHROMIUM") or shutil.which("chromium") or shutil.which("chromium-browser")
-if CHROMIUM is None:
-    pytest.skip("no Chromium: ./test.sh installs the Debian package; or set PARKOUR_CHROMIUM", allow_module_level=True)
-sync_api = pytest.importorskip("playwright.sync_api")
 
 SIMS, ROBOT_RUNS, REPLAYS = 1000, 180, 20
 RUNS = SIMS + ROBOT_RUNS + REPLAYS
@@ -35,9 +27,6 @@ ZETA0S = (0.86, 0.88, 0.9, 0.92, 0.94)  # the experiment's settings, three seeds
 ENDINGS = ["jumps done"] * 5 + ["e-stop", "robot disarmed (fell or timed out)", "link lost", "stopped",
                                 "error: the link write timed out"]  # fmt: skip
 CLOSED_LOOP = {"target_m": 0.55, "kp": 0.04, "ki": 0.0, "kd": 0.02, "zeta0_min": 0.8, "zeta0_max": 0.98}
-CSP_LISTENER = """window.__csp_violations = [];
-document.addEventListener("securitypolicyviolation", (e) => window.__csp_violations.push(
-  `${e.violatedDirective} refused ${e.blockedURI} (${e.sourceFile}:${e.lineNumber})`));"""
 RANGE = "document.querySelector('#runs-range').textContent"
 ROWS = "document.querySelectorAll('#run-table tbody tr')"
 
@@ -107,48 +96,19 @@ def service(store):
 
 @pytest.fixture(scope="module")
 def browser():
-    with sync_api.sync_playwright() as playwright:
-        launched = playwright.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+    with chromium() as launched:
         yield launched
-        launched.close()
 
 
 @pytest.fixture(scope="module")
 def page(browser, service):
     base, token, _ = service
-    context = browser.new_context(viewport={"width": 1360, "height": 900})
-    context.add_init_script(CSP_LISTENER)
-    view = context.new_page()
-    errors = []
-    view.on("pageerror", lambda error: errors.append(str(error)))
-    view.on("console", lambda message: "Content Security Policy" in message.text and errors.append(message.text))
-    view.goto(f"{base}/")
-    view.fill("#token", token)
-    view.dispatch_event("#token", "change")
-    yield view
-    assert view.evaluate("window.__csp_violations") == [], "the panel runs under its CSP"
-    assert not errors, errors
-    context.close()
-
-
-def _until(page, expression: str, timeout: float = 30_000) -> None:
-    """Wait until ``expression`` is true in the page (``page.evaluate``: the CSP refuses the eval
-    that ``wait_for_function`` uses)."""
-    deadline = time.monotonic() + timeout / 1000
-    while not page.evaluate(expression):
-        if time.monotonic() > deadline:
-            shown = page.evaluate("[...document.querySelectorAll('.message')].map((m) => m.textContent)")
-            pytest.fail(f"not true within {timeout / 1000:g} s: {expression} (messages shown: {shown})")
-        time.sleep(0.05)
+    with panel(browser, base, token) as view:
+        yield view
 
 
 def _range_is(page, text: str) -> None:
-    _until(page, f"{RANGE} === {text!r}")
-
-
-def _shot(page, name: str, selector: str | None = None) -> None:
-    target = ROOT / "docs" / "screenshots" if os.environ.get("PARKOUR_SCREENSHOTS") else Path("/tmp")
-    (page.locator(selector) if selector else page).screenshot(path=str(target / f"{name}.png"))
+    until(page, f"{RANGE} === {text!r}")
 
 
 def _as_shown(value: float) -> str:
@@ -193,24 +153,24 @@ def test_history_pages_through_every_run_with_a_basket_across_filters(page, serv
     assert page.is_disabled("#runs-next") and _shown_ids(page)[-1] == 1
     # A filter: the basket keeps the runs ticked under the one before.
     page.select_option("#history-form select[name=kind]", "robot")
-    _until(page, f"{RANGE}.startsWith('runs 1–50 of 181 ')")
+    until(page, f"{RANGE}.startsWith('runs 1–50 of 181 ')")
     robot = _shown_ids(page)
     page.check(f"#run-{robot[0]} input[type=checkbox]")
     assert _basket(page) == [newest[3], second[10], robot[0]]
     assert page.inner_text("#basket-count") == "3 runs"
     page.select_option("#history-form select[name=size]", "100")
-    _until(page, f"{RANGE} === 'runs 1–100 of 181 (page 1 of 2)'")
+    until(page, f"{RANGE} === 'runs 1–100 of 181 (page 1 of 2)'")
     page.select_option("#history-form select[name=kind]", "")
     _range_is(page, f"runs 1–100 of {total:,} (page 1 of 13)")
     assert page.is_checked(f"#run-{newest[3]} input[type=checkbox]"), "a run in the basket is ticked when shown"
     assert not page.is_checked(f"#run-{newest[4]} input[type=checkbox]")
     # Sorted by a column's header, through every page.
     page.click("#run-table th[data-sort=climb] button")
-    _until(page, "document.querySelector('#run-table th[data-sort=climb]').getAttribute('aria-sort') === 'descending'")
+    until(page, "document.querySelector('#run-table th[data-sort=climb]').getAttribute('aria-sort') === 'descending'")
     climbs = page.evaluate(f"[...{ROWS}].map((row) => Number(row.querySelector('.col-climb').textContent))")
     assert climbs == sorted(climbs, reverse=True)
     page.click("#runs-next")
-    _until(page, f"{RANGE}.startsWith('runs 101–200 ')")
+    until(page, f"{RANGE}.startsWith('runs 101–200 ')")
     assert page.evaluate(f"Number({ROWS}[0].querySelector('.col-climb').textContent)") <= climbs[-1]
     page.click(f"#basket-runs button[data-run='{second[10]}']")
     assert _basket(page) == [newest[3], robot[0]]
@@ -221,7 +181,7 @@ def test_history_pages_through_every_run_with_a_basket_across_filters(page, serv
     page.click("#runs-next")  # the robot runs: how each ended
     _range_is(page, f"runs 51–100 of {total:,} (page 2 of 25)")
     page.evaluate("window.scrollTo(0, 0)")
-    _shot(page, "history_paging")
+    screenshot(page, "history_paging")
     assert httpx.get(f"{base}/api/v1/runs", params={"limit": 1}).json()["total"] == total
 
 
@@ -230,20 +190,20 @@ def test_how_each_run_ended_and_was_driven_stands_out(page):
     filter; a robot run's jumps count its touchdowns; search finds notes and tags."""
     page.click("nav [data-tab=history]")
     page.select_option("#history-form select[name=end_reason]", "e-stop")
-    _until(page, f"{RANGE}.startsWith('runs 1–') && [...{ROWS}].every((row) => row.querySelector('.badge-estop'))")
+    until(page, f"{RANGE}.startsWith('runs 1–') && [...{ROWS}].every((row) => row.querySelector('.badge-estop'))")
     estop = page.locator("#run-table tbody tr .badge-estop").first
     assert estop.inner_text() == "e-stop" and estop.get_attribute("title") == "e-stop"
     assert page.evaluate(f"[...{ROWS}].every((row) => row.querySelector('.col-status').textContent === 'failed')")
     red = page.evaluate(f"getComputedStyle({ROWS}[0].querySelector('.badge-estop')).backgroundColor")
     assert red == "rgb(214, 31, 31)", "an e-stop stands out"
     page.select_option("#history-form select[name=end_reason]", "error")
-    _until(page, f"[...{ROWS}].length > 0 && [...{ROWS}].every((row) => row.querySelector('.badge-error'))")
+    until(page, f"[...{ROWS}].length > 0 && [...{ROWS}].every((row) => row.querySelector('.badge-error'))")
     page.select_option("#history-form select[name=end_reason]", "")
     page.select_option("#history-form select[name=loop]", "closed")
     page.select_option("#history-form select[name=controller]", "pid")
     closed = "row.querySelector('.col-loop').textContent === 'closed'"
     held = "row.querySelector('.col-target').textContent === '0.55'"
-    _until(page, f"[...{ROWS}].length > 0 && [...{ROWS}].every((row) => {closed} && {held})")
+    until(page, f"[...{ROWS}].length > 0 && [...{ROWS}].every((row) => {closed} && {held})")
     jumps = page.evaluate(
         f"[...{ROWS}].map((row) => row.querySelector('.col-jumps')).map((c) => [c.textContent, c.title])"
     )
@@ -252,11 +212,11 @@ def test_how_each_run_ended_and_was_driven_stands_out(page):
         page.select_option(f"#history-form select[name={name}]", "")
     page.fill("#history-form input[name=q]", "SEED-2")
     page.click("#history-form button[type=submit]")
-    _until(page, f"{RANGE} === 'runs 1–5 of 5 (page 1 of 1)'")
+    until(page, f"{RANGE} === 'runs 1–5 of 5 (page 1 of 1)'")
     assert page.evaluate(f"[...{ROWS}].every((row) => row.querySelector('.tags').textContent === 'seed-2')")
     page.fill("#history-form input[name=q]", "")
     page.click("#history-form button[type=submit]")
-    _until(page, f"{RANGE}.startsWith('runs 1–50 of ')")
+    until(page, f"{RANGE}.startsWith('runs 1–50 of ')")
 
 
 def test_the_view_is_in_the_address_bar_and_a_link_restores_it(page, browser):
@@ -267,9 +227,9 @@ def test_the_view_is_in_the_address_bar_and_a_link_restores_it(page, browser):
     page.fill("#history-form input[name=tag]", "wet-wall")
     page.select_option("#history-form select[name=sort]", "-climb")
     page.click("#history-form button[type=submit]")
-    _until(page, f"{RANGE}.startsWith('runs 1–50 of ')")
+    until(page, f"{RANGE}.startsWith('runs 1–50 of ')")
     page.click("#runs-next")
-    _until(page, f"{RANGE}.startsWith('runs 51–100 of ')")
+    until(page, f"{RANGE}.startsWith('runs 51–100 of ')")
     page.click("#run-columns summary")
     page.uncheck("#run-column-choices input[name=notes]")
     page.uncheck("#run-column-choices input[name=controller]")
@@ -281,12 +241,12 @@ def test_the_view_is_in_the_address_bar_and_a_link_restores_it(page, browser):
     with browser.new_context(viewport={"width": 1360, "height": 900}) as elsewhere:
         other = elsewhere.new_page()
         other.goto(link)
-        _until(other, f"{RANGE} === {range_text!r}")
+        until(other, f"{RANGE} === {range_text!r}")
         assert other.get_attribute("#tab-history", "aria-selected") == "true"
         assert _shown_ids(other) == shown
         assert other.input_value("#history-form input[name=tag]") == "wet-wall"
         assert other.input_value("#history-form select[name=sort]") == "-climb"
-        _until(other, f"document.querySelectorAll('#basket-runs li').length === {len(wanted)}")
+        until(other, f"document.querySelectorAll('#basket-runs li').length === {len(wanted)}")
         assert _basket(other) == wanted
         assert other.is_hidden("#run-table tbody tr:first-child .col-notes")
         assert other.is_visible("#run-table tbody tr:first-child .col-climb")
@@ -297,7 +257,7 @@ def test_the_view_is_in_the_address_bar_and_a_link_restores_it(page, browser):
     page.fill("#history-form input[name=tag]", "")
     page.select_option("#history-form select[name=kind]", "")
     page.select_option("#history-form select[name=sort]", "-id")
-    _until(page, f"{RANGE}.startsWith('runs 1–50 of ')")
+    until(page, f"{RANGE}.startsWith('runs 1–50 of ')")
 
 
 def test_an_experiments_page_has_its_outcomes_endings_and_jobs(page, service):
@@ -311,7 +271,7 @@ def test_an_experiments_page_has_its_outcomes_endings_and_jobs(page, service):
     page.click("nav [data-tab=history]")
     page.click("#experiments-box summary")
     page.click(f"#experiment-table button[data-experiment='{experiment}']")
-    _until(page, "!document.querySelector('#experiment-page').hidden")
+    until(page, "!document.querySelector('#experiment-page').hidden")
     _range_is(page, "runs 1–16 of 16 (page 1 of 1)")
     assert page.inner_text("#experiment-title") == f"Experiment {experiment}: energy over seeds"
     assert "e-stopped at the wall's top" in page.inner_text("#experiment-notes")
@@ -320,16 +280,16 @@ def test_an_experiments_page_has_its_outcomes_endings_and_jobs(page, service):
     outcomes = _cells(page, "#experiment-outcomes tbody tr")
     assert [row[:2] for row in outcomes] == [["all", "16"], ["robot", "1"], ["sim", "15"]], outcomes
     assert " ± " in outcomes[0][2] and " … " in outcomes[0][3] and outcomes[1][3] == "— (one run)"
-    _until(page, f"document.querySelector('#experiment-jobs tbody tr td')?.textContent === '{job_id}'")
+    until(page, f"document.querySelector('#experiment-jobs tbody tr td')?.textContent === '{job_id}'")
     page.locator("#experiment-page").scroll_into_view_if_needed()
-    _shot(page, "history_experiment")
+    screenshot(page, "history_experiment")
     page.click(f"#experiment-jobs button[data-job='{job_id}']")
-    _until(page, "document.querySelector('#tab-jobs').getAttribute('aria-selected') === 'true'")
-    _until(page, f"(document.querySelector('#job-plot').textContent || '').includes('Job {job_id}')", timeout=60_000)
+    until(page, "document.querySelector('#tab-jobs').getAttribute('aria-selected') === 'true'")
+    until(page, f"(document.querySelector('#job-plot').textContent || '').includes('Job {job_id}')", timeout=60_000)
     page.click("nav [data-tab=history]")
     page.click("#experiment-close")
     everything = f"{RANGE}.endsWith('of {RUNS + 16:,} (page 1 of 25)')"
-    _until(page, f"document.querySelector('#experiment-page').hidden && {everything}")
+    until(page, f"document.querySelector('#experiment-page').hidden && {everything}")
     page.click("#experiments-box summary")
 
 
@@ -344,7 +304,7 @@ def test_runs_grouped_over_seeds_give_each_settings_mean_and_interval(page, serv
     page.click("#group-runs")
     page.select_option("#aggregate-by", "zeta0")
     page.click("#aggregate-go")
-    _until(page, "document.querySelectorAll('#aggregate-table tbody tr').length === 5")
+    until(page, "document.querySelectorAll('#aggregate-table tbody tr').length === 5")
     rows = _cells(page, "#aggregate-table tbody tr")
     assert [row[:2] for row in rows] == [[str(z), "3"] for z in ZETA0S], rows
     asked = {"by": "zeta0", "experiment_id": experiment, "kind": "sim"}
@@ -356,25 +316,25 @@ def test_runs_grouped_over_seeds_give_each_settings_mean_and_interval(page, serv
     assert bars == 5
     assert "by=zeta0" in page.url
     page.locator("#aggregate-box").scroll_into_view_if_needed()
-    _shot(page, "history_aggregate", "#aggregate-box")
+    screenshot(page, "history_aggregate", "#aggregate-box")
     page.click("#aggregate-close")
     assert page.is_hidden("#aggregate-box") and "by=" not in page.url
     page.select_option("#history-form select[name=kind]", "")
     page.select_option("#history-form select[name=experiment_id]", "")
-    _until(page, f"{RANGE}.startsWith('runs 1–50 of ')")
+    until(page, f"{RANGE}.startsWith('runs 1–50 of ')")
 
 
 def test_the_basket_plots_a_parameter_against_an_outcome_and_compares(page):
     page.click("nav [data-tab=history]")
     page.click("#basket-clear")
     page.select_option("#history-form select[name=kind]", "sim")
-    _until(page, f"{RANGE}.startsWith('runs 1–50 of {SIMS + 15:,} ')")
+    until(page, f"{RANGE}.startsWith('runs 1–50 of {SIMS + 15:,} ')")
     for run_id in _shown_ids(page)[:6]:
         page.check(f"#run-{run_id} input[type=checkbox]")
     page.click("#basket-plot-box summary")
-    _until(page, "document.querySelector('#basket-plot').data?.[0]?.x.length === 6")
+    until(page, "document.querySelector('#basket-plot').data?.[0]?.x.length === 6")
     page.select_option("#basket-y", "jumps_completed")
-    _until(page, "document.querySelector('#basket-plot').layout.yaxis.title.text === 'jumps completed'")
+    until(page, "document.querySelector('#basket-plot').layout.yaxis.title.text === 'jumps completed'")
     page.click("#compare")
     page.wait_for_selector("#compare-table")
     assert page.evaluate("document.querySelectorAll('#compare-table tr:first-of-type th').length") == 7

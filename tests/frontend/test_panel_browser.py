@@ -5,9 +5,7 @@ Set PARKOUR_SCREENSHOTS=1 to refresh docs/screenshots/ from this run.
 
 import io
 import json
-import os
 import re
-import shutil
 import socket
 import time
 from pathlib import Path
@@ -22,18 +20,13 @@ from backend.robot.virtual import VirtualRobot
 from backend.store.database import make_engine, session_factory, sqlite_url
 from sim_core.noise import NO_NOISE
 from tests.backend.api.bodies import RUN
+from tests.frontend.browser import CSP_LISTENER, chromium, panel, screenshot, until
 from tests.helpers import free_port, start_service
 from tests.robot_runs import store_robot_run
 
 # A browser and a service (slow), and a robot answering in real time (the e-stop acknowledged within
 # 150 ms, a closed loop): ./test.sh runs this file alone, after the rest.
 pytestmark = [pytest.mark.slow, pytest.mark.realtime]
-
-ROOT = Path(__file__).resolve().parents[2]
-CHROMIUM = os.environ.get("PARKOUR_CHROMIUM") or shutil.which("chromium") or shutil.which("chromium-browser")
-if CHROMIUM is None:
-    pytest.skip("no Chromium: ./test.sh installs the Debian package; or set PARKOUR_CHROMIUM", allow_module_level=True)
-sync_api = pytest.importorskip("playwright.sync_api")
 
 
 @pytest.fixture(scope="module")
@@ -55,52 +48,8 @@ def service(data_dir):
 @pytest.fixture(scope="module")
 def page(service):
     base, token = service
-    with sync_api.sync_playwright() as playwright:
-        # WebGL for the 3D view without a GPU: SwiftShader, Chromium's software renderer.
-        browser = playwright.chromium.launch(
-            executable_path=CHROMIUM, args=["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
-        )
-        context = browser.new_context(viewport={"width": 1360, "height": 900})
-        # What the Content-Security-Policy refuses (backend/api/security.py), reported by the page.
-        context.add_init_script(CSP_LISTENER)
-        view = context.new_page()
-        errors = []
-        view.on("pageerror", lambda error: errors.append(str(error)))
-        view.on("console", lambda message: "Content Security Policy" in message.text and errors.append(message.text))
-        view.on(
-            "requestfailed",
-            # Closing a finished job's event stream aborts it on purpose.
-            lambda request: "ERR_ABORTED" in (request.failure or "") or errors.append(f"failed {request.url}"),
-        )
-        view.goto(f"{base}/")
-        view.fill("#token", token)
-        view.dispatch_event("#token", "change")
+    with chromium() as browser, panel(browser, base, token, failed_requests=True) as view:
         yield view
-        assert view.evaluate("window.__csp_violations") == [], "the panel runs under its CSP"
-        assert not errors, errors
-        browser.close()
-
-
-CSP_LISTENER = """window.__csp_violations = [];
-document.addEventListener("securitypolicyviolation", (e) => window.__csp_violations.push(
-  `${e.violatedDirective} refused ${e.blockedURI} (${e.sourceFile}:${e.lineNumber})`));"""
-
-
-def _until(page, expression: str, timeout: float = 30_000) -> None:
-    """Wait until ``expression`` is true in the page. Not ``page.wait_for_function``: it evaluates
-    its predicate in the page with eval, which the panel's CSP (script-src 'self') refuses;
-    ``page.evaluate`` goes through the DevTools protocol, which the page's CSP does not govern."""
-    deadline = time.monotonic() + timeout / 1000
-    while not page.evaluate(expression):
-        if time.monotonic() > deadline:
-            shown = page.evaluate("[...document.querySelectorAll('.message')].map((m) => m.textContent)")
-            pytest.fail(f"not true within {timeout / 1000:g} s: {expression} (messages shown: {shown})")
-        time.sleep(0.05)
-
-
-def _shot(page, name):
-    target = ROOT / "docs" / "screenshots" if os.environ.get("PARKOUR_SCREENSHOTS") else Path("/tmp")
-    page.screenshot(path=str(target / f"{name}.png"), full_page=False)
 
 
 def test_the_sign_in_link_keeps_the_token_out_of_the_address_bar_and_says_it_is_accepted(page, service):
@@ -113,19 +62,19 @@ def test_the_sign_in_link_keeps_the_token_out_of_the_address_bar_and_says_it_is_
     try:
         fresh.goto(f"{base}/panel/#token={token}")
         status = "document.querySelector('#token-status').dataset.state"
-        _until(fresh, f"{status} === 'accepted'")
+        until(fresh, f"{status} === 'accepted'")
         assert token not in fresh.url and "#" not in fresh.url, "the token left the address bar"
         assert fresh.evaluate("localStorage.getItem('parkourlab-token')") == token
         assert fresh.input_value("#token") == token and fresh.inner_text("#token-status") == "accepted"
         assert fresh.get_attribute("#token", "aria-invalid") == "false"
         fresh.fill("#token", "not-the-token")
         fresh.dispatch_event("#token", "change")
-        _until(fresh, f"{status} === 'refused'")
+        until(fresh, f"{status} === 'refused'")
         assert fresh.get_attribute("#token", "aria-invalid") == "true"
         assert "not accepted" in fresh.inner_text("#token-status")
         fresh.fill("#token", "")
         fresh.dispatch_event("#token", "change")
-        _until(fresh, f"{status} === 'none'")
+        until(fresh, f"{status} === 'none'")
         assert fresh.evaluate("window.__csp_violations") == []
     finally:
         context.close()
@@ -139,11 +88,11 @@ def test_simulate_shows_plots_and_the_gait(page):
     assert page.evaluate("document.querySelector('#path-plot').layout.shapes.length") == 2, "the walls are drawn"
     assert "l0 = 0.223 m" in page.inner_text("#sim-units") and "s" in page.inner_text("#sim-units")
     page.click("#find-gait")
-    _until(page, "document.querySelector('#gait-readout').textContent.includes('stable')", timeout=20_000)
+    until(page, "document.querySelector('#gait-readout').textContent.includes('stable')", timeout=20_000)
     assert "Period 2" in page.inner_text("#gait-readout")
-    _shot(page, "simulate")
+    screenshot(page, "simulate")
     page.click("#save-run")
-    _until(page, "document.querySelector('.message.ok')?.textContent.includes('stored')")
+    until(page, "document.querySelector('.message.ok')?.textContent.includes('stored')")
     run_id = page.inner_text(".message.ok").split()[1]
     page.click("nav [data-tab=history]")
     page.wait_for_selector(f"#run-{run_id}")
@@ -161,7 +110,7 @@ def test_basin_and_sweep_are_jobs_drawn_in_simulate(page):
     page.wait_for_selector("#sweep-plot .scatterlayer .trace", timeout=60_000)
     assert page.inner_text("#analysis-status").startswith("sweep job") and "done" in page.inner_text("#analysis-status")
     page.locator("#sweep-plot").scroll_into_view_if_needed()
-    _shot(page, "simulate_analyses")
+    screenshot(page, "simulate_analyses")
 
 
 def _sent(page, action, path: str) -> list[str]:
@@ -202,11 +151,11 @@ def test_a_bad_value_is_marked_at_its_field_and_nothing_is_sent(page, value, mes
     page.fill("input[name=zetaL]", "0.87")
     page.fill("input[name=jumps]", "51")  # a drawn trajectory takes at most 50 jumps
     page.click("#run-sim")
-    _until(page, "document.querySelector('#jumps-error')?.textContent === 'must be at least 1 and at most 50 jumps'")
+    until(page, "document.querySelector('#jumps-error')?.textContent === 'must be at least 1 and at most 50 jumps'")
     assert page.get_attribute("input[name=zetaL]", "aria-invalid") == "false", "the fixed field is unmarked"
     page.fill("input[name=jumps]", "8")
     page.click("#run-sim")
-    _until(page, "document.querySelector('.message.ok')?.textContent.includes('jumps simulated')")
+    until(page, "document.querySelector('.message.ok')?.textContent.includes('jumps simulated')")
     assert page.query_selector("#sim-form .field-error") is None and page.query_selector(".message.error") is None
 
 
@@ -241,15 +190,15 @@ def test_a_job_runs_to_completion_with_progress(page):
     page.click("#submit-job")
     page.wait_for_selector("#job-table tbody tr .state", timeout=10_000)
     # The Simulate tab's analyses are jobs too: follow this MJTF job's own row to the end.
-    _until(
+    until(
         page,
         "document.querySelector('#job-table tbody tr:first-child td:nth-child(2)').textContent === 'mjtf'"
         " && document.querySelector('#job-table tbody tr:first-child .state').textContent === 'done'",
         timeout=60_000,
     )
     page.click("#job-table tbody tr:first-child .show")
-    _until(page, "document.querySelector('#job-plot').textContent.includes('Mean Jumps To Failure')")
-    _shot(page, "jobs")
+    until(page, "document.querySelector('#job-plot').textContent.includes('Mean Jumps To Failure')")
+    screenshot(page, "jobs")
 
 
 def test_a_cancelled_jobs_chart_says_partial_and_leaves_out_levels_that_never_ran(page, service):
@@ -265,7 +214,7 @@ def test_a_cancelled_jobs_chart_says_partial_and_leaves_out_levels_that_never_ra
     page.click("nav [data-tab=jobs]")
     page.wait_for_selector(f"#job-table .show[data-id='{job}']")
     page.click(f"#job-table .show[data-id='{job}']")
-    _until(page, f"document.querySelector('#job-plot').textContent.includes('Job {job}:')")
+    until(page, f"document.querySelector('#job-plot').textContent.includes('Job {job}:')")
     title = page.evaluate("document.querySelector('#job-plot .gtitle').textContent")
     assert "partial (cancelled" in title and "no trials at zeta0" in title
     drawn = page.evaluate("document.querySelector('#job-plot').data[0].x")
@@ -285,7 +234,7 @@ def test_sweep_and_basin_grid_jobs_from_the_jobs_tab(page):
     # Newest first: the basin job just scheduled, then the sweep (the Simulate tab's jobs are older).
     row = "document.querySelector('#job-table tbody tr:nth-child({n}) {cell}').textContent"
     newest = [row.format(n=n, cell=cell) for n in (1, 2) for cell in ("td:nth-child(2)", ".state")]
-    _until(
+    until(
         page,
         f"{newest[0]} === 'basin' && {newest[1]} === 'done' && {newest[2]} === 'sweep' && {newest[3]} === 'done'",
         timeout=60_000,
@@ -293,7 +242,7 @@ def test_sweep_and_basin_grid_jobs_from_the_jobs_tab(page):
     page.click("#job-table tbody tr:nth-child(1) .show")
     page.wait_for_selector("#job-plot .heatmaplayer image", timeout=10_000)
     page.click("#job-table tbody tr:nth-child(2) .show")
-    _until(page, "document.querySelector('#job-plot').textContent.includes('max |λ|')", timeout=10_000)
+    until(page, "document.querySelector('#job-plot').textContent.includes('max |λ|')", timeout=10_000)
     page.select_option("#job-kind", "mjtf")
 
 
@@ -327,11 +276,11 @@ def test_tabs_keys_an_empty_result_and_sort_at_once(page, service):
     page.click("nav [data-tab=history]")
     page.fill("#history-form input[name=tag]", "no-such-tag")
     page.click("#history-form button[type=submit]")
-    _until(page, "document.querySelector('#run-table td.empty')?.textContent === 'No runs match these filters.'")
+    until(page, "document.querySelector('#run-table td.empty')?.textContent === 'No runs match these filters.'")
     page.fill("#history-form input[name=tag]", "")
     with page.expect_response(lambda response: "sort=-climb" in response.url):
         page.select_option("#history-form select[name=sort]", "-climb")
-    _until(page, "!document.querySelector('#run-table td.empty')")
+    until(page, "!document.querySelector('#run-table td.empty')")
     page.select_option("#history-form select[name=sort]", "-id")
 
 
@@ -341,20 +290,20 @@ def test_runs_and_jobs_filed_under_an_experiment_appear_on_its_page(page, servic
     experiment = httpx.post(f"{base}/api/v1/experiments", json={"name": "energy study"}, headers=auth).json()["id"]
     page.reload()  # the forms' experiment choices are read when the panel opens
     page.click("nav [data-tab=simulate]")
-    _until(page, f"!!document.querySelector('#sim-form select.experiment-choice option[value=\"{experiment}\"]')")
+    until(page, f"!!document.querySelector('#sim-form select.experiment-choice option[value=\"{experiment}\"]')")
     page.select_option("#sim-form select.experiment-choice", str(experiment))
     page.click("#save-run")
-    _until(page, "document.querySelector('.message.ok')?.textContent.includes('stored')")
+    until(page, "document.querySelector('.message.ok')?.textContent.includes('stored')")
     run_id = int(page.inner_text(".message.ok").split()[1])
     page.click("#run-basin")  # the Simulate tab's analyses are filed with its saved runs
-    _until(page, "document.querySelector('#analysis-status').textContent.startsWith('basin job')")
+    until(page, "document.querySelector('#analysis-status').textContent.startsWith('basin job')")
     basin_job = int(page.inner_text("#analysis-status").split()[2].rstrip(":"))
     page.click("nav [data-tab=jobs]")
     page.select_option("#job-form select.experiment-choice", str(experiment))
     page.fill("input[name=trials]", "4")
     page.fill("input[name=cap]", "20")
     page.click("#submit-job")
-    _until(page, "document.querySelector('.message.ok')?.textContent.includes('scheduled')")
+    until(page, "document.querySelector('.message.ok')?.textContent.includes('scheduled')")
     job_id = int(page.inner_text(".message.ok").split()[1])
     page.click("nav [data-tab=history]")
     page.click("#experiments-box summary")
@@ -362,8 +311,8 @@ def test_runs_and_jobs_filed_under_an_experiment_appear_on_its_page(page, servic
     only_its_run = (
         f"!!document.querySelector('#run-{run_id}') && document.querySelectorAll('#run-table tbody tr').length === 1"
     )
-    _until(page, only_its_run)
-    _until(page, "!document.querySelector('#experiment-jobs').hidden")
+    until(page, only_its_run)
+    until(page, "!document.querySelector('#experiment-jobs').hidden")
     assert page.inner_text("#experiment-jobs caption") == f"Jobs in experiment {experiment}: energy study"
     first_cells = "#experiment-jobs tbody tr td:first-child"
     filed_jobs = page.eval_on_selector_all(first_cells, "cells => cells.map((cell) => cell.textContent)")
@@ -376,6 +325,7 @@ def test_runs_and_jobs_filed_under_an_experiment_appear_on_its_page(page, servic
 def test_history_compares_and_exports(page, service):
     base, token = service
     auth = {"Authorization": f"Bearer {token}"}
+    stored = []
     for zeta0, notes in ((0.88, "plain"), (0.92, MARKUP_NOTE)):
         body = {
             "controls": [{"psi0_deg": 30, "zeta0": zeta0}],
@@ -384,10 +334,11 @@ def test_history_compares_and_exports(page, service):
         }
         run = httpx.post(f"{base}/api/v1/runs", json=body, headers=auth)
         run.raise_for_status()
-        httpx.patch(f"{base}/api/v1/runs/{run.json()['id']}", json={"notes": notes}, headers=auth).raise_for_status()
+        stored.append(run.json()["id"])
+        httpx.patch(f"{base}/api/v1/runs/{stored[-1]}", json={"notes": notes}, headers=auth).raise_for_status()
     page.click("nav [data-tab=history]")
-    # The table may still show an earlier visit's rows: wait for the reload with the saved run and these two.
-    _until(page, "document.querySelectorAll('#run-table tbody tr').length >= 3")
+    # The table may still show an earlier visit's rows: wait for the reload that lists these two.
+    until(page, " && ".join(f"document.querySelector('#run-{run_id}') !== null" for run_id in stored))
     boxes = page.locator("#run-table tbody input[type=checkbox]")  # found again if the list is drawn again
     boxes.nth(0).check()
     boxes.nth(1).check()
@@ -407,7 +358,7 @@ def test_history_compares_and_exports(page, service):
     assert page.query_selector("#compare-table img") is None and page.evaluate("window.__xss") is None
     exported = page.request.get(base + page.get_attribute("#export-csv", "href"))
     assert exported.ok and exported.text().startswith("id,")
-    _shot(page, "history")
+    screenshot(page, "history")
 
 
 def test_experiments_group_runs_in_history(page, service):
@@ -426,14 +377,14 @@ def test_experiments_group_runs_in_history(page, service):
     }
     run = httpx.post(f"{base}/api/v1/runs", json=body, headers={"Authorization": f"Bearer {token}"}).json()
     page.click("#experiment-table button.show-experiment")
-    _until(
+    until(
         page,
         "document.querySelectorAll('#run-table tbody tr').length === 1"
         f" && !!document.querySelector('#run-{run['id']}')",
     )
     page.select_option("#experiment-filter", "")
     page.click("#history-form button[type=submit]")
-    _until(page, "document.querySelectorAll('#run-table tbody tr').length > 1")
+    until(page, "document.querySelectorAll('#run-table tbody tr').length > 1")
 
 
 def test_tags_and_notes_are_edited_in_history(page, service):
@@ -445,7 +396,7 @@ def test_tags_and_notes_are_edited_in_history(page, service):
     page.fill("#run-editor input[name=tags]", "keep wet-wall")
     page.fill("#run-editor textarea[name=notes]", "Left foot slipped on jump 3; try psi0 32.")
     page.click("#run-editor-save")
-    _until(page, f"document.querySelector('#run-{run_id} .notes').textContent.includes('slipped')")
+    until(page, f"document.querySelector('#run-{run_id} .notes').textContent.includes('slipped')")
     stored = httpx.get(f"{base}/api/v1/runs/{run_id}").json()
     assert stored["tags"] == ["keep", "wet-wall"] and stored["notes"].startswith("Left foot slipped")
     page.click(f"#run-{run_id} button.edit-run")
@@ -469,7 +420,7 @@ def test_the_3d_view_draws_the_climb(page):
     updates = []
     page.on("websocket", lambda ws: ws.on("framereceived", lambda _frame: updates.append(time.monotonic())))
     page.click("nav [data-tab=view3d]")
-    _until(page, "document.querySelector('#view-status').textContent.includes('updates/s')")
+    until(page, "document.querySelector('#view-status').textContent.includes('updates/s')")
     frame = page.frame_locator("#view-frame")
     frame.locator("text=Gait of these controls").wait_for(timeout=30_000)
     time.sleep(3)
@@ -479,7 +430,7 @@ def test_the_3d_view_draws_the_climb(page):
     assert "stable" in frame.locator("text=Gait of these controls").locator("..").inner_text()
     back = frame.locator("a", has_text="Control panel")
     assert back.get_attribute("target") == "_top", "the link back opens the panel at top level, not inside it"
-    _shot(page, "view3d")
+    screenshot(page, "view3d")
 
 
 def test_a_run_opens_in_3d_and_shares_as_a_file(page, service, tmp_path):
@@ -488,7 +439,7 @@ def test_a_run_opens_in_3d_and_shares_as_a_file(page, service, tmp_path):
     page.wait_for_selector("#run-table button.open-3d")
     page.click("#run-table button.open-3d")
     page.wait_for_selector("#view3d:not([hidden])")
-    _until(page, "document.querySelector('#view-status').textContent.includes('replay')")
+    until(page, "document.querySelector('#view-status').textContent.includes('replay')")
     run_id = page.get_attribute("#run-table button.open-3d", "data-run")
     shared = page.request.get(f"{base}/api/v1/runs/{run_id}/share.html")
     assert shared.ok
@@ -535,11 +486,11 @@ def test_each_person_has_their_own_3d_view(page, service):
         other_view.locator("text=Gait of these controls").wait_for(timeout=30_000)
         page.click("nav [data-tab=history]")
         page.click("#run-table button.open-3d")  # History → "3D" here
-        _until(page, "document.querySelector('#view-status').textContent.includes('replay')")
+        until(page, "document.querySelector('#view-status').textContent.includes('replay')")
         page.frame_locator("#view-frame").locator("text=Share this run (HTML)").wait_for(timeout=30_000)
         other.click("nav [data-tab=history]")
         other.click("nav [data-tab=view3d]")
-        _until(other, "document.querySelector('#view-status').textContent.includes('Mode: simulate')")
+        until(other, "document.querySelector('#view-status').textContent.includes('Mode: simulate')")
         other_view.locator("text=Gait of these controls").wait_for(timeout=10_000)
         assert other_view.locator("text=Share this run (HTML)").is_hidden(), "their view did not switch to replay"
         assert "yours" in other.text_content("#view-status")
@@ -555,24 +506,24 @@ def test_closed_loop_run_then_emergency_stop(page, service):
         page.fill("input[name=url]", robot.url)
         page.fill("input[name=tracker_port]", str(tracker_port))
         page.click("#connect")
-        _until(page, "document.querySelector('#robot-state').textContent === 'disarmed'")
+        until(page, "document.querySelector('#robot-state').textContent === 'disarmed'")
         page.fill("#robot-run-form input[name=jumps]", "12")
         page.check("#closed-loop")
         page.click("#live-run")
-        _until(page, "document.querySelector('#robot-status').textContent.includes('jumps done')", timeout=30_000)
+        until(page, "document.querySelector('#robot-status').textContent.includes('jumps done')", timeout=30_000)
         stored = httpx.get(f"{base}/api/v1/runs?kind=robot&limit=1").json()["items"][0]
         commands = httpx.get(f"{base}/api/v1/runs/{stored['id']}").json()["results"]["commands"]
         assert sum(command["why"].startswith("pid") for command in commands) >= 8, "the PID set the legs"
         page.wait_for_selector("#live-plot .main-svg", timeout=10_000)
-        _shot(page, "robot")
+        screenshot(page, "robot")
         page.uncheck("#closed-loop")
         page.fill("#robot-run-form input[name=jumps]", "200")
         page.click("#live-run")
-        _until(page, "document.querySelector('#robot-status').textContent.includes('running')", timeout=10_000)
+        until(page, "document.querySelector('#robot-status').textContent.includes('running')", timeout=10_000)
         time.sleep(1.0)
         page.fill("#token", "")  # a colleague's browser: stopping needs no token
         page.click("#estop")
-        _until(page, "document.querySelector('.message')?.textContent.includes('Emergency stop acknowledged')")
+        until(page, "document.querySelector('.message')?.textContent.includes('Emergency stop acknowledged')")
         assert robot.firmware.state.name == "ESTOPPED"
     finally:
         page.remove_listener("dialog", _accept)
@@ -605,7 +556,7 @@ def robot(page, service):
         page.fill("input[name=url]", virtual.url)
         page.fill("input[name=tracker_port]", str(tracker_port))
         page.click("#connect")
-        _until(page, f"{ROBOT_STATE} === 'disarmed'", timeout=10_000)
+        until(page, f"{ROBOT_STATE} === 'disarmed'", timeout=10_000)
         yield virtual
     finally:
         httpx.post(f"{_base}/api/v1/robot/disconnect", headers={"Authorization": f"Bearer {token}"})
@@ -645,7 +596,7 @@ def test_the_estop_stays_on_screen(page):
         page.click("nav [data-tab=robot]")
         page.evaluate("window.scrollTo(0, document.body.scrollHeight)")
         assert page.evaluate(ESTOP_ON_TOP), "on a 390 px screen too"
-        _shot(page, "robot_phone")
+        screenshot(page, "robot_phone")
         page.evaluate("window.scrollTo(0, 0)")
         assert page.evaluate(ESTOP_ON_TOP)
     finally:
@@ -671,7 +622,7 @@ def test_the_estop_needs_no_token(page, service):
     assert answer.value.ok and "authorization" not in answer.value.request.headers
     reason = answer.value.json()["reason"]
     # Its own answer: an earlier test's e-stop message may still be on the page (a CI run read it).
-    _until(page, f"document.querySelector('.message')?.textContent.includes({json.dumps(reason)})")
+    until(page, f"document.querySelector('.message')?.textContent.includes({json.dumps(reason)})")
     message = page.inner_text(".message")
     # The service's own answer (no robot connected: not acknowledged, and why), never "paste the token".
     assert "token" not in message.lower(), message
@@ -684,17 +635,17 @@ def test_a_latched_estop_shows_a_banner_until_reset(page, robot):
     page.click("#estop")
     page.wait_for_selector("#estop-banner", state="visible")
     assert "EMERGENCY STOP latched — the robot is stopped. Reset to continue." in page.inner_text("#estop-banner")
-    _until(page, f"{ROBOT_STATE} === 'estopped'")
+    until(page, f"{ROBOT_STATE} === 'estopped'")
     page.click("nav [data-tab=simulate]")  # on every tab
     assert page.is_visible("#estop-banner")
     page.evaluate("window.scrollTo(0, document.body.scrollHeight)")
     box = page.locator("#estop-banner").bounding_box()
     assert box["y"] >= 0 and box["y"] + box["height"] <= 900, "the banner stays at the top while scrolling"
     page.click("nav [data-tab=robot]")
-    _shot(page, "robot_estop")
+    screenshot(page, "robot_estop")
     page.click("#estop-banner-reset")
     page.wait_for_selector("#estop-banner", state="hidden")
-    _until(page, f"{ROBOT_STATE} === 'disarmed'")
+    until(page, f"{ROBOT_STATE} === 'disarmed'")
     assert robot.firmware.state.name == "DISARMED"
 
 
@@ -711,18 +662,18 @@ def test_start_run_on_a_disarmed_robot_asks(page, service, robot):
     try:
         page.fill("#robot-run-form input[name=jumps]", "3")
         page.click("#live-run")
-        _until(page, "document.querySelector('.message')?.textContent.includes('Run not started')")
+        until(page, "document.querySelector('.message')?.textContent.includes('Run not started')")
         assert questions == [("confirm", ARM_AND_LAUNCH)]
         assert not runs, "Cancel sends no run"
         assert httpx.get(f"{base}/api/v1/robot").json()["state"] == "disarmed"
         # Armed: no question, the run starts.
         page.click("#arm")
-        _until(page, f"{ROBOT_STATE} === 'armed'")
+        until(page, f"{ROBOT_STATE} === 'armed'")
         page.click("#live-run")
-        _until(page, "document.querySelector('.message')?.textContent.includes('Run started')")
+        until(page, "document.querySelector('.message')?.textContent.includes('Run started')")
         assert len(questions) == 1 and len(runs) == 1
         page.click("#stop-run")
-        _until(page, f"{ROBOT_STATE} === 'disarmed'", timeout=15_000)
+        until(page, f"{ROBOT_STATE} === 'disarmed'", timeout=15_000)
     finally:
         page.remove_listener("dialog", cancel)
 
@@ -731,13 +682,13 @@ def test_disarm_and_disconnect(page, robot):
     assert "0x0013A20040B0B0B0" in page.inner_text("#robot-status"), "the status shows the robot's address"
     assert "frames_in" in page.inner_text("#robot-counters")
     page.click("#arm")
-    _until(page, f"{ROBOT_STATE} === 'armed'")
+    until(page, f"{ROBOT_STATE} === 'armed'")
     assert robot.firmware.state.name == "ARMED"
     page.click("#disarm")
-    _until(page, f"{ROBOT_STATE} === 'disarmed'")
+    until(page, f"{ROBOT_STATE} === 'disarmed'")
     assert robot.firmware.state.name == "DISARMED"
     page.click("#disconnect")
-    _until(page, f"{ROBOT_STATE} === 'disconnected'")
+    until(page, f"{ROBOT_STATE} === 'disconnected'")
     assert "not connected" in page.inner_text("#robot-counters")
 
 
@@ -751,7 +702,7 @@ def test_the_robot_address_is_sent(page, robot):
     assert "no telemetry" in page.inner_text(".message.error")
     page.fill("input[name=robot_address]", "0x0013A20040B0B0B0")
     page.click("#connect")
-    _until(page, f"{ROBOT_STATE} === 'disarmed'", timeout=10_000)
+    until(page, f"{ROBOT_STATE} === 'disarmed'", timeout=10_000)
     assert [body["robot_address"] for body in sent] == ["0x0013A20040B0B0B1", "0x0013A20040B0B0B0"]
     assert "0x0013A20040B0B0B0" in page.inner_text("#robot-status")
 
@@ -763,13 +714,13 @@ def test_a_connect_form_port_that_is_not_a_port_is_marked_and_not_sent(page, rob
     for typed, says in (("", "enter a number"), ("udp", '"udp" is not a number'), ("70000", "at most 65535")):
         page.fill("input[name=tracker_port]", typed)
         page.click("#connect")
-        _until(page, "document.querySelector('#tracker_port-error') !== null")
+        until(page, "document.querySelector('#tracker_port-error') !== null")
         assert says in page.inner_text("#tracker_port-error"), typed
         assert page.get_attribute("input[name=tracker_port]", "aria-invalid") == "true"
     page.fill("input[name=tracker_port]", port)
     page.fill("input[name=url]", "/dev/ttyUSB97")  # refused by the service: marked at its field
     page.click("#connect")
-    _until(page, "document.querySelector('#url-error') !== null")
+    until(page, "document.querySelector('#url-error') !== null")
     assert page.inner_text("#url-error") == "/dev/ttyUSB97 does not exist", "in the user's words, no 'Value error,'"
     assert [body["url"] for body in sent] == ["/dev/ttyUSB97"], "nothing was sent while the port was bad"
 
@@ -779,24 +730,24 @@ def test_a_second_browser_follows_live(page, service, robot):
     with page.context.new_page() as other:  # no token: reading needs none
         other.goto(f"{base}/")
         other.click("nav [data-tab=robot]")
-        _until(other, f"{ROBOT_STATE} === 'disarmed'")
-        _until(other, "document.querySelector('#live-state').textContent === 'live updates: on'")
+        until(other, f"{ROBOT_STATE} === 'disarmed'")
+        until(other, "document.querySelector('#live-state').textContent === 'live updates: on'")
         page.click("#arm")
-        _until(other, f"{ROBOT_STATE} === 'armed'", timeout=10_000)
+        until(other, f"{ROBOT_STATE} === 'armed'", timeout=10_000)
         page.click("#disarm")
-        _until(other, f"{ROBOT_STATE} === 'disarmed'", timeout=10_000)
+        until(other, f"{ROBOT_STATE} === 'disarmed'", timeout=10_000)
         page.click("#estop")
         other.wait_for_selector("#estop-banner", state="visible", timeout=10_000)
         page.click("#reset")
         other.wait_for_selector("#estop-banner", state="hidden", timeout=10_000)
         # Off the Robot tab the live socket closes; back on it, it opens again.
         other.click("nav [data-tab=simulate]")
-        _until(other, "document.querySelector('#live-state').textContent.includes('off')")
+        until(other, "document.querySelector('#live-state').textContent.includes('off')")
         other.click("nav [data-tab=robot]")
         page.click("#arm")
-        _until(other, f"{ROBOT_STATE} === 'armed'", timeout=10_000)
+        until(other, f"{ROBOT_STATE} === 'armed'", timeout=10_000)
         page.click("#disarm")
-        _until(page, f"{ROBOT_STATE} === 'disarmed'")
+        until(page, f"{ROBOT_STATE} === 'disarmed'")
 
 
 # Every draw of the live plot, with the run it belongs to and how many points it has.
@@ -828,10 +779,10 @@ def test_the_live_plot_starts_fresh_for_each_run(page, robot):
         page.uncheck("#closed-loop")
         for _run in range(2):
             page.click("#live-run")
-            _until(page, "document.querySelector('#robot-status').textContent.includes('running')")
-            _until(page, "document.querySelector('#robot-status').textContent.includes('jumps done')", timeout=30_000)
-            _until(page, f"{ROBOT_STATE} === 'disarmed'")
-            _until(page, LIVE_PLOT_CAUGHT_UP)  # redrawn at most twice a second: the last one shows every pose
+            until(page, "document.querySelector('#robot-status').textContent.includes('running')")
+            until(page, "document.querySelector('#robot-status').textContent.includes('jumps done')", timeout=30_000)
+            until(page, f"{ROBOT_STATE} === 'disarmed'")
+            until(page, LIVE_PLOT_CAUGHT_UP)  # redrawn at most twice a second: the last one shows every pose
         draws = page.evaluate("window.__draws")
     finally:
         page.remove_listener("dialog", _accept)
@@ -848,7 +799,7 @@ def test_the_status_fields_of_the_new_service_are_shown_as_text(page):
     """``estop`` and ``run.id`` (the service's issue-13 status), fed to the panel as a live message would be."""
     with page.expect_response(lambda response: response.url.endswith("/api/v1/robot")):
         page.click("nav [data-tab=robot]")
-    _until(page, "document.querySelector('#live-state').textContent === 'live updates: on'")
+    until(page, "document.querySelector('#live-state').textContent === 'live updates: on'")
     page.evaluate("async () => (await import('/panel/robot.js')).closeLive()")  # only the statuses below
     page.evaluate(STOP_EVENTS)  # the robot's events would move the banner alone while they flow
     status = {
@@ -878,7 +829,7 @@ def test_the_status_fields_of_the_new_service_are_shown_as_text(page):
               "tracker": {"latest": {"time": 20.0 + 0.01 * k, "x": 0.0, "y": 0.3}}} for k in range(30)]  # fmt: skip
     page.evaluate(SHOW_STATUSES, burst)
     assert len(page.evaluate("window.__draws")) <= 1, "30 statuses at once: at most one redraw now"
-    _until(page, "window.__draws.length > 0 && window.__draws.at(-1)[1] === 31", timeout=5_000)
+    until(page, "window.__draws.length > 0 && window.__draws.at(-1)[1] === 31", timeout=5_000)
     assert len(page.evaluate("window.__draws")) <= 2, "and one more with the newest data"
     page.evaluate(feed, {**status, "estop": {"latched": False, "reason": None}, "state": "disarmed"})
     assert page.is_hidden("#estop-banner")
@@ -949,11 +900,11 @@ def test_a_latched_estop_reaches_every_open_panel(page, service, robot):
         print(f"banner shown: {1000 * on_history:.0f} ms after the press on History; on a new panel "
               f"{shown:.0f} ms after it began loading, by its own clock (DOMContentLoaded, once Plotly "
               f"has run: {loaded:.0f} ms; seen from here after {1000 * on_opening:.0f} ms)")  # fmt: skip
-        _shot(history, "estop_on_history")
+        screenshot(history, "estop_on_history")
         page.click("#estop-banner-reset")  # needs the token: the first panel has it
         for panel in (history, late, page):
             panel.locator("#estop-banner").wait_for(state="hidden", timeout=SHOWN_WITHIN_MS)
-        _until(page, f"{ROBOT_STATE} === 'disarmed'")
+        until(page, f"{ROBOT_STATE} === 'disarmed'")
         for panel in (history, late):
             assert panel.evaluate("window.__csp_violations") == [], "the stream is allowed by the CSP"
     finally:
@@ -978,7 +929,7 @@ def test_without_the_stream_a_panel_polls_and_tries_the_stream_again(page, servi
         _events_are(other, "live")  # tried again (2 s, then 5 s, ... after each refusal)
         page.click("#estop-banner-reset")
         other.locator("#estop-banner").wait_for(state="hidden", timeout=SHOWN_WITHIN_MS)
-        _until(page, f"{ROBOT_STATE} === 'disarmed'")
+        until(page, f"{ROBOT_STATE} === 'disarmed'")
     finally:
         context.close()
 
@@ -1005,7 +956,7 @@ def test_the_robot_tab_says_who_runs_the_robot_and_offers_stop(page, service, ro
         assert said.startswith(f"Live run {run['id']} is running since {since}"), said
         if run.get("started_by"):
             assert said.endswith(f", started by {run['started_by']}."), said
-        _shot(other, "robot_run_owner")
+        screenshot(other, "robot_run_owner")
         other.click("#run-owner-stop")
         other.locator(".message.error").wait_for(timeout=SHOWN_WITHIN_MS)
         assert "needs the API token" in other.inner_text(".message.error")
@@ -1014,7 +965,7 @@ def test_the_robot_tab_says_who_runs_the_robot_and_offers_stop(page, service, ro
         for panel in (page, other):
             panel.locator("#run-owner").wait_for(state="hidden", timeout=RUN_STARTS_WITHIN_MS)
         assert not httpx.get(f"{base}/api/v1/robot").json()["run"]["active"]
-        _until(page, f"{ROBOT_STATE} === 'disarmed'", timeout=15_000)
+        until(page, f"{ROBOT_STATE} === 'disarmed'", timeout=15_000)
     finally:
         page.remove_listener("dialog", _accept)
         context.close()
@@ -1085,9 +1036,9 @@ def test_stored_script_is_shown_as_text_in_every_view(page, service):
 
     # Jobs: the list, a result drawn; a job refused for its kind, whose message quotes the payload.
     page.click("nav [data-tab=jobs]")
-    _until(page, f"document.querySelector('#job-{job['id']} .state')?.textContent === 'done'", timeout=60_000)
+    until(page, f"document.querySelector('#job-{job['id']} .state')?.textContent === 'done'", timeout=60_000)
     page.click(f"#job-{job['id']} .show")
-    _until(page, f"document.querySelector('#job-plot').textContent.includes('Job {job['id']}: Mean Jumps')")
+    until(page, f"document.querySelector('#job-plot').textContent.includes('Job {job['id']}: Mean Jumps')")
     post_kind = "async (kind) => (await import('/panel/api.js')).call('POST', '/jobs', { kind }).catch(() => {})"
     page.evaluate(post_kind, XSS[2])
     page.wait_for_selector(".message.error")
@@ -1102,7 +1053,7 @@ def test_stored_script_is_shown_as_text_in_every_view(page, service):
     page.fill("#experiment-form input[name=name]", XSS[2])
     page.fill("#experiment-form input[name=description]", XSS[0])
     page.click("#create-experiment")
-    _until(page, "document.querySelector('.message.ok')?.textContent.includes('created')")
+    until(page, "document.querySelector('.message.ok')?.textContent.includes('created')")
     assert XSS[2] in page.inner_text(".message.ok")
     row = f"#experiment-table tr:has(button[data-experiment='{experiment['id']}'])"
     page.wait_for_selector(row)
@@ -1116,7 +1067,7 @@ def test_stored_script_is_shown_as_text_in_every_view(page, service):
 
     # The experiment's runs: notes and tags in the table, in the editor, in the comparison.
     page.click(f"{row} button.show-experiment")
-    _until(
+    until(
         page,
         "document.querySelectorAll('#run-table tbody tr').length === 3"
         + "".join(f" && !!document.querySelector('#run-{run['id']}')" for run in runs),
@@ -1144,7 +1095,7 @@ def test_stored_script_is_shown_as_text_in_every_view(page, service):
     # An earlier test's table may still be on the page: wait for the one of these runs.
     headers = " && ".join(f"text.includes('run {run['id']}')" for run in runs)
     table = "document.querySelector('#compare-table')?.innerText ?? ''"
-    _until(page, f"(() => {{ const text = {table}; return {headers}; }})()")
+    until(page, f"(() => {{ const text = {table}; return {headers}; }})()")
     compared = page.inner_text("#compare-table")
     assert all(payload in compared for payload in XSS), compared
     page.locator("#compare-table").scroll_into_view_if_needed()
@@ -1153,7 +1104,7 @@ def test_stored_script_is_shown_as_text_in_every_view(page, service):
 
     # The Robot tab shows the link's status, no stored text: nothing there may run either.
     page.click("nav [data-tab=robot]")
-    _until(page, "document.querySelector('#robot-state').textContent !== '—'")
+    until(page, "document.querySelector('#robot-state').textContent !== '—'")
     _no_script_ran(page, "the Robot tab")
     page.click("nav [data-tab=history]")
     page.select_option("#experiment-filter", "")
@@ -1213,7 +1164,7 @@ def _show_runs(page, runs):
     page.click("#basket-clear")  # the basket outlives pages and filters: empty it of earlier tests' runs
     page.select_option("#history-form select[name=kind]", "robot")
     page.click("#history-form button[type=submit]")
-    _until(page, " && ".join(f"!!document.querySelector('#run-{run}')" for run in runs))
+    until(page, " && ".join(f"!!document.querySelector('#run-{run}')" for run in runs))
 
 
 def test_history_calibrates_selected_runs_and_lists_the_calibration(page, service, varied_runs):
@@ -1232,14 +1183,14 @@ def test_history_calibrates_selected_runs_and_lists_the_calibration(page, servic
     for bad in (XSS[0], "paper"):
         page.fill("#calibrate-form input[name=name]", bad)
         page.click("#calibrate-fit")
-        _until(page, "document.querySelector('#name-error') !== null")
+        until(page, "document.querySelector('#name-error') !== null")
         assert page.get_attribute("#calibrate-form input[name=name]", "aria-invalid") == "true"
         _no_script_ran(page, "the calibrate dialog")
     assert "built-in preset" in page.inner_text("#name-error")
-    _shot(page, "history_calibrate")
+    screenshot(page, "history_calibrate")
     page.fill("#calibrate-form input[name=name]", "table.v1")
     page.click("#calibrate-fit")
-    _until(page, "!!document.querySelector('#calibration-params') && !document.querySelector('#calibrate-dialog').open",
+    until(page, "!!document.querySelector('#calibration-params') && !document.querySelector('#calibrate-dialog').open",
            timeout=60_000)  # fmt: skip
     cells = (
         "[...document.querySelectorAll('#calibration-params tr')].map((r) => [...r.children].map((c) => c.textContent))"
@@ -1257,11 +1208,11 @@ def test_history_calibrates_selected_runs_and_lists_the_calibration(page, servic
     assert page.inner_text("#calibration-table tr[data-name='table.v1'] button.show-calibration") == "table.v1"
     assert "table.v1" in page.evaluate("[...document.querySelectorAll('#touchdown-preset option')].map((o) => o.value)")
     page.locator("#calibrations-box").scroll_into_view_if_needed()
-    _shot(page, "history_calibration")
+    screenshot(page, "history_calibration")
     _no_script_ran(page, "the calibration report")
     page.once("dialog", _accept)
     page.click("#calibration-table tr[data-name='table.v1'] button.delete-calibration")
-    _until(page, "!document.querySelector(\"#calibration-table tr[data-name='table.v1']\")")
+    until(page, "!document.querySelector(\"#calibration-table tr[data-name='table.v1']\")")
     assert page.inner_text("#calibration-out") == ""
     assert httpx.get(f"{base}/api/v1/calibrations/table.v1").status_code == 404
 
@@ -1279,21 +1230,21 @@ def test_a_robot_runs_touchdowns_are_drawn_against_the_models(page, service, var
     run = varied_runs[2]
     page.click(f"#run-{run} button.show-touchdowns")
     traces = "document.querySelector('#touchdown-plot').data?.map((t) => t.name).join('|') ?? ''"
-    _until(page, f'{traces} === "measured|paper\'s model"')
+    until(page, f'{traces} === "measured|paper\'s model"')
     rms = page.inner_text("#touchdowns-rms")
     assert "paper: xdot" in rms and "calibrated" not in rms, rms
     page.select_option("#touchdown-preset", "touch.v1")
-    _until(page, f'{traces} === "measured|paper\'s model|calibrated (touch.v1)"')
-    _until(page, "document.querySelector('#touchdowns-rms').textContent.includes('calibrated (touch.v1)')")
+    until(page, f'{traces} === "measured|paper\'s model|calibrated (touch.v1)"')
+    until(page, "document.querySelector('#touchdowns-rms').textContent.includes('calibrated (touch.v1)')")
     rms = page.inner_text("#touchdowns-rms")
     assert "calibrated (touch.v1): xdot" in rms and "rise" in rms, rms
     page.select_option("#touchdown-channel", "rise")
-    _until(page, "document.querySelector('#touchdown-plot').layout.yaxis.title.text === 'rise [l0]'")
+    until(page, "document.querySelector('#touchdown-plot').layout.yaxis.title.text === 'rise [l0]'")
     residuals = page.evaluate("document.querySelector('#residual-plot').data.map((t) => [t.name, t.y.length])")
     assert [name for name, _ in residuals] == ["paper's model", "calibrated (touch.v1)"] and residuals[0][1] > 20
     assert page.evaluate("document.querySelector('#touchdown-plot').data.every((t) => t.y.every((v) => v !== null))")
     page.locator("#touchdowns-box").scroll_into_view_if_needed()
-    _shot(page, "history_touchdowns")
+    screenshot(page, "history_touchdowns")
     httpx.delete(f"{base}/api/v1/calibrations/touch.v1", headers={"Authorization": f"Bearer {token}"})
 
 
@@ -1310,16 +1261,16 @@ def test_the_connect_form_offers_natnet_and_marks_its_fields(page):
     )
     page.fill("input[name=natnet_rigid_body_id]", "-1")
     page.click("#connect")
-    _until(page, "document.querySelector('#natnet_rigid_body_id-error') !== null")
+    until(page, "document.querySelector('#natnet_rigid_body_id-error') !== null")
     assert "at least 0" in page.inner_text("#natnet_rigid_body_id-error") and sent == []
     page.fill("input[name=natnet_rigid_body_id]", "7")
     page.fill("input[name=natnet_version]", "9.9")
     page.fill("input[name=natnet_multicast_group]", "")
     page.click("#connect")
-    _until(page, "document.querySelector('#natnet_version-error') !== null")
+    until(page, "document.querySelector('#natnet_version-error') !== null")
     assert "9.9" in page.inner_text("#natnet_version-error")
     assert page.get_attribute("input[name=natnet_version]", "aria-invalid") == "true"
-    _shot(page, "robot_natnet")
+    screenshot(page, "robot_natnet")
     [body] = sent
     assert (
         body["tracker_protocol"] == "natnet"

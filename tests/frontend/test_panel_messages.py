@@ -1,6 +1,6 @@
 """Issue 26, "every message says the real reason in the user's terms": the control panel in
-headless Chromium against the real service (as tests/frontend/test_panel_browser.py, whose
-helpers it shares, with a service and a browser of its own so that its tests stand alone).
+headless Chromium against the real service (as tests/frontend/test_panel_browser.py, with the
+helpers of tests/frontend/browser.py, and a service and a browser of its own so that its tests stand alone).
 
 Each test names the message the panel used to give and what it says now.
 """
@@ -10,7 +10,7 @@ import time
 import httpx
 import pytest
 
-from tests.frontend.test_panel_browser import CHROMIUM, CSP_LISTENER, _until, sync_api
+from tests.frontend.browser import chromium, panel, until
 from tests.helpers import free_port, start_service
 
 pytestmark = pytest.mark.slow  # a browser and a service
@@ -29,31 +29,16 @@ def service(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def browser():
-    with sync_api.sync_playwright() as playwright:
-        launched = playwright.chromium.launch(
-            executable_path=CHROMIUM, args=["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
-        )
+    with chromium() as launched:
         yield launched
-        launched.close()
 
 
 @pytest.fixture
 def page(browser, service):
     """A fresh panel with the token: its own context (storage), its errors and CSP refusals checked."""
     base, token = service
-    context = browser.new_context(viewport={"width": 1360, "height": 900})
-    context.add_init_script(CSP_LISTENER)
-    panel = context.new_page()
-    errors = []
-    panel.on("pageerror", lambda error: errors.append(str(error)))
-    panel.goto(f"{base}/")
-    panel.fill("#token", token)
-    panel.dispatch_event("#token", "change")
-    _until(panel, "document.querySelector('#token-status').dataset.state === 'accepted'")
-    yield panel
-    assert panel.evaluate("window.__csp_violations") == [], "the panel runs under its CSP"
-    assert not errors, errors
-    context.close()
+    with panel(browser, base, token) as fresh:
+        yield fresh
 
 
 def _fill_legs(page, psi0: str, zeta0: str) -> None:
@@ -66,7 +51,7 @@ def test_a_gait_not_found_says_the_apis_reason(page):
     field marked: the API's reason (a 422 whose detail is a sentence) was never shown."""
     _fill_legs(page, "60", "0.5")
     page.click("#find-gait")
-    _until(page, f"{BANNER}.startsWith('Fixed point: ')")
+    until(page, f"{BANNER}.startsWith('Fixed point: ')")
     message = page.inner_text(".message.error")
     assert message.startswith("Fixed point: the map fails from the guess [-0.8, -0.15]: slip at jump 1"), message
     assert "marked" not in message and page.query_selector("#sim-form [aria-invalid=true]") is None
@@ -85,7 +70,7 @@ def test_a_refusal_of_a_field_not_on_the_form_shows_the_apis_message(page):
 
     page.route("**/api/v1/sim/trajectory", refuse)
     page.click("#run-sim")
-    _until(page, f"{BANNER}.startsWith('Run trajectory: ')")
+    until(page, f"{BANNER}.startsWith('Run trajectory: ')")
     assert page.inner_text(".message.error") == (
         "Run trajectory: model.mu: Input should be less than or equal to 100; fix the marked field(s) too"
     )
@@ -98,7 +83,7 @@ def test_save_run_keeps_a_long_runs_path_at_a_rate_that_fits(page, service):
     base, _token = service
     page.fill("#sim-form input[name=jumps]", "2000")
     page.click("#save-run")
-    _until(page, f"{BANNER}.includes('stored')", timeout=60_000)
+    until(page, f"{BANNER}.includes('stored')", timeout=60_000)
     message = page.inner_text(".message")
     assert "its path thinned to 50 samples per √(l0/g) (from 60: a stored path is held to rate × jumps ≤ 100,000)" in (
         message
@@ -114,7 +99,7 @@ def test_the_job_forms_messages_read_as_sentences(page):
     page.fill("input[name=seed]", "1e19")
     page.fill("input[name=zeta0s]", "")
     page.click("#submit-job")
-    _until(page, "document.querySelector('#seed-error') !== null")
+    until(page, "document.querySelector('#seed-error') !== null")
     assert page.inner_text("#seed-error") == (
         "must be at least 0 and at most 9007199254740991 (the largest whole number a browser sends exactly)"
     )
@@ -122,7 +107,7 @@ def test_the_job_forms_messages_read_as_sentences(page):
     page.fill("input[name=zeta0s]", "0.86, 1.5")
     page.fill("input[name=seed]", "7")
     page.click("#submit-job")
-    _until(page, "document.querySelector('#zeta0s-error') !== null")
+    until(page, "document.querySelector('#zeta0s-error') !== null")
     assert page.inner_text("#zeta0s-error") == "each must be more than 0 and less than 1 l0"
     assert page.query_selector("#seed-error") is None
 
@@ -134,10 +119,10 @@ def test_a_sign_in_link_opened_in_a_tab_showing_the_panel_signs_it_in(page, serv
     page.evaluate("localStorage.clear()")
     page.fill("#token", "")
     page.dispatch_event("#token", "change")
-    _until(page, "document.querySelector('#token-status').dataset.state === 'none'")
+    until(page, "document.querySelector('#token-status').dataset.state === 'none'")
     page.evaluate("window.__sameDocument = true")  # gone if the page loads again
     page.goto(f"{base}/panel/#token={token}")
-    _until(page, "document.querySelector('#token-status').dataset.state === 'accepted'")
+    until(page, "document.querySelector('#token-status').dataset.state === 'accepted'")
     assert page.evaluate("window.__sameDocument") is True, "signed in without a reload"
     assert page.input_value("#token") == token and "#" not in page.url
     assert page.evaluate("localStorage.getItem('parkourlab-token')") == token
@@ -148,7 +133,7 @@ def test_the_3d_tabs_status_follows_the_view(page, service):
     a replay opened for this view (or a mode chosen inside it) left it saying "Mode: simulate"."""
     base, token = service
     page.click("nav [data-tab=view3d]")
-    _until(page, "document.querySelector('#view-status').textContent.startsWith('Mode: simulate')", timeout=60_000)
+    until(page, "document.querySelector('#view-status').textContent.startsWith('Mode: simulate')", timeout=60_000)
     run = httpx.post(f"{base}/api/v1/runs", json={"controls": [{"psi0_deg": 30, "zeta0": 0.9}],
                      "start": {"xdot": -0.93, "ydot": -0.2}, "jumps": 4},
                      headers={"Authorization": f"Bearer {token}"}, timeout=60).json()  # fmt: skip
@@ -156,7 +141,7 @@ def test_the_3d_tabs_status_follows_the_view(page, service):
     body = {"viewer": viewer, "run_id": run["id"]}
     opened = httpx.post(f"{base}/api/v1/view/replay", json=body, headers={"Authorization": f"Bearer {token}"})
     assert opened.status_code == 200, opened.text
-    _until(page, f"document.querySelector('#view-status').textContent.startsWith('Mode: replay, run {run['id']}')")
+    until(page, f"document.querySelector('#view-status').textContent.startsWith('Mode: replay, run {run['id']}')")
     page.click("nav [data-tab=simulate]")
     asked = []
     page.on("request", lambda request: "/api/v1/view?" in request.url and asked.append(request.url))
@@ -207,18 +192,18 @@ def test_the_jobs_tab_pages_through_every_job_and_says_where_a_queued_one_stands
     total, ids = len(everything["items"]), [job["id"] for job in everything["items"]]
     page.click("nav [data-tab=jobs]")
     rows = "[...document.querySelectorAll('#job-table tbody tr')].map((row) => Number(row.cells[0].textContent))"
-    _until(page, f"{rows}.length === 20")
+    until(page, f"{rows}.length === 20")
     assert page.evaluate(rows) == ids[:20]
     counted = f" of {total}" if everything.get("total") is not None else ""
     assert page.inner_text("#jobs-range") == f"jobs 1–20{counted}, newest first"
     assert page.is_disabled("#jobs-newer") and page.is_enabled("#jobs-older")
     page.click("#jobs-older")
-    _until(page, f"{rows}[0] === {ids[20]}")
+    until(page, f"{rows}[0] === {ids[20]}")
     assert page.evaluate(rows) == ids[20:40]
     assert page.inner_text("#jobs-range") == f"jobs 21–{min(total, 40)}{counted}, newest first"
     assert page.is_enabled("#jobs-newer") and page.is_disabled("#jobs-older") == (total <= 40)
     page.click("#jobs-newer")
-    _until(page, f"{rows}[0] === {ids[0]}")
+    until(page, f"{rows}[0] === {ids[0]}")
 
     def queued(route):
         listed = route.fetch().json()
@@ -234,7 +219,7 @@ def test_the_jobs_tab_pages_through_every_job_and_says_where_a_queued_one_stands
     page.on("request", lambda request: "/events" in request.url and "/jobs/" in request.url and streams.append(1))
     page.click("nav [data-tab=simulate]")
     page.click("nav [data-tab=jobs]")
-    _until(page, f"document.querySelector('#job-{ids[0]} .state').textContent === 'queued'")
+    until(page, f"document.querySelector('#job-{ids[0]} .state').textContent === 'queued'")
     assert page.inner_text(f"#job-{ids[0]} small.queue") == "2nd in the queue, done in about 3 min"
     assert page.inner_text(f"#job-{ids[1]} small.queue") == "next to run"
     assert page.query_selector(f"#job-{ids[2]} small.queue") is None, "nothing said when the API says nothing"
@@ -254,6 +239,6 @@ def test_the_panel_submits_jobs_as_panel_for_the_queues_share(page, service):
     page.fill("input[name=trials]", "2")
     page.fill("input[name=cap]", "20")
     page.click("#submit-job")
-    _until(page, "document.querySelector('#job-table tbody tr .state') !== null")
+    until(page, "document.querySelector('#job-table tbody tr .state') !== null")
     newest = httpx.get(f"{base}/api/v1/jobs?limit=1").json()["items"][0]
     assert newest["submitted_by"] == "panel"
