@@ -4,7 +4,7 @@
 // jobs, each with a Show that opens it in the Jobs tab. Every value reaches the page as text.
 import { $, say, call, on } from "./api.js";
 import { selectTab } from "./tabs.js";
-import { describeJob } from "./jobs.js";
+import { describeJob, showJob } from "./jobs.js";
 import { element, fillTable, attributes } from "./dom.js";
 import { endingBadge } from "./run_cells.js";
 
@@ -102,15 +102,12 @@ export function closeExperiment() {
 
 on("#experiment-close", "click", () => { closeExperiment(); return showRuns(null); });
 
-// Show: the job in the Jobs tab, drawn by that tab's own Show (its table's handler reads the
-// button's data-id), whichever of its pages the job is on.
-on("#experiment-jobs", "click", (event) => {
+// Show: the job in the Jobs tab, drawn as that tab's own Show draws it, whichever of its pages
+// the job is on.
+on("#experiment-jobs", "click", async (event) => {
   const button = event.target.closest("button.show-job");
   if (!button) return;
   selectTab("jobs");
-  const show = attributes(element("button", "Show"), { type: "button", class: "show", "data-id": button.dataset.job, hidden: "" });
-  $("#job-table").append(show);
-  show.click();
-  show.remove();
+  await showJob(button.dataset.job);
   $("#job-plot").scrollIntoView({ block: "nearest" });
 });

@@ -183,6 +183,12 @@ on("#job-table", "click", async (event) => {
     await call("POST", `/jobs/${id}/cancel`);
     return loadJobs();
   }
+  return showJob(id);
+});
+
+// A job's results: its plot in the Jobs tab, or a word where it has none (the table's Show, and
+// an experiment's list of jobs).
+export async function showJob(id) {
   const results = await call("GET", `/jobs/${id}/results`);
   const job = results.job;
   if (results.levels) {
@@ -204,4 +210,4 @@ on("#job-table", "click", async (event) => {
     const gaits = results.result.gaits || [];
     say(`Job ${id}: ${gaits.length} gait(s): ${gaits.map((g) => `period ${g.period} at (${g.state.map((v) => v.toFixed(3)).join(", ")}), max |λ| ${g.max_abs_eigenvalue.toFixed(3)}`).join("; ")}.`);
   }
-});
+}
