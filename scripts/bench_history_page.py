@@ -31,6 +31,7 @@ import datetime
 import json
 import multiprocessing
 import random
+import re
 import shutil
 import statistics
 import subprocess
@@ -80,10 +81,27 @@ NEW = [
 ]
 
 
-def seed(url: str, count: int, rng: random.Random) -> None:
-    """``count`` runs at schema :data:`BASE_SCHEMA`: the models' columns that the table has then."""
+def schema_of(tree: Path) -> str:
+    """The newest migration of the checkout at ``tree``: the schema its service expects."""
+    versions = tree / "backend" / "store" / "migrations" / "versions"
+    found = {}
+    for path in versions.glob("*.py"):
+        text = path.read_text()
+        revision = re.search(r'^revision = "(\w+)"', text, re.M)
+        down = re.search(r'^down_revision = "(\w+)"', text, re.M)
+        if revision:
+            found[revision.group(1)] = down.group(1) if down else None
+    heads = set(found) - set(found.values())
+    if len(heads) != 1:
+        raise SystemExit(f"{versions}: expected one newest migration, found {sorted(heads)}")
+    return heads.pop()
+
+
+def seed(url: str, count: int, rng: random.Random, schema: str = BASE_SCHEMA) -> None:
+    """``count`` runs at migration ``schema`` (a base revision's, which its service can open): the
+    models' columns that the table has then."""
     engine = make_engine(url)
-    migrate(engine, BASE_SCHEMA)
+    migrate(engine, schema)
     metadata = MetaData()
     metadata.reflect(engine, only=["runs", "run_tags"])
     runs, columns = metadata.tables["runs"], set(metadata.tables["runs"].columns.keys())

@@ -3,7 +3,8 @@
 This shared 2-core machine changes speed by up to 1.5x within minutes (the same code measured 138
 and then 243 req/s ten minutes apart), so two bench_load.py runs one after the other compare the
 machine, not the code. This script checks ``--base`` out into a temporary git worktree, starts
-both services (``parkour serve``, each on its own copy of one seeded store) and loads them in
+both services (``parkour serve``, each on its own copy of one store seeded at the base's schema
+and migrated forward for this tree's) and loads them in
 short alternating phases (the order flips each round), so a slow minute hits both alike. It
 prints each side's medians and, per round, the ratios new / base of throughput, reads p95 and the
 whole machine's CPU per request (the service's own process alone no longer says it all: the run
@@ -21,9 +22,10 @@ import subprocess
 import tempfile
 from pathlib import Path
 
-from bench_load import phase  # scripts/ is on the path when this script runs
-from bench_store import seed
+from bench_history_page import schema_of, seed  # scripts/ is on the path when this script runs
+from bench_load import phase
 
+from backend.store.database import make_engine, migrate, sqlite_url
 from tests.helpers import start_service
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -58,10 +60,16 @@ def main() -> None:
         if subprocess.run([*git_worktree, "add", "--detach", "-q", str(base_tree), args.base]).returncode:
             raise SystemExit(f"--base {args.base!r} is no revision git can check out (git said why, above)")
         (scratch / "seed").mkdir()
-        seed(f"sqlite:///{scratch / 'seed' / 'parkourlab.sqlite3'}", args.runs, random.Random(0))
+        # Seeded at the base's schema, which its service can open; this tree's service gets its
+        # copy migrated to this tree's newest first (as bench_history_page.py does).
+        seed(sqlite_url(scratch / "seed"), args.runs, random.Random(0), schema=schema_of(base_tree))
         tokens = {}
         for name, (tree, port) in sides.items():
             shutil.copytree(scratch / "seed", scratch / name)
+            if name == "new":
+                engine = make_engine(sqlite_url(scratch / name))
+                migrate(engine)
+                engine.dispose()
             processes[name] = start_service(scratch / name, port, "--no-view", tree=tree)
             tokens[name] = (scratch / name / "api_token").read_text().strip()
             phase(f"http://127.0.0.1:{port}", tokens[name], 2, 2.0)  # warm: kernels, database pages
