@@ -18,8 +18,9 @@ clients each loop over pages of 50 on their own keep-alive connection, no pause:
 
 Prints p50/p95/max per side and set, and the new/base ratios per round. ``--writes 0.05`` makes
 that fraction of requests store a run (each commit makes the read workers count totals afresh).
+``--same-queries`` asks the base the new queries too, for a base that answers them.
 Usage: PYTHONPATH=. python scripts/bench_history_page.py --base REV [--runs 100000] [--clients 20]
-       [--rounds 3] [--seconds 8] [--writes 0]
+       [--rounds 3] [--seconds 8] [--writes 0] [--same-queries]
 """
 
 from __future__ import annotations
@@ -248,11 +249,17 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=8.0, help="each phase's length")
     parser.add_argument("--writes", type=float, default=0.0, help="the fraction of requests that store a run")
     parser.add_argument("--port", type=int, default=8791, help="the base's port; the new one's is the next")
+    parser.add_argument(
+        "--same-queries",
+        action="store_true",
+        help="ask the base the new queries too (a base from issue 26 on answers them): both sides do the same work",
+    )
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
     scratch = Path(tempfile.mkdtemp(prefix="parkourlab-history-"))
     base_tree = scratch / "base-tree"
-    sides = {"base": (base_tree, args.port, COMMON), "new": (ROOT, args.port + 1, COMMON + NEW)}
+    base_queries = COMMON + NEW if args.same_queries else COMMON
+    sides = {"base": (base_tree, args.port, base_queries), "new": (ROOT, args.port + 1, COMMON + NEW)}
     processes: dict[str, subprocess.Popen] = {}
     results: dict = {"runs": args.runs, "clients": args.clients, "base": args.base, "rounds": {"base": [], "new": []}}
     git_worktree = ["git", "-C", str(ROOT), "worktree"]

@@ -141,6 +141,17 @@ class ListCache:
         self.counts: dict[tuple, int] = {}
         self.orders: OrderedDict[tuple, array] = OrderedDict()
         self.ids_kept = 0
+        self.asked: set[tuple] = set()  # orders asked for under this stamp, kept or not
+
+    def asked_again(self, key: tuple) -> bool:
+        """Whether the order ``key`` was asked for before under this stamp (and note that it was
+        now): an order worth reading whole and keeping is one asked for twice before a write."""
+        if key in self.asked:
+            return True
+        if len(self.asked) >= COUNTS_KEPT:
+            self.asked.clear()
+        self.asked.add(key)
+        return False
 
     def keep_count(self, key: tuple, count: int) -> None:
         if len(self.counts) >= COUNTS_KEPT:

@@ -149,10 +149,11 @@ def listed_page(
     filtered page needs the matching runs sorted; on SQLite it is cut from their whole order,
     read once and kept on the connection until a run changes
     (:class:`~backend.repositories.run_filters.ListCache`): sorting the runs of one kind by date
-    reads 25,000 rows (70 ms), every page after that its 50 (1-2 ms). The first pages
-    (``offset`` below :data:`WHOLE_ORDER_FROM`) are read by themselves unless the order is kept
-    already: right after a write (every write drops what was kept) most reads ask for a first
-    page, and reading whole orders for each of them halved the throughput of a mix with 20% writes."""
+    reads 25,000 rows (70 ms), every page after that its 50 (1-2 ms). A first page (``offset``
+    below :data:`WHOLE_ORDER_FROM`) is read by itself the first time its order is asked for after
+    a write, and the order read whole only when asked again before the next write: every write
+    drops what was kept, and reading a whole order for each first page after a write halved the
+    throughput of a mix with 20% writes."""
     if sort not in SORTS:
         raise ValueError(f"sort must be one of {', '.join(SORTS)}, got {sort!r}")
     by_id = sort.lstrip("-") == "id"
@@ -161,7 +162,7 @@ def listed_page(
     cache = None if by_id and cursor is not None else list_cache(connection)
     key = (tuple(values.items()), sort)
     ids = None if cache is None else cache.order(key)
-    if ids is None and cache is not None and values and offset >= WHOLE_ORDER_FROM:
+    if ids is None and cache is not None and values and (offset >= WHOLE_ORDER_FROM or cache.asked_again(key)):
         ids = array("q", connection.execute(_ids_statement(sort, tuple(values)), values).scalars())
         cache.keep_order(key, ids)
         cache.keep_count(key[0], len(ids))
