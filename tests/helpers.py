@@ -11,6 +11,8 @@ import sys
 import threading
 import time
 from collections import Counter
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import httpx
@@ -51,6 +53,19 @@ def start_service(data_dir: Path, port: int, *options: str, tree: Path | None = 
     process.kill()
     process.wait()
     pytest.fail(f"the service did not start within {SERVICE_START_TIMEOUT:g} s")
+
+
+@contextmanager
+def served(data_dir: Path, *options: str) -> Iterator[tuple[str, str]]:
+    """``parkour serve`` over ``data_dir`` on a free port (:func:`start_service`): its base URL and
+    its API token. Afterwards SIGTERM, and it must end within 30 s (a hang fails the test)."""
+    port = free_port()
+    process = start_service(data_dir, port, *options)
+    try:
+        yield f"http://127.0.0.1:{port}", (data_dir / "api_token").read_text().strip()
+    finally:
+        process.terminate()
+        process.wait(30)
 
 
 def start_robot_sim(port: int, tracker_port: int, *options: str) -> subprocess.Popen:

@@ -16,7 +16,7 @@ from backend.store.database import make_engine, migrate, session_factory, sqlite
 from backend.store.models import Experiment
 from backend.store.run_record import RunRecord
 from tests.frontend.browser import chromium, panel, screenshot, until
-from tests.helpers import free_port, start_service
+from tests.helpers import served
 
 pytestmark = pytest.mark.slow  # a browser and a service: ~40 s
 
@@ -87,11 +87,8 @@ def store(tmp_path_factory):
 @pytest.fixture(scope="module")
 def service(store):
     data, experiment_id = store
-    port = free_port()
-    process = start_service(data, port, "--no-view")
-    yield f"http://127.0.0.1:{port}", (data / "api_token").read_text().strip(), experiment_id
-    process.terminate()
-    process.wait(30)
+    with served(data, "--no-view") as (base, token):
+        yield base, token, experiment_id
 
 
 @pytest.fixture(scope="module")

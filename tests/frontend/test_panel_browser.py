@@ -21,7 +21,7 @@ from backend.store.database import make_engine, session_factory, sqlite_url
 from sim_core.noise import NO_NOISE
 from tests.backend.api.bodies import RUN
 from tests.frontend.browser import CSP_LISTENER, chromium, panel, screenshot, until
-from tests.helpers import free_port, start_service
+from tests.helpers import free_port, served
 from tests.robot_runs import store_robot_run
 
 # A browser and a service (slow), and a robot answering in real time (the e-stop acknowledged within
@@ -37,12 +37,8 @@ def data_dir(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def service(data_dir):
-    data, port = data_dir, free_port()
-    process = start_service(data, port, "--view-port", "0")
-    base = f"http://127.0.0.1:{port}"
-    yield base, (data / "api_token").read_text().strip()
-    process.terminate()
-    process.wait(30)
+    with served(data_dir, "--view-port", "0") as base_and_token:
+        yield base_and_token
 
 
 @pytest.fixture(scope="module")

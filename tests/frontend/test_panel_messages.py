@@ -11,7 +11,7 @@ import httpx
 import pytest
 
 from tests.frontend.browser import chromium, panel, until
-from tests.helpers import free_port, start_service
+from tests.helpers import served
 
 pytestmark = pytest.mark.slow  # a browser and a service
 
@@ -20,11 +20,8 @@ BANNER = "document.querySelector('#messages .message')?.textContent ?? ''"
 
 @pytest.fixture(scope="module")
 def service(tmp_path_factory):
-    data, port = tmp_path_factory.mktemp("messages") / "data", free_port()
-    process = start_service(data, port, "--view-port", "0")
-    yield f"http://127.0.0.1:{port}", (data / "api_token").read_text().strip()
-    process.terminate()
-    process.wait(30)
+    with served(tmp_path_factory.mktemp("messages") / "data", "--view-port", "0") as base_and_token:
+        yield base_and_token
 
 
 @pytest.fixture(scope="module")
