@@ -23,12 +23,10 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
-import numpy as np
-
 from backend.robot.link import LinkError, LinkState, RobotLink
 from backend.robot.messages import Leg
 from backend.robot.touchdown import PITCH_LOOKBACK, Touchdown, scan_touchdowns
-from backend.robot.tracker import PoseHistory
+from backend.robot.tracker import PoseHistory, pose_arrays
 from sim_core.controls import LegControl
 from sim_core.errors import ParameterError
 from sim_core.walls import wall_of
@@ -151,11 +149,6 @@ class LiveRun:
         )
 
 
-def _arrays(poses) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``(time, x, y, pitch)`` of tracker poses, as arrays."""
-    return tuple(np.array([getattr(p, name) for p in poses], dtype=float) for name in ("time", "x", "y", "pitch"))
-
-
 PidLaw = tuple[float, float, float, float, float, float]  # hover zeta0, kp, ki, kd, zeta0 min, max
 
 
@@ -214,9 +207,9 @@ def execute(
             # the same at the thousandth jump as at the first, and the link's thread keeps its time.
             first, poses = tracker.numbered_from(max(run.first_pose, scan_from - 1 - PITCH_LOOKBACK))
             if scan_from - first < len(poses):
-                times, xs, ys, pitches = _arrays(poses)
-                scan = scan_touchdowns(times, xs, ys, robot, leg_for, pitches, start=scan_from - first,
-                                       first_index=len(run.touchdowns))  # fmt: skip
+                arrays = pose_arrays(poses)
+                scan = scan_touchdowns(arrays["time"], arrays["x"], arrays["y"], robot, leg_for, arrays["pitch"],
+                                       start=scan_from - first, first_index=len(run.touchdowns))  # fmt: skip
                 scan_from = first + scan.resume
                 run.touchdown_controls.extend(leg_for(touchdown.index) for touchdown in scan.touchdowns)
                 for touchdown in scan.touchdowns:

@@ -213,7 +213,12 @@ class PoseHistory:
     def as_arrays(self) -> dict[str, np.ndarray]:
         with self._lock:
             poses = list(self._poses)
-        return {name: np.array([getattr(p, name) for p in poses]) for name in ("time", "x", "y", "pitch")}
+        return pose_arrays(poses)
+
+
+def pose_arrays(poses: list[Pose]) -> dict[str, np.ndarray]:
+    """``time``, ``x``, ``y`` and ``pitch`` of ``poses``, each as an array."""
+    return {name: np.array([getattr(p, name) for p in poses]) for name in ("time", "x", "y", "pitch")}
 
 
 class UdpPoseSource(PoseHistory):
