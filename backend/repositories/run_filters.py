@@ -1,22 +1,15 @@
-"""Which runs a list, an export or an aggregate covers (:class:`RunFilter`), as SQL conditions, and
-how many runs a filter selects (:func:`matching_count`).
+"""Which runs a list, an export or an aggregate covers (:class:`RunFilter`), as SQL conditions.
 
-Every criterion but the search ``q`` reads an index. A page's total is a COUNT over the runs that
-match. On SQLite each connection keeps the counts it made, and the orders of ids that pages were
-cut from (:class:`ListCache`), while no run or tag has changed (the runs' version, which triggers
-move: :func:`store_stamp`): paging through one filter and sort counts and sorts it once.
+Every criterion but the search ``q`` reads an index. What a connection keeps of the lists it read
+(totals, orders) is :mod:`~backend.repositories.run_list_cache`'s.
 """
 
 from __future__ import annotations
 
 import datetime
-import functools
-from array import array
-from collections import OrderedDict
 from dataclasses import dataclass
 
-from sqlalchemy import Select, String, bindparam, func, select
-from sqlalchemy.orm import Session
+from sqlalchemy import Integer, Select, String, bindparam, func, literal_column, select
 
 from backend.store.models import Run, RunTag
 
@@ -56,10 +49,25 @@ def _same_or_kind_of(v):
     return (Run.end_reason == v) | ((Run.end_reason >= v + ":") & (Run.end_reason < v + ";"))
 
 
-def _search(pattern):
-    return Run.notes.ilike(pattern, escape="\\") | Run.id.in_(
-        select(RunTag.run_id).where(RunTag.tag.ilike(pattern, escape="\\"))
+def _tagged(tag, runs_tagged=None):
+    return (runs_tagged or _among_tagged)(RunTag.tag == tag)
+
+
+def _search(pattern, runs_tagged=None):
+    return Run.notes.ilike(pattern, escape="\\") | (runs_tagged or _among_tagged)(
+        RunTag.tag.ilike(pattern, escape="\\")
     )
+
+
+# How a condition on the tags becomes one on the runs: the list of the runs tagged (the tags'
+# index, then each run by its id: a rare tag is a few lookups, whatever the sort), or for a count
+# of the newest runs only the part of that list from an id on.
+def _among_tagged(condition):
+    return Run.id.in_(select(RunTag.run_id).where(condition))
+
+
+def _among_tagged_since(since):
+    return lambda condition: Run.id.in_(select(RunTag.run_id).where(condition, RunTag.run_id >= since))
 
 
 # Each filter criterion as the condition it puts on a query, given its value (a literal, or a
@@ -79,9 +87,10 @@ _CONDITIONS = {
     "psi0_max": lambda v: Run.psi0_deg <= v,
     "created_after": lambda v: Run.created_at >= v,
     "created_before": lambda v: Run.created_at < v,
-    "tag": lambda v: Run.id.in_(select(RunTag.run_id).where(RunTag.tag == v)),
+    "tag": _tagged,
     "q": _search,
 }
+_READ_TAGS = frozenset({"tag", "q"})  # the criteria that read run_tags: they take how (runs_tagged) too
 _BOUND = {"q": _containing}  # a criterion's value as its condition takes it (the others: as given)
 _TYPED = {"end_reason": String, "q": String}  # bindparams whose type a concatenation or LIKE needs
 
@@ -103,102 +112,22 @@ def filtered(query: Select, where: RunFilter) -> Select:
     return query
 
 
-def where_criteria(query: Select, criteria: tuple[str, ...]) -> Select:
-    """``query`` with the conditions of ``criteria``, each value a bindparam named as its criterion."""
+def where_criteria(query: Select, criteria: tuple[str, ...], *, since: bool = False) -> Select:
+    """``query`` with the conditions of ``criteria``, each value a bindparam named as its criterion.
+    ``since``: only the runs from the id bound as ``since`` on, read through the id's range (and
+    the tags' from that id) even where an index of a criterion would serve a whole count better:
+    the newest runs, counted again after a write (:mod:`~backend.repositories.run_list_cache`;
+    SQLite only: it reads ``likelihood``, which PostgreSQL has not)."""
+    first_id = bindparam("since", type_=Integer) if since else None
+    runs_tagged = _among_tagged_since(first_id) if since else _among_tagged
     for criterion in criteria:
-        query = query.where(_CONDITIONS[criterion](bindparam(criterion, type_=_TYPED.get(criterion))))
+        value = bindparam(criterion, type_=_TYPED.get(criterion))
+        if criterion in _READ_TAGS:
+            query = query.where(_CONDITIONS[criterion](value, runs_tagged))
+        else:
+            query = query.where(_CONDITIONS[criterion](value))
+    if since:
+        # SQLite's planner takes an index of the criterion (zeta0 >= ?: every run in the range)
+        # over the id range unless told that few runs pass it.
+        query = query.where(func.likelihood(Run.id >= first_id, literal_column("0.001")))
     return query
-
-
-@functools.lru_cache(maxsize=256)
-def _count_statement(criteria: tuple[str, ...]) -> Select:
-    return where_criteria(select(func.count()).select_from(Run), criteria)
-
-
-def matching_count(session: Session, where: RunFilter) -> int:
-    """How many runs ``where`` selects: one COUNT, or on SQLite the one counted before for the same
-    criteria on this connection if no run has changed since (:func:`list_cache`). Paging through a
-    filter counts it once, not once per page."""
-    values = bound_values(where)
-    connection = session.connection()
-    cache = list_cache(connection)
-    key = tuple(values.items())
-    if cache is not None and key in cache.counts:
-        return cache.counts[key]
-    count = connection.execute(_count_statement(tuple(values)), values).scalar_one()
-    if cache is not None:
-        cache.keep_count(key, count)
-    return count
-
-
-class ListCache:
-    """What one SQLite connection has read of the run list while the runs' version stood at
-    ``stamp``: counts by criteria, and whole orders of matching ids by (criteria, sort), the
-    least recently used dropped past :data:`IDS_KEPT` ids (8 bytes each)."""
-
-    def __init__(self, stamp: int):
-        self.stamp = stamp
-        self.counts: dict[tuple, int] = {}
-        self.orders: OrderedDict[tuple, array] = OrderedDict()
-        self.ids_kept = 0
-        self.asked: set[tuple] = set()  # orders asked for under this stamp, kept or not
-
-    def asked_again(self, key: tuple) -> bool:
-        """Whether the order ``key`` was asked for before under this stamp (and note that it was
-        now): an order worth reading whole and keeping is one asked for twice before a write."""
-        if key in self.asked:
-            return True
-        if len(self.asked) >= COUNTS_KEPT:
-            self.asked.clear()
-        self.asked.add(key)
-        return False
-
-    def keep_count(self, key: tuple, count: int) -> None:
-        if len(self.counts) >= COUNTS_KEPT:
-            self.counts.clear()
-        self.counts[key] = count
-
-    def order(self, key: tuple) -> array | None:
-        ids = self.orders.get(key)
-        if ids is not None:
-            self.orders.move_to_end(key)
-        return ids
-
-    def keep_order(self, key: tuple, ids: array) -> None:
-        self.orders[key] = ids
-        self.ids_kept += len(ids)
-        while self.ids_kept > IDS_KEPT and len(self.orders) > 1:
-            _key, oldest = self.orders.popitem(last=False)
-            self.ids_kept -= len(oldest)
-
-
-COUNTS_KEPT = 256
-IDS_KEPT = 2_000_000  # 16 MB of ids a connection keeps at most (20 orders of 100,000 runs)
-_CACHE = "parkourlab.run_list"  # a pooled SQLite connection's info: its ListCache
-
-
-def list_cache(connection) -> ListCache | None:
-    """The connection's :class:`ListCache` for the runs as they are now (a new one once they have
-    changed), or None where nothing may be kept: on other databases, and while the connection has
-    a transaction open (its uncommitted writes may yet be rolled back)."""
-    stamp = store_stamp(connection)
-    if stamp is None:
-        return None
-    cache = connection.info.get(_CACHE)
-    if cache is None or cache.stamp != stamp:
-        cache = connection.info[_CACHE] = ListCache(stamp)
-    return cache
-
-
-def store_stamp(connection) -> int | None:
-    """The runs' version (``store_versions``, moved by SQLite's triggers whenever any connection adds
-    or deletes a run or a tag or changes what a list filters or sorts by — not a live run's
-    duration alone: migration 0008), or None when it cannot be relied on: on other databases, and
-    while ``connection`` has a transaction open. Read before what is kept under it, so a change
-    committed in between makes the next read see a new version, never an old one."""
-    if connection.dialect.name != "sqlite" or connection.connection.dbapi_connection.in_transaction:
-        return None
-    return connection.exec_driver_sql(_STAMP).scalar_one_or_none()
-
-
-_STAMP = "SELECT version FROM store_versions WHERE name = 'runs'"

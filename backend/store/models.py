@@ -145,10 +145,12 @@ class RunTag(Base):
 class StoreVersion(Base):
     """How often a part of the store has changed: ``runs`` counts the changes of runs and their tags
     that a list can see — a run or tag added or deleted, a change of what lists filter or sort by —
-    bumped by SQLite triggers (migration 0008). The run list's read workers keep the totals and
-    orders they read while it stands still (``repositories.run_filters.store_stamp``); other
-    commits — a job's trials, a live run's journal entries and its duration — leave them valid.
-    PostgreSQL has the table but no triggers (its counts are not kept)."""
+    bumped by SQLite triggers (migration 0008); ``runs_reshaped`` only those that are not to the
+    newest run (migration 0010). The run list's read workers keep the orders they read while
+    ``runs`` stands still and the totals' bases while ``runs_reshaped`` does
+    (``repositories.run_list_cache``); other commits — a job's trials, a live run's journal
+    entries and its duration — leave them valid. PostgreSQL has the table but no triggers (its
+    counts are not kept)."""
 
     __tablename__ = "store_versions"
 

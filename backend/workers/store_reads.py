@@ -17,8 +17,8 @@ assembles it): the workers import no service.
 A worker reads through its own connection, so it sees what was committed before the request
 came (a run just stored is listed); the page is the same JSON the route would encode itself
 (:data:`PAGE` is its response model). The page's ``total`` is counted once per filter while the
-store is unchanged: a worker's connection keeps its counts until anything is committed
-(``repositories.runs.matching_count``).
+store is unchanged, and after a new run only from the runs since the last count
+(``repositories.run_list_cache.matching_count``).
 """
 
 from __future__ import annotations

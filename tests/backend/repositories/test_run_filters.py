@@ -1,12 +1,9 @@
-"""Which runs a filter selects (backend/repositories/run_filters.py): the conditions and what a
-connection keeps of the run list between changes."""
-
-from array import array
+"""Which runs a filter selects (backend/repositories/run_filters.py): the conditions."""
 
 import pytest
 
-from backend.repositories import run_filters
-from backend.repositories.run_filters import ListCache, RunFilter, bound_values, matching_count
+from backend.repositories.run_filters import RunFilter, bound_values
+from backend.repositories.run_list_cache import matching_count
 from backend.repositories.runs import add_run
 from backend.store.run_record import RunRecord
 
@@ -54,21 +51,3 @@ def test_each_filter_selects_what_it_says(stored, where, count):
 def test_only_the_criteria_set_are_bound_and_a_search_as_its_pattern():
     assert bound_values(RunFilter()) == {}
     assert bound_values(RunFilter(kind="sim", q="50%_x")) == {"kind": "sim", "q": "%50\\%\\_x%"}
-
-
-def test_a_cache_keeps_the_most_recent_orders_within_its_bound(monkeypatch):
-    monkeypatch.setattr(run_filters, "IDS_KEPT", 5)
-    cache = ListCache(stamp=1)
-    cache.keep_order(("a",), array("q", [1, 2, 3]))
-    cache.keep_order(("b",), array("q", [4, 5]))
-    assert cache.order(("a",)) is not None  # used: now the most recent
-    cache.keep_order(("c",), array("q", [6]))
-    assert cache.order(("b",)) is None and list(cache.order(("a",))) == [1, 2, 3] and cache.ids_kept == 4
-
-
-def test_a_cache_forgets_its_counts_past_its_bound(monkeypatch):
-    monkeypatch.setattr(run_filters, "COUNTS_KEPT", 2)
-    cache = ListCache(stamp=1)
-    for key in ("a", "b", "c"):
-        cache.keep_count((key,), 1)
-    assert list(cache.counts) == [("c",)]

@@ -9,7 +9,7 @@ import random
 import pytest
 from sqlalchemy import insert
 
-from backend.repositories.run_filters import store_stamp
+from backend.repositories.run_list_cache import store_stamp
 from backend.repositories.runs import SORTS, RunFilter, add_run, listed_page, matching_count, outcome_columns
 from backend.store.database import make_engine, migrate, session_factory, sqlite_url
 from backend.store.models import Experiment, Run, RunTag
