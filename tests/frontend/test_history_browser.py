@@ -178,6 +178,11 @@ def test_history_pages_through_every_run_with_a_basket_across_filters(page, serv
     page.click("#runs-next")  # the robot runs: how each ended
     _range_is(page, f"runs 51–100 of {total:,} (page 2 of 25)")
     page.evaluate("window.scrollTo(0, 0)")
+    table_fits = (
+        "(() => { const box = document.querySelector('#run-table').parentElement;"
+        " return box.scrollWidth <= box.clientWidth; })()"
+    )
+    assert page.evaluate(table_fits), "every column, edit, 3D and share included, shows without scrolling sideways"
     screenshot(page, "history_paging")
     assert httpx.get(f"{base}/api/v1/runs", params={"limit": 1}).json()["total"] == total
 
