@@ -13,7 +13,22 @@ from __future__ import annotations
 
 import typer
 
-from cli import atlas, basin, bench, calibrate, export, gaits, mjtf, pid, reproduce, robot, serve, simulate, sweep
+from cli import (
+    atlas,
+    basin,
+    bench,
+    calibrate,
+    control_study,
+    export,
+    gaits,
+    mjtf,
+    pid,
+    reproduce,
+    robot,
+    serve,
+    simulate,
+    sweep,
+)
 
 app = typer.Typer(
     name="parkour",
@@ -24,7 +39,22 @@ app = typer.Typer(
     rich_markup_mode=None,
 )
 # In the order of --help.
-COMMANDS = (simulate, gaits, basin, sweep, mjtf, pid, atlas, reproduce, robot, calibrate, export, bench, serve)
+COMMANDS = (
+    simulate,
+    gaits,
+    basin,
+    sweep,
+    mjtf,
+    pid,
+    control_study,
+    atlas,
+    reproduce,
+    robot,
+    calibrate,
+    export,
+    bench,
+    serve,
+)
 for command in COMMANDS:
     app.add_typer(command.app)
 

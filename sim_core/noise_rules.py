@@ -72,12 +72,19 @@ def perturbed_controls(schedule, k, pitch, base_zeta0, sigma_psi0, sigma_zeta0, 
     """
     row = k % schedule.shape[0]
     zeta0 = schedule[row, ZETA0_COLUMN] if math.isnan(base_zeta0) else base_zeta0
+    return commanded_controls(
+        k, pitch, schedule[row, PSI0_COLUMN], zeta0, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
+    )
+
+
+@kernel
+def commanded_controls(k, pitch, psi0, zeta0, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0):
+    """Controls ``(psi0, zeta0)`` of jump ``k`` commanded ``(psi0, zeta0)``, with pitch ``pitch``
+    and fresh noise (the draws in the order :func:`perturbed_controls` takes them)."""
     right_leg = k % 2 == 1  # sim_core.walls.wall_of(k) is Wall.RIGHT, spelled for numba
     psi0_draw = _draw(sigma_psi0)
     zeta0_draw = _draw(sigma_zeta0)
-    return noisy_controls(
-        schedule[row, PSI0_COLUMN], zeta0, right_leg, pitch, asymmetry_psi0, asymmetry_zeta0, psi0_draw, zeta0_draw
-    )
+    return noisy_controls(psi0, zeta0, right_leg, pitch, asymmetry_psi0, asymmetry_zeta0, psi0_draw, zeta0_draw)
 
 
 @kernel

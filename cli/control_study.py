@@ -1,0 +1,90 @@
+"""``parkour control-study``: the standard closed-loop benchmark, every controller on the same noise."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+
+from cli.options import JsonOption, ModelSetup, handles_errors, print_json, progress_bar, with_model, with_noise
+from sim_core.control_laws import KINDS
+from sim_core.noise import NoiseModel
+from sim_core.validation import ParameterError
+
+app = typer.Typer(rich_markup_mode=None)
+NOT_YET = ("lqr", "deadbeat")  # issue 27's other laws, not built yet: named in the error
+
+
+def parse_controllers(text: str) -> list[str]:
+    """``pid,pid-pitch`` as names, in order, each once; a ParameterError naming ``controllers``."""
+    names = [name.strip() for name in text.split(",") if name.strip()]
+    if not names:
+        raise ParameterError("controllers", f"must name at least one of {', '.join(KINDS)}")
+    for name in names:
+        if name not in KINDS:
+            later = f" ({', '.join(NOT_YET)}: not built yet)" if name in NOT_YET else ""
+            raise ParameterError("controllers", f"must be among {', '.join(KINDS)}, got {name!r}{later}")
+    if len(set(names)) != len(names):
+        raise ParameterError("controllers", f"names a controller twice: {text!r}")
+    return names
+
+
+@app.command("control-study")
+@handles_errors
+@with_model
+@with_noise
+def control_study_command(
+    setup: ModelSetup,
+    noise: NoiseModel,
+    controllers: Annotated[
+        str, typer.Option("--controllers", help=f"Comma-separated, of: {', '.join(KINDS)}.")
+    ] = "pid,pid-pitch",
+    target: Annotated[float, typer.Option("--target", help="Height to hold [m].")] = 0.55,
+    seeds: Annotated[int, typer.Option("--seeds", help="Trials per controller (seeds seed0, seed0 + 1, ...).")] = 200,
+    seed0: Annotated[int, typer.Option("--seed0", help="The first trial's seed (>= 0).")] = 0,
+    jumps: Annotated[int, typer.Option("--jumps", help="Jumps per trial.")] = 400,
+    psi0: Annotated[float, typer.Option("--psi0", help="Nominal leg angle [degrees].")] = 35.0,
+    start_zeta0: Annotated[float, typer.Option("--start-zeta0", help="zeta0 of the climbing gait at the start.")] = 0.9,
+    as_json: JsonOption = False,
+) -> None:
+    """Every controller climbing to a target height under noise, on the same noise draws: failures,
+    height error once risen, jumps to rise, clipped commands, the law's time per jump."""
+    from experiments.fig12 import Config, PidClimb
+    from sim_core.control_laws import Pid
+    from sim_core.control_study import control_study
+
+    names = parse_controllers(controllers)
+    leg_length = setup.robot.scales.length
+    loop = PidClimb.of(setup.model, Config(target_m=target, psi0_deg=psi0, start_zeta0=start_zeta0, jumps=jumps),
+                       leg_length)  # fmt: skip
+    laws = [Pid(loop.controller, psi0, pitch_feedback=name == "pid-pitch") for name in names]
+    outcomes = []
+    with progress_bar("controllers") as progress:
+        for done, law in enumerate(laws, start=1):
+            outcomes += control_study(setup.model, [law], loop.start, start_zeta0, jumps, seed0, seeds, noise)
+            progress(done, len(laws))
+    result = {
+        "target_m": target,
+        "jumps": jumps,
+        "seeds": [seed0, seeds],
+        "noise": noise.to_dict(),
+        "controllers": [outcome.to_dict(leg_length) for outcome in outcomes],
+    }
+    if as_json:
+        print_json(result)
+        return
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table("controller", "failures", "height RMS", "median |error|", "rise [jumps]", "clipped", "µs/jump",
+                  title=f"{seeds} trials × {jumps} jumps to {target:g} m, the same noise for each")  # fmt: skip
+
+    def cm(value: float | None) -> str:
+        return "—" if value is None else f"{value * 100:.2f} cm"
+
+    for entry in result["controllers"]:
+        rise = "—" if entry["rise_jumps"] is None else f"{entry['rise_jumps']:g}"
+        table.add_row(entry["name"], f"{entry['failures']}/{entry['trials']}", cm(entry["height_rms_m"]),
+                      cm(entry["height_median_abs_m"]), rise, f"{entry['saturated_fraction']:.1%}",
+                      f"{entry['us_per_jump']:.3f}")  # fmt: skip
+    Console().print(table)

@@ -1,0 +1,214 @@
+"""The standard closed-loop benchmark: each controller climbing to a target under noise, every one
+on the same noise draws, and how often and how well it holds the height.
+
+A trial is a compiled loop (:func:`controlled_loop`) from the climbing gait's section state,
+``jumps`` jumps with the noise of :mod:`sim_core.noise` drawn from the trial's seed (``seed0 + i``):
+the draws are taken in the same order whatever the controller commands, so trial ``i`` meets the
+same leg noise, pitch drift and state disturbances under every controller, and with the ``pid``
+kind it is exactly :func:`sim_core.closed_loop.closed_loop_climb`'s run.
+
+Per controller (:class:`ControllerOutcome`): failures and their codes; the height error over the
+touchdowns after a run first reaches 90% of its climb (from its first touchdown to the target),
+pooled over every run while it is up, as an RMS and a median absolute error; ``rise_jumps``, the
+median first touchdown at 90%; the share of commands the law had to clip to the leg's range; and
+the law's own time per jump (:func:`controller_time_us`, the compiled step alone, not the jump).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections import Counter
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim_core._jit import kernel
+from sim_core.control_laws import MEMORY_SIZE, Pid
+from sim_core.controllers import control_step
+from sim_core.failures import OK, Failure
+from sim_core.integrate import STATE_SIZE
+from sim_core.noise import NoiseModel
+from sim_core.noise_rules import commanded_controls, disturbed_state, pitch_step, seed_trial
+from sim_core.params import ModelParams
+from sim_core.poincare import check_jumps, check_section_state
+from sim_core.stride import jump
+from sim_core.validation import check_range
+
+RISE_FRACTION = 0.9  # a run has risen once it has climbed 90% of the way to its target
+MAX_TRIALS = 100_000
+
+
+@dataclass(frozen=True)
+class ControllerOutcome:
+    """One controller's trials. Heights and errors in l0 (:meth:`to_dict` gives metres)."""
+
+    name: str
+    trials: int
+    failure_codes: dict[str, int]
+    height_errors: np.ndarray  # pooled over the runs, after each first reached 90% of its climb
+    rise_jumps: np.ndarray  # per run that rose: the first touchdown at 90% of the climb
+    commands: int
+    saturated: int
+    us_per_jump: float
+
+    @property
+    def failures(self) -> int:
+        return sum(self.failure_codes.values())
+
+    def to_dict(self, leg_length: float) -> dict:
+        """The ``parkour control-study --json`` entry; ``leg_length`` [m] converts heights."""
+        errors = self.height_errors
+        return {
+            "name": self.name,
+            "trials": self.trials,
+            "failures": self.failures,
+            "failure_rate": self.failures / self.trials,
+            "failure_codes": dict(sorted(self.failure_codes.items())),
+            "height_rms_m": float(np.sqrt(np.mean(errors**2))) * leg_length if errors.size else None,
+            "height_median_abs_m": float(np.median(np.abs(errors))) * leg_length if errors.size else None,
+            "rise_jumps": float(np.median(self.rise_jumps)) if self.rise_jumps.size else None,
+            "us_per_jump": self.us_per_jump,
+            "saturated_fraction": self.saturated / self.commands if self.commands else 0.0,
+        }
+
+
+def control_study(
+    model: ModelParams,
+    controllers: list[Pid],
+    start,
+    start_zeta0: float,
+    jumps: int,
+    seed0: int,
+    seeds: int,
+    noise: NoiseModel,
+) -> list[ControllerOutcome]:
+    """Every controller on trials ``seed0 .. seed0 + seeds - 1``, each from section state ``start``,
+    its first touchdown at the controller's nominal leg angle and ``start_zeta0``."""
+    state = check_section_state(start)
+    jumps = check_jumps(jumps)
+    check_range("seeds", seeds, 1, MAX_TRIALS, low_open=False, high_open=False)
+    check_range("seed0", seed0, 0, 2**32 - seeds, low_open=False, high_open=False)
+    check_range("start_zeta0", start_zeta0, 0.0, 1.0)
+    if not controllers:
+        raise ValueError("no controller to study")
+    outcomes = []
+    for controller in controllers:
+        kind, parameters = controller.kernel_args()
+        codes: Counter[str] = Counter()
+        errors, rises = [], []
+        commands = saturated = 0
+        target = controller.height.target
+        for seed in range(seed0, seed0 + seeds):
+            height = np.full(jumps + 1, math.nan)
+            clipped = np.zeros(jumps, dtype=np.bool_)
+            status, completed = controlled_loop(
+                state[0], state[1], math.radians(controller.psi0_deg), start_zeta0, kind, parameters, seed,
+                *noise.kernel_args(), *model.kernel_args(), height, clipped,
+            )  # fmt: skip
+            if status != OK:
+                codes[Failure(status).code] += 1
+            reached = height[: completed + 1]
+            issued = completed + (status != OK)  # a failed jump's command was issued too
+            commands += issued
+            saturated += int(np.count_nonzero(clipped[:issued]))
+            risen = np.flatnonzero((reached - reached[0]) >= RISE_FRACTION * (target - reached[0]))
+            if risen.size:
+                rises.append(int(risen[0]))
+                if status == OK:
+                    errors.append(target - reached[risen[0] :])
+        outcomes.append(
+            ControllerOutcome(
+                name=controller.name,
+                trials=seeds,
+                failure_codes=dict(codes),
+                height_errors=np.concatenate(errors) if errors else np.empty(0),
+                rise_jumps=np.array(rises, dtype=float),
+                commands=commands,
+                saturated=saturated,
+                us_per_jump=controller_time_us(controller),
+            )
+        )
+    return outcomes
+
+
+def controller_time_us(controller: Pid, steps: int = 200_000) -> float:
+    """The law's own time per jump [µs]: its compiled step over ``steps`` touchdowns, best of 3."""
+    kind, parameters = controller.kernel_args()
+    _time_steps(kind, parameters, 10)  # compiled before the clock starts
+    best = math.inf
+    for _ in range(3):
+        began = time.perf_counter()
+        _time_steps(kind, parameters, steps)
+        best = min(best, time.perf_counter() - began)
+    return 1e6 * best / steps
+
+
+@kernel
+def _time_steps(kind, parameters, steps):
+    memory = np.zeros(MEMORY_SIZE)
+    memory[1] = math.nan
+    total = 0.0
+    for k in range(steps):  # heights and pitches that vary, so no step is folded away
+        psi0, zeta0, _ = control_step(kind, parameters, memory, 0.3 + 1e-7 * k, 1e-6 * (k % 7), k % 2 == 0)
+        total += psi0 + zeta0
+    return total
+
+
+# Flat scalar arguments, in closed_loop.pid_loop's order from the seed on: repeated on purpose.
+@kernel
+def controlled_loop(
+    xdot,
+    ydot,
+    first_psi0,
+    first_zeta0,
+    kind,
+    parameters,
+    seed,
+    sigma_psi0,
+    sigma_zeta0,
+    sigma_velocity,
+    sigma_pitch,
+    asymmetry_psi0,
+    asymmetry_zeta0,
+    alpha,
+    d_hat,
+    c_zeta,
+    c_psi,
+    mu,
+    height,
+    saturated,
+):
+    """One trial under controller ``(kind, parameters)``; fills ``height`` per touchdown reached [l0]
+    and ``saturated`` per command. Returns ``(status, jumps completed)``."""
+    seed_trial(seed)
+    no_record = np.empty((0, STATE_SIZE))
+    memory = np.zeros(MEMORY_SIZE)
+    memory[1] = math.nan
+    jumps = height.shape[0] - 1
+    pitch = 0.0
+    psi0, zeta0 = commanded_controls(
+        0, pitch, first_psi0, first_zeta0, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
+    )
+    foot = 0.0
+    for k in range(jumps + 1):
+        body = foot + zeta0 * math.sin(psi0)
+        height[k] = body
+        if k == jumps:
+            break
+        # What touchdown k shows (its height, the pitch tracked in its stance) sets touchdown k + 1.
+        command_psi0, command_zeta0, clipped = control_step(kind, parameters, memory, body, pitch, (k + 1) % 2 == 0)
+        saturated[k] = clipped
+        next_pitch = pitch_step(pitch, sigma_pitch)
+        next_psi0, next_zeta0 = commanded_controls(
+            k + 1, next_pitch, command_psi0, command_zeta0, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
+        )
+        status, xdot, ydot, rise, _stance_time, _flight_time, _ = jump(
+            xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c_psi, mu, no_record
+        )
+        if status != OK:
+            return status, k
+        xdot, ydot = disturbed_state(xdot, ydot, sigma_velocity)
+        foot += rise
+        pitch, psi0, zeta0 = next_pitch, next_psi0, next_zeta0
+    return OK, jumps
