@@ -13,11 +13,11 @@ import numpy as np
 from sim_core.height_controller import HeightController
 from sim_core.validation import ParameterError, check_range
 
-PID, PID_PITCH = 0, 1
-KINDS = {"pid": PID, "pid-pitch": PID_PITCH}
+PID, PID_PITCH, LQR = 0, 1, 2
+KINDS = {"pid": PID, "pid-pitch": PID_PITCH, "lqr": LQR}
 # The leg angle's range relative to the body [deg]: the robot's angle servos (backend/robot/limits.py).
 PSI0_RANGE_DEG = (10.0, 60.0)
-MEMORY_SIZE = 2  # a law's state between touchdowns: the PID's integral and its previous error
+MEMORY_SIZE = 2  # a law's state between touchdowns: the PID's integral and previous error; the LQR's last command
 
 
 @dataclass(frozen=True)
@@ -43,6 +43,10 @@ class Pid:
     def name(self) -> str:
         return "pid-pitch" if self.pitch_feedback else "pid"
 
+    @property
+    def target(self) -> float:
+        return self.height.target
+
     def kernel_args(self) -> tuple[int, np.ndarray]:
         """``(kind, parameters)`` for :func:`control_step`."""
         height = self.height
@@ -50,3 +54,48 @@ class Pid:
         parameters = [height.target, height.zeta0_hover, height.kp, height.ki, height.kd, height.zeta0_min,
                       height.zeta0_max, math.radians(self.psi0_deg), low, high, float(self.pitch_feedback)]  # fmt: skip
         return KINDS[self.name], np.array(parameters)
+
+
+@dataclass(frozen=True)
+class Lqr:
+    """A discrete LQR on the return map linearised about a gait of jumping in place
+    (:func:`sim_core.return_map_lqr.design_lqr` computes it from the model). Its state at touchdown
+    ``k`` is the section state's deviation from the gait's, the height error (clipped to
+    ``±error_clip`` [l0]: a far target is approached at the pace of a near one) and the deviation
+    of the controls the robot touched down with (the one jump of delay); its input the next
+    touchdown's ``(psi0, zeta0)`` deviation, ``gain`` (2 × 5, row-major: psi0's row, then
+    zeta0's). The tracked pitch is fed to the leg angle as in ``pid-pitch``; commands stay within
+    ``zeta0_range`` and ``psi0_range_deg`` relative to the body. Angles in the state in rad."""
+
+    target: float  # [l0]
+    psi0_deg: float  # the gait's leg angle
+    zeta0: float  # the gait's leg length (jumping in place)
+    state: tuple[float, float]  # the gait's section state [sqrt(g l0)]
+    gain: tuple[float, ...]
+    error_clip: float = 0.4  # [l0]
+    state_clip: float = 0.15  # [sqrt(g l0)]: each section-state deviation the law acts on, at most
+    zeta0_range: tuple[float, float] = (HeightController.zeta0_min, HeightController.zeta0_max)
+    psi0_range_deg: tuple[float, float] = PSI0_RANGE_DEG
+
+    def __post_init__(self) -> None:
+        check_range("target", self.target, 0.0, 1e4)
+        check_range("error_clip", self.error_clip, 0.0, 10.0)
+        check_range("state_clip", self.state_clip, 0.0, 10.0)
+        for field, (low, high), bound in (("zeta0_range", self.zeta0_range, 1.0),
+                                          ("psi0_range_deg", self.psi0_range_deg, 90.0)):  # fmt: skip
+            check_range(field, low, 0.0, bound)
+            check_range(field, high, 0.0, bound)
+            if not low < high:
+                raise ParameterError(field, f"must be an interval (low < high), got [{low:g}, {high:g}]")
+        check_range("psi0_deg", self.psi0_deg, *self.psi0_range_deg, low_open=False, high_open=False)
+        if len(self.gain) != 10 or not all(math.isfinite(value) for value in self.gain):
+            raise ParameterError("gain", f"must be 10 finite numbers (2 x 5), got {len(self.gain)}")
+
+    name = "lqr"
+
+    def kernel_args(self) -> tuple[int, np.ndarray]:
+        """``(kind, parameters)`` for :func:`sim_core.controllers.control_step`."""
+        psi0_low, psi0_high = (math.radians(value) for value in self.psi0_range_deg)
+        parameters = [self.target, math.radians(self.psi0_deg), self.zeta0, *self.state, *self.zeta0_range,
+                      psi0_low, psi0_high, self.error_clip, 1.0, *self.gain, self.state_clip]  # fmt: skip
+        return LQR, np.array(parameters)

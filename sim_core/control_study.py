@@ -24,8 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim_core._jit import kernel
-from sim_core.control_laws import MEMORY_SIZE, Pid
-from sim_core.controllers import control_step
+from sim_core.control_laws import Lqr, Pid
+from sim_core.controllers import control_step, start_memory
 from sim_core.failures import OK, Failure
 from sim_core.integrate import STATE_SIZE
 from sim_core.noise import NoiseModel
@@ -75,7 +75,7 @@ class ControllerOutcome:
 
 def control_study(
     model: ModelParams,
-    controllers: list[Pid],
+    controllers: list[Pid | Lqr],
     start,
     start_zeta0: float,
     jumps: int,
@@ -98,7 +98,7 @@ def control_study(
         codes: Counter[str] = Counter()
         errors, rises = [], []
         commands = saturated = 0
-        target = controller.height.target
+        target = controller.target
         for seed in range(seed0, seed0 + seeds):
             height = np.full(jumps + 1, math.nan)
             clipped = np.zeros(jumps, dtype=np.bool_)
@@ -132,7 +132,7 @@ def control_study(
     return outcomes
 
 
-def controller_time_us(controller: Pid, steps: int = 200_000) -> float:
+def controller_time_us(controller: Pid | Lqr, steps: int = 200_000) -> float:
     """The law's own time per jump [µs]: its compiled step over ``steps`` touchdowns, best of 3."""
     kind, parameters = controller.kernel_args()
     _time_steps(kind, parameters, 10)  # compiled before the clock starts
@@ -146,11 +146,11 @@ def controller_time_us(controller: Pid, steps: int = 200_000) -> float:
 
 @kernel
 def _time_steps(kind, parameters, steps):
-    memory = np.zeros(MEMORY_SIZE)
-    memory[1] = math.nan
+    memory = start_memory(kind, 0.6, 0.9)
     total = 0.0
-    for k in range(steps):  # heights and pitches that vary, so no step is folded away
-        psi0, zeta0, _ = control_step(kind, parameters, memory, 0.3 + 1e-7 * k, 1e-6 * (k % 7), k % 2 == 0)
+    for k in range(steps):  # heights, pitches and states that vary, so no step is folded away
+        vary = 1e-7 * (k % 11)
+        psi0, zeta0, _ = control_step(kind, parameters, memory, 0.3 + vary, 10 * vary, -0.9 + vary, -0.2, k % 2 == 0)
         total += psi0 + zeta0
     return total
 
@@ -183,8 +183,7 @@ def controlled_loop(
     and ``saturated`` per command. Returns ``(status, jumps completed)``."""
     seed_trial(seed)
     no_record = np.empty((0, STATE_SIZE))
-    memory = np.zeros(MEMORY_SIZE)
-    memory[1] = math.nan
+    memory = start_memory(kind, first_psi0, first_zeta0)
     jumps = height.shape[0] - 1
     pitch = 0.0
     psi0, zeta0 = commanded_controls(
@@ -197,7 +196,9 @@ def controlled_loop(
         if k == jumps:
             break
         # What touchdown k shows (its height, the pitch tracked in its stance) sets touchdown k + 1.
-        command_psi0, command_zeta0, clipped = control_step(kind, parameters, memory, body, pitch, (k + 1) % 2 == 0)
+        command_psi0, command_zeta0, clipped = control_step(
+            kind, parameters, memory, body, pitch, xdot, ydot, (k + 1) % 2 == 0
+        )
         saturated[k] = clipped
         next_pitch = pitch_step(pitch, sigma_pitch)
         next_psi0, next_zeta0 = commanded_controls(
