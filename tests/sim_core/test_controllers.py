@@ -34,7 +34,7 @@ def test_the_pid_is_the_height_law_and_holds_the_leg_angle():
 
 @pytest.mark.parametrize(("next_on_left", "sign"), [(True, -1.0), (False, 1.0)])
 def test_pitch_feedback_turns_the_next_leg_back_by_the_pitch_its_wall_adds(next_on_left, sign):
-    """The left wall's leg meets it at psi0 + pitch, the right's at psi0 - pitch (model.md §5.1):
+    """The left wall's leg meets it at psi0 + pitch, the right's at psi0 - pitch (docs/model.md §5.1):
     the command takes that back, so the leg meets the wall at the nominal angle."""
     law = Pid(HEIGHT, 35.0, pitch_feedback=True)
     pitch = math.radians(3.0)

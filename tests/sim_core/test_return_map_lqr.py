@@ -51,7 +51,7 @@ def test_the_map_is_linearised_about_a_gait_of_jumping_in_place():
     jacobian = linearised_map(PAPER, law.state, psi0, hover)
     assert jacobian.shape == (3, 6) and np.all(np.isfinite(jacobian))
     # Jumping in place: the state maps to itself and the body does not rise, so the map's own
-    # state block has the gait's eigenvalues (|lambda| ~ 0.99: model.md §4.2), inside the unit circle.
+    # state block has the gait's eigenvalues (|lambda| ~ 0.99: docs/model.md §4.2), inside the unit circle.
     assert 0.9 < np.max(np.abs(np.linalg.eigvals(jacobian[:2, :2]))) < 1.0
 
 
