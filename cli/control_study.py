@@ -9,24 +9,15 @@ import typer
 from cli.options import JsonOption, ModelSetup, handles_errors, print_json, progress_bar, with_model, with_noise
 from sim_core.control_laws import KINDS
 from sim_core.noise import NoiseModel
-from sim_core.validation import ParameterError
 
 app = typer.Typer(rich_markup_mode=None)
-NOT_YET = ("deadbeat",)  # issue 27's other law, not built yet: named in the error
 
 
-def parse_controllers(text: str) -> list[str]:
+def parse_controllers(text: str) -> tuple[str, ...]:
     """``pid,pid-pitch`` as names, in order, each once; a ParameterError naming ``controllers``."""
-    names = [name.strip() for name in text.split(",") if name.strip()]
-    if not names:
-        raise ParameterError("controllers", f"must name at least one of {', '.join(KINDS)}")
-    for name in names:
-        if name not in KINDS:
-            later = f" ({name}: not built yet)" if name in NOT_YET else ""
-            raise ParameterError("controllers", f"must be among {', '.join(KINDS)}, got {name!r}{later}")
-    if len(set(names)) != len(names):
-        raise ParameterError("controllers", f"names a controller twice: {text!r}")
-    return names
+    from experiments.control_study import check_controllers
+
+    return check_controllers(name.strip() for name in text.split(",") if name.strip())
 
 
 @app.command("control-study")
@@ -49,34 +40,12 @@ def control_study_command(
 ) -> None:
     """Every controller climbing to a target height under noise, on the same noise draws: failures,
     height error once risen, jumps to rise, clipped commands, the law's time per jump."""
-    from experiments.fig12 import Config, PidClimb
-    from sim_core.control_laws import Pid
-    from sim_core.control_study import control_study
-    from sim_core.return_map_lqr import design_lqr
+    from experiments.control_study import Config, run
 
-    names = parse_controllers(controllers)
-    leg_length = setup.robot.scales.length
-    loop = PidClimb.of(setup.model, Config(target_m=target, psi0_deg=psi0, start_zeta0=start_zeta0, jumps=jumps),
-                       leg_length)  # fmt: skip
-    height = loop.controller
-    laws = [
-        design_lqr(setup.model, height.target, psi0, loop.hover, zeta0_range=(height.zeta0_min, height.zeta0_max))
-        if name == "lqr"
-        else Pid(height, psi0, pitch_feedback=name == "pid-pitch")
-        for name in names
-    ]
-    outcomes = []
-    with progress_bar("controllers") as progress:
-        for done, law in enumerate(laws, start=1):
-            outcomes += control_study(setup.model, [law], loop.start, start_zeta0, jumps, seed0, seeds, noise)
-            progress(done, len(laws))
-    result = {
-        "target_m": target,
-        "jumps": jumps,
-        "seeds": [seed0, seeds],
-        "noise": noise.to_dict(),
-        "controllers": [outcome.to_dict(leg_length) for outcome in outcomes],
-    }
+    config = Config(controllers=parse_controllers(controllers), target_m=target, psi0_deg=psi0,
+                    start_zeta0=start_zeta0, jumps=jumps, seeds=seeds, seed0=seed0, noise=noise)  # fmt: skip
+    with progress_bar("trials") as progress:
+        result = run(setup.model, setup.robot.scales.length, config, progress=progress).to_dict()
     if as_json:
         print_json(result)
         return

@@ -11,7 +11,10 @@ Per controller (:class:`ControllerOutcome`): failures and their codes; the heigh
 touchdowns after a run first reaches 90% of its climb (from its first touchdown to the target),
 pooled over every run while it is up, as an RMS and a median absolute error; ``rise_jumps``, the
 median first touchdown at 90%; the share of commands the law had to clip to the leg's range; and
-the law's own time per jump (:func:`controller_time_us`, the compiled step alone, not the jump).
+the law's own time per jump (:func:`controller_time_us`, the compiled step alone, not the jump);
+the jumps done by each failed trial and the first trials' climbs whole, to draw. The trials run in
+chunks of seeds (:func:`study_chunk`) through a chunk map (:mod:`sim_core.chunks`), as a job on the
+service's worker or a Dask cluster; the outcome does not depend on the chunking.
 """
 
 from __future__ import annotations
@@ -19,11 +22,12 @@ from __future__ import annotations
 import math
 import time
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from sim_core._jit import kernel
+from sim_core.chunks import ChunkMap, Progress, chunk_slices, in_process
 from sim_core.control_laws import Lqr, Pid
 from sim_core.controllers import control_step, start_memory
 from sim_core.failures import OK, Failure
@@ -37,6 +41,8 @@ from sim_core.validation import check_range
 
 RISE_FRACTION = 0.9  # a run has risen once it has climbed 90% of the way to its target
 MAX_TRIALS = 100_000
+CHUNK_SEEDS = 50  # trials per chunk: a progress step of about a tenth of a second at 400 jumps
+EXAMPLES = 3  # the first trials' climbs kept whole, to show
 
 
 @dataclass(frozen=True)
@@ -51,6 +57,8 @@ class ControllerOutcome:
     commands: int
     saturated: int
     us_per_jump: float
+    failure_jumps: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=np.int64))  # jumps done, per failure
+    examples: tuple[np.ndarray, ...] = ()  # the first trials' touchdown heights [l0], up to EXAMPLES
 
     @property
     def failures(self) -> int:
@@ -72,6 +80,25 @@ class ControllerOutcome:
             "saturated_fraction": self.saturated / self.commands if self.commands else 0.0,
         }
 
+    @classmethod
+    def merged(cls, parts: list[ControllerOutcome], us_per_jump: float | None = None) -> ControllerOutcome:
+        """One controller's chunks of trials (in seed order) as one outcome."""
+        codes: Counter[str] = Counter()
+        for part in parts:
+            codes.update(part.failure_codes)
+        return cls(
+            name=parts[0].name,
+            trials=sum(part.trials for part in parts),
+            failure_codes=dict(codes),
+            height_errors=np.concatenate([part.height_errors for part in parts]),
+            rise_jumps=np.concatenate([part.rise_jumps for part in parts]),
+            commands=sum(part.commands for part in parts),
+            saturated=sum(part.saturated for part in parts),
+            us_per_jump=parts[0].us_per_jump if us_per_jump is None else us_per_jump,
+            failure_jumps=np.concatenate([part.failure_jumps for part in parts]),
+            examples=tuple(example for part in parts for example in part.examples)[:EXAMPLES],
+        )
+
 
 def control_study(
     model: ModelParams,
@@ -82,9 +109,15 @@ def control_study(
     seed0: int,
     seeds: int,
     noise: NoiseModel,
+    *,
+    chunk_map: ChunkMap = in_process,
+    progress: Progress | None = None,
+    chunk_seeds: int = CHUNK_SEEDS,
 ) -> list[ControllerOutcome]:
     """Every controller on trials ``seed0 .. seed0 + seeds - 1``, each from section state ``start``,
-    its first touchdown at the controller's nominal leg angle and ``start_zeta0``."""
+    its first touchdown at the controller's nominal leg angle and ``start_zeta0``. The trials run
+    as chunks of ``chunk_seeds`` seeds per controller through ``chunk_map`` (:mod:`sim_core.chunks`);
+    results do not depend on it."""
     state = check_section_state(start)
     jumps = check_jumps(jumps)
     check_range("seeds", seeds, 1, MAX_TRIALS, low_open=False, high_open=False)
@@ -92,44 +125,69 @@ def control_study(
     check_range("start_zeta0", start_zeta0, 0.0, 1.0)
     if not controllers:
         raise ValueError("no controller to study")
-    outcomes = []
-    for controller in controllers:
-        kind, parameters = controller.kernel_args()
-        codes: Counter[str] = Counter()
-        errors, rises = [], []
-        commands = saturated = 0
-        target = controller.target
-        for seed in range(seed0, seed0 + seeds):
-            height = np.full(jumps + 1, math.nan)
-            clipped = np.zeros(jumps, dtype=np.bool_)
-            status, completed = controlled_loop(
-                state[0], state[1], math.radians(controller.psi0_deg), start_zeta0, kind, parameters, seed,
-                *noise.kernel_args(), *model.kernel_args(), height, clipped,
-            )  # fmt: skip
-            if status != OK:
-                codes[Failure(status).code] += 1
-            reached = height[: completed + 1]
-            issued = completed + (status != OK)  # a failed jump's command was issued too
-            commands += issued
-            saturated += int(np.count_nonzero(clipped[:issued]))
-            risen = np.flatnonzero((reached - reached[0]) >= RISE_FRACTION * (target - reached[0]))
-            if risen.size:
-                rises.append(int(risen[0]))
-                if status == OK:
-                    errors.append(target - reached[risen[0] :])
-        outcomes.append(
-            ControllerOutcome(
-                name=controller.name,
-                trials=seeds,
-                failure_codes=dict(codes),
-                height_errors=np.concatenate(errors) if errors else np.empty(0),
-                rise_jumps=np.array(rises, dtype=float),
-                commands=commands,
-                saturated=saturated,
-                us_per_jump=controller_time_us(controller),
-            )
-        )
-    return outcomes
+    pieces = chunk_slices(seeds, chunk_seeds)
+    arguments = [
+        (model, controller, state, start_zeta0, jumps, seed0 + piece.start, piece.stop - piece.start, noise)
+        for controller in controllers
+        for piece in pieces
+    ]
+    parts = chunk_map(study_chunk, arguments, progress)
+    return [
+        ControllerOutcome.merged(parts[i * len(pieces) : (i + 1) * len(pieces)], controller_time_us(controller))
+        for i, controller in enumerate(controllers)
+    ]
+
+
+def study_chunk(
+    model: ModelParams,
+    controller: Pid | Lqr,
+    state: np.ndarray,
+    start_zeta0: float,
+    jumps: int,
+    seed0: int,
+    seeds: int,
+    noise: NoiseModel,
+) -> ControllerOutcome:
+    """One controller on trials ``seed0 .. seed0 + seeds - 1`` (a chunk of :func:`control_study`);
+    its ``us_per_jump`` is left at 0 (timed once, for the whole study)."""
+    kind, parameters = controller.kernel_args()
+    codes: Counter[str] = Counter()
+    errors, rises, failed_at, examples = [], [], [], []
+    commands = saturated = 0
+    target = controller.target
+    for seed in range(seed0, seed0 + seeds):
+        height = np.full(jumps + 1, math.nan)
+        clipped = np.zeros(jumps, dtype=np.bool_)
+        status, completed = controlled_loop(
+            state[0], state[1], math.radians(controller.psi0_deg), start_zeta0, kind, parameters, seed,
+            *noise.kernel_args(), *model.kernel_args(), height, clipped,
+        )  # fmt: skip
+        if status != OK:
+            codes[Failure(status).code] += 1
+            failed_at.append(completed)
+        reached = height[: completed + 1]
+        if seed < seed0 + EXAMPLES:
+            examples.append(reached)
+        issued = completed + (status != OK)  # a failed jump's command was issued too
+        commands += issued
+        saturated += int(np.count_nonzero(clipped[:issued]))
+        risen = np.flatnonzero((reached - reached[0]) >= RISE_FRACTION * (target - reached[0]))
+        if risen.size:
+            rises.append(int(risen[0]))
+            if status == OK:
+                errors.append(target - reached[risen[0] :])
+    return ControllerOutcome(
+        name=controller.name,
+        trials=seeds,
+        failure_codes=dict(codes),
+        height_errors=np.concatenate(errors) if errors else np.empty(0),
+        rise_jumps=np.array(rises, dtype=float),
+        commands=commands,
+        saturated=saturated,
+        us_per_jump=0.0,
+        failure_jumps=np.array(failed_at, dtype=np.int64),
+        examples=tuple(examples),
+    )
 
 
 def controller_time_us(controller: Pid | Lqr, steps: int = 200_000) -> float:
