@@ -38,8 +38,9 @@ def runs_frame(records: list[dict[str, Any]]) -> pd.DataFrame:
 def results_frame(results: Mapping[str, Any]) -> pd.DataFrame:
     """A job's results as a table: MJTF, one row per energy level (``zeta0`` [l0], ``trials``,
     ``mean``, ``std`` jumps to failure, and an ``outcome.<code>`` count per way a trial ended);
-    a sweep, one row per zeta0 point; a gait search, one row per gait. A basin is a grid, not a
-    table: ValueError (its ``result`` is plain data)."""
+    a sweep, one row per zeta0 point; a gait search, one row per gait; a control study, one row
+    per controller (``failure_codes.<code>`` flattened). A basin is a grid, not a table: ValueError
+    (its ``result`` is plain data)."""
     pandas = require_pandas()
     kind = results["job"]["kind"]
     if kind == "mjtf":
@@ -47,7 +48,7 @@ def results_frame(results: Mapping[str, Any]) -> pd.DataFrame:
     result = results.get("result")
     if result is None:
         raise ValueError(f"job {results['job']['id']} has no result yet (state {results['job']['state']})")
-    rows = {"sweep": "points", "gaits": "gaits"}.get(kind)
+    rows = {"sweep": "points", "gaits": "gaits", "control-study": "controllers"}.get(kind)
     if rows is None:
         raise ValueError(f"a {kind} job's result is not a table: use Client.results(job)['result']")
     return pandas.json_normalize(result[rows])

@@ -1,4 +1,4 @@
-"""Batch jobs through the client: submit (MJTF, sweep, basin, gait search), follow, wait, read
+"""Batch jobs through the client: submit (MJTF, sweep, basin, gait search, control study), follow, wait, read
 results, cancel. The part of :class:`parkourlab.Client` that deals with ``/api/v1/jobs``."""
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ class JobCalls:
     _http: Http
 
     def submit_job(self, kind: str, **spec: Any) -> Job:
-        """Queue a job of ``kind`` (``mjtf``, ``sweep``, ``basin``, ``gaits``) with ``spec`` as its
+        """Queue a job of ``kind`` (``mjtf``, ``sweep``, ``basin``, ``gaits``, ``control-study``) with ``spec`` as its
         body (the API's field names; docs/service.md). Returns it queued (202). The typed
         ``submit_*`` methods below are the same with each field named."""
         body = {"kind": kind} | present(spec)
@@ -105,6 +105,30 @@ class JobCalls:
         ``grid`` × ``grid`` of guesses."""
         spec = {"controls": legs(controls), "period": period, "grid": grid}
         return self.submit_job("gaits", **spec, model=mapping(model), experiment_id=experiment_id)
+
+    def submit_control_study(
+        self,
+        controllers: Sequence[str],
+        *,
+        target_m: float | None = None,
+        seeds: int | None = None,
+        seed0: int | None = None,
+        jumps: int | None = None,
+        psi0_deg: float | None = None,
+        start_zeta0: float | None = None,
+        noise: Mapping[str, float] | None = None,
+        model: Mapping[str, Any] | None = None,
+        experiment_id: int | None = None,
+    ) -> Job:
+        """The closed-loop benchmark (``parkour control-study``): each of ``controllers`` (``pid``,
+        ``pid-pitch``, ``lqr`` …) climbing to ``target_m`` [m] from the climbing gait at
+        ``psi0_deg`` [deg] and ``start_zeta0`` [l0], ``seeds`` trials of ``jumps`` jumps (seeds
+        ``seed0``, ``seed0 + 1`` …), every controller on the same ``noise`` draws. Its result: per
+        controller failures, height RMS and median error [m], jumps to rise, clipped commands
+        (``results_frame`` gives a row each), and the panel's plots."""
+        spec = {"controllers": list(controllers), "target_m": target_m, "seeds": seeds, "seed0": seed0}
+        spec |= {"jumps": jumps, "psi0_deg": psi0_deg, "start_zeta0": start_zeta0, "noise": mapping(noise)}
+        return self.submit_job("control-study", **spec, model=mapping(model), experiment_id=experiment_id)
 
     def job(self, job: JobRef) -> Job:
         """A job's state now: ``state``, ``completed`` of ``total``, ``progress`` in [0, 1], ``error``."""

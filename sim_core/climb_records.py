@@ -25,6 +25,9 @@ from sim_core.params import PhysicalParams
 from sim_core.walls import Wall
 
 FLOOR = 0.0  # [m] the chute's floor: the height of the first foot's touchdown
+# [m] the top of the lab's chute, its air table's length up the slope (the paper's climbs end there,
+# §VI.D): the highest height a controller may be asked to hold, in every front end.
+CHUTE_TOP = 2.0
 SAMPLE_RATE = 200.0  # path samples per sqrt(l0/g): ~2.4 ms for the paper's robot
 
 

@@ -1,5 +1,5 @@
-"""Batch jobs: the four kinds a client can ask for (MJTF, energy sweep, basin, gait search), each
-bounded by a work budget, and what a job and its results look like."""
+"""Batch jobs: the kinds a client can ask for (MJTF, energy sweep, basin, gait search, control
+study), each bounded by a work budget, and what a job and its results look like."""
 
 from __future__ import annotations
 
@@ -22,6 +22,8 @@ from backend.schemas.common import (
     Strict,
     Zeta0,
 )
+from sim_core.climb_records import CHUTE_TOP, FLOOR
+from sim_core.control_laws import KINDS, PSI0_RANGE_DEG
 from sim_core.noise import ASYMMETRY_LIMITS, SIGMA_LIMITS, NoiseModel
 
 # A job's work, in jumps at its worst (every trial to its cap, every basin point to its jump limit):
@@ -142,6 +144,43 @@ class GaitSearchJobCreate(Strict):
     grid: Annotated[int, Field(ge=1, le=20)] = 6
 
 
+class ControlStudyJobCreate(Strict):
+    """The closed-loop benchmark (``parkour control-study``): each controller climbing to
+    ``target_m`` on the same noise draws, ``seeds`` trials of ``jumps`` jumps each."""
+
+    kind: Literal["control-study"]
+    experiment_id: RecordRef | None = None
+    model: ModelIn = ModelIn()
+    controllers: Annotated[
+        list[str], Field(min_length=1, max_length=8, description=f"names, each once, of: {', '.join(KINDS)}")
+    ] = ["pid", "pid-pitch", "lqr"]
+    target_m: Annotated[
+        float, Field(gt=FLOOR, le=CHUTE_TOP, description="height to hold [m], above the floor, within the chute")
+    ] = 0.55
+    psi0_deg: Annotated[
+        float, Field(ge=PSI0_RANGE_DEG[0], le=PSI0_RANGE_DEG[1], description="nominal leg angle [deg]")
+    ] = 35.0
+    start_zeta0: Zeta0 = 0.9
+    jumps: Annotated[int, Field(ge=1, le=100_000)] = 400
+    seeds: Annotated[int, Field(ge=1, le=MAX_TRIALS)] = 200
+    seed0: Annotated[int, Field(ge=0, le=2**32 - MAX_TRIALS)] = 0
+    noise: NoiseIn = NoiseIn()
+
+    @field_validator("controllers")
+    @classmethod
+    def _known(cls, names: list[str]) -> list[str]:
+        unknown = [name for name in names if name not in KINDS]
+        if unknown:
+            raise ValueError(f"must be among {', '.join(KINDS)}, got {unknown[0]!r}")
+        if len(set(names)) != len(names):
+            raise ValueError(f"names a controller twice: {', '.join(names)}")
+        return names
+
+    @model_validator(mode="after")
+    def _within_budget(self) -> ControlStudyJobCreate:
+        return _within_budget(self)
+
+
 def worst_case_jumps(job) -> tuple[int, str]:
     """A job's work in jumps at its worst, and the formula that counts it: for a request body or a
     stored spec alike (both have the fields this reads)."""
@@ -151,6 +190,8 @@ def worst_case_jumps(job) -> tuple[int, str]:
         return job.steps * job.basin_grid**2 * job.basin_jumps, "steps x basin_grid² x basin_jumps"
     if job.kind == "basin":
         return job.grid**2 * job.jumps, "grid² x jumps"
+    if job.kind == "control-study":
+        return len(job.controllers) * job.seeds * job.jumps, "controllers x seeds x jumps"
     return job.grid**2 * GAIT_SEARCH_JUMPS, f"grid² x {GAIT_SEARCH_JUMPS}"
 
 
@@ -176,10 +217,12 @@ JobCreate = Annotated[
     Annotated[MJTFJobCreate, KindTag("mjtf")]
     | Annotated[SweepJobCreate, KindTag("sweep")]
     | Annotated[BasinJobCreate, KindTag("basin")]
-    | Annotated[GaitSearchJobCreate, KindTag("gaits")],
+    | Annotated[GaitSearchJobCreate, KindTag("gaits")]
+    | Annotated[ControlStudyJobCreate, KindTag("control-study")],
     Discriminator(_job_kind),
 ]
-JOB_KINDS = {"mjtf": MJTFJobCreate, "sweep": SweepJobCreate, "basin": BasinJobCreate, "gaits": GaitSearchJobCreate}
+JOB_KINDS = {"mjtf": MJTFJobCreate, "sweep": SweepJobCreate, "basin": BasinJobCreate, "gaits": GaitSearchJobCreate,
+             "control-study": ControlStudyJobCreate}  # fmt: skip
 
 
 class JobOut(BaseModel):

@@ -108,8 +108,23 @@ class GaitSearchSpec:
     kind: str = "gaits"
 
 
-JobSpec = MJTFSpec | SweepSpec | BasinSpec | GaitSearchSpec
-SPECS: dict[str, type] = {"mjtf": MJTFSpec, "sweep": SweepSpec, "basin": BasinSpec, "gaits": GaitSearchSpec}
+@dataclass(frozen=True)
+class ControlStudySpec:
+    controllers: tuple[str, ...] = ("pid", "pid-pitch", "lqr")
+    model: ModelSpec = field(default_factory=ModelSpec)
+    target_m: float = 0.55
+    psi0_deg: float = 35.0
+    start_zeta0: float = 0.9
+    jumps: int = 400
+    seeds: int = 200
+    seed0: int = 0
+    noise: NoiseSpec = field(default_factory=NoiseSpec)
+    kind: str = "control-study"
+
+
+JobSpec = MJTFSpec | SweepSpec | BasinSpec | GaitSearchSpec | ControlStudySpec
+SPECS: dict[str, type] = {"mjtf": MJTFSpec, "sweep": SweepSpec, "basin": BasinSpec, "gaits": GaitSearchSpec,
+                          "control-study": ControlStudySpec}  # fmt: skip
 _PARTS = {"model": ModelSpec, "noise": NoiseSpec, "guess": StateSpec}
 
 
@@ -146,7 +161,7 @@ def decode(stored: dict) -> JobSpec:
             value = _PARTS[spec_field.name](**value)
         elif spec_field.name == "controls":
             value = tuple(LegSpec(**leg) for leg in value)
-        elif spec_field.name == "zeta0s":
+        elif spec_field.name in ("zeta0s", "controllers"):
             value = tuple(value)
         values[spec_field.name] = value
     return cls(**values)

@@ -153,11 +153,13 @@ def run_study_here(spec) -> dict:
 
 
 def run_study(spec, chunk_map, progress) -> dict:
-    """A sweep, basin or gait-search job's computation; returns its JSON result."""
+    """A sweep, basin, gait-search or control-study job's computation; returns its JSON result."""
     from sim_core.gait_search import search_gaits
     from sim_core.sweep import energy_sweep, zeta0_values
 
     model = model_params(spec.model)
+    if spec.kind == "control-study":
+        return _control_study(spec, model, chunk_map, progress)
     if spec.kind == "sweep":
         psi0 = math.radians(spec.psi0_deg)
         grid = None if spec.basin_grid == 0 else BasinGrid(*DEFAULT_BASIN_WINDOW, spec.basin_grid)
@@ -195,6 +197,18 @@ def run_study(spec, chunk_map, progress) -> dict:
             progress=progress,
         )
     return basin.to_dict()
+
+
+def _control_study(spec, model: ModelParams, chunk_map, progress) -> dict:
+    """The benchmark's JSON (``parkour control-study --json``) and what the panel plots of it."""
+    from experiments.control_study import Config, run
+
+    leg_length = resolve_model(None, spec.model.preset).robot.leg_length  # a stored preset is resolved already
+    config = Config(controllers=tuple(spec.controllers), target_m=spec.target_m, psi0_deg=spec.psi0_deg,
+                    start_zeta0=spec.start_zeta0, jumps=spec.jumps, seeds=spec.seeds, seed0=spec.seed0,
+                    noise=spec.noise.model())  # fmt: skip
+    result = run(model, leg_length, config, chunk_map=chunk_map, progress=progress)
+    return {**result.to_dict(), "plots": result.plots()}
 
 
 def simulate_run(body: RunCreate) -> RunRecord:

@@ -68,6 +68,9 @@ def test_each_kind_of_job_its_table(fake_pandas):
     assert results_frame(results("sweep", {"points": points, "psi0_deg": 30})) == ("json_normalize", points)
     gaits = [{"period": 1, "state": {"xdot": -0.9, "ydot": -0.2}}]
     assert results_frame(results("gaits", {"gaits": gaits})) == ("json_normalize", gaits)
+    controllers = [{"name": "pid", "failures": 3, "failure_codes": {"slip": 3}}, {"name": "lqr", "failures": 0}]
+    study = {"controllers": controllers, "target_m": 0.55, "plots": {}}
+    assert results_frame(results("control-study", study)) == ("json_normalize", controllers)
 
 
 def test_a_basin_or_a_job_without_its_result_is_refused(fake_pandas):

@@ -98,6 +98,10 @@ EVERY_FIELD = {
         tolerance=0.05, model={"preset": "paper"}, experiment_id=2,
     ),
     "gaits": lambda c: c.submit_gaits([(30, 0.87), (30, 0.9)], period=2, grid=4, model={"alpha": 2.0}, experiment_id=2),
+    "control-study": lambda c: c.submit_control_study(
+        ["pid", "lqr"], target_m=0.5, seeds=20, seed0=3, jumps=100, psi0_deg=33.0, start_zeta0=0.88,
+        noise={"pitch_drift_deg": 0.5}, model={"preset": "paper"}, experiment_id=2,
+    ),
 }  # fmt: skip
 
 
@@ -117,7 +121,7 @@ def test_typed_submits_name_every_field_of_their_kind():
     from backend.schemas import JOB_KINDS
 
     for kind, request_model in JOB_KINDS.items():
-        parameters = set(inspect.signature(getattr(Client, f"submit_{kind}")).parameters) - {"self"}
+        parameters = set(inspect.signature(getattr(Client, f"submit_{kind.replace('-', '_')}")).parameters) - {"self"}
         assert parameters == set(request_model.model_fields) - {"kind"}, kind
 
 

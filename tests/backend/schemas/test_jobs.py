@@ -10,6 +10,7 @@ from backend.schemas.jobs import (
     JOB_KINDS,
     WORK_BUDGET_JUMPS,
     BasinJobCreate,
+    ControlStudyJobCreate,
     GaitSearchJobCreate,
     JobCreate,
     JobOut,
@@ -26,7 +27,8 @@ MJTF = {"zeta0s": [0.9]}
 SWEEP = {"kind": "sweep"}
 BASIN = {"kind": "basin", "controls": [LEG]}
 GAITS = {"kind": "gaits", "controls": [LEG]}
-BODIES = {"mjtf": MJTF, "sweep": SWEEP, "basin": BASIN, "gaits": GAITS}
+CONTROL = {"kind": "control-study"}
+BODIES = {"mjtf": MJTF, "sweep": SWEEP, "basin": BASIN, "gaits": GAITS, "control-study": CONTROL}
 
 
 @pytest.mark.parametrize("kind", JOB_KINDS)
@@ -101,8 +103,10 @@ def test_mjtf_levels_are_distinct():
         (SweepJobCreate, SWEEP | {"steps": 500, "basin_grid": 200, "basin_jumps": 25}, {"basin_jumps": 26},
          "steps x basin_grid² x basin_jumps"),
         (BasinJobCreate, BASIN | {"grid": 1000, "jumps": 500}, {"jumps": 501}, "grid² x jumps"),
+        (ControlStudyJobCreate, CONTROL | {"controllers": ["pid", "lqr"], "seeds": 50_000, "jumps": 5000},
+         {"jumps": 5001}, "controllers x seeds x jumps"),
     ],
-    ids=["mjtf", "sweep", "basin"],
+    ids=["mjtf", "sweep", "basin", "control-study"],
 )  # fmt: skip
 def test_a_job_at_the_work_budget_is_taken_and_one_jump_over_is_refused_naming_the_formula(
     schema, at_budget, over, formula
@@ -141,6 +145,19 @@ def test_a_sweeps_basin_grid_is_none_or_at_least_2(grid, taken):
         (GaitSearchJobCreate, GAITS, "grid", 20, 21),
         (GaitSearchJobCreate, GAITS, "grid", 1, 0),
         (GaitSearchJobCreate, GAITS, "period", 1, 0),
+        (ControlStudyJobCreate, CONTROL, "target_m", 2.0, 2.0001),
+        (ControlStudyJobCreate, CONTROL, "target_m", 1e-9, 0.0),
+        (ControlStudyJobCreate, CONTROL, "psi0_deg", 10.0, 9.99),
+        (ControlStudyJobCreate, CONTROL, "psi0_deg", 60.0, 60.01),
+        (ControlStudyJobCreate, CONTROL, "start_zeta0", 0.999, 1.0),
+        (ControlStudyJobCreate, CONTROL, "jumps", 1, 0),
+        (ControlStudyJobCreate, CONTROL, "jumps", 100_000, 100_001),
+        (ControlStudyJobCreate, CONTROL, "seeds", 1, 0),
+        (ControlStudyJobCreate, CONTROL, "seeds", 100_000, 100_001),
+        (ControlStudyJobCreate, CONTROL, "seed0", 0, -1),
+        (ControlStudyJobCreate, CONTROL, "seed0", 2**32 - 100_000, 2**32 - 99_999),
+        (ControlStudyJobCreate, CONTROL, "controllers", ["pid-pitch"], ["pid-pitch", "pid-pitch"]),
+        (ControlStudyJobCreate, CONTROL, "controllers", ["lqr"], ["lqr", "pd"]),
     ],
 )
 def test_study_jobs_outside_their_range_are_refused_naming_the_field(schema, body, field, inside, outside):

@@ -9,7 +9,7 @@ import pytest
 from sqlalchemy import delete, select, update
 
 from backend.errors import NotFound
-from backend.schemas import BasinJobCreate, GaitSearchJobCreate, LegIn, MJTFJobCreate, StateIn
+from backend.schemas import BasinJobCreate, ControlStudyJobCreate, GaitSearchJobCreate, LegIn, MJTFJobCreate, StateIn
 from backend.services import job_runner, jobs, room
 from backend.store.models import Job, Trial
 from sim_core import get_preset
@@ -124,6 +124,27 @@ def test_a_study_job_stores_its_result(sessions, session, compute):
     assert (done.state, done.completed, done.total) == ("done", 1, 1)
     result = jobs.job_results(session, job.id).result
     assert result["gaits"][0]["period"] == 1 and result["gaits"][0]["stable"]
+
+
+def test_a_control_study_left_running_by_a_crash_is_computed_again_to_the_same_result(sessions, session, runner):
+    """A control study is deterministic: the job a crash left ``running`` (its progress part way)
+    is queued again at the next start and ends with the result an uninterrupted run gives."""
+    spec = ControlStudyJobCreate(kind="control-study", controllers=["pid-pitch", "pid"], seeds=60, jumps=60)
+    job = jobs.create_job(session, spec)
+    job_runner.JobRunner(sessions, runner.pool).run(job.id)
+    uninterrupted = jobs.job_results(session, job.id).result
+    assert job_now(sessions, job.id).total == 4, "two controllers x two chunks of 50 seeds"
+    session.execute(update(Job).where(Job.id == job.id).values(state="running", completed=1, result=None,
+                                                               finished_at=None))  # fmt: skip
+    session.commit()
+
+    runner.start()
+    resumed = wait_until(sessions, job.id, lambda j: j.state in jobs.FINAL)
+    assert (resumed.state, resumed.completed, resumed.total) == ("done", 4, 4)
+    result = jobs.job_results(session, job.id).result
+    for entry in (*result["controllers"], *uninterrupted["controllers"]):
+        entry.pop("us_per_jump")  # timed, so never the same twice
+    assert result == uninterrupted and [entry["name"] for entry in result["controllers"]] == ["pid-pitch", "pid"]
 
 
 def test_a_failing_job_is_recorded_and_the_runner_goes_on(sessions, session, runner):

@@ -3,7 +3,14 @@
 import pytest
 from pydantic import ValidationError
 
-from backend.schemas import JOB_KINDS, BasinJobCreate, GaitSearchJobCreate, MJTFJobCreate, SweepJobCreate
+from backend.schemas import (
+    JOB_KINDS,
+    BasinJobCreate,
+    ControlStudyJobCreate,
+    GaitSearchJobCreate,
+    MJTFJobCreate,
+    SweepJobCreate,
+)
 from backend.services.job_specs import (
     SPEC_VERSION,
     LegSpec,
@@ -22,6 +29,7 @@ REQUESTS = [
     SweepJobCreate(kind="sweep", steps=3, basin_grid=0),
     BasinJobCreate(kind="basin", controls=LEGS, grid=4, jumps=5),
     GaitSearchJobCreate(kind="gaits", controls=LEGS, grid=2),
+    ControlStudyJobCreate(kind="control-study", controllers=["lqr", "pid"], seeds=3, noise={"velocity": 0.02}),
 ]
 
 

@@ -164,3 +164,48 @@ def test_the_submitter_is_the_client_header_else_the_address(client, auth):
     assert named["submitted_by"] == "panel" and unnamed["submitted_by"] == "testclient"
     bad = client.post("/api/v1/jobs", json=body, headers=auth | {"X-Parkour-Client": "<script>"})
     assert bad.status_code == 422 and bad.json()["detail"][0]["loc"] == ["header", "X-Parkour-Client"]
+
+
+def test_a_control_study_job_gives_the_studys_numbers_and_its_plots(client, auth):
+    """The job is parkour control-study's study (experiments/control_study.run) on the same seeds,
+    with the panel's plots beside the command line's JSON."""
+    from experiments.control_study import Config, run
+
+    spec = {"kind": "control-study", "controllers": ["pid", "lqr"], "target_m": 0.5, "jumps": 80, "seeds": 12,
+            "seed0": 4, "noise": {"pitch_drift_deg": 2.0}}  # fmt: skip
+    job = client.post("/api/v1/jobs", json=spec, headers=auth)
+    assert job.status_code == 202, job.text
+    assert _wait(client, job.json()["id"])["state"] == "done"
+    result = client.get(f"/api/v1/jobs/{job.json()['id']}/results").json()["result"]
+    robot = get_preset("paper")
+    config = Config(controllers=("pid", "lqr"), target_m=0.5, jumps=80, seeds=12, seed0=4,
+                    noise=NoiseModel(pitch_drift_deg=2.0))  # fmt: skip
+    expected = run(robot.to_model(), robot.leg_length, config)
+    for got, want in zip(result["controllers"], expected.to_dict()["controllers"], strict=True):
+        assert got.pop("us_per_jump") > 0 and want.pop("us_per_jump") > 0  # timed: not the same twice
+        assert got == want
+    assert result["seeds"] == [4, 12] and result["noise"]["pitch_drift_deg"] == 2.0
+    assert [plot["name"] for plot in result["plots"]["controllers"]] == ["pid", "lqr"]
+    assert result["plots"]["controllers"][0]["failure_curve"]["failures"][-1] == result["controllers"][0]["failures"]
+
+
+@pytest.mark.parametrize(
+    ("change", "field", "says"),
+    [
+        ({"controllers": ["pid", "mpc"]}, "controllers", "must be among pid"),
+        ({"controllers": ["lqr", "lqr"]}, "controllers", "names a controller twice"),
+        ({"controllers": []}, "controllers", "at least 1"),
+        ({"target_m": 0.0}, "target_m", "greater than 0"),
+        ({"target_m": 2.5}, "target_m", "less than or equal to 2"),
+        ({"psi0_deg": 80}, "psi0_deg", "less than or equal to 60"),
+        ({"seeds": 0}, "seeds", "greater than or equal to 1"),
+        ({"jumps": 100_000, "seeds": 100_000}, "control-study", "controllers x seeds x jumps"),
+        ({"noise": {"pitch_drift_deg": -1}}, "pitch_drift_deg", "greater than or equal to 0"),
+    ],
+)
+def test_bad_control_studies_are_a_422_naming_the_field(client, auth, change, field, says):
+    response = client.post("/api/v1/jobs", json={"kind": "control-study", **change}, headers=auth)
+    assert response.status_code == 422, response.text
+    errors = response.json()["detail"]
+    assert any(field in map(str, error["loc"]) and says in error["msg"] for error in errors), errors
+    assert client.get("/api/v1/jobs").json()["items"] == []
