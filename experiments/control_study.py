@@ -16,13 +16,13 @@ import numpy as np
 from experiments.fig12 import Config as ClimbConfig
 from experiments.fig12 import PidClimb
 from sim_core.chunks import ChunkMap, Progress, in_process
-from sim_core.control_laws import KINDS, Lqr, Pid
+from sim_core.climb_records import CHUTE_TOP, FLOOR
+from sim_core.control_laws import KINDS, Controller, Pid
 from sim_core.control_study import ControllerOutcome, control_study
 from sim_core.noise import NoiseModel
 from sim_core.params import ModelParams
-from sim_core.validation import ParameterError
+from sim_core.validation import ParameterError, check_range
 
-NOT_YET = ("deadbeat",)  # issue 27's other law, not built yet: named in the error
 FAILURE_CURVE_POINTS = 41  # failures counted at this many jumps, 0 .. jumps
 ERROR_BINS = 40  # the height error's histogram, over ±ERROR_SPAN_M
 ERROR_SPAN_M = 0.05
@@ -35,8 +35,7 @@ def check_controllers(names) -> tuple[str, ...]:
         raise ParameterError("controllers", f"must name at least one of {', '.join(KINDS)}")
     for name in names:
         if name not in KINDS:
-            later = f" ({name}: not built yet)" if name in NOT_YET else ""
-            raise ParameterError("controllers", f"must be among {', '.join(KINDS)}, got {name!r}{later}")
+            raise ParameterError("controllers", f"must be among {', '.join(KINDS)}, got {name!r}")
     if len(set(names)) != len(names):
         raise ParameterError("controllers", f"names a controller twice: {', '.join(names)}")
     return names
@@ -47,7 +46,7 @@ class Config:
     """The study: ``controllers`` by name, the height to hold [m], the climb's nominal leg angle
     [deg] and starting zeta0, and the trials (seeds ``seed0 .. seed0 + seeds - 1``)."""
 
-    controllers: tuple[str, ...] = ("pid", "pid-pitch", "lqr")
+    controllers: tuple[str, ...] = ("pid", "pid-pitch", "lqr", "deadbeat")
     target_m: float = 0.55
     psi0_deg: float = 35.0
     start_zeta0: float = 0.9
@@ -95,21 +94,27 @@ class Result:
         return {"target_m": self.config.target_m, "controllers": controllers}
 
 
-def laws_for(model: ModelParams, config: Config, leg_length: float) -> tuple[PidClimb, list[Pid | Lqr]]:
+def laws_for(model: ModelParams, config: Config, leg_length: float) -> tuple[PidClimb, list[Controller]]:
     """The climb (its start, its PID) and each named law for it; ``leg_length`` [m] converts the
     target. Checked first: a ParameterError naming the field."""
     names = check_controllers(config.controllers)
+    check_range("target", config.target_m, FLOOR, CHUTE_TOP, high_open=False)
     climb = ClimbConfig(target_m=config.target_m, psi0_deg=config.psi0_deg, start_zeta0=config.start_zeta0,
                         jumps=config.jumps)  # fmt: skip
     loop = PidClimb.of(model, climb, leg_length)
     height = loop.controller
-    laws: list[Pid | Lqr] = []
+    laws: list[Controller] = []
     for name in names:
         if name == "lqr":
             from sim_core.return_map_lqr import design_lqr  # scipy's Riccati solver, only when asked
 
             zeta0_range = (height.zeta0_min, height.zeta0_max)
             laws.append(design_lqr(model, height.target, config.psi0_deg, loop.hover, zeta0_range=zeta0_range))
+        elif name == "deadbeat":
+            from sim_core.deadbeat import design_deadbeat
+
+            zeta0_range = (height.zeta0_min, height.zeta0_max)
+            laws.append(design_deadbeat(model, height.target, config.psi0_deg, loop.hover, zeta0_range=zeta0_range))
         else:
             laws.append(Pid(height, config.psi0_deg, pitch_feedback=name == "pid-pitch"))
     return loop, laws

@@ -13,11 +13,11 @@ import numpy as np
 from sim_core.height_controller import HeightController
 from sim_core.validation import ParameterError, check_range
 
-PID, PID_PITCH, LQR = 0, 1, 2
-KINDS = {"pid": PID, "pid-pitch": PID_PITCH, "lqr": LQR}
+PID, PID_PITCH, LQR, DEADBEAT = 0, 1, 2, 3
+KINDS = {"pid": PID, "pid-pitch": PID_PITCH, "lqr": LQR, "deadbeat": DEADBEAT}
 # The leg angle's range relative to the body [deg]: the robot's angle servos (backend/robot/limits.py).
 PSI0_RANGE_DEG = (10.0, 60.0)
-MEMORY_SIZE = 2  # a law's state between touchdowns: the PID's integral and previous error; the LQR's last command
+MEMORY_SIZE = 2  # a law's state between touchdowns: the PID's integral and previous error; else the last command
 
 
 @dataclass(frozen=True)
@@ -32,12 +32,8 @@ class Pid:
     psi0_range_deg: tuple[float, float] = PSI0_RANGE_DEG
 
     def __post_init__(self) -> None:
-        low, high = self.psi0_range_deg
-        check_range("psi0_range_deg", low, 0.0, 90.0)
-        check_range("psi0_range_deg", high, 0.0, 90.0)
-        if not low < high:
-            raise ParameterError("psi0_range_deg", f"must be an interval (low < high), got [{low:g}, {high:g}]")
-        check_range("psi0_deg", self.psi0_deg, low, high, low_open=False, high_open=False)
+        _check_interval("psi0_range_deg", self.psi0_range_deg, 90.0)
+        check_range("psi0_deg", self.psi0_deg, *self.psi0_range_deg, low_open=False, high_open=False)
 
     @property
     def name(self) -> str:
@@ -81,12 +77,8 @@ class Lqr:
         check_range("target", self.target, 0.0, 1e4)
         check_range("error_clip", self.error_clip, 0.0, 10.0)
         check_range("state_clip", self.state_clip, 0.0, 10.0)
-        for field, (low, high), bound in (("zeta0_range", self.zeta0_range, 1.0),
-                                          ("psi0_range_deg", self.psi0_range_deg, 90.0)):  # fmt: skip
-            check_range(field, low, 0.0, bound)
-            check_range(field, high, 0.0, bound)
-            if not low < high:
-                raise ParameterError(field, f"must be an interval (low < high), got [{low:g}, {high:g}]")
+        _check_interval("zeta0_range", self.zeta0_range, 1.0)
+        _check_interval("psi0_range_deg", self.psi0_range_deg, 90.0)
         check_range("psi0_deg", self.psi0_deg, *self.psi0_range_deg, low_open=False, high_open=False)
         if len(self.gain) != 10 or not all(math.isfinite(value) for value in self.gain):
             raise ParameterError("gain", f"must be 10 finite numbers (2 x 5), got {len(self.gain)}")
@@ -99,3 +91,57 @@ class Lqr:
         parameters = [self.target, math.radians(self.psi0_deg), self.zeta0, *self.state, *self.zeta0_range,
                       psi0_low, psi0_high, self.error_clip, 1.0, *self.gain, self.state_clip]  # fmt: skip
         return LQR, np.array(parameters)
+
+
+@dataclass(frozen=True)
+class Deadbeat:
+    """The deadbeat law on a short horizon with a safety guard (:mod:`sim_core.deadbeat`; built by
+    :func:`sim_core.deadbeat.design_deadbeat`): zeta0 chosen each jump by the design model
+    (``model``: ``(alpha, d_hat, c_zeta, c_psi, mu)``, :meth:`sim_core.params.ModelParams.kernel_args`)
+    to climb at most ``climb_per_jump`` [l0] a jump toward ``target`` [l0] over the next two
+    touchdowns, keeping the section state near the gait's ``state`` (weight ``q_state``), never a
+    command the model predicts fails; the leg angle at ``psi0_deg`` (the pitch fed back as in
+    ``pid-pitch``), zeta0 within ``zeta0_range``. ``zeta0`` is the gait's (jumping in place)."""
+
+    target: float  # [l0]
+    psi0_deg: float
+    zeta0: float
+    state: tuple[float, float]  # the gait's section state [sqrt(g l0)]
+    model: tuple[float, float, float, float, float]
+    climb_per_jump: float = 0.5  # [l0]: a 2 l0 climb in about 6 jumps
+    q_state: float = 1.0  # per (sqrt(g l0))², against l0² of height
+    zeta0_range: tuple[float, float] = (HeightController.zeta0_min, HeightController.zeta0_max)
+    psi0_range_deg: tuple[float, float] = PSI0_RANGE_DEG
+
+    name = "deadbeat"
+
+    def __post_init__(self) -> None:
+        check_range("target", self.target, 0.0, 1e4)
+        check_range("climb_per_jump", self.climb_per_jump, 0.0, 10.0)
+        check_range("q_state", self.q_state, 0.0, 1e6, low_open=False)
+        _check_interval("zeta0_range", self.zeta0_range, 1.0)
+        _check_interval("psi0_range_deg", self.psi0_range_deg, 90.0)
+        check_range("psi0_deg", self.psi0_deg, *self.psi0_range_deg, low_open=False, high_open=False)
+        check_range("zeta0", self.zeta0, *self.zeta0_range, low_open=False, high_open=False)
+        for field, values, size in (("state", self.state, 2), ("model", self.model, 5)):
+            if len(values) != size or not all(math.isfinite(value) for value in values):
+                raise ParameterError(field, f"must be {size} finite numbers, got {values!r}")
+
+    def kernel_args(self) -> tuple[int, np.ndarray]:
+        """``(kind, parameters)`` for :func:`sim_core.controllers.control_step`, in
+        :mod:`sim_core.deadbeat`'s layout."""
+        psi0_low, psi0_high = (math.radians(value) for value in self.psi0_range_deg)
+        parameters = [self.target, math.radians(self.psi0_deg), self.zeta0, *self.zeta0_range, psi0_low, psi0_high,
+                      self.climb_per_jump, 1.0, *self.model, *self.state, self.q_state]  # fmt: skip
+        return DEADBEAT, np.array(parameters)
+
+
+Controller = Pid | Lqr | Deadbeat  # what every front end hands the compiled loop
+
+
+def _check_interval(field: str, interval: tuple[float, float], bound: float) -> None:
+    low, high = interval
+    check_range(field, low, 0.0, bound)
+    check_range(field, high, 0.0, bound)
+    if not low < high:
+        raise ParameterError(field, f"must be an interval (low < high), got [{low:g}, {high:g}]")

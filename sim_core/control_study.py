@@ -28,7 +28,7 @@ import numpy as np
 
 from sim_core._jit import kernel
 from sim_core.chunks import ChunkMap, Progress, chunk_slices, in_process
-from sim_core.control_laws import Lqr, Pid
+from sim_core.control_laws import Controller
 from sim_core.controllers import control_step, start_memory
 from sim_core.failures import OK, Failure
 from sim_core.integrate import STATE_SIZE
@@ -102,7 +102,7 @@ class ControllerOutcome:
 
 def control_study(
     model: ModelParams,
-    controllers: list[Pid | Lqr],
+    controllers: list[Controller],
     start,
     start_zeta0: float,
     jumps: int,
@@ -140,7 +140,7 @@ def control_study(
 
 def study_chunk(
     model: ModelParams,
-    controller: Pid | Lqr,
+    controller: Controller,
     state: np.ndarray,
     start_zeta0: float,
     jumps: int,
@@ -190,10 +190,15 @@ def study_chunk(
     )
 
 
-def controller_time_us(controller: Pid | Lqr, steps: int = 200_000) -> float:
-    """The law's own time per jump [µs]: its compiled step over ``steps`` touchdowns, best of 3."""
+def controller_time_us(controller: Controller, seconds: float = 0.05) -> float:
+    """The law's own time per jump [µs]: its compiled step over about ``seconds`` of touchdowns,
+    best of 3 (a model-predictive law takes a thousand times a PID's, so the count is set by a
+    first run of 100)."""
     kind, parameters = controller.kernel_args()
     _time_steps(kind, parameters, 10)  # compiled before the clock starts
+    began = time.perf_counter()
+    _time_steps(kind, parameters, 100)
+    steps = int(min(max(100 * seconds / max(time.perf_counter() - began, 1e-9), 100), 1_000_000))
     best = math.inf
     for _ in range(3):
         began = time.perf_counter()

@@ -19,6 +19,9 @@ Kinds so far:
   touched down with (:mod:`sim_core.return_map_lqr` designs it), the pitch fed back as above.
   The law also sees the section state ``xdot, ydot`` at the touchdown, which the robot's tracker
   estimates from the body's track.
+- ``deadbeat``: zeta0 from the section state by the design model's own stance and closed-form
+  flight (:mod:`sim_core.deadbeat`), a set share of the height error each jump, behind a guard
+  that never sends a command the model predicts fails; the leg angle nominal, pitch fed back.
 """
 
 from __future__ import annotations
@@ -29,7 +32,8 @@ import numpy as np
 
 from sim_core._jit import kernel
 from sim_core.closed_loop import pid_step
-from sim_core.control_laws import LQR, MEMORY_SIZE, PID_PITCH
+from sim_core.control_laws import DEADBEAT, LQR, MEMORY_SIZE, PID_PITCH
+from sim_core.deadbeat import PITCH_GAIN, PSI0_HIGH, PSI0_LOW, PSI0_STAR, deadbeat_zeta0
 
 
 def new_memory(kind: int, first_psi0: float, first_zeta0: float) -> np.ndarray:
@@ -41,7 +45,7 @@ def new_memory(kind: int, first_psi0: float, first_zeta0: float) -> np.ndarray:
 @kernel
 def start_memory(kind, first_psi0, first_zeta0):
     memory = np.empty(MEMORY_SIZE)
-    if kind == LQR:  # the controls of the touchdown before the first command
+    if kind in (LQR, DEADBEAT):  # the controls of the touchdown before the first command
         memory[0], memory[1] = first_psi0, first_zeta0
     else:  # the PID: no integral, no error before
         memory[0], memory[1] = 0.0, math.nan
@@ -56,6 +60,8 @@ def control_step(kind, parameters, memory, height, pitch, xdot, ydot, next_on_le
     (:func:`new_memory`) is updated in place."""
     if kind == LQR:
         return _lqr_step(parameters, memory, height, pitch, xdot, ydot, next_on_left)
+    if kind == DEADBEAT:
+        return _deadbeat_step(parameters, memory, height, pitch, xdot, ydot, next_on_left)
     zeta0_min, zeta0_max, psi0 = parameters[5], parameters[6], parameters[7]
     error = parameters[0] - height
     zeta0, integral = pid_step(
@@ -100,3 +106,16 @@ def _turned_back(psi0, pitch, next_on_left, pitch_gain, psi0_min, psi0_max):
     turned = psi0 - pitch_gain * (pitch if next_on_left else -pitch)
     clamped = min(max(turned, psi0_min), psi0_max)
     return clamped, clamped != turned
+
+
+@kernel
+def _deadbeat_step(parameters, memory, height, pitch, xdot, ydot, next_on_left):
+    """zeta0 by :func:`sim_core.deadbeat.deadbeat_zeta0` from the controls last touched down with
+    (the memory), the leg angle the gait's turned back by the pitch."""
+    zeta0, guarded = deadbeat_zeta0(parameters, memory[0], memory[1], height, xdot, ydot)
+    psi0 = parameters[PSI0_STAR]
+    memory[0], memory[1] = psi0, zeta0
+    psi0, clipped = _turned_back(
+        psi0, pitch, next_on_left, parameters[PITCH_GAIN], parameters[PSI0_LOW], parameters[PSI0_HIGH]
+    )
+    return psi0, zeta0, guarded or clipped

@@ -42,6 +42,25 @@ def liftoff_velocity(psi, zeta_dot, psi_dot):
 
 
 @kernel
+def lift_off(xdot, ydot, psi0, zeta0, alpha, c_zeta, c_psi, mu, record):
+    """A jump's stance alone: from its touchdown (section state ``xdot, ydot``, controls ``psi0
+    [rad], zeta0``) to lift-off. Returns ``(status, psi, liftoff_xdot, liftoff_ydot, stance_time,
+    rows_recorded)``: the leg angle [rad] and body velocity at lift-off, NaN where the stance
+    failed (its time is kept where one was integrated); ``record`` as for :func:`jump`."""
+    nan = math.nan
+    if not math.isfinite(xdot + ydot + psi0 + zeta0) or xdot >= 0.0:
+        return INVALID_STATE, nan, nan, nan, nan, 0
+    zeta_dot, psi_dot = touchdown_polar_state(xdot, ydot, psi0, zeta0)
+    final = np.empty(STATE_SIZE)
+    status, rows = stance(zeta0, psi0, zeta_dot, psi_dot, alpha, c_zeta, c_psi, mu, final, record)
+    if status != OK:
+        return status, nan, nan, nan, final[TIME], rows
+    psi = final[PSI]
+    liftoff_xdot, liftoff_ydot = liftoff_velocity(psi, final[ZETA_DOT], final[PSI_DOT])
+    return OK, psi, liftoff_xdot, liftoff_ydot, final[TIME], rows
+
+
+@kernel
 def jump(xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c_psi, mu, record):
     """One application of the Poincaré map.
 
@@ -58,17 +77,13 @@ def jump(xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c
         after ``status`` are NaN, except the stance time where a stance was integrated.
     """
     nan = math.nan
-    finite_inputs = math.isfinite(xdot + ydot + psi0 + zeta0 + next_psi0 + next_zeta0)
-    if not finite_inputs or xdot >= 0.0 or not (0.0 < next_zeta0 < 1.0):
+    if not math.isfinite(next_psi0 + next_zeta0) or not (0.0 < next_zeta0 < 1.0):
         return INVALID_STATE, nan, nan, nan, nan, nan, 0
-    zeta_dot, psi_dot = touchdown_polar_state(xdot, ydot, psi0, zeta0)
-    final = np.empty(STATE_SIZE)
-    status, rows = stance(zeta0, psi0, zeta_dot, psi_dot, alpha, c_zeta, c_psi, mu, final, record)
-    stance_time = final[TIME]
+    status, psi, liftoff_xdot, liftoff_ydot, stance_time, rows = lift_off(
+        xdot, ydot, psi0, zeta0, alpha, c_zeta, c_psi, mu, record
+    )
     if status != OK:
         return status, nan, nan, nan, stance_time, nan, rows
-    psi = final[PSI]
-    liftoff_xdot, liftoff_ydot = liftoff_velocity(psi, final[ZETA_DOT], final[PSI_DOT])
     # Flight: from x = -d/2 + cos(psi) to the next touchdown x = d/2 - zeta0' cos(psi0').
     distance = d_hat - math.cos(psi) - next_zeta0 * math.cos(next_psi0)
     if liftoff_xdot <= 0.0 or distance <= 0.0:

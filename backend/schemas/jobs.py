@@ -153,7 +153,7 @@ class ControlStudyJobCreate(Strict):
     model: ModelIn = ModelIn()
     controllers: Annotated[
         list[str], Field(min_length=1, max_length=8, description=f"names, each once, of: {', '.join(KINDS)}")
-    ] = ["pid", "pid-pitch", "lqr"]
+    ] = ["pid", "pid-pitch", "lqr", "deadbeat"]
     target_m: Annotated[
         float, Field(gt=FLOOR, le=CHUTE_TOP, description="height to hold [m], above the floor, within the chute")
     ] = 0.55

@@ -110,7 +110,7 @@ class GaitSearchSpec:
 
 @dataclass(frozen=True)
 class ControlStudySpec:
-    controllers: tuple[str, ...] = ("pid", "pid-pitch", "lqr")
+    controllers: tuple[str, ...] = ("pid", "pid-pitch", "lqr", "deadbeat")
     model: ModelSpec = field(default_factory=ModelSpec)
     target_m: float = 0.55
     psi0_deg: float = 35.0

@@ -4,6 +4,7 @@ import { API, $, say, call, on } from "./api.js";
 import { filedUnder, SQRT_GL0, checked, simControls } from "./forms.js";
 import { draw, layout, plotSweep, plotBasin } from "./plots.js";
 import { element, fillTable, attributes } from "./dom.js";
+import { hideControlStudy, showControlStudy } from "./control_study.js";
 
 const streams = new Map();
 const FINAL = ["done", "cancelled", "failed"];
@@ -12,6 +13,7 @@ export function describeJob(job) {
   const spec = job.spec || {};
   if (job.kind === "mjtf") return `psi0 ${spec.psi0_deg}°, zeta0 ${(spec.zeta0s || []).join(", ")} × ${spec.trials} trials`;
   if (job.kind === "sweep") return `psi0 ${spec.psi0_deg}°, zeta0 ${spec.zeta0_low}–${spec.zeta0_high}, ${spec.steps} steps`;
+  if (job.kind === "control-study") return `${(spec.controllers || []).join(", ")} to ${spec.target_m} m, ${spec.seeds} × ${spec.jumps} jumps`;
   const legs = (spec.controls || []).map((leg) => `${leg.psi0_deg}°/${leg.zeta0}`).join(", ");
   return job.kind === "basin" ? `${legs}, ${spec.grid}² start states` : legs;
 }
@@ -143,7 +145,11 @@ const JOB_FIELDS = {
     { name: "basin_grid", rule: "SweepJobCreate.basin_grid" }],
   basin: [{ name: "grid", rule: "BasinJobCreate.grid" }, { name: "basin_jumps", rule: "BasinJobCreate.jumps", unit: "jumps" },
     { name: "tolerance", rule: "BasinJobCreate.tolerance", unit: SQRT_GL0 }],
+  "control-study": [{ name: "study_target", rule: "ControlStudyJobCreate.target_m", unit: "m" }, { name: "study_seeds", rule: "ControlStudyJobCreate.seeds" },
+    { name: "study_jumps", rule: "ControlStudyJobCreate.jumps", unit: "jumps" }, { name: "study_seed0", rule: "ControlStudyJobCreate.seed0" }],
 };
+const STUDY_LOCATIONS = { controllers: "study_controllers", target_m: "study_target", seeds: "study_seeds", jumps: "study_jumps",
+  seed0: "study_seed0" };
 const JOB_LOCATIONS = { psi0_deg: "psi0", zeta0s: "zeta0s", trials: "trials", cap: "cap", seed: "seed", zeta0_low: "zeta0_low",
   zeta0_high: "zeta0_high", steps: "steps", basin_grid: "basin_grid", grid: "grid", jumps: "basin_jumps", tolerance: "tolerance" };
 
@@ -155,6 +161,11 @@ async function jobSpec(form) {
   if (v === null) return null;
   if (kind === "mjtf") {
     return { body: { kind, psi0_deg: v.psi0, trials: v.trials, cap: v.cap, seed: v.seed, zeta0s: v.zeta0s }, locations: JOB_LOCATIONS };
+  }
+  if (kind === "control-study") {
+    const controllers = [...form.elements.study_controllers.selectedOptions].map((option) => option.value);
+    const body = { kind, controllers, target_m: v.study_target, seeds: v.study_seeds, jumps: v.study_jumps, seed0: v.study_seed0 };
+    return { body, locations: { ...STUDY_LOCATIONS, ...Object.fromEntries(Object.entries(STUDY_LOCATIONS).map(([field, input]) => [`control-study.${field}`, input])) } };
   }
   if (kind === "sweep") {
     const body = { kind, psi0_deg: v.sweep_psi0, zeta0_low: v.zeta0_low, zeta0_high: v.zeta0_high, steps: v.steps, basin_grid: v.basin_grid };
@@ -191,6 +202,7 @@ on("#job-table", "click", async (event) => {
 export async function showJob(id) {
   const results = await call("GET", `/jobs/${id}/results`);
   const job = results.job;
+  hideControlStudy();
   if (results.levels) {
     // Only the levels with trials are drawn; a job that is not done says so in the title.
     const missing = results.missing_zeta0s || [];
@@ -204,6 +216,8 @@ export async function showJob(id) {
     say(`Job ${id} is ${job.state}: no result${job.error ? ` (${job.error})` : " yet"}.`, job.state === "failed" ? "error" : "ok");
   } else if (job.kind === "sweep") {
     plotSweep("job-plot", results.result, `Job ${id}: symmetric gait at psi0 = ${job.spec.psi0_deg}° over zeta0`);
+  } else if (job.kind === "control-study") {
+    showControlStudy(id, results.result);
   } else if (job.kind === "basin") {
     plotBasin("job-plot", results.result, `Job ${id}: basin of attraction`);
   } else {

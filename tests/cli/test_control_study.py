@@ -9,12 +9,12 @@ ENTRY = {"name", "trials", "failures", "failure_rate", "failure_codes", "height_
 
 
 def test_control_study_json_contract():
-    payload = json_of("control-study", "--controllers", "pid,pid-pitch,lqr", "--target", "0.55", "--seeds", "6",
-                      "--seed0", "3", "--jumps", "60", "--pitch-drift", "1.0")  # fmt: skip
+    payload = json_of("control-study", "--controllers", "pid,pid-pitch,lqr,deadbeat", "--target", "0.55",
+                      "--seeds", "6", "--seed0", "3", "--jumps", "60", "--pitch-drift", "1.0")  # fmt: skip
     assert set(payload) == {"target_m", "jumps", "seeds", "noise", "controllers"}
     assert payload["target_m"] == 0.55 and payload["jumps"] == 60 and payload["seeds"] == [3, 6]
     assert payload["noise"]["pitch_drift_deg"] == 1.0
-    assert [entry["name"] for entry in payload["controllers"]] == ["pid", "pid-pitch", "lqr"]
+    assert [entry["name"] for entry in payload["controllers"]] == ["pid", "pid-pitch", "lqr", "deadbeat"]
     for entry in payload["controllers"]:
         assert set(entry) == ENTRY and entry["trials"] == 6
         assert entry["failure_rate"] == entry["failures"] / 6 and entry["us_per_jump"] > 0
@@ -23,14 +23,12 @@ def test_control_study_json_contract():
 @pytest.mark.parametrize(
     ("args", "says"),
     [
-        (
-            ("--controllers", "deadbeat"),
-            "controllers: must be among pid, pid-pitch, lqr, got 'deadbeat' (deadbeat: not built",
-        ),
+        (("--controllers", "mpc"), "controllers: must be among pid, pid-pitch, lqr, deadbeat, got 'mpc'"),
         (("--controllers", "pid,pid"), "controllers: names a controller twice"),
         (("--controllers", " , "), "controllers: must name at least one"),
         (("--seeds", "0"), "seeds"),
         (("--target", "-1"), "target"),
+        (("--target", "2.5"), "target: must be in (0, 2]"),
         (("--psi0", "80"), "psi0"),
     ],
 )

@@ -61,7 +61,12 @@ def test_the_json_and_the_plots_tell_the_same_study(result):
 
 @pytest.mark.parametrize(
     ("names", "says"),
-    [((), "must name at least one"), (("pid", "pid"), "twice"), (("deadbeat",), "not built yet"), (("mpc",), "'mpc'")],
+    [
+        ((), "must name at least one"),
+        (("pid", "pid"), "twice"),
+        (("deadbeat", "lqr", "deadbeat"), "twice"),
+        (("mpc",), "'mpc'"),
+    ],
 )
 def test_controllers_are_checked_by_name(names, says):
     with pytest.raises(ParameterError, match=says) as caught:

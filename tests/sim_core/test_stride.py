@@ -15,7 +15,7 @@ from sim_core import ControlSchedule, LegControl, iterate_map, iterate_map_batch
 from sim_core.failures import COLLAPSE, INVALID_STATE, NO_FLIGHT, NO_LIFTOFF, OK, SLIP
 from sim_core.integrate import PSI, PSI_DOT, STANCE_TIME_CAP, STATE_SIZE, TIME, ZETA, ZETA_DOT
 from sim_core.reference import reference_jump
-from sim_core.stride import jump, liftoff_velocity, orbit, orbit_batch, scheduled_jump, touchdown_polar_state
+from sim_core.stride import jump, lift_off, liftoff_velocity, orbit, orbit_batch, scheduled_jump, touchdown_polar_state
 
 ATOL_REFERENCE = 1e-8  # kernel vs scipy DOP853 at rtol = atol = 1e-11 (as test_reference.py)
 REFERENCE_TOLERANCES = {"rtol": 1e-11, "atol": 1e-11}
@@ -59,6 +59,21 @@ def test_flight_is_ballistic_from_the_recorded_liftoff(paper):
     at_liftoff = 0.5 * (vx**2 + vy**2) + math.sin(liftoff[PSI])
     at_touchdown = 0.5 * (next_xdot**2 + next_ydot**2) + rise + right.zeta0 * math.sin(right.psi0)
     assert at_touchdown == pytest.approx(at_liftoff, rel=FLIGHT_ENERGY_RTOL)
+
+
+def test_lift_off_is_the_jumps_own_stance(paper):
+    """lift_off ends where jump's stance ends: the recorded lift-off row, the same stance time, and
+    the same failure with the stance time kept; an invalid state fails before any stance."""
+    record = np.empty((500, STATE_SIZE))
+    alpha, _, c_zeta, c_psi, mu = paper.kernel_args()
+    status, psi, vx, vy, stance_time, rows = lift_off(*START, LEG.psi0, LEG.zeta0, alpha, c_zeta, c_psi, mu, record)
+    assert status == OK and record[rows - 1, PSI] == psi
+    assert (vx, vy) == liftoff_velocity(psi, record[rows - 1, ZETA_DOT], record[rows - 1, PSI_DOT])
+    assert stance_time == _jump(paper, START)[4]
+    slipping = LegControl.from_degrees(70.0, 0.9)
+    failed = lift_off(*START, slipping.psi0, slipping.zeta0, alpha, c_zeta, c_psi, mu, NO_RECORD)
+    assert failed[0] == SLIP == _jump(paper, START, slipping)[0] and math.isnan(failed[1])
+    assert lift_off(0.1, -0.2, LEG.psi0, LEG.zeta0, alpha, c_zeta, c_psi, mu, NO_RECORD)[0] == INVALID_STATE
 
 
 @pytest.mark.parametrize(
