@@ -17,7 +17,8 @@ from experiments.fig12 import Config as ClimbConfig
 from experiments.fig12 import PidClimb
 from sim_core.chunks import ChunkMap, Progress, in_process
 from sim_core.climb_records import CHUTE_TOP, FLOOR
-from sim_core.control_laws import KINDS, Controller, Pid
+from sim_core.control_design import design_law
+from sim_core.control_laws import KINDS, Controller
 from sim_core.control_study import ControllerOutcome, control_study
 from sim_core.noise import NoiseModel
 from sim_core.params import ModelParams
@@ -102,21 +103,7 @@ def laws_for(model: ModelParams, config: Config, leg_length: float) -> tuple[Pid
     climb = ClimbConfig(target_m=config.target_m, psi0_deg=config.psi0_deg, start_zeta0=config.start_zeta0,
                         jumps=config.jumps)  # fmt: skip
     loop = PidClimb.of(model, climb, leg_length)
-    height = loop.controller
-    laws: list[Controller] = []
-    for name in names:
-        if name == "lqr":
-            from sim_core.return_map_lqr import design_lqr  # scipy's Riccati solver, only when asked
-
-            zeta0_range = (height.zeta0_min, height.zeta0_max)
-            laws.append(design_lqr(model, height.target, config.psi0_deg, loop.hover, zeta0_range=zeta0_range))
-        elif name == "deadbeat":
-            from sim_core.deadbeat import design_deadbeat
-
-            zeta0_range = (height.zeta0_min, height.zeta0_max)
-            laws.append(design_deadbeat(model, height.target, config.psi0_deg, loop.hover, zeta0_range=zeta0_range))
-        else:
-            laws.append(Pid(height, config.psi0_deg, pitch_feedback=name == "pid-pitch"))
+    laws = [design_law(name, model, loop.controller, config.psi0_deg) for name in names]
     return loop, laws
 
 

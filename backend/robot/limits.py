@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from backend.robot.messages import on_the_wire
 from sim_core.validation import ParameterError, check_range
 
 
@@ -22,7 +23,10 @@ class ServoLimits:
                 raise ParameterError(f"limits.{name}", f"must be an interval low < high, got [{low:g}, {high:g}]")
 
     def check(self, psi0_deg: float, zeta0: float) -> None:
-        """Raise :class:`ParameterError` naming the field and the servo range if a command is outside it."""
+        """Raise :class:`ParameterError` naming the field and the servo range if a command is outside
+        it, as SET_LEG carries it (0.01°, 0.0001 l0): a law's angle clipped to 30° in radians comes
+        back as 29.999999999999996° and goes out as 30.00°, within a range from 30°."""
+        psi0_deg, zeta0 = on_the_wire(psi0_deg, zeta0)
         check_range("psi0_deg", psi0_deg, *self.psi0_deg, low_open=False, high_open=False)
         check_range("zeta0", zeta0, *self.zeta0, low_open=False, high_open=False)
 

@@ -16,7 +16,6 @@ drains to the store (:mod:`backend.services.robot_journal`).
 
 from __future__ import annotations
 
-import math
 import queue
 import threading
 import time
@@ -24,6 +23,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 from backend.robot.link import LinkError, LinkState, RobotLink
+from backend.robot.live_law import LiveLaw, pitch_at
 from backend.robot.messages import Leg
 from backend.robot.touchdown import PITCH_LOOKBACK, Touchdown, scan_touchdowns
 from backend.robot.tracker import PoseHistory, pose_arrays
@@ -149,35 +149,30 @@ class LiveRun:
         )
 
 
-PidLaw = tuple[float, float, float, float, float, float]  # hover zeta0, kp, ki, kd, zeta0 min, max
-
-
 def execute(
     run: LiveRun,
     link: RobotLink,
     tracker: PoseHistory,
     robot,
     legs: list[LegControl],
-    controller: tuple[float, PidLaw] | None,
+    controller: LiveLaw | None,
     on_end: Callable[[LiveRun], None],
 ) -> None:
     """The run's control loop, on its own thread, to the end. Then the robot is made safe,
     ``on_end(run)`` stores the run, and only then the snapshot turns inactive and ``run.done`` is
-    set, whatever happened. ``controller`` is (target height [m], PID law), or None for open
-    loop; ``robot`` the physical parameters (touchdown detection, units)."""
-    from sim_core.closed_loop import pid_step  # loaded before the first touchdown, not with the service
-
+    set, whatever happened. ``controller`` is the law closed at each touchdown (this thread
+    owns it from here), or None for open loop; ``robot`` the physical parameters (touchdown
+    detection, units)."""
     commanded = run.commanded
     commanded.update({Leg.LEFT: legs[0], Leg.RIGHT: legs[1]})
-    integral, previous_error = 0.0, math.nan
     seen_poses = run.first_pose
     scan_from = run.first_pose + 1  # the tracker's index of the first pose not yet scanned for touchdowns
 
-    def send(leg: Leg, control: LegControl, why: str) -> None:
+    def send(leg: Leg, control: LegControl, why: str, **law) -> None:
         link.set_leg(leg, control.psi0_deg, control.zeta0)
         commanded[leg] = control
         run.record("command", {"time": time.time(), "leg": leg.name.lower(), "psi0_deg": control.psi0_deg,
-                               "zeta0": control.zeta0, "why": why}, run.commands)  # fmt: skip
+                               "zeta0": control.zeta0, "why": why, **law}, run.commands)  # fmt: skip
         run.publish()
 
     def leg_for(k: int) -> LegControl:
@@ -216,12 +211,10 @@ def execute(
                     run.record("touchdown", (touchdown, run.touchdown_controls[touchdown.index]), run.touchdowns)
                     run.publish()
                     if controller is not None:
-                        target_m, law = controller
-                        error = (target_m - touchdown.body_height) / robot.leg_length
-                        command, integral = pid_step(error, previous_error, integral, *law)
-                        previous_error = error
                         leg = Leg.of(wall_of(touchdown.index + 2))  # the next touchdown's (climb numbering)
-                        send(leg, LegControl(commanded[leg].psi0, command), f"pid after touchdown {touchdown.index}")
+                        pitch = pitch_at(arrays["time"], arrays["pitch"], touchdown.time, PITCH_LOOKBACK)
+                        control, law = controller.command(touchdown, pitch, commanded[leg].psi0)
+                        send(leg, control, f"{controller.name} after touchdown {touchdown.index}", **law)
                 if len(run.touchdowns) >= run.jumps:
                     run.end_reason = "jumps done"
             time.sleep(POLL)

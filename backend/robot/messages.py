@@ -15,6 +15,7 @@ positions, battery, fault flags), HEARTBEAT.
 
 from __future__ import annotations
 
+import math
 import struct
 from dataclasses import dataclass
 from enum import IntEnum
@@ -190,6 +191,15 @@ def _exact(layout: struct.Struct, body: bytes) -> tuple:
     if len(body) != layout.size:
         raise ProtocolError(f"body of {len(body)} bytes, expected {layout.size}")
     return layout.unpack(body)
+
+
+def on_the_wire(psi0_deg: float, zeta0: float) -> tuple[float, float]:
+    """A leg command as SET_LEG carries it (0.01° and 0.0001 l0 steps, rounded): what the robot
+    gets, so what the servo limits are checked against. Non-finite values pass through, for the
+    check to refuse."""
+    if not (math.isfinite(psi0_deg) and math.isfinite(zeta0)):
+        return psi0_deg, zeta0
+    return round(psi0_deg * 100.0) / 100.0, round(zeta0 * 10_000.0) / 10_000.0
 
 
 def _centidegrees(degrees: float) -> int:

@@ -5,12 +5,15 @@ from __future__ import annotations
 import ipaddress
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, Field, field_validator
+from pydantic import BaseModel, Field, ValidationInfo, field_validator
 
 from backend.robot.natnet import COMMAND_PORT, MULTICAST_GROUP, parse_version
 from backend.robot.ports import check_port
 from backend.robot.xbee import ROBOT_ADDRESS
 from backend.schemas.common import LegIn, Psi0Deg, RecordRef, Strict, Tags, Zeta0
+from sim_core.climb_records import CHUTE_TOP, FLOOR
+from sim_core.control_design import DEADBEAT_CLIMB_PER_JUMP
+from sim_core.control_laws import KINDS
 
 
 class RobotConnect(Strict):
@@ -88,12 +91,38 @@ class RobotConnect(Strict):
 
 
 class ClosedLoopIn(Strict):
-    target_m: Annotated[float, Field(gt=0.0, le=100.0, description="height to hold [m]")]
+    """A closed loop: ``controller`` holds ``target_m`` from each touchdown to the next leg
+    (docs/analyses.md, "Controllers"); the PIDs take the gains, every law the zeta0 range, the
+    deadbeat its climb per jump. The LQR and the deadbeat are designed on the service's model
+    (a calibrated preset gives its own)."""
+
+    target_m: Annotated[
+        float, Field(gt=FLOOR, le=CHUTE_TOP, description="height to hold [m], above the floor, within the chute")
+    ]
+    controller: Annotated[str, Field(description=f"the law, one of: {', '.join(KINDS)}")] = "pid"
     kp: Annotated[float, Field(ge=0.0, le=10.0)] = 0.04
     ki: Annotated[float, Field(ge=0.0, le=10.0)] = 0.0
     kd: Annotated[float, Field(ge=0.0, le=10.0)] = 0.02
     zeta0_min: Zeta0 = 0.80
     zeta0_max: Zeta0 = 0.98
+    climb_per_jump: Annotated[
+        float, Field(gt=0.0, le=1.0, description="deadbeat: the most it climbs toward the target a jump [l0]")
+    ] = DEADBEAT_CLIMB_PER_JUMP
+
+    @field_validator("controller")
+    @classmethod
+    def _known(cls, name: str) -> str:
+        if name not in KINDS:
+            raise ValueError(f"must be one of {', '.join(KINDS)}, got {name!r}")
+        return name
+
+    @field_validator("zeta0_max")
+    @classmethod
+    def _above_the_min(cls, zeta0_max: float, info: ValidationInfo) -> float:
+        zeta0_min = info.data.get("zeta0_min")
+        if zeta0_min is not None and not zeta0_min < zeta0_max:
+            raise ValueError(f"must exceed zeta0_min = {zeta0_min:g}, got {zeta0_max:g}")
+        return zeta0_max
 
 
 class RobotRunCreate(Strict):

@@ -21,6 +21,7 @@ from backend.errors import NotFound
 from backend.robot.latch import EstopLatch
 from backend.robot.limits import ServoLimits
 from backend.robot.link import EstopResult, LinkError, LinkState, RobotLink
+from backend.robot.live_law import live_law_for
 from backend.robot.live_run import LiveRun, RunSnapshot, execute, telemetry_dict
 from backend.robot.supervisor import LinkSupervisor
 from backend.schemas import RobotConnect, RobotRunCreate
@@ -236,7 +237,8 @@ class RobotService:
             for leg in legs:
                 link.limits.check(leg.psi0_deg, leg.zeta0)  # a clear 422 before anything moves
             tracker = self.tracker
-            controller = self._controller(body, legs)
+            loop = body.closed_loop
+            controller = None if loop is None else live_law_for(loop, self.robot, legs, link.limits)
             with self.sessions() as session:
                 where = {"url": link.url, "robot_address": f"0x{link.robot_address:016X}"}
                 run_id = open_robot_run(
@@ -268,16 +270,6 @@ class RobotService:
         run.stop("stopped")
         run.done.wait(STOP_WAIT)
         return self.status()
-
-    def _controller(self, body: RobotRunCreate, legs: list[LegControl]):
-        """Closed loop: (target height [m], the PID law) about the in-place zeta0; else None."""
-        from sim_core.sweep import find_in_place_zeta0
-
-        loop = body.closed_loop
-        if loop is None:
-            return None
-        hover = find_in_place_zeta0(self.robot.to_model(), legs[0].psi0, zeta0_range=(loop.zeta0_min, loop.zeta0_max))
-        return loop.target_m, (hover, loop.kp, loop.ki, loop.kd, loop.zeta0_min, loop.zeta0_max)
 
 
 def _estop_latch(latch: EstopLatch, link: RobotLink | None) -> dict:

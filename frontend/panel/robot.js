@@ -185,7 +185,7 @@ on("#reset", "click", reset);
 on("#estop-banner-reset", "click", reset);
 
 on("#closed-loop", "change", (event) => {
-  for (const name of ["target_m", "kp", "ki", "kd"]) $("#robot-run-form").elements[name].disabled = !event.target.checked;
+  for (const name of ["controller", "target_m", "kp", "ki", "kd"]) $("#robot-run-form").elements[name].disabled = !event.target.checked;
 });
 $("#closed-loop").dispatchEvent(new Event("change"));
 
@@ -196,7 +196,7 @@ const ROBOT_RUN_FIELDS = [...LEG_FIELDS, { name: "jumps", rule: "RobotRunCreate.
 const CLOSED_LOOP_FIELDS = [{ name: "target_m", rule: "ClosedLoopIn.target_m", unit: "m" }, { name: "kp", rule: "ClosedLoopIn.kp" },
   { name: "ki", rule: "ClosedLoopIn.ki" }, { name: "kd", rule: "ClosedLoopIn.kd" }];
 const ROBOT_RUN_LOCATIONS = { ...SIM_LOCATIONS, max_seconds: "max_seconds", "closed_loop.target_m": "target_m",
-  "closed_loop.kp": "kp", "closed_loop.ki": "ki", "closed_loop.kd": "kd" };
+  "closed_loop.kp": "kp", "closed_loop.ki": "ki", "closed_loop.kd": "kd", "closed_loop.controller": "controller" };
 
 on("#robot-run-form", "submit", async (event) => {
   event.preventDefault();
@@ -204,7 +204,7 @@ on("#robot-run-form", "submit", async (event) => {
   const v = await checked(event.target, closed ? [...ROBOT_RUN_FIELDS, ...CLOSED_LOOP_FIELDS] : ROBOT_RUN_FIELDS);
   if (v === null) return;
   const body = { controls: [{ psi0_deg: v.psiL, zeta0: v.zetaL }, { psi0_deg: v.psiR, zeta0: v.zetaR }], jumps: v.jumps, max_seconds: v.max_seconds };
-  if (closed) body.closed_loop = { target_m: v.target_m, kp: v.kp, ki: v.ki, kd: v.kd };
+  if (closed) body.closed_loop = { controller: event.target.elements.controller.value, target_m: v.target_m, kp: v.kp, ki: v.ki, kd: v.kd };
   Object.assign(body, filedUnder(event.target));
   // The robot's state now, not as last shown: a disarmed robot is armed by the run and jumps.
   const current = await call("GET", "/robot");
@@ -216,7 +216,7 @@ on("#robot-run-form", "submit", async (event) => {
   } finally {
     pendingTarget = undefined;
   }
-  say(`Run started: ${body.jumps} jumps at most, ${body.max_seconds} s at most${body.closed_loop ? `, holding ${body.closed_loop.target_m} m` : ""}.`);
+  say(`Run started: ${body.jumps} jumps at most, ${body.max_seconds} s at most${body.closed_loop ? `, ${body.closed_loop.controller} holding ${body.closed_loop.target_m} m` : ""}.`);
 });
 const stopRun = async () => showStatus(await call("POST", "/robot/runs/stop"));
 on("#stop-run", "click", stopRun);

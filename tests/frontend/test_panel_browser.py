@@ -505,11 +505,13 @@ def test_closed_loop_run_then_emergency_stop(page, service):
         until(page, "document.querySelector('#robot-state').textContent === 'disarmed'")
         page.fill("#robot-run-form input[name=jumps]", "12")
         page.check("#closed-loop")
+        page.select_option("#robot-run-form select[name=controller]", "lqr")
         page.click("#live-run")
         until(page, "document.querySelector('#robot-status').textContent.includes('jumps done')", timeout=30_000)
         stored = httpx.get(f"{base}/api/v1/runs?kind=robot&limit=1").json()["items"][0]
+        assert stored["controller"] == "lqr", "History shows the law the panel chose"
         commands = httpx.get(f"{base}/api/v1/runs/{stored['id']}").json()["results"]["commands"]
-        assert sum(command["why"].startswith("pid") for command in commands) >= 8, "the PID set the legs"
+        assert sum(command["why"].startswith("lqr") for command in commands) >= 8, "the LQR set the legs"
         page.wait_for_selector("#live-plot .main-svg", timeout=10_000)
         screenshot(page, "robot")
         page.uncheck("#closed-loop")

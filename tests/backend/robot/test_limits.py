@@ -55,3 +55,13 @@ def test_limits_no_servo_could_have_are_refused_when_made(limits, field, says):
     with pytest.raises(ParameterError) as raised:
         ServoLimits(**limits)
     assert raised.value.field == field and says in raised.value.message
+
+
+def test_a_command_is_checked_as_the_message_carries_it():
+    """SET_LEG carries 0.01° and 0.0001 l0: a law's 30° that came back from radians as
+    29.999999999999996° goes out as 30.00° and is within a range from 30°; a command that would
+    go out past the end is refused."""
+    tight = ServoLimits(psi0_deg=(30.0, 40.0), zeta0=(0.8, 0.9))
+    assert math.degrees(math.radians(30.0)) < 30.0
+    tight.check(math.degrees(math.radians(30.0)), 0.9 + 1e-12)
+    assert not tight.allows(40.006, 0.85) and not tight.allows(35.0, 0.90006)

@@ -131,13 +131,16 @@ def test_a_live_run_is_bounded_in_jumps_and_time(field, inside, outside):
 @pytest.mark.parametrize(
     ("field", "inside", "outside"),
     [
-        ("target_m", 100.0, 100.01),
+        ("target_m", 2.0, 2.01),  # the chute's top
         ("target_m", 1e-3, 0.0),
         ("kp", 10.0, 10.01),
         ("ki", 0.0, -0.01),
         ("kd", 10.0, 10.01),
         ("zeta0_min", 0.01, 0.0),
         ("zeta0_max", 0.99, 1.0),
+        ("zeta0_max", 0.81, 0.8),  # above zeta0_min
+        ("controller", "deadbeat", "mpc"),
+        ("climb_per_jump", 1.0, 0.0),
     ],
 )
 def test_a_closed_loops_gains_and_range_are_bounded_naming_the_field(field, inside, outside):
@@ -150,6 +153,7 @@ def test_a_closed_loops_gains_and_range_are_bounded_naming_the_field(field, insi
 def test_a_closed_loop_needs_a_target_and_defaults_to_a_pd_law():
     loop = accepted(ClosedLoopIn, {"target_m": 0.4})
     assert (loop.kp, loop.ki, loop.kd, loop.zeta0_min, loop.zeta0_max) == (0.04, 0.0, 0.02, 0.80, 0.98)
+    assert loop.controller == "pid", "today's loop unless another law is named"
     assert refused(ClosedLoopIn, {}) == [("target_m",)]
 
 

@@ -234,18 +234,44 @@ def test_commands_beyond_the_servo_limits_are_a_422(client, auth, connected):
 @pytest.mark.slow
 @pytest.mark.robot_speed(1.0)
 @pytest.mark.realtime
-def test_closed_loop_live_run_holds_a_height(client, auth, connected):
-    body = {"controls": [{"psi0_deg": 35, "zeta0": 0.9}] * 2, "jumps": 25, "closed_loop": {"target_m": 0.4}}
+@pytest.mark.parametrize("controller", ["pid", "lqr", "deadbeat"])
+def test_closed_loop_live_run_holds_a_height(client, auth, connected, controller):
+    loop = {"target_m": 0.4} | ({} if controller == "pid" else {"controller": controller})
+    body = {"controls": [{"psi0_deg": 35, "zeta0": 0.9}] * 2, "jumps": 25, "closed_loop": loop}
     client.post("/api/v1/robot/runs", json=body, headers=auth)
     status = _finish(client, timeout=90)
-    results = client.get(f"/api/v1/runs/{status['run']['stored_run_id']}").json()["results"]
+    run = client.get(f"/api/v1/runs/{status['run']['stored_run_id']}").json()
+    results = run["results"]
     heights = [td["body_height"] for td in results["touchdowns"]]
     # The robot answers in real time, so when each command lands differs from run to run (by up to
     # 0.035 m in a jump of a loaded CI machine): the loop must close the gap, not trace one path.
     errors = [abs(h - 0.4) for h in heights]
     assert errors[0] > 0.15 and errors[-1] < 0.025, heights
     assert sum(errors[-8:]) / 8 < 0.025 and max(errors[-8:]) < 0.05, heights
-    assert sum(c["why"].startswith("pid") for c in results["commands"]) >= 20
+    laws = [c for c in results["commands"] if c["why"].startswith(f"{controller} after touchdown")]
+    assert len(laws) >= 20 and all(c["controller"] == controller and len(c["state"]) == 2 for c in laws)
+    assert (run["controller"], run["target"], results["closed_loop"]["controller"]) == (controller, 0.4, controller)
+    if controller == "lqr":  # it commands the leg angle too, within the servos' range
+        assert len({round(c["psi0_deg"], 6) for c in laws}) > 1 and all(10 <= c["psi0_deg"] <= 60 for c in laws)
+
+
+@pytest.mark.parametrize(
+    ("change", "loc", "says"),
+    [
+        ({"controller": "mpc"}, ["body", "closed_loop", "controller"], "must be one of pid, pid-pitch, lqr, deadbeat"),
+        ({"target_m": 2.5}, ["body", "closed_loop", "target_m"], "less than or equal to 2"),
+        ({"target_m": 0.0}, ["body", "closed_loop", "target_m"], "greater than 0"),
+        ({"zeta0_min": 0.7}, ["body", "closed_loop.zeta0_min"], "must be in [0.75, 0.98]"),
+        ({"kp": 11}, ["body", "closed_loop", "kp"], "less than or equal to 10"),
+    ],
+)
+def test_a_closed_loop_it_cannot_run_is_a_422_naming_the_field(client, auth, connected, change, loc, says):
+    body = {"controls": CONTROLS, "jumps": 5, "closed_loop": {"target_m": 0.4, "controller": "lqr"} | change}
+    response = client.post("/api/v1/robot/runs", json=body, headers=auth)
+    assert response.status_code == 422, response.text
+    detail = response.json()["detail"][0]
+    assert detail["loc"] == loc and says in detail["msg"], detail
+    assert connected.firmware.state.name == "DISARMED" and client.get("/api/v1/robot").json()["run"] is None
 
 
 @pytest.mark.parametrize("url", ["/dev/sda", "/dev/watchdog", "/dev/null", "http://robot", "socket://a b:1"])

@@ -1,0 +1,98 @@
+"""A controller closed on the robot: the compiled law of :mod:`sim_core.controllers`, stepped once
+per detected touchdown by a live run's loop (its one owner, the loop's thread).
+
+At detected touchdown ``i`` (the climb's touchdown ``i + 1``) the law sees what the robot
+observes there — the body's height, the pitch the tracker gave for that stance (NaN when the
+markers gave none) and the section state fitted from the flight before it — and returns the
+controls of the climb's next touchdown, ``i + 2``: the leg the robot positions during the coming
+stance. Heights are the tracker's [m] over the leg length, the frame ``target_m`` is given in,
+so the law's target and heights share an origin. The ``pid`` law is today's loop
+(:func:`sim_core.closed_loop.pid_step`, each leg keeping its own angle; the error now taken as
+``target / l0 - height / l0``, the same to rounding); the others command the angle too. Every
+command says which law, whether it was clipped to the leg's range, and the law's state after it
+(the PID's integral and last error; the LQR's and deadbeat's last command).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from backend.robot.limits import ServoLimits
+from backend.robot.touchdown import Touchdown
+from sim_core.control_laws import PID, Controller
+from sim_core.controls import LegControl
+from sim_core.params import PhysicalParams
+from sim_core.validation import check_range
+from sim_core.walls import Wall, wall_of
+
+
+@dataclass
+class LiveLaw:
+    """``law`` holding ``target_m`` [m] on a robot of ``leg_length`` [m], whose first detected
+    touchdown is made with ``first`` (the right leg's start controls: the climb's touchdown 1)."""
+
+    target_m: float
+    law: Controller
+    leg_length: float  # [m]
+    first: LegControl
+
+    def __post_init__(self) -> None:
+        from sim_core.controllers import control_step, new_memory  # compiled before the first touchdown
+
+        self._step = control_step
+        self.kind, self.parameters = self.law.kernel_args()
+        self.memory = new_memory(self.kind, self.first.psi0, self.first.zeta0)
+        # One step on a copy, so the law is compiled (or loaded from numba's cache) before the run starts.
+        control_step(self.kind, self.parameters, self.memory.copy(), 1.0, 0.0, -0.9, -0.2, True)
+
+    @property
+    def name(self) -> str:
+        return self.law.name
+
+    def command(self, touchdown: Touchdown, pitch: float, leg_psi0: float) -> tuple[LegControl, dict]:
+        """The next touchdown's controls after detected ``touchdown`` (``pitch`` [rad] tracked in
+        its stance; ``leg_psi0`` [rad] the angle that leg holds now, which ``pid`` keeps), and
+        what the journal keeps of it: the law, clipping and its state after the step."""
+        xdot, ydot = touchdown.state
+        on_left = wall_of(touchdown.index + 2) == Wall.LEFT  # the next touchdown
+        height = touchdown.body_height / self.leg_length
+        psi0, zeta0, clipped = self._step(self.kind, self.parameters, self.memory, height, pitch, xdot, ydot, on_left)
+        if self.kind == PID:
+            psi0 = leg_psi0
+        state = [None if math.isnan(value) else float(value) for value in self.memory]
+        journal = {"controller": self.name, "clipped": bool(clipped), "state": state}
+        return LegControl(float(psi0), float(zeta0)), journal
+
+
+def pitch_at(time: np.ndarray, pitch: np.ndarray, at: float, lookback: int) -> float:
+    """The pitch [rad] the tracker gave at time ``at`` [s]: of the last pose at or before it, else
+    of the newest of the ``lookback`` before that with one; NaN when none has."""
+    last = int(np.searchsorted(time, at, side="right")) - 1
+    for i in range(last, max(last - lookback, -1), -1):
+        if math.isfinite(pitch[i]):
+            return float(pitch[i])
+    return math.nan
+
+
+def live_law_for(loop, robot: PhysicalParams, legs: list[LegControl], limits: ServoLimits) -> LiveLaw:
+    """The closed loop ``loop`` (a :class:`backend.schemas.ClosedLoopIn`) as the run's law: about
+    the in-place zeta0 at the left leg's angle, designed on ``robot``'s model (the LQR's gains and
+    the deadbeat's predictions from it: a calibrated preset gives its own), its commands within
+    the servos' ``limits``, compiled before anything moves. A law that cannot be built, or a
+    zeta0 range the servos cannot reach, is a ParameterError naming the field (a 422)."""
+    from sim_core.control_design import design_law
+    from sim_core.height_controller import HeightController
+    from sim_core.sweep import find_in_place_zeta0
+
+    for name in ("zeta0_min", "zeta0_max"):
+        check_range(f"closed_loop.{name}", getattr(loop, name), *limits.zeta0, low_open=False, high_open=False)
+    model = robot.to_model()
+    hover = find_in_place_zeta0(model, legs[0].psi0, zeta0_range=(loop.zeta0_min, loop.zeta0_max))
+    height = HeightController(loop.target_m / robot.leg_length, hover, loop.kp, loop.ki, loop.kd, loop.zeta0_min,
+                              loop.zeta0_max)  # fmt: skip
+    law = design_law(loop.controller, model, height, legs[0].psi0_deg, psi0_range_deg=limits.psi0_deg,
+                     climb_per_jump=loop.climb_per_jump)  # fmt: skip
+    return LiveLaw(loop.target_m, law, robot.leg_length, legs[1])
