@@ -22,6 +22,7 @@ import numpy as np
 
 from backend.robot.limits import ServoLimits
 from backend.robot.touchdown import Touchdown
+from sim_core.control_design import SteppedLaw, law_holding
 from sim_core.control_laws import PID, Controller
 from sim_core.controls import LegControl
 from sim_core.params import PhysicalParams
@@ -40,31 +41,28 @@ class LiveLaw:
     first: LegControl
 
     def __post_init__(self) -> None:
-        from sim_core.controllers import control_step, new_memory  # compiled before the first touchdown
-
-        self._step = control_step
-        self.kind, self.parameters = self.law.kernel_args()
-        self.memory = new_memory(self.kind, self.first.psi0, self.first.zeta0)
-        # One step on a copy, so the law is compiled (or loaded from numba's cache) before the run starts.
-        control_step(self.kind, self.parameters, self.memory.copy(), 1.0, 0.0, -0.9, -0.2, True)
+        self.stepped = SteppedLaw(self.law, self.first)  # compiled before the run starts
 
     @property
     def name(self) -> str:
         return self.law.name
 
+    @property
+    def memory(self) -> np.ndarray:
+        return self.stepped.memory
+
     def command(self, touchdown: Touchdown, pitch: float, leg_psi0: float) -> tuple[LegControl, dict]:
         """The next touchdown's controls after detected ``touchdown`` (``pitch`` [rad] tracked in
         its stance; ``leg_psi0`` [rad] the angle that leg holds now, which ``pid`` keeps), and
         what the journal keeps of it: the law, clipping and its state after the step."""
-        xdot, ydot = touchdown.state
         on_left = wall_of(touchdown.index + 2) == Wall.LEFT  # the next touchdown
-        height = touchdown.body_height / self.leg_length
-        psi0, zeta0, clipped = self._step(self.kind, self.parameters, self.memory, height, pitch, xdot, ydot, on_left)
-        if self.kind == PID:
+        psi0, zeta0, clipped = self.stepped.step(
+            touchdown.body_height / self.leg_length, pitch, *touchdown.state, on_left
+        )
+        if self.stepped.kind == PID:
             psi0 = leg_psi0
-        state = [None if math.isnan(value) else float(value) for value in self.memory]
-        journal = {"controller": self.name, "clipped": bool(clipped), "state": state}
-        return LegControl(float(psi0), float(zeta0)), journal
+        journal = {"controller": self.name, "clipped": clipped, "state": self.stepped.state}
+        return LegControl(psi0, zeta0), journal
 
 
 def pitch_at(time: np.ndarray, pitch: np.ndarray, at: float, lookback: int) -> float:
@@ -83,16 +81,9 @@ def live_law_for(loop, robot: PhysicalParams, legs: list[LegControl], limits: Se
     the deadbeat's predictions from it: a calibrated preset gives its own), its commands within
     the servos' ``limits``, compiled before anything moves. A law that cannot be built, or a
     zeta0 range the servos cannot reach, is a ParameterError naming the field (a 422)."""
-    from sim_core.control_design import design_law
-    from sim_core.height_controller import HeightController
-    from sim_core.sweep import find_in_place_zeta0
-
     for name in ("zeta0_min", "zeta0_max"):
         check_range(f"closed_loop.{name}", getattr(loop, name), *limits.zeta0, low_open=False, high_open=False)
-    model = robot.to_model()
-    hover = find_in_place_zeta0(model, legs[0].psi0, zeta0_range=(loop.zeta0_min, loop.zeta0_max))
-    height = HeightController(loop.target_m / robot.leg_length, hover, loop.kp, loop.ki, loop.kd, loop.zeta0_min,
-                              loop.zeta0_max)  # fmt: skip
-    law = design_law(loop.controller, model, height, legs[0].psi0_deg, psi0_range_deg=limits.psi0_deg,
-                     climb_per_jump=loop.climb_per_jump)  # fmt: skip
+    law = law_holding(loop.controller, robot.to_model(), loop.target_m / robot.leg_length, legs[0].psi0_deg,
+                      gains=(loop.kp, loop.ki, loop.kd), zeta0_range=(loop.zeta0_min, loop.zeta0_max),
+                      psi0_range_deg=limits.psi0_deg, climb_per_jump=loop.climb_per_jump)  # fmt: skip
     return LiveLaw(loop.target_m, law, robot.leg_length, legs[1])

@@ -9,7 +9,8 @@ coordinates, docs/model.md §2).
 - :class:`Controls` — what simulate mode's sliders set: both legs and the robot;
 - :class:`SimulatedClimb` — the model climbing in real time, each jump with the controls of the
   moment it starts, the next leg read at lift-off as the robot does, ending at a failing jump or
-  at the chute's floor (docs/model.md §7).
+  at the chute's floor (docs/model.md §7); with a law set (:meth:`SimulatedClimb.set_law`), the
+  loop closed as on the robot: at each touchdown the law sets the next touchdown's leg.
 """
 
 from __future__ import annotations
@@ -22,6 +23,8 @@ import numpy as np
 from frontend.viewer.motion import PathClip, Pose
 from sim_core import LegControl, PhysicalParams, climb
 from sim_core.climb_records import ClimbSetup, End, Jump, JumpStart, NextLeg, Samples
+from sim_core.control_design import SteppedLaw
+from sim_core.control_laws import Controller
 from sim_core.trajectory import STANCE
 from sim_core.walls import Wall
 
@@ -122,6 +125,16 @@ class Controls:
         return self.left if wall == Wall.LEFT else self.right
 
 
+@dataclass(frozen=True)
+class LawCommand:
+    """What the law commanded at touchdown ``jump``: the next touchdown's leg, and whether it was
+    clipped to the leg's range."""
+
+    jump: int
+    leg: LegControl
+    clipped: bool
+
+
 class SimulatedClimb:
     """The model climbing between the walls in real time: a driver of :mod:`sim_core.climb`.
 
@@ -136,16 +149,30 @@ class SimulatedClimb:
         self._lock = threading.Lock()
         self._controls = controls
         self._start_state = state
+        self._law: Controller | None = None
         self.reset(state)
 
     def reset(self, state: tuple[float, float] | None = None) -> None:
-        """Back to the floor: touchdown 0 on the left wall, the foot at the floor, at time 0."""
+        """Back to the floor: touchdown 0 on the left wall, the foot at the floor, at time 0 (a law
+        set starts afresh: its memory from touchdown 0's controls)."""
         with self._lock:
             self._start_state = state or self._start_state
             controls = self._controls
-            start = climb.launch(ClimbSetup(controls.robot), controls.leg_for(Wall.LEFT), self._start_state)
+            first = controls.leg_for(Wall.LEFT)
+            start = climb.launch(ClimbSetup(controls.robot), first, self._start_state)
+            self.stepped = None if self._law is None else SteppedLaw(self._law, first)
+            self.commands: list[LawCommand] = []
             self.plans: list[JumpPlan] = []
             self._plan(start)
+
+    def set_law(self, law: Controller | None) -> None:
+        """Close the loop with ``law`` (its target in l0 above the floor), or open it (None); from
+        the next :meth:`reset`."""
+        self._law = law
+
+    @property
+    def law(self) -> Controller | None:
+        return self._law
 
     @property
     def controls(self) -> Controls:
@@ -182,18 +209,34 @@ class SimulatedClimb:
         return self.current.clip.end
 
     def _plan(self, start: JumpStart) -> None:
-        """Jump ``start`` planned with the next leg's controls of now (read again at lift-off)."""
+        """Jump ``start`` planned with the next leg's controls of now (read again at lift-off); closed
+        loop, the law's command from this touchdown."""
         controls = self._controls
         setup = ClimbSetup(controls.robot)
-        next_leg = climb.read_next_leg(start, controls.leg_for(start.wall.other))
+        if self.stepped is not None:
+            self._command(start, controls.robot)
+        next_leg = climb.read_next_leg(start, self._next_leg_for(start))
         self.plans.append(JumpPlan.of(climb.jump(setup, start, next_leg), controls.robot))
         self._next_leg_read = False
+
+    def _command(self, start: JumpStart, robot: PhysicalParams) -> None:
+        """The law at touchdown ``start``: what it shows (height above the floor and pitch, as the
+        robot's tracker gives them, and the section state) sets the next touchdown's leg."""
+        psi0, zeta0, clipped = self.stepped.step(start.body_height / robot.leg_length, start.pitch, *start.state,
+                                                 start.wall.other == Wall.LEFT)  # fmt: skip
+        self.commands.append(LawCommand(start.jump, LegControl(psi0, zeta0), clipped))
+
+    def _next_leg_for(self, start: JumpStart) -> LegControl:
+        """The next wall's leg as commanded now: the law's command from this touchdown, else the sliders'."""
+        if self.stepped is not None and self.commands and self.commands[-1].jump == start.jump:
+            return self.commands[-1].leg
+        return self._controls.leg_for(start.wall.other)
 
     def _read_next_leg(self) -> None:
         """At lift-off the flight toward the other wall takes that leg's controls of now."""
         self._next_leg_read = True
         plan = self.current
-        next_leg = climb.read_next_leg(plan.jump.start, self._controls.leg_for(plan.wall.other))
+        next_leg = climb.read_next_leg(plan.jump.start, self._next_leg_for(plan.jump.start))
         replanned = climb.replan(ClimbSetup(plan.robot), plan.jump, next_leg)
         if replanned is not plan.jump:
             self.plans[-1] = JumpPlan.of(replanned, plan.robot)

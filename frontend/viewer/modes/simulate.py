@@ -1,8 +1,11 @@
-"""Simulate mode: the model climbing in real time with the sliders' controls.
+"""Simulate mode: the model climbing in real time with the sliders' controls, or holding a height.
 
 A slider acts from the next touchdown (:class:`frontend.viewer.simulated_climb.SimulatedClimb`); the
 readout names the gait of the controls in use, looked for in the background
-(:mod:`frontend.viewer.modes.gait_search`).
+(:mod:`frontend.viewer.modes.gait_search`). A controller closes the loop as on the robot: from
+each touchdown the chosen law (designed in the background on the sliders' robot, about the gait
+of jumping in place at the left leg's angle) sets the next touchdown's leg, and the readout
+shows its command each jump.
 """
 
 from __future__ import annotations
@@ -19,7 +22,13 @@ from frontend.viewer.motion import TRAIL_STRIDE
 from frontend.viewer.scene import ChuteScene
 from frontend.viewer.simulated_climb import Controls, SimulatedClimb
 from sim_core import FixedPoint, LegControl, PhysicalParams
+from sim_core.climb_records import CHUTE_TOP
+from sim_core.control_design import law_holding
+from sim_core.control_laws import KINDS
+from sim_core.errors import FixedPointNotFound, ParameterError
 from sim_core.trajectory import STANCE
+
+OPEN_LOOP = "off"  # the controller dropdown's "the sliders set the legs"
 
 
 class SimulateMode(Mode):
@@ -49,6 +58,11 @@ class SimulateMode(Mode):
             self.gui_damping = self._ranged_slider(
                 "damping [N·s/m]", 0.0, 3.0, 0.05, robot.c_zeta, hint="leg and pivot"
             )
+            self.gui_controller = gui.add_dropdown(
+                "Controller", (OPEN_LOOP, *KINDS), initial_value=OPEN_LOOP,
+                hint="close the loop: from each touchdown the law sets the next leg (the sliders set the first)",
+            )  # fmt: skip
+            self.gui_target = self._ranged_slider("target [m]", 0.1, CHUTE_TOP, 0.01, 0.55, hint="the height held")
             self.gui_playback = gui.add_button_group("Playback", ("Play", "Pause", "Step jump", "Restart"))
             self.gui_speed = self._ranged_slider("speed [×]", 0.1, 4.0, 0.1, 1.0)
             self.gui_readout = gui.add_markdown("")
@@ -61,6 +75,10 @@ class SimulateMode(Mode):
         self.gui_symmetric.on_update(self._on_control)
         self.gui_preset.on_update(self._on_preset)
         self.gui_playback.on_click(self._on_playback)
+        self.gui_controller.on_update(self._on_law)
+        self.gui_target.on_update(self._on_law)
+        self.law_note = "off: the sliders set the legs"
+        self._law_generation = 0
         self.playing = True
         self.time = 0.0
         self.input_note: str | None = None  # why what was typed is not used (half-typed, out of range)
@@ -124,6 +142,8 @@ class SimulateMode(Mode):
         self.applied = self.controls()
         self.climb.set_controls(self.applied)
         self._find_gait(restart=restart)
+        if self.gui_controller.value != OPEN_LOOP:
+            self._design_law()  # the law is the sliders' robot's and leg angle's
 
     def _on_speed(self, _event) -> None:
         with self.lock:
@@ -159,6 +179,52 @@ class SimulateMode(Mode):
         self.scene.clear_history()
         self.time, self._shown, self.playing = 0.0, 0, True
 
+    # The closed loop ------------------------------------------------------------------------------
+    def _on_law(self, _event) -> None:
+        if self._quiet:
+            return
+        with self.lock:
+            note = self._out_of_range((self.gui_target,))
+            if note is not None:
+                self.law_note = f"not used: {note}"
+                return
+            self._design_law()
+
+    def _design_law(self) -> None:
+        """Design the chosen law in the background (the newest request wins), then restart with it."""
+        self._law_generation += 1
+        generation, name, controls = self._law_generation, self.gui_controller.value, self.applied
+        target_m = float(self.gui_target.value)
+        self.law_note = "designing…" if name != OPEN_LOOP else self.law_note
+
+        def design() -> None:
+            law, note = None, "off: the sliders set the legs"
+            if name != OPEN_LOOP:
+                robot = controls.robot
+                try:
+                    law = law_holding(name, robot.to_model(), target_m / robot.leg_length, controls.left.psi0_deg)
+                    note = f"{name} holding {target_m:g} m"
+                except (ParameterError, FixedPointNotFound) as error:
+                    note = f"{name} cannot be designed here: {error} (the sliders set the legs)"
+            with self.lock:
+                if generation != self._law_generation:
+                    return
+                self.law_note = note
+                self.climb.set_law(law)
+                self._restart()
+
+        with contextlib.suppress(RuntimeError):  # closed: the browser has gone
+            self._gait_worker.submit(design)
+
+    def _law_words(self) -> str:
+        commands = self.climb.commands
+        if self.climb.law is None or not commands:
+            return self.law_note
+        last = commands[-1]
+        clipped = " (clipped to the leg's range)" if last.clipped else ""
+        return (f"{self.law_note} · touchdown {last.jump + 1} → psi0 {last.leg.psi0_deg:.2f}°, "
+                f"zeta0 {last.leg.zeta0:.4f}{clipped}")  # fmt: skip
+
     # The fixed-point readout --------------------------------------------------------------------
     def _find_gait(self, *, restart: bool) -> None:
         """Look for the gait of the current controls in the background (the newest request wins)."""
@@ -182,6 +248,7 @@ class SimulateMode(Mode):
     def close(self) -> None:
         """Compute nothing more: a search under way is not waited for and its answer is dropped."""
         self._gait_generation += 1
+        self._law_generation += 1
         self._gait_worker.shutdown(wait=False, cancel_futures=True)
 
     # Per frame ----------------------------------------------------------------------------------
@@ -219,5 +286,6 @@ class SimulateMode(Mode):
             f"**Jump** {pose.jump + 1} · **height** {pose.y:.3f} m · **climb/jump** {last}  \n"
             f"**Failure:** {failure}  \n"
             f"**Gait of these controls:** {self.gait_note}  \n"
+            f"**Controller:** {self._law_words()}  \n"
             f"alpha = {robot.to_model().alpha:.1f} · t = {t:.1f} s · {updates_per_s:.0f} updates/s"
         )

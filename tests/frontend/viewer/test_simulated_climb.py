@@ -119,3 +119,39 @@ def test_each_jump_starts_where_and_when_the_one_before_ends_and_the_last_where_
     deeper = LegControl.from_degrees(30, 0.86)
     controls = Controls(PERIOD_1, deeper, ROBOT)
     assert (controls.leg_for(Wall.LEFT), controls.leg_for(Wall.RIGHT)) == (PERIOD_1, deeper)
+
+
+@pytest.mark.parametrize("name", ["pid", "lqr", "deadbeat"])
+def test_a_closed_loop_climbs_as_the_benchmarks_compiled_loop_does(name):
+    """With a law set, each touchdown's command is the next touchdown's leg, as in the benchmark's
+    compiled trial (sim_core.control_study.controlled_loop) without noise: the same touchdown
+    heights, jump for jump, and the target held."""
+    from experiments.control_study import Config, laws_for
+    from sim_core.control_study import controlled_loop
+    from sim_core.noise import NoiseModel
+
+    config = Config(controllers=(name,), target_m=0.5, jumps=30)
+    loop, (law,) = laws_for(ROBOT.to_model(), config, ROBOT.leg_length)
+    first = LegControl.from_degrees(35.0, 0.9)
+    view = SimulatedClimb(Controls(first, first, ROBOT), tuple(loop.start))
+    view.set_law(law)
+    view.reset()
+    view.pose_at(60.0)
+    heights = np.full(31, np.nan)
+    kind, parameters = law.kernel_args()
+    no_noise = [0.0] * len(NoiseModel().kernel_args())
+    status, _ = controlled_loop(*loop.start, first.psi0, first.zeta0, kind, parameters, 0, *no_noise,
+                                *ROBOT.to_model().kernel_args(), heights, np.zeros(30, dtype=np.bool_))  # fmt: skip
+    shown = np.array([plan.jump.start.body_height for plan in view.plans[:31]]) / ROBOT.leg_length
+    assert status == 0 and len(view.commands) >= 30
+    assert_allclose(shown, heights, rtol=1e-9, atol=1e-12)
+    assert abs(view.plans[30].jump.start.body_height - 0.5) < 0.01
+    assert view.plans[1].leg == view.commands[0].leg, "touchdown 0's command is touchdown 1's leg"
+
+
+def test_opening_the_loop_gives_the_sliders_back():
+    climb = _climb()
+    law_free = [plan.next_leg for plan in climb.plans]
+    climb.set_law(None)
+    climb.reset()
+    assert climb.stepped is None and climb.commands == [] and [plan.next_leg for plan in climb.plans] == law_free

@@ -94,3 +94,38 @@ def test_simulate_mode_stops_a_descending_climb_at_the_floor_and_says_so(browser
     assert simulate.climb.current.failure is ClimbEnd.FLOOR
     assert "**Failure:** **floor** at jump" in readout and "the body reached the chute's floor" in readout, readout
     assert "height** 0.000 m" in readout, readout
+
+
+@pytest.mark.parametrize("name", ["lqr", "deadbeat"])
+def test_a_controller_holds_the_height_a_browser_chose_and_the_readout_shows_its_command(browsers, name):
+    browser, session = browsers()
+    other = browsers()[1].modes["simulate"]  # a second browser's view keeps its own open loop
+    simulate = session.modes["simulate"]
+    wait_for(lambda: simulate.gait_note != "searching…")
+    browser.set_gui("target [m]", 0.45)
+    browser.set_gui("Controller", name)
+    wait_for(lambda: simulate.law_note == f"{name} holding 0.45 m", timeout=30)
+    with session.lock:
+        simulate.playback("Pause")
+        simulate.time = 25.0  # about 70 jumps of the paper's robot
+        simulate.frame(0.0)
+        readout = simulate.readout(60.0)
+    assert simulate.climb.current.failure is None
+    heights = [plan.jump.start.body_height for plan in simulate.climb.plans[-10:]]
+    assert max(abs(height - 0.45) for height in heights) < 0.01, heights
+    assert f"**Controller:** {name} holding 0.45 m · touchdown" in readout and "→ psi0" in readout, readout
+    assert other.climb.law is None and "off: the sliders set the legs" in other.readout(60.0)
+    browser.set_gui("Controller", "off")
+    wait_for(lambda: simulate.climb.law is None and simulate.law_note.startswith("off"))
+
+
+def test_a_target_out_of_the_chute_is_not_used_and_says_why(browsers):
+    browser, session = browsers()
+    simulate = session.modes["simulate"]
+    wait_for(lambda: simulate.gait_note != "searching…")
+    browser.set_gui("Controller", "pid")
+    wait_for(lambda: simulate.law_note == "pid holding 0.55 m", timeout=30)
+    browser.set_gui("target [m]", 5.0)  # typed; the browser then holds the box to the slider's end
+    wait_for(lambda: "not used" in simulate.law_note)
+    assert "target [m] must be 0.1 to 2, got" in simulate.law_note, simulate.law_note
+    assert simulate.climb.law is not None and simulate.climb.law.target == pytest.approx(0.55 / 0.2232, rel=0.01)
