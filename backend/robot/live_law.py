@@ -16,7 +16,7 @@ command says which law, whether it was clipped to the leg's range, and the law's
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -24,7 +24,7 @@ from backend.robot.limits import ServoLimits
 from backend.robot.touchdown import Touchdown
 from sim_core.control_design import SteppedLaw, law_holding
 from sim_core.control_laws import PID, Controller
-from sim_core.controls import LegControl
+from sim_core.controls import NO_OFFSETS, LegControl, LegOffsets
 from sim_core.params import PhysicalParams
 from sim_core.validation import check_range
 from sim_core.walls import Wall, wall_of
@@ -33,15 +33,22 @@ from sim_core.walls import Wall, wall_of
 @dataclass
 class LiveLaw:
     """``law`` holding ``target_m`` [m] on a robot of ``leg_length`` [m], whose first detected
-    touchdown is made with ``first`` (the right leg's start controls: the climb's touchdown 1)."""
+    touchdown is made with ``first`` (the right leg's start controls: the climb's touchdown 1).
+    ``offsets``: the legs' servo offsets a calibration found (:class:`sim_core.controls.LegOffsets`);
+    each command is the law's less its leg's offset, so the leg realises what the law chose, held
+    to the servos' ``limits`` (clipped, and said so, where the offset would take it past them)."""
 
     target_m: float
     law: Controller
     leg_length: float  # [m]
     first: LegControl
+    offsets: LegOffsets = NO_OFFSETS
+    limits: ServoLimits = field(default_factory=ServoLimits)
 
     def __post_init__(self) -> None:
         self.stepped = SteppedLaw(self.law, self.first)  # compiled before the run starts
+        self._psi0_offset = tuple(math.radians(offset) for offset in self.offsets.psi0_offset_deg)
+        self._psi0_range = tuple(math.radians(bound) for bound in self.limits.psi0_deg)
 
     @property
     def name(self) -> str:
@@ -55,14 +62,17 @@ class LiveLaw:
         """The next touchdown's controls after detected ``touchdown`` (``pitch`` [rad] tracked in
         its stance; ``leg_psi0`` [rad] the angle that leg holds now, which ``pid`` keeps), and
         what the journal keeps of it: the law, clipping and its state after the step."""
-        on_left = wall_of(touchdown.index + 2) == Wall.LEFT  # the next touchdown
-        psi0, zeta0, clipped = self.stepped.step(
-            touchdown.body_height / self.leg_length, pitch, *touchdown.state, on_left
-        )
-        if self.stepped.kind == PID:
-            psi0 = leg_psi0
+        wall = wall_of(touchdown.index + 2)  # the next touchdown's
+        height = touchdown.body_height / self.leg_length
+        psi0, zeta0, clipped = self.stepped.step(height, pitch, *touchdown.state, wall == Wall.LEFT)
+        side = 1 if wall == Wall.RIGHT else 0
+        commanded = (leg_psi0 if self.stepped.kind == PID else psi0 - self._psi0_offset[side],
+                     zeta0 - self.offsets.zeta0_offset[side])  # fmt: skip
+        held = (min(max(commanded[0], self._psi0_range[0]), self._psi0_range[1]),
+                min(max(commanded[1], self.limits.zeta0[0]), self.limits.zeta0[1]))  # fmt: skip
+        clipped = clipped or held != commanded
         journal = {"controller": self.name, "clipped": clipped, "state": self.stepped.state}
-        return LegControl(psi0, zeta0), journal
+        return LegControl(*held), journal
 
 
 def pitch_at(time: np.ndarray, pitch: np.ndarray, at: float, lookback: int) -> float:
@@ -86,4 +96,4 @@ def live_law_for(loop, robot: PhysicalParams, legs: list[LegControl], limits: Se
     law = law_holding(loop.controller, robot.to_model(), loop.target_m / robot.leg_length, legs[0].psi0_deg,
                       gains=(loop.kp, loop.ki, loop.kd), zeta0_range=(loop.zeta0_min, loop.zeta0_max),
                       psi0_range_deg=limits.psi0_deg, climb_per_jump=loop.climb_per_jump)  # fmt: skip
-    return LiveLaw(loop.target_m, law, robot.leg_length, legs[1])
+    return LiveLaw(loop.target_m, law, robot.leg_length, legs[1], limits=limits)

@@ -102,3 +102,22 @@ def test_it_is_compiled_before_the_run_starts():
     law = LiveLaw(0.4, design_law("deadbeat", ROBOT.to_model(), HeightController(1.8, 0.96), 35.0),
                   ROBOT.leg_length, LEGS[1])  # fmt: skip
     assert law.name == "deadbeat" and tuple(law.memory) == (LEGS[1].psi0, LEGS[1].zeta0), "the warm-up left it as new"
+
+
+def test_a_calibrations_offsets_are_taken_off_each_command_within_the_servos_range():
+    """The leg realises command + offset, so the law's choice is sent less its leg's offset; where
+    that passes a servo's end the command is held there and counted as clipped."""
+    from sim_core.controls import LegOffsets
+
+    law = design_law("lqr", ROBOT.to_model(), HeightController(1.8, 0.96), 35.0)
+    offsets = LegOffsets(psi0_offset_deg=(0.6, -0.8), zeta0_offset=(0.004, -0.005))
+    plain, offset = LiveLaw(0.4, law, ROBOT.leg_length, LEGS[1]), LiveLaw(0.4, law, ROBOT.leg_length, LEGS[1], offsets)
+    for index, height in enumerate(HEIGHTS):
+        side = (index + 2) % 2  # the next touchdown's leg: 0 left, 1 right
+        want, _ = plain.command(_touchdown(index, height), 0.0, 0.0)
+        got, _ = offset.command(_touchdown(index, height), 0.0, 0.0)
+        assert got.psi0_deg == pytest.approx(want.psi0_deg - offsets.psi0_offset_deg[side], abs=1e-12)
+        assert got.zeta0 == pytest.approx(want.zeta0 - offsets.zeta0_offset[side], abs=1e-15)
+    at_the_end = LiveLaw(0.4, law, ROBOT.leg_length, LEGS[1], LegOffsets(zeta0_offset=(-0.09, -0.09)))
+    control, journal = at_the_end.command(_touchdown(0, 0.1), 0.0, 0.0)
+    assert control.zeta0 == ServoLimits().zeta0[1] and journal["clipped"]
