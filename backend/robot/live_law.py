@@ -85,15 +85,18 @@ def pitch_at(time: np.ndarray, pitch: np.ndarray, at: float, lookback: int) -> f
     return math.nan
 
 
-def live_law_for(loop, robot: PhysicalParams, legs: list[LegControl], limits: ServoLimits) -> LiveLaw:
+def live_law_for(
+    loop, robot: PhysicalParams, legs: list[LegControl], limits: ServoLimits, *, offsets: LegOffsets = NO_OFFSETS
+) -> LiveLaw:
     """The closed loop ``loop`` (a :class:`backend.schemas.ClosedLoopIn`) as the run's law: about
     the in-place zeta0 at the left leg's angle, designed on ``robot``'s model (the LQR's gains and
-    the deadbeat's predictions from it: a calibrated preset gives its own), its commands within
-    the servos' ``limits``, compiled before anything moves. A law that cannot be built, or a
+    the deadbeat's predictions from it: a calibrated preset gives its own, and its leg
+    ``offsets`` come off each command), its commands within the servos' ``limits``, compiled
+    before anything moves. A law that cannot be built, or a
     zeta0 range the servos cannot reach, is a ParameterError naming the field (a 422)."""
     for name in ("zeta0_min", "zeta0_max"):
         check_range(f"closed_loop.{name}", getattr(loop, name), *limits.zeta0, low_open=False, high_open=False)
     law = law_holding(loop.controller, robot.to_model(), loop.target_m / robot.leg_length, legs[0].psi0_deg,
                       gains=(loop.kp, loop.ki, loop.kd), zeta0_range=(loop.zeta0_min, loop.zeta0_max),
                       psi0_range_deg=limits.psi0_deg, climb_per_jump=loop.climb_per_jump)  # fmt: skip
-    return LiveLaw(loop.target_m, law, robot.leg_length, legs[1], limits=limits)
+    return LiveLaw(loop.target_m, law, robot.leg_length, legs[1], offsets, limits)

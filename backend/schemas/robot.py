@@ -93,8 +93,9 @@ class RobotConnect(Strict):
 class ClosedLoopIn(Strict):
     """A closed loop: ``controller`` holds ``target_m`` from each touchdown to the next leg
     (docs/analyses.md, "Controllers"); the PIDs take the gains, every law the zeta0 range, the
-    deadbeat its climb per jump. The LQR and the deadbeat are designed on the service's model
-    (a calibrated preset gives its own)."""
+    deadbeat its climb per jump. The LQR and the deadbeat are designed on ``preset`` (a stored
+    calibration gives its own controller, its leg offsets taken off each command), else on the
+    service's robot."""
 
     target_m: Annotated[
         float, Field(gt=FLOOR, le=CHUTE_TOP, description="height to hold [m], above the floor, within the chute")
@@ -108,6 +109,15 @@ class ClosedLoopIn(Strict):
     climb_per_jump: Annotated[
         float, Field(gt=0.0, le=1.0, description="deadbeat: the most it climbs toward the target a jump [l0]")
     ] = DEADBEAT_CLIMB_PER_JUMP
+    preset: Annotated[
+        str | None,
+        Field(
+            min_length=1,
+            max_length=80,
+            description="the model the law is designed on: a built-in preset or a "
+            "stored calibration, whose leg offsets are taken off each command (default: the service's robot)",
+        ),
+    ] = None
 
     @field_validator("controller")
     @classmethod

@@ -21,10 +21,11 @@ from backend.errors import NotFound
 from backend.robot.latch import EstopLatch
 from backend.robot.limits import ServoLimits
 from backend.robot.link import EstopResult, LinkError, LinkState, RobotLink
-from backend.robot.live_law import live_law_for
+from backend.robot.live_law import LiveLaw, live_law_for
 from backend.robot.live_run import LiveRun, RunSnapshot, execute, telemetry_dict
 from backend.robot.supervisor import LinkSupervisor
 from backend.schemas import RobotConnect, RobotRunCreate
+from backend.services.models import resolve_model
 from backend.services.robot_journal import JournalWriter
 from backend.services.robot_records import open_robot_run, recover_interrupted
 from backend.services.robot_tracker import PoseSource, TrackerSlot
@@ -237,8 +238,7 @@ class RobotService:
             for leg in legs:
                 link.limits.check(leg.psi0_deg, leg.zeta0)  # a clear 422 before anything moves
             tracker = self.tracker
-            loop = body.closed_loop
-            controller = None if loop is None else live_law_for(loop, self.robot, legs, link.limits)
+            controller = self._law(body.closed_loop, legs, link.limits)
             with self.sessions() as session:
                 where = {"url": link.url, "robot_address": f"0x{link.robot_address:016X}"}
                 run_id = open_robot_run(
@@ -262,6 +262,17 @@ class RobotService:
             return None
         run.done.wait(timeout)
         return run.snapshot
+
+    def _law(self, loop, legs: list[LegControl], limits) -> LiveLaw | None:
+        """The closed loop's law (None: open loop), designed on its ``preset`` (a stored calibration:
+        its fitted robot and leg offsets) or on the service's robot."""
+        if loop is None:
+            return None
+        if loop.preset is None:
+            return live_law_for(loop, self.robot, legs, limits)
+        with self.sessions() as session:
+            design = resolve_model(session, loop.preset, field="closed_loop.preset")
+        return live_law_for(loop, design.robot, legs, limits, offsets=design.offsets)
 
     def stop_run(self) -> dict:
         run = self._run

@@ -1,6 +1,7 @@
 """The robot's routes (backend/api/routes/robot.py) against the virtual robot: the token for every call
 but the e-stop, live runs recorded like simulated runs and safe to stop, the live view's stream."""
 
+import math
 import socket
 import threading
 import time
@@ -263,6 +264,7 @@ def test_closed_loop_live_run_holds_a_height(client, auth, connected, controller
         ({"target_m": 0.0}, ["body", "closed_loop", "target_m"], "greater than 0"),
         ({"zeta0_min": 0.7}, ["body", "closed_loop.zeta0_min"], "must be in [0.75, 0.98]"),
         ({"kp": 11}, ["body", "closed_loop", "kp"], "less than or equal to 10"),
+        ({"preset": "no-such-table"}, ["body", "closed_loop.preset"], "unknown preset 'no-such-table'; known presets"),
     ],
 )
 def test_a_closed_loop_it_cannot_run_is_a_422_naming_the_field(client, auth, connected, change, loc, says):
@@ -352,3 +354,39 @@ def test_a_recorded_run_replays_to_the_same_touchdowns(client, auth, connected):
     simulated = client.post("/api/v1/runs", json={"controls": CONTROLS[:1], "start": {"xdot": -0.9, "ydot": -0.2}},
                             headers=auth).json()  # fmt: skip
     assert client.post(f"/api/v1/runs/{simulated['id']}/replay", headers=auth).status_code == 409
+
+
+def test_a_closed_loop_designed_on_a_stored_calibration_takes_its_leg_offsets_off(client, auth, connected):
+    """closed_loop.preset names a calibration: the LQR is designed on its fitted model and each
+    command is the law's less the fitted offset of its leg; the stored run names the preset."""
+    from backend.robot.limits import ServoLimits
+    from backend.robot.live_law import live_law_for
+    from backend.schemas import ClosedLoopIn
+    from backend.services.models import resolve_model
+    from sim_core.controls import LegControl
+    from sim_core.noise import NoiseModel
+    from tests.tracked_climbs import Truth, store_varied_runs
+
+    truth = Truth.of(alpha=72.0, c_zeta=1.25, c_psi=0.8, psi0_offset_deg=(0.6, -0.8), zeta0_offset=(0.004, -0.005))
+    with client.app.state.sessions() as session:
+        runs = store_varied_runs(session, truth, noise=NoiseModel(), jumps=30)
+    assert client.post("/api/v1/calibrations", json={"runs": runs, "name": "table"}, headers=auth).status_code == 201
+    loop = {"target_m": 0.4, "controller": "lqr", "preset": "table"}
+    body = {"controls": [{"psi0_deg": 35, "zeta0": 0.9}] * 2, "jumps": 6, "closed_loop": loop}
+    assert client.post("/api/v1/robot/runs", json=body, headers=auth).status_code == 202
+    run = client.get(f"/api/v1/runs/{_finish(client)['run']['stored_run_id']}").json()
+    assert run["results"]["closed_loop"]["preset"] == "table" and run["controller"] == "lqr"
+    laws = [c for c in run["results"]["commands"] if c["why"].startswith("lqr after touchdown")]
+    assert len(laws) >= 4
+    # The same law stepped on the same touchdowns, offline: the service designed it on the calibration.
+    with client.app.state.sessions() as session:
+        design = resolve_model(session, "table")
+    legs = [LegControl.from_degrees(35, 0.9)] * 2
+    twin = live_law_for(ClosedLoopIn(**loop), design.robot, legs, ServoLimits(), offsets=design.offsets)
+    from backend.robot.touchdown import Touchdown
+
+    for command, stored in zip(laws, run["results"]["touchdowns"], strict=False):
+        touchdown = Touchdown.from_dict({key: stored[key] for key in Touchdown.__dataclass_fields__})
+        control, _ = twin.command(touchdown, math.nan, 0.0)
+        assert command["psi0_deg"] == pytest.approx(control.psi0_deg, abs=1e-9)
+        assert command["zeta0"] == pytest.approx(control.zeta0, abs=1e-12)
