@@ -230,15 +230,16 @@ class RobotService:
         link = self._connected()
         with self._lock:
             self._refuse_during_run("start another")
+            legs = [LegControl.from_degrees(leg.psi0_deg, leg.zeta0) for leg in body.controls]
+            for leg in legs:
+                link.limits.check(leg.psi0_deg, leg.zeta0)  # a clear 422 before anything moves
+            # Designed (and compiled) first: an e-stop pressed meanwhile is seen by the checks below.
+            controller = self._law(body.closed_loop, legs, link.limits)
             if self.latch.held:
                 raise RobotUnavailable(f"the e-stop latch holds ({self.latch.state.reason()}): reset before you start")
             if link.state not in (LinkState.DISARMED, LinkState.ARMED):
                 raise RobotUnavailable(f"the robot is {link.state.value}; it must be disarmed or armed to start")
-            legs = [LegControl.from_degrees(leg.psi0_deg, leg.zeta0) for leg in body.controls]
-            for leg in legs:
-                link.limits.check(leg.psi0_deg, leg.zeta0)  # a clear 422 before anything moves
             tracker = self.tracker
-            controller = self._law(body.closed_loop, legs, link.limits)
             with self.sessions() as session:
                 where = {"url": link.url, "robot_address": f"0x{link.robot_address:016X}"}
                 run_id = open_robot_run(
