@@ -6,7 +6,8 @@ from typing import Annotated
 
 import typer
 
-from cli.options import JsonOption, ModelSetup, handles_errors, print_json, progress_bar, with_model, with_noise
+from cli.options import JsonOption, ModelSetup, SchedulerOption, handles_errors, print_json, with_model, with_noise
+from cli.studies import run_study
 from sim_core.control_laws import KINDS
 from sim_core.noise import NoiseModel
 
@@ -36,6 +37,7 @@ def control_study_command(
     jumps: Annotated[int, typer.Option("--jumps", help="Jumps per trial.")] = 400,
     psi0: Annotated[float, typer.Option("--psi0", help="Nominal leg angle [degrees].")] = 35.0,
     start_zeta0: Annotated[float, typer.Option("--start-zeta0", help="zeta0 of the climbing gait at the start.")] = 0.9,
+    scheduler: SchedulerOption = None,
     as_json: JsonOption = False,
 ) -> None:
     """Every controller climbing to a target height under noise, on the same noise draws: failures,
@@ -44,8 +46,8 @@ def control_study_command(
 
     config = Config(controllers=parse_controllers(controllers), target_m=target, psi0_deg=psi0,
                     start_zeta0=start_zeta0, jumps=jumps, seeds=seeds, seed0=seed0, noise=noise)  # fmt: skip
-    with progress_bar("trials") as progress:
-        result = run(setup.model, setup.robot.scales.length, config, progress=progress).to_dict()
+    description = f"control study: {len(config.controllers)} controllers x {seeds} trials"
+    result = run_study(run, description, scheduler, setup.model, setup.robot.scales.length, config).to_dict()
     if as_json:
         print_json(result)
         return

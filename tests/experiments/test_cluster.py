@@ -86,3 +86,19 @@ def test_cli_basin_on_the_cluster_matches_in_process(scheduler):
     remote = runner.invoke(app, [*args, "--scheduler", scheduler])
     assert local.exit_code == 0 and remote.exit_code == 0, remote.output
     assert remote.stdout == local.stdout
+
+
+def test_a_control_study_on_the_cluster_equals_in_process(scheduler):
+    """The benchmark's chunks (a controller's trials, 50 seeds each) on two worker processes: the
+    same outcome as in-process, to the last digit, but for the law's own timing."""
+    from experiments.control_study import Config, run
+    from sim_core.presets import get_preset
+
+    robot = get_preset("paper")
+    config = Config(controllers=("pid", "deadbeat"), jumps=80, seeds=60, seed0=5)
+    with chunk_map_for(scheduler) as chunk_map:
+        clustered = run(robot.to_model(), robot.leg_length, config, chunk_map=chunk_map).to_dict()
+    local = run(robot.to_model(), robot.leg_length, config).to_dict()
+    for entry in (*clustered["controllers"], *local["controllers"]):
+        entry.pop("us_per_jump")
+    assert clustered == local
