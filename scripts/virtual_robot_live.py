@@ -63,7 +63,7 @@ def main() -> None:
             fitted = api.post("/api/v1/calibrations", json={"runs": open_loop, "name": "table"})
             fitted.raise_for_status()
             params = fitted.json()["params"]
-            print(f"calibrated from runs {open_loop}: " + ", ".join(f"{k} {v:.3g}" for k, v in params.items()))
+            print(f"calibrated from runs {open_loop}: {params}", flush=True)
             for controller, preset in CASES:
                 for _ in range(args.runs):
                     loop = {"target_m": args.target, "controller": controller} | ({"preset": preset} if preset else {})

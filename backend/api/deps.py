@@ -74,7 +74,9 @@ async def run_filter(
         Query(min_length=1, max_length=200, description='as recorded, or its kind: "error" matches "error: …"'),
     ] = None,
     loop: schemas.RunLoop | None = None,
-    controller: Annotated[str | None, Query(min_length=1, max_length=16, description='"pid"')] = None,
+    controller: Annotated[
+        str | None, Query(min_length=1, max_length=16, description="a closed loop's law: pid, pid-pitch, lqr, deadbeat")
+    ] = None,
     q: Annotated[
         str | None, Query(min_length=1, max_length=200, description="text in the notes or a tag (any case)")
     ] = None,

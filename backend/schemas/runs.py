@@ -116,7 +116,7 @@ class RunOut(RunBase):
         '"link lost", "robot disarmed (fell or timed out)", "error: …", "interrupted: …"; null for simulations',
     )  # fmt: skip
     loop: RunLoop = Field(RunLoop.OPEN, description="closed: a robot run holding a height (a replay: as its run)")
-    controller: str | None = Field(None, description='the closed loop\'s controller ("pid"); null when open')
+    controller: str | None = Field(None, description="the closed loop's law (pid, lqr, ...); null when open")
     target: float | None = Field(None, description="the height a closed loop held [m]; null when open")
     touchdowns: int | None = Field(
         None, description="robot and replay runs: the touchdowns recorded, which is what their jumps ask for "
