@@ -19,9 +19,9 @@ Kinds so far:
   touched down with (:mod:`sim_core.return_map_lqr` designs it), the pitch fed back as above.
   The law also sees the section state ``xdot, ydot`` at the touchdown, which the robot's tracker
   estimates from the body's track.
-- ``deadbeat``: zeta0 from the section state by the design model's own stance and closed-form
-  flight (:mod:`sim_core.deadbeat`), a set share of the height error each jump, behind a guard
-  that never sends a command the model predicts fails; the leg angle nominal, pitch fed back.
+- ``deadbeat``: zeta0 chosen two jumps ahead on the design model's own map from the section state
+  (:mod:`sim_core.deadbeat`), climbing at most ``climb_per_jump`` a jump, behind a guard that
+  never sends a command the model predicts fails; the leg angle nominal, pitch fed back.
 """
 
 from __future__ import annotations

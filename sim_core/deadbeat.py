@@ -36,7 +36,7 @@ import numpy as np
 from sim_core._jit import kernel
 from sim_core.failures import OK
 from sim_core.integrate import STATE_SIZE
-from sim_core.stride import jump, lift_off
+from sim_core.stride import flight, jump, lift_off
 
 # Parameter layout of the compiled law (sim_core.control_laws.Deadbeat.kernel_args).
 TARGET, PSI0_STAR, ZETA0_STAR, ZETA0_LOW, ZETA0_HIGH, PSI0_LOW, PSI0_HIGH, CLIMB_PER_JUMP, PITCH_GAIN = range(9)
@@ -61,11 +61,9 @@ def horizon_cost(parameters, psi, vx, vy, foot_to_body, next_zeta0, aim_1, aim_2
     failure within the two jumps."""
     alpha, d_hat, c_zeta, c_psi, mu = design_model(parameters)
     psi0_star, zeta0_star = parameters[PSI0_STAR], parameters[ZETA0_STAR]
-    flight_time = (d_hat - math.cos(psi) - next_zeta0 * math.cos(psi0_star)) / vx
-    if not (flight_time > 0.0 and vx > 0.0):
+    status, xdot, ydot, landed, _ = flight(psi, vx, vy, d_hat, psi0_star, next_zeta0)  # landed: above this foot
+    if status != OK:
         return math.inf
-    landed = math.sin(psi) + vy * flight_time - 0.5 * flight_time * flight_time  # body above this foot
-    xdot, ydot = -vx, vy - flight_time  # the section state of touchdown k + 1 (flipped)
     status, xdot, ydot, rise, _, _, _ = jump(xdot, ydot, psi0_star, next_zeta0, psi0_star, zeta0_star, alpha, d_hat,
                                              c_zeta, c_psi, mu, record)  # fmt: skip
     if status != OK:

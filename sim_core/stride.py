@@ -84,15 +84,30 @@ def jump(xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c
     )
     if status != OK:
         return status, nan, nan, nan, stance_time, nan, rows
-    # Flight: from x = -d/2 + cos(psi) to the next touchdown x = d/2 - zeta0' cos(psi0').
+    status, next_xdot, next_ydot, touchdown_height, flight_time = flight(
+        psi, liftoff_xdot, liftoff_ydot, d_hat, next_psi0, next_zeta0
+    )
+    if status != OK:
+        return status, nan, nan, nan, stance_time, nan, rows
+    rise = touchdown_height - next_zeta0 * math.sin(next_psi0)
+    return OK, next_xdot, next_ydot, rise, stance_time, flight_time, rows
+
+
+@kernel
+def flight(psi, liftoff_xdot, liftoff_ydot, d_hat, next_psi0, next_zeta0):
+    """The closed-form flight from lift-off (leg angle ``psi`` [rad], body velocity) to the other
+    wall, where the next leg touches down at ``(next_psi0, next_zeta0)``: ``(status, next_xdot,
+    next_ydot, touchdown_height, flight_time)``, the state flipped to the left wall and the body's
+    height above this foot [l0]; NO_FLIGHT and NaNs where the body never reaches that wall."""
+    nan = math.nan
+    # From x = -d/2 + cos(psi) to the next touchdown x = d/2 - zeta0' cos(psi0').
     distance = d_hat - math.cos(psi) - next_zeta0 * math.cos(next_psi0)
     if liftoff_xdot <= 0.0 or distance <= 0.0:
-        return NO_FLIGHT, nan, nan, nan, stance_time, nan, rows
+        return NO_FLIGHT, nan, nan, nan, nan
     flight_time = distance / liftoff_xdot
     touchdown_height = math.sin(psi) + liftoff_ydot * flight_time - 0.5 * flight_time * flight_time
-    rise = touchdown_height - next_zeta0 * math.sin(next_psi0)
     # The flip: the right-wall touchdown becomes a left-wall one (x -> -x).
-    return OK, -liftoff_xdot, liftoff_ydot - flight_time, rise, stance_time, flight_time, rows
+    return OK, -liftoff_xdot, liftoff_ydot - flight_time, touchdown_height, flight_time
 
 
 @kernel
