@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from backend.robot.live_law import LiveLaw, pitch_at
-from backend.robot.touchdown import PITCH_LOOKBACK, Touchdown, scan_touchdowns
+from backend.robot.touchdown import Touchdown, scan_touchdowns
 from sim_core import ControlSchedule, LegControl, PhysicalParams, climb, gait_of
 from sim_core.climb_records import ClimbSetup
 from sim_core.errors import FixedPointNotFound
@@ -88,7 +88,7 @@ def closed_climb(
             found.append(touchdown)
             if law is not None:
                 wall = wall_of(touchdown.index + 2)
-                pitch = pitch_at(arrays["time"], arrays["pitch"], touchdown.time, PITCH_LOOKBACK)
+                pitch = pitch_at(arrays["time"], arrays["pitch"], touchdown.time)
                 commanded[wall], _ = law.command(touchdown, pitch, commanded[wall].psi0)
         if len(found) >= touchdowns:
             return ClosedClimb(found[:touchdowns], False)

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from backend.robot.limits import ServoLimits
-from backend.robot.touchdown import Touchdown
+from backend.robot.touchdown import Touchdown, pitch_before
 from sim_core.control_design import SteppedLaw, law_holding
 from sim_core.control_laws import PID, Controller
 from sim_core.controls import NO_OFFSETS, LegControl, LegOffsets
@@ -75,14 +75,10 @@ class LiveLaw:
         return LegControl(*held), journal
 
 
-def pitch_at(time: np.ndarray, pitch: np.ndarray, at: float, lookback: int) -> float:
+def pitch_at(time: np.ndarray, pitch: np.ndarray, at: float) -> float:
     """The pitch [rad] the tracker gave at time ``at`` [s]: of the last pose at or before it, else
-    of the newest of the ``lookback`` before that with one; NaN when none has."""
-    last = int(np.searchsorted(time, at, side="right")) - 1
-    for i in range(last, max(last - lookback, -1), -1):
-        if math.isfinite(pitch[i]):
-            return float(pitch[i])
-    return math.nan
+    the newest one looked back to (:func:`backend.robot.touchdown.pitch_before`); NaN when none has."""
+    return pitch_before(pitch, int(np.searchsorted(time, at, side="right")) - 1, math.nan)
 
 
 def live_law_for(

@@ -212,7 +212,7 @@ def execute(
                     run.publish()
                     if controller is not None:
                         leg = Leg.of(wall_of(touchdown.index + 2))  # the next touchdown's (climb numbering)
-                        pitch = pitch_at(arrays["time"], arrays["pitch"], touchdown.time, PITCH_LOOKBACK)
+                        pitch = pitch_at(arrays["time"], arrays["pitch"], touchdown.time)
                         control, law = controller.command(touchdown, pitch, commanded[leg].psi0)
                         send(leg, control, f"{controller.name} after touchdown {touchdown.index}", **law)
                 if len(run.touchdowns) >= run.jumps:

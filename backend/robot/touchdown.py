@@ -102,7 +102,7 @@ def scan_touchdowns(
         wall = Wall.RIGHT if x[i] > 0 else Wall.LEFT
         number = first_index + len(touchdowns)
         leg = leg_for(number)
-        psi = leg.psi0 - wall * _pitch_at(pitch, i)  # the leg turned with the body
+        psi = leg.psi0 - wall * pitch_before(pitch, i)  # the leg turned with the body
         line = wall * (half - leg.zeta0 * robot.leg_length * math.cos(psi))
         if wall * x[i] < wall * line:
             continue
@@ -132,14 +132,15 @@ def scan_touchdowns(
     return Scan(touchdowns, len(time) if flight_start is None else flight_start)
 
 
-def _pitch_at(pitch: np.ndarray | None, i: int) -> float:
-    """The body's pitch at pose ``i``: its own, else the newest finite one before it, else 0."""
+def pitch_before(pitch: np.ndarray | None, i: int, missing: float = 0.0) -> float:
+    """The body's pitch at pose ``i``: its own, else the newest finite one of the
+    :data:`PITCH_LOOKBACK` poses before it, else ``missing`` (also without a pitch stream)."""
     if pitch is None:
-        return 0.0
+        return missing
     for j in range(i, max(i - PITCH_LOOKBACK, -1), -1):
         if math.isfinite(pitch[j]):
             return float(pitch[j])
-    return 0.0
+    return missing
 
 
 def height_gains(touchdowns: list[Touchdown], robot: PhysicalParams) -> np.ndarray:

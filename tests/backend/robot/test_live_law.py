@@ -10,7 +10,7 @@ import pytest
 
 from backend.robot.limits import ServoLimits
 from backend.robot.live_law import LiveLaw, live_law_for, pitch_at
-from backend.robot.touchdown import Touchdown
+from backend.robot.touchdown import PITCH_LOOKBACK, Touchdown
 from sim_core.closed_loop import pid_step
 from sim_core.control_design import design_law
 from sim_core.controllers import control_step, new_memory
@@ -91,11 +91,15 @@ def test_a_zeta0_range_the_servos_cannot_reach_is_refused_naming_it(field, value
 def test_the_pitch_is_the_last_given_at_or_before_the_touchdown():
     time = np.array([0.0, 0.01, 0.02, 0.03, 0.04])
     pitch = np.array([0.1, 0.2, math.nan, math.nan, 0.5])
-    assert pitch_at(time, pitch, 0.015, 10) == 0.2
-    assert pitch_at(time, pitch, 0.035, 10) == 0.2, "looked back past the poses without one"
-    assert pitch_at(time, pitch, 0.04, 10) == 0.5
-    assert math.isnan(pitch_at(time, pitch, 0.035, 1)), "not further than the lookback"
-    assert math.isnan(pitch_at(time, np.full(5, math.nan), 0.04, 10))
+    assert pitch_at(time, pitch, 0.015) == 0.2
+    assert pitch_at(time, pitch, 0.035) == 0.2, "looked back past the poses without one"
+    assert pitch_at(time, pitch, 0.04) == 0.5
+    # The look-back spans PITCH_LOOKBACK poses, the touchdown's own included.
+    far = np.full(PITCH_LOOKBACK + 1, math.nan)
+    far[0] = 0.3  # PITCH_LOOKBACK poses before the last
+    assert math.isnan(pitch_at(np.arange(far.size) * 0.01, far, 1.0)), "not further than the lookback"
+    assert pitch_at(np.arange(far.size - 1) * 0.01, far[:-1], 1.0) == 0.3, "as far as the lookback"
+    assert math.isnan(pitch_at(time, np.full(5, math.nan), 0.04))
 
 
 def test_it_is_compiled_before_the_run_starts():
