@@ -970,8 +970,9 @@ def test_the_robot_tab_says_who_runs_the_robot_and_offers_stop(page, service, ro
 
 
 def test_who_runs_the_robot_is_shown_as_text_with_or_without_a_name(page):
-    with page.expect_response(lambda response: response.url.endswith("/api/v1/robot")):
-        page.click("nav [data-tab=robot]")  # its answer drawn before the statuses below, not after
+    with page.expect_response(lambda response: response.url.endswith("/api/v1/robot")) as answer:
+        page.click("nav [data-tab=robot]")
+    answer.value.finished()  # the tab's own status is drawn before the statuses below, not after them
     page.evaluate("async () => (await import('/panel/robot.js')).closeLive()")  # only the statuses below
     page.evaluate(STOP_EVENTS)
     feed = "async (status) => (await import('/panel/robot.js')).showStatus(status)"
