@@ -130,6 +130,28 @@ class JobCalls:
         spec |= {"jumps": jumps, "psi0_deg": psi0_deg, "start_zeta0": start_zeta0, "noise": mapping(noise)}
         return self.submit_job("control-study", **spec, model=mapping(model), experiment_id=experiment_id)
 
+    def submit_mfpt(
+        self,
+        *,
+        psi0_deg: float | None = None,
+        zeta0: float | None = None,
+        start: State | None = None,
+        guess: State | None = None,
+        noise: Mapping[str, float] | None = None,
+        grid: int | None = None,
+        pitch_spacing: float | None = None,
+        model: Mapping[str, Any] | None = None,
+        experiment_id: int | None = None,
+    ) -> Job:
+        """Mean first-passage time (``parkour mfpt``): the expected jumps to failure of symmetric
+        controls ``psi0_deg`` [deg], ``zeta0`` [l0] under ``noise``, from ``start`` (a touchdown
+        state; default the gait's fixed point, found from ``guess``), by a Markov chain on a grid of
+        ``grid`` velocity nodes and ``pitch_spacing`` [pitch-step sigmas]. Its result: ``mfpt_jumps``,
+        ``lambda2``, ``discretisation_error``, ``cells``, ``seconds`` and each grid's numbers."""
+        spec = {"psi0_deg": psi0_deg, "zeta0": zeta0, "start": state(start), "guess": state(guess)}
+        spec |= {"noise": mapping(noise), "grid": grid, "pitch_spacing": pitch_spacing}
+        return self.submit_job("mfpt", **spec, model=mapping(model), experiment_id=experiment_id)
+
     def job(self, job: JobRef) -> Job:
         """A job's state now: ``state``, ``completed`` of ``total``, ``progress`` in [0, 1], ``error``."""
         return self._http.call("GET", f"/api/v1/jobs/{job_id(job)}")

@@ -42,11 +42,10 @@ from backend.schemas.experiments import (
     ExperimentSummary,
     ExperimentUpdate,
 )
+from backend.schemas.job_budget import QUEUE_BUDGET_JUMPS, WORK_BUDGET_JUMPS
 from backend.schemas.jobs import (
     CLIENT_PATTERN,
     JOB_KINDS,
-    QUEUE_BUDGET_JUMPS,
-    WORK_BUDGET_JUMPS,
     BasinJobCreate,
     ControlStudyJobCreate,
     GaitSearchJobCreate,
@@ -55,6 +54,7 @@ from backend.schemas.jobs import (
     JobPage,
     JobResults,
     JobState,
+    MfptJobCreate,
     MJTFJobCreate,
     MJTFLevelOut,
     NoiseIn,
@@ -122,6 +122,7 @@ __all__ = [
     "MJTFLevelOut",
     "MapIn",
     "MapOut",
+    "MfptJobCreate",
     "ModelIn",
     "NoiseIn",
     "Page",

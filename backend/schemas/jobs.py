@@ -1,5 +1,5 @@
 """Batch jobs: the kinds a client can ask for (MJTF, energy sweep, basin, gait search, control
-study), each bounded by a work budget, and what a job and its results look like."""
+study, MFPT), each bounded by a work budget, and what a job and its results look like."""
 
 from __future__ import annotations
 
@@ -22,22 +22,12 @@ from backend.schemas.common import (
     Strict,
     Zeta0,
 )
+from backend.schemas.job_budget import MFPT_MAX_GRID, within_budget
 from sim_core.climb_records import CHUTE_TOP, FLOOR
 from sim_core.control_laws import KINDS, PSI0_RANGE_DEG
+from sim_core.mfpt_grid import ChainGrid
 from sim_core.noise import ASYMMETRY_LIMITS, SIGMA_LIMITS, NoiseModel
 
-# A job's work, in jumps at its worst (every trial to its cap, every basin point to its jump limit):
-# about an hour of the job worker on the lab's machine (1.35e5-1.6e5 jumps/s measured by
-# scripts/bench_job_rate.py on 2 cores). Larger jobs are refused with a 422 naming the limit.
-WORK_BUDGET_JUMPS = 500_000_000
-# The queue's budget: queued and running work together (each job at its worst, a running one's
-# share still to do), about eight hours of the job worker; one client (a script, the panel) may
-# hold at most CLIENT_SHARE of it, so another always finds room. Past either, a 429 says so.
-QUEUE_BUDGET_JUMPS = 8 * WORK_BUDGET_JUMPS
-CLIENT_SHARE = 0.5
-MAX_QUEUED_JOBS = 1000  # jobs waiting at once, however small
-JOB_RATE_JUMPS_PER_S = 135_000  # the job worker's rate (the low end of scripts/bench_job_rate.py): for estimates
-GAIT_SEARCH_JUMPS = 1000  # a gait search's work per guess, at most (Levenberg–Marquardt's map evaluations)
 CLIENT_PATTERN = r"^[\w.:@/-]{1,64}$"  # the X-Parkour-Client header: who submits, for the queue's fairness
 
 
@@ -88,8 +78,8 @@ class MJTFJobCreate(Strict):
         return values
 
     @model_validator(mode="after")
-    def _within_budget(self) -> MJTFJobCreate:
-        return _within_budget(self)
+    def within_budget(self) -> MJTFJobCreate:
+        return within_budget(self)
 
 
 class SweepJobCreate(Strict):
@@ -112,7 +102,7 @@ class SweepJobCreate(Strict):
             raise ValueError(f"zeta0_low must be below zeta0_high, got {self.zeta0_low:g} >= {self.zeta0_high:g}")
         if self.basin_grid == 1:
             raise ValueError("basin_grid must be 0 (no basins) or at least 2")
-        return _within_budget(self)
+        return within_budget(self)
 
 
 class BasinJobCreate(Strict):
@@ -129,8 +119,8 @@ class BasinJobCreate(Strict):
     tolerance: Annotated[float, Field(gt=0.0, lt=10.0)] = 0.02
 
     @model_validator(mode="after")
-    def _within_budget(self) -> BasinJobCreate:
-        return _within_budget(self)
+    def within_budget(self) -> BasinJobCreate:
+        return within_budget(self)
 
 
 class GaitSearchJobCreate(Strict):
@@ -177,33 +167,40 @@ class ControlStudyJobCreate(Strict):
         return names
 
     @model_validator(mode="after")
-    def _within_budget(self) -> ControlStudyJobCreate:
-        return _within_budget(self)
+    def within_budget(self) -> ControlStudyJobCreate:
+        return within_budget(self)
 
 
-def worst_case_jumps(job) -> tuple[int, str]:
-    """A job's work in jumps at its worst, and the formula that counts it: for a request body or a
-    stored spec alike (both have the fields this reads)."""
-    if job.kind == "mjtf":
-        return len(job.zeta0s) * job.trials * job.cap, "levels x trials x cap"
-    if job.kind == "sweep":
-        return job.steps * job.basin_grid**2 * job.basin_jumps, "steps x basin_grid² x basin_jumps"
-    if job.kind == "basin":
-        return job.grid**2 * job.jumps, "grid² x jumps"
-    if job.kind == "control-study":
-        return len(job.controllers) * job.seeds * job.jumps, "controllers x seeds x jumps"
-    return job.grid**2 * GAIT_SEARCH_JUMPS, f"grid² x {GAIT_SEARCH_JUMPS}"
+class MfptJobCreate(Strict):
+    """The mean first-passage time of symmetric controls under noise (``parkour mfpt``), from the
+    gait's fixed point (or ``start``), on a grid of ``grid`` velocity nodes and one √2 coarser."""
 
+    kind: Literal["mfpt"]
+    experiment_id: RecordRef | None = None
+    model: ModelIn = ModelIn()
+    psi0_deg: Psi0Deg = 30.0
+    zeta0: Zeta0 = 0.9
+    start: StateIn | None = None
+    guess: StateIn | None = None
+    noise: NoiseIn = NoiseIn()
+    grid: Annotated[
+        int, Field(ge=4, le=MFPT_MAX_GRID, description="velocity nodes per axis over where noisy paths go")
+    ] = ChainGrid().velocity_nodes
+    pitch_spacing: Annotated[
+        float, Field(ge=0.25, le=2.0, description="pitch nodes' spacing [standard deviations of the pitch step]")
+    ] = ChainGrid().pitch_spacing
 
-def _within_budget(job):
-    """``job`` if its worst-case work fits the budget."""
-    jumps, formula = worst_case_jumps(job)
-    if jumps > WORK_BUDGET_JUMPS:
-        raise ValueError(
-            f"the job would take up to {jumps:.3g} jumps ({formula}), over the limit of {WORK_BUDGET_JUMPS:.3g} "
-            "(about an hour of the job worker); ask for less, or split it into several jobs"
-        )
-    return job
+    @field_validator("noise")
+    @classmethod
+    def _symmetric(cls, noise: NoiseIn) -> NoiseIn:
+        for field in ASYMMETRY_LIMITS:
+            if getattr(noise, field) != 0.0:
+                raise ValueError(f"{field} must be 0 for the MFPT chain (an L/R asymmetry needs the wall in the state)")
+        return noise
+
+    @model_validator(mode="after")
+    def within_budget(self) -> MfptJobCreate:
+        return within_budget(self)
 
 
 def _job_kind(value) -> str:
@@ -218,11 +215,12 @@ JobCreate = Annotated[
     | Annotated[SweepJobCreate, KindTag("sweep")]
     | Annotated[BasinJobCreate, KindTag("basin")]
     | Annotated[GaitSearchJobCreate, KindTag("gaits")]
-    | Annotated[ControlStudyJobCreate, KindTag("control-study")],
+    | Annotated[ControlStudyJobCreate, KindTag("control-study")]
+    | Annotated[MfptJobCreate, KindTag("mfpt")],
     Discriminator(_job_kind),
 ]
 JOB_KINDS = {"mjtf": MJTFJobCreate, "sweep": SweepJobCreate, "basin": BasinJobCreate, "gaits": GaitSearchJobCreate,
-             "control-study": ControlStudyJobCreate}  # fmt: skip
+             "control-study": ControlStudyJobCreate, "mfpt": MfptJobCreate}  # fmt: skip
 
 
 class JobOut(BaseModel):

@@ -1,10 +1,10 @@
 """The job queue: a budget of queued work, each client's share of it, and where each job stands.
 
 Jobs run one at a time (:mod:`backend.services.job_runner`). What is queued and running is bounded
-by :data:`~backend.schemas.jobs.QUEUE_BUDGET_JUMPS` of work, each job counted at its worst
-(:func:`~backend.schemas.jobs.worst_case_jumps`; a running one by the share it has still to do), and
+by :data:`~backend.schemas.job_budget.QUEUE_BUDGET_JUMPS` of work, each job counted at its worst
+(:func:`~backend.schemas.job_budget.worst_case_jumps`; a running one by the share it has still to do), and
 one client — a script, the panel: the ``X-Parkour-Client`` header, else its address — may hold at
-most :data:`~backend.schemas.jobs.CLIENT_SHARE` of it, so one script cannot starve the panel. A job
+most :data:`~backend.schemas.job_budget.CLIENT_SHARE` of it, so one script cannot starve the panel. A job
 past either is refused with a 429 (:class:`~backend.errors.QueueFull`) saying what is queued.
 A queued job's place is its rank among the queued jobs by id (the runner takes them oldest
 first); its estimate is the work ahead of it and its own at the job worker's rate, at the latest.
@@ -19,14 +19,14 @@ from sqlalchemy.orm import Session
 
 from backend.errors import QueueFull
 from backend.repositories import jobs as stored_jobs
-from backend.schemas.jobs import (
+from backend.schemas.job_budget import (
     CLIENT_SHARE,
     JOB_RATE_JUMPS_PER_S,
     MAX_QUEUED_JOBS,
     QUEUE_BUDGET_JUMPS,
-    JobState,
     worst_case_jumps,
 )
+from backend.schemas.jobs import JobState
 from backend.services.job_specs import UnreadableSpec, decode
 from backend.store.models import Job
 

@@ -122,10 +122,23 @@ class ControlStudySpec:
     kind: str = "control-study"
 
 
-JobSpec = MJTFSpec | SweepSpec | BasinSpec | GaitSearchSpec | ControlStudySpec
+@dataclass(frozen=True)
+class MfptSpec:
+    model: ModelSpec = field(default_factory=ModelSpec)
+    psi0_deg: float = 30.0
+    zeta0: float = 0.9
+    start: StateSpec | None = None
+    guess: StateSpec | None = None
+    noise: NoiseSpec = field(default_factory=NoiseSpec)
+    grid: int = 30
+    pitch_spacing: float = 0.5
+    kind: str = "mfpt"
+
+
+JobSpec = MJTFSpec | SweepSpec | BasinSpec | GaitSearchSpec | ControlStudySpec | MfptSpec
 SPECS: dict[str, type] = {"mjtf": MJTFSpec, "sweep": SweepSpec, "basin": BasinSpec, "gaits": GaitSearchSpec,
-                          "control-study": ControlStudySpec}  # fmt: skip
-_PARTS = {"model": ModelSpec, "noise": NoiseSpec, "guess": StateSpec}
+                          "control-study": ControlStudySpec, "mfpt": MfptSpec}  # fmt: skip
+_PARTS = {"model": ModelSpec, "noise": NoiseSpec, "guess": StateSpec, "start": StateSpec}
 
 
 class UnreadableSpec(ValueError):

@@ -14,6 +14,7 @@ export function describeJob(job) {
   if (job.kind === "mjtf") return `psi0 ${spec.psi0_deg}°, zeta0 ${(spec.zeta0s || []).join(", ")} × ${spec.trials} trials`;
   if (job.kind === "sweep") return `psi0 ${spec.psi0_deg}°, zeta0 ${spec.zeta0_low}–${spec.zeta0_high}, ${spec.steps} steps`;
   if (job.kind === "control-study") return `${(spec.controllers || []).join(", ")} to ${spec.target_m} m, ${spec.seeds} × ${spec.jumps} jumps`;
+  if (job.kind === "mfpt") return `MFPT of ${spec.psi0_deg}°/${spec.zeta0}, grid ${spec.grid}`;
   const legs = (spec.controls || []).map((leg) => `${leg.psi0_deg}°/${leg.zeta0}`).join(", ");
   return job.kind === "basin" ? `${legs}, ${spec.grid}² start states` : legs;
 }
@@ -197,6 +198,18 @@ on("#job-table", "click", async (event) => {
   return showJob(id);
 });
 
+// An MFPT job: the estimate in words, and each grid's MFPT against its size (the two agreeing is
+// the estimate's own error).
+function showMfpt(id, result) {
+  const jumps = (value) => (value >= 1e5 ? value.toExponential(2) : value.toFixed(1));
+  say(`Job ${id}: MFPT ${jumps(result.mfpt_jumps)} jumps (discretisation error ${(100 * result.discretisation_error).toFixed(1)}%), ` +
+    `λ₂ ${result.lambda2.toFixed(6)} (1/(1−λ₂) ${jumps(result.lambda2_jumps)} jumps), ${result.cells} cells, ${result.seconds.toFixed(1)} s.`);
+  draw("job-plot", [{
+    x: result.grids.map((grid) => grid.cells), y: result.grids.map((grid) => grid.mfpt_jumps), mode: "lines+markers", name: "MFPT",
+    text: result.grids.map((grid) => `${grid.velocity_nodes} velocity nodes, pitch spacing ${grid.pitch_spacing.toFixed(2)} σ`),
+  }], layout(`Job ${id}: mean first-passage time on two grids`, "cells of the chain", "jumps to failure"));
+}
+
 // A job's results: its plot in the Jobs tab, or a word where it has none (the table's Show, and
 // an experiment's list of jobs).
 export async function showJob(id) {
@@ -220,6 +233,8 @@ export async function showJob(id) {
     showControlStudy(id, results.result);
   } else if (job.kind === "basin") {
     plotBasin("job-plot", results.result, `Job ${id}: basin of attraction`);
+  } else if (job.kind === "mfpt") {
+    showMfpt(id, results.result);
   } else {
     const gaits = results.result.gaits || [];
     say(`Job ${id}: ${gaits.length} gait(s): ${gaits.map((g) => `period ${g.period} at (${g.state.map((v) => v.toFixed(3)).join(", ")}), max |λ| ${g.max_abs_eigenvalue.toFixed(3)}`).join("; ")}.`);

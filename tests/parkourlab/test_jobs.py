@@ -102,6 +102,10 @@ EVERY_FIELD = {
         ["pid", "lqr"], target_m=0.5, seeds=20, seed0=3, jumps=100, psi0_deg=33.0, start_zeta0=0.88,
         noise={"pitch_drift_deg": 0.5}, model={"preset": "paper"}, experiment_id=2,
     ),
+    "mfpt": lambda c: c.submit_mfpt(
+        psi0_deg=31.0, zeta0=0.93, start=(-0.93, -0.17), guess=(-0.9, -0.2), noise={"velocity": 0.02}, grid=20,
+        pitch_spacing=0.7, model={"preset": "paper"}, experiment_id=2,
+    ),
 }  # fmt: skip
 
 

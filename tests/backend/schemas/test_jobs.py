@@ -1,4 +1,4 @@
-"""Batch jobs' bodies (backend/schemas/jobs.py): four kinds told apart by ``kind`` (MJTF when it is
+"""Batch jobs' bodies (backend/schemas/jobs.py): the kinds told apart by ``kind`` (MJTF when it is
 left out), each bounded field by field and by one work budget in jumps, and a job read back."""
 
 import dataclasses
@@ -6,9 +6,9 @@ import datetime
 
 import pytest
 
+from backend.schemas.job_budget import WORK_BUDGET_JUMPS, worst_case_jumps
 from backend.schemas.jobs import (
     JOB_KINDS,
-    WORK_BUDGET_JUMPS,
     BasinJobCreate,
     ControlStudyJobCreate,
     GaitSearchJobCreate,
@@ -16,6 +16,7 @@ from backend.schemas.jobs import (
     JobOut,
     JobResults,
     JobState,
+    MfptJobCreate,
     MJTFJobCreate,
     NoiseIn,
     SweepJobCreate,
@@ -28,7 +29,8 @@ SWEEP = {"kind": "sweep"}
 BASIN = {"kind": "basin", "controls": [LEG]}
 GAITS = {"kind": "gaits", "controls": [LEG]}
 CONTROL = {"kind": "control-study"}
-BODIES = {"mjtf": MJTF, "sweep": SWEEP, "basin": BASIN, "gaits": GAITS, "control-study": CONTROL}
+MFPT = {"kind": "mfpt"}
+BODIES = {"mjtf": MJTF, "sweep": SWEEP, "basin": BASIN, "gaits": GAITS, "control-study": CONTROL, "mfpt": MFPT}
 
 
 @pytest.mark.parametrize("kind", JOB_KINDS)
@@ -210,3 +212,27 @@ def test_partial_results_list_the_levels_with_trials_and_those_without():
     )
     assert results.result is None and results.levels[0].outcomes == {"slip": 5}
     assert JobResults.model_validate_json(results.model_dump_json()) == results
+
+
+def test_an_mfpt_job_at_its_largest_grid_without_drift_is_within_the_budget():
+    # Its worst case (both grids at the pair limit, the finest rule) is bounded by MFPT_MAX_PAIRS,
+    # not by the grid: the chain refuses more pairs when it meets them.
+    job = accepted(MfptJobCreate, MFPT | {"grid": 60, "pitch_spacing": 0.25, "noise": {"pitch_drift_deg": 0.0}})
+    jumps, formula = worst_case_jumps(job)
+    assert jumps <= WORK_BUDGET_JUMPS and "pairs" in formula
+
+
+@pytest.mark.parametrize(
+    ("change", "where", "says"),
+    [
+        ({"grid": 61}, ("grid",), "less than or equal to 60"),
+        ({"grid": 3}, ("grid",), "greater than or equal to 4"),
+        ({"pitch_spacing": 0.1}, ("pitch_spacing",), "greater than or equal to 0.25"),
+        ({"zeta0": 1.0}, ("zeta0",), "less than 1"),
+        ({"noise": {"asymmetry_psi0_deg": 0.5}}, ("noise",), "asymmetry_psi0_deg must be 0 for the MFPT chain"),
+        ({"start": {"xdot": 0.5, "ydot": 0.0}}, ("start", "xdot"), "less than 0"),
+    ],
+)
+def test_a_bad_mfpt_job_is_refused_naming_the_field(change, where, says):
+    assert refused(MfptJobCreate, MFPT | change) == [where]
+    assert says in refusal_messages(MfptJobCreate, MFPT | change)

@@ -8,6 +8,7 @@ from backend.schemas import (
     BasinJobCreate,
     ControlStudyJobCreate,
     GaitSearchJobCreate,
+    MfptJobCreate,
     MJTFJobCreate,
     SweepJobCreate,
 )
@@ -30,6 +31,7 @@ REQUESTS = [
     BasinJobCreate(kind="basin", controls=LEGS, grid=4, jumps=5),
     GaitSearchJobCreate(kind="gaits", controls=LEGS, grid=2),
     ControlStudyJobCreate(kind="control-study", controllers=["lqr", "pid"], seeds=3, noise={"velocity": 0.02}),
+    MfptJobCreate(kind="mfpt", zeta0=0.96, start={"xdot": -0.9, "ydot": 0.1}, grid=12, noise={"pitch_drift_deg": 0}),
 ]
 
 

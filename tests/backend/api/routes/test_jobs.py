@@ -189,6 +189,27 @@ def test_a_control_study_job_gives_the_studys_numbers_and_its_plots(client, auth
     assert result["plots"]["controllers"][0]["failure_curve"]["failures"][-1] == result["controllers"][0]["failures"]
 
 
+def test_an_mfpt_job_gives_the_chains_numbers(client, auth):
+    """The job is parkour mfpt's computation (sim_core.mfpt) on the same grid, to the last digit."""
+    from sim_core.controls import LegControl
+    from sim_core.mfpt import mfpt
+    from sim_core.mfpt_grid import ChainGrid
+
+    start = {"xdot": -0.9339, "ydot": -0.1661}
+    spec = {"kind": "mfpt", "zeta0": 0.9, "start": start, "grid": 8, "pitch_spacing": 2.0,
+            "noise": {"pitch_drift_deg": 0.0, "velocity": 0.1}}  # fmt: skip
+    job = client.post("/api/v1/jobs", json=spec, headers=auth)
+    assert job.status_code == 202, job.text
+    assert _wait(client, job.json()["id"], timeout=300.0)["state"] == "done"  # a first compile of the chain's kernels
+    result = client.get(f"/api/v1/jobs/{job.json()['id']}/results").json()["result"]
+    expected = mfpt(get_preset("paper").to_model(), LegControl(math.radians(30.0), 0.9),
+                    NoiseModel(pitch_drift_deg=0.0, velocity=0.1), start=(start["xdot"], start["ydot"]),
+                    grid=ChainGrid(velocity_nodes=8, pitch_spacing=2.0, max_pairs=600_000)).to_dict()  # fmt: skip
+    for key in ("mfpt_jumps", "lambda2", "discretisation_error", "cells"):
+        assert result[key] == pytest.approx(expected[key], rel=1e-9), key
+    assert result["controls"]["zeta0"] == 0.9 and result["noise"]["velocity"] == 0.1
+
+
 @pytest.mark.parametrize(
     ("change", "field", "says"),
     [

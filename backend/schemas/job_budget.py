@@ -1,0 +1,57 @@
+"""What a job may cost: its work counted in jumps at its worst, the budget one job and the queue
+may take, and the job worker's rate for estimates. For request bodies and stored specs alike
+(:func:`worst_case_jumps` reads only the fields both have)."""
+
+from __future__ import annotations
+
+from sim_core.mfpt_grid import ChainGrid
+
+# A job's work, in jumps at its worst (every trial to its cap, every basin point to its jump limit):
+# about an hour of the job worker on the lab's machine (1.35e5-1.6e5 jumps/s measured by
+# scripts/bench_job_rate.py on 2 cores). Larger jobs are refused with a 422 naming the limit.
+WORK_BUDGET_JUMPS = 500_000_000
+# The queue's budget: queued and running work together (each job at its worst, a running one's
+# share still to do), about eight hours of the job worker; one client (a script, the panel) may
+# hold at most CLIENT_SHARE of it, so another always finds room. Past either, a 429 says so.
+QUEUE_BUDGET_JUMPS = 8 * WORK_BUDGET_JUMPS
+CLIENT_SHARE = 0.5
+MAX_QUEUED_JOBS = 1000  # jobs waiting at once, however small
+JOB_RATE_JUMPS_PER_S = 135_000  # the job worker's rate (the low end of scripts/bench_job_rate.py): for estimates
+GAIT_SEARCH_JUMPS = 1000  # a gait search's work per guess, at most (Levenberg–Marquardt's map evaluations)
+# The MFPT chain in the job worker: at most this many (velocity node, pitch) pairs a grid, so that
+# the worst case (both grids, the finest rule) stays within the work budget.
+MFPT_MAX_PAIRS = 600_000
+MFPT_MAX_GRID = 60
+
+
+def mfpt_grid_of(job) -> ChainGrid:
+    """The chain's grid of an MFPT job (request body or stored spec)."""
+    return ChainGrid(velocity_nodes=job.grid, pitch_spacing=job.pitch_spacing, max_pairs=MFPT_MAX_PAIRS)
+
+
+def worst_case_jumps(job) -> tuple[int, str]:
+    """A job's work in jumps at its worst, and the formula that counts it: for a request body or a
+    stored spec alike (both have the fields this reads)."""
+    if job.kind == "mjtf":
+        return len(job.zeta0s) * job.trials * job.cap, "levels x trials x cap"
+    if job.kind == "sweep":
+        return job.steps * job.basin_grid**2 * job.basin_jumps, "steps x basin_grid² x basin_jumps"
+    if job.kind == "basin":
+        return job.grid**2 * job.jumps, "grid² x jumps"
+    if job.kind == "control-study":
+        return len(job.controllers) * job.seeds * job.jumps, "controllers x seeds x jumps"
+    if job.kind == "mfpt":
+        drifts = job.noise.pitch_drift_deg > 0.0
+        return mfpt_grid_of(job).worst_case_jumps(drifts), "2 grids x (pairs x draws + paths x path jumps)"
+    return job.grid**2 * GAIT_SEARCH_JUMPS, f"grid² x {GAIT_SEARCH_JUMPS}"
+
+
+def within_budget(job):
+    """``job`` if its worst-case work fits the budget."""
+    jumps, formula = worst_case_jumps(job)
+    if jumps > WORK_BUDGET_JUMPS:
+        raise ValueError(
+            f"the job would take up to {jumps:.3g} jumps ({formula}), over the limit of {WORK_BUDGET_JUMPS:.3g} "
+            "(about an hour of the job worker); ask for less, or split it into several jobs"
+        )
+    return job
