@@ -83,6 +83,7 @@ class RobotLink:
         # The latched ESTOP that the heartbeat thread sends in place of heartbeats until the robot
         # acknowledges it (None: none), so the robot's own watchdog disarms it even on a lossy line.
         self._pending_estop: Command | None = None
+        self._resetting = False  # a RESET is under way (written by reset(), read by the reader)
 
     # Connection -----------------------------------------------------------------------------
     def connect(self, timeout: float = 3.0) -> LinkState:
@@ -168,6 +169,7 @@ class RobotLink:
         RESET is not confirmed."""
         with self.port.write_lock:  # not between the heartbeat thread's pick of a repeat and its write
             pending = self._forget_estop()
+        self._resetting = True  # the robot's telemetry may now take the link out of e-stopped
         try:
             self._command(Command(self._next_seq(), Kind.RESET), expect=LinkState.DISARMED)
         except LinkError:
@@ -175,6 +177,8 @@ class RobotLink:
                 if self._pending_estop is None:
                     self._pending_estop = pending
             raise
+        finally:
+            self._resetting = False
         self.latch.release()
 
     def set_leg(self, leg: Leg, psi0_deg: float, zeta0: float) -> None:
@@ -338,7 +342,18 @@ class RobotLink:
         elif isinstance(message, Telemetry):
             self.telemetry = message
             self._telemetry_heard += 1
-            self._move(FROM_ROBOT[message.state], "telemetry")
+            state = FROM_ROBOT[message.state]
+            if not self._held_estopped(state):
+                self._move(state, "telemetry")
+
+    def _held_estopped(self, state: LinkState) -> bool:
+        """An e-stopped link under a held latch leaves e-stopped only for the RESET under way, to
+        disarmed. A TELEMETRY the robot wrote before it latched can be read after its ESTOP's
+        acknowledgement (CI saw ESTOPPED -> ARMED -> ESTOPPED under load): it is kept as the last
+        telemetry, but un-stops nothing."""
+        if self.state != LinkState.ESTOPPED or not self.latch.held:
+            return False
+        return not (self._resetting and state == LinkState.DISARMED)
 
     def _heartbeat_loop(self) -> None:
         # An unacknowledged ESTOP goes instead of the heartbeat, so a line that clears still

@@ -322,6 +322,21 @@ def test_both_ends_of_the_virtual_radio_disable_nagle(robot, link):
         assert sock.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY)
 
 
+def test_a_telemetry_written_before_the_robot_latched_does_not_unstop_the_link(robot, link):
+    # Read after the ESTOP's acknowledgement, an ARMED telemetry the robot wrote before it latched
+    # would move the link to armed until the next one (CI saw it in a garbage flood under load).
+    link.arm()
+    _wait_for(lambda: link.state == LinkState.ARMED)
+    assert link.estop().acknowledged
+    stopped, heard = len(link.transitions), link._telemetry_heard
+    robot.inject(received_frame(telemetry(9, RobotState.ARMED)))
+    _wait_for(lambda: link._telemetry_heard >= heard + 3)  # it, and the robot's own after it
+    assert link.state == LinkState.ESTOPPED and link.transitions[stopped:] == []
+    link.reset()
+    _wait_for(lambda: link.state == LinkState.DISARMED)
+    assert not link.latch.held
+
+
 def test_make_safe_disarms_whatever_the_link_believes(robot, link):
     link.arm()
     armed = len(link.transitions)
