@@ -37,7 +37,7 @@ class Chain:
     """One grid's chain. Its transient states' matrix is the product ``P = steps @ jumps``: the
     pitch step from each state to the *pairs* (velocity node, pitch its leg sees), then each
     pair's noisy jump to the states it lands on. Kept as the two factors, ``P`` has a tenth of
-    their product's entries to multiply (each pair is shared by the ~15 pitch steps that reach
+    their product's entries to multiply (each pair is shared by the 17 pitch steps that reach
     it). ``success`` is the probability that each state's next jump succeeds."""
 
     xdots: np.ndarray

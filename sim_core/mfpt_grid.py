@@ -15,13 +15,14 @@ pitch layer sees a narrow band of velocities); without drift, every node of the 
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
 from sim_core.validation import ParameterError, check_range
 
 MAX_STATES = 2_000_000  # about 2 GB of transition rows at the finest rule: refused before allocating
+MAX_PATH_JUMPS = 10_000_000  # the exploring paths' jumps: their draws are held at once (400 MB)
 MAX_PAIRS = 3_000_000  # pairs whose jumps are run (each a few hundred stances): an hour at the finest rule
 TAIL_GROWTH = 1.25  # spacing ratio of consecutive nodes outside the core
 CORE_PERCENTILES = (5.0, 95.0)  # the core: where paths spend 90% of their time (each axis)
@@ -81,20 +82,22 @@ class ChainGrid:
             if len(strata) != 4 or any(isinstance(v, bool) or int(v) != v or not 1 <= v <= 16 for v in strata):
                 raise ParameterError("grid.strata", f"must be 4 integers in [1, 16], got {self.strata!r}")
             object.__setattr__(self, "strata", tuple(int(v) for v in strata))
+        if self.paths * self.path_jumps > MAX_PATH_JUMPS:
+            raise ParameterError(
+                "grid.path_jumps",
+                f"paths x path_jumps must be at most {MAX_PATH_JUMPS:,} (their draws are held at once), "
+                f"got {self.paths} x {self.path_jumps}",
+            )
         check_range("grid.pitch_spacing", self.pitch_spacing, 0.05, 4.0, low_open=False, high_open=False)
         check_range("grid.half_width", self.half_width, 0.05, 10.0, low_open=False, high_open=False)
 
     def refined(self, factor: float = math.sqrt(2.0)) -> ChainGrid:
-        """The next grid: ``factor`` times the velocity nodes (within 4-400), the pitch spacing over ``factor``."""
-        return ChainGrid(
+        """The next grid: ``factor`` times the velocity nodes, the pitch spacing over ``factor``
+        (each kept within its range)."""
+        return replace(
+            self,
             velocity_nodes=min(400, max(4, round(self.velocity_nodes * factor))),
-            pitch_spacing=self.pitch_spacing / factor,
-            strata=self.strata,
-            margin=self.margin,
-            half_width=self.half_width,
-            paths=self.paths,
-            path_jumps=self.path_jumps,
-            max_pairs=self.max_pairs,
+            pitch_spacing=min(4.0, max(0.05, self.pitch_spacing / factor)),
         )
 
     def strata_for(self, pitch_drifts: bool) -> tuple[int, int, int, int]:

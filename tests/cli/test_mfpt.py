@@ -6,7 +6,7 @@ from tests.cli.helpers import invoke, json_of
 
 
 def test_mfpt_json_contract():
-    payload = json_of("mfpt", "--controls", "30:0.96", "--grid", "8", "--guess", "-0.93", "0.2")
+    payload = json_of("mfpt", "--controls", "30:0.96", "--grid", "8", "--pitch-spacing", "2", "--guess", "-0.93", "0.2")
     assert {"mfpt_jumps", "lambda2", "discretisation_error", "cells", "seconds"} <= set(payload)
     assert payload["mfpt_jumps"] > 1 and 0 < payload["lambda2"] < 1
     assert payload["controls"] == {"psi0_deg": pytest.approx(30.0), "zeta0": 0.96}

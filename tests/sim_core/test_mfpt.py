@@ -55,7 +55,7 @@ def test_mfpt_agrees_with_monte_carlo_at_an_unseen_level_and_noise(paper):
         LegControl(psi0, zeta0),
         noise,
         start=level.start,
-        grid=ChainGrid(velocity_nodes=20, pitch_spacing=0.7, paths=200, path_jumps=2000),
+        grid=ChainGrid(velocity_nodes=16, pitch_spacing=1.0, paths=200, path_jumps=2000),
         progress=lambda done, total: progress.append((done, total)),
     )
     low, high = level.ci95
@@ -65,7 +65,7 @@ def test_mfpt_agrees_with_monte_carlo_at_an_unseen_level_and_noise(paper):
     assert progress[-1][0] == progress[-1][1], "progress reaches its total"
     payload = result.to_dict()
     assert {"mfpt_jumps", "lambda2", "discretisation_error", "cells", "seconds"} <= set(payload)
-    assert len(payload["grids"]) == 2 and payload["grids"][1]["velocity_nodes"] == 20
+    assert len(payload["grids"]) == 2 and payload["grids"][1]["velocity_nodes"] == 16
 
 
 def test_without_drift_the_chain_is_one_layer_and_the_gait_lasts_far_beyond_monte_carlo(paper):

@@ -112,6 +112,12 @@ def test_a_bad_grid_is_refused_naming_its_field(field, value):
     assert error.value.field == f"grid.{field}"
 
 
+def test_exploring_paths_whose_draws_would_not_fit_in_memory_are_refused():
+    ChainGrid(paths=10_000, path_jumps=1000)
+    with pytest.raises(ParameterError, match="paths x path_jumps must be at most 10,000,000"):
+        ChainGrid(paths=10_000, path_jumps=1001)
+
+
 def test_too_many_states_are_refused_before_memory_is_taken():
     check_states(MAX_STATES)
     with pytest.raises(ParameterError, match="memory"):
@@ -123,3 +129,5 @@ def test_refining_multiplies_the_nodes_and_divides_the_pitch_spacing():
     finer = grid.refined(2.0)
     assert finer.velocity_nodes == 40 and finer.pitch_spacing == pytest.approx(0.35)
     assert finer.strata == grid.strata
+    coarsest = ChainGrid(velocity_nodes=5, pitch_spacing=3.5).refined(0.5)
+    assert (coarsest.velocity_nodes, coarsest.pitch_spacing) == (4, 4.0), "kept within the ranges"
