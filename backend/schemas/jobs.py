@@ -78,7 +78,7 @@ class MJTFJobCreate(Strict):
         return values
 
     @model_validator(mode="after")
-    def within_budget(self) -> MJTFJobCreate:
+    def _within_budget(self) -> MJTFJobCreate:
         return within_budget(self)
 
 
@@ -119,7 +119,7 @@ class BasinJobCreate(Strict):
     tolerance: Annotated[float, Field(gt=0.0, lt=10.0)] = 0.02
 
     @model_validator(mode="after")
-    def within_budget(self) -> BasinJobCreate:
+    def _within_budget(self) -> BasinJobCreate:
         return within_budget(self)
 
 
@@ -167,7 +167,7 @@ class ControlStudyJobCreate(Strict):
         return names
 
     @model_validator(mode="after")
-    def within_budget(self) -> ControlStudyJobCreate:
+    def _within_budget(self) -> ControlStudyJobCreate:
         return within_budget(self)
 
 
@@ -199,7 +199,7 @@ class MfptJobCreate(Strict):
         return noise
 
     @model_validator(mode="after")
-    def within_budget(self) -> MfptJobCreate:
+    def _within_budget(self) -> MfptJobCreate:
         return within_budget(self)
 
 
