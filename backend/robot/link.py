@@ -7,14 +7,14 @@ for ``heartbeat_timeout`` is a lost link: the state becomes ``disconnected`` and
 callbacks run (a live run aborts, keeping what it recorded). Leg commands are checked against the
 servo limits before they are sent. Every state change is kept in ``transitions``.
 
-Faults a lab meets are bounded and counted, never raised into a caller's lap: only Receive Packets
-from ``robot_address`` are heard (another radio's are ``foreign_frames``), and the radio's own
-Transmit Statuses are counted but are no sign of the robot's life. :meth:`RobotLink.estop` takes no
-lock held for longer than one bounded write, and gives up after its ``timeout`` with an honest
-:class:`EstopResult`; the heartbeat thread then sends that ESTOP instead of heartbeats until the
-robot acknowledges it. The e-stop latch is the service's (:class:`backend.robot.latch.EstopLatch`):
-it outlives the link, every connection sends the latched ESTOP first, and ARM and START are
-refused (:class:`EstopLatched`) until a RESET is acknowledged.
+Faults a lab meets are bounded and counted, never raised into a caller's lap: only Receive Packets from
+``robot_address`` are heard (another radio's are ``foreign_frames``), and the radio's own Transmit Statuses
+are counted but are no sign of the robot's life. :meth:`RobotLink.estop` takes no lock held for longer than
+one bounded write, and gives up after its ``timeout`` with an honest :class:`EstopResult`; the heartbeat
+thread then sends that ESTOP instead of heartbeats until the robot acknowledges it. The e-stop latch is the
+service's (:class:`backend.robot.latch.EstopLatch`): it outlives the link, every connection sends the
+latched ESTOP first, ARM and START are refused (:class:`EstopLatched`) and the link stays e-stopped
+(:func:`~backend.robot.link_types.telemetry_moves`) until a RESET is acknowledged.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ import serial
 from backend.robot.latch import EstopLatch
 from backend.robot.limits import ServoLimits
 from backend.robot.link_port import WRITE_TIMEOUT, LinkPort
-from backend.robot.link_types import FROM_ROBOT, SAFE, EstopResult, LinkError, LinkState, Transition
+from backend.robot.link_types import FROM_ROBOT, SAFE, EstopResult, LinkError, LinkState, Transition, telemetry_moves
 from backend.robot.messages import Ack, Command, Kind, Leg, ProtocolError, Result, SetLeg, Telemetry, decode
 from backend.robot.xbee import ROBOT_ADDRESS, TX_STATUS, FrameError, FrameParser, parse_rx_packet, parse_tx_status
 
@@ -164,9 +164,8 @@ class RobotLink:
         return FROM_ROBOT[self.telemetry.state]
 
     def reset(self) -> None:
-        """Clear an e-stop (to disarmed) and release the latch once the robot confirms it. Repeats of
-        an unacknowledged ESTOP stop before the RESET is sent (none may follow it), and resume if the
-        RESET is not confirmed."""
+        """Clear an e-stop (to disarmed) and release the latch once the robot confirms it. Repeats of an
+        unacknowledged ESTOP stop before the RESET is sent (none may follow it), and resume if it is not confirmed."""
         with self.port.write_lock:  # not between the heartbeat thread's pick of a repeat and its write
             pending = self._forget_estop()
         self._resetting = True  # the robot's telemetry may now take the link out of e-stopped
@@ -343,17 +342,8 @@ class RobotLink:
             self.telemetry = message
             self._telemetry_heard += 1
             state = FROM_ROBOT[message.state]
-            if not self._held_estopped(state):
+            if telemetry_moves(self.state, state, latched=self.latch.held, resetting=self._resetting):
                 self._move(state, "telemetry")
-
-    def _held_estopped(self, state: LinkState) -> bool:
-        """An e-stopped link under a held latch leaves e-stopped only for the RESET under way, to
-        disarmed. A TELEMETRY the robot wrote before it latched can be read after its ESTOP's
-        acknowledgement (CI saw ESTOPPED -> ARMED -> ESTOPPED under load): it is kept as the last
-        telemetry, but un-stops nothing."""
-        if self.state != LinkState.ESTOPPED or not self.latch.held:
-            return False
-        return not (self._resetting and state == LinkState.DISARMED)
 
     def _heartbeat_loop(self) -> None:
         # An unacknowledged ESTOP goes instead of the heartbeat, so a line that clears still

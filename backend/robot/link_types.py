@@ -29,6 +29,16 @@ FROM_ROBOT = {
 SAFE = (RobotState.DISARMED, RobotState.ESTOPPED)  # what every ending must leave the robot in
 
 
+def telemetry_moves(current: LinkState, reported: LinkState, *, latched: bool, resetting: bool) -> bool:
+    """Whether a TELEMETRY reporting ``reported`` moves a link that is ``current``. E-stopped under
+    a held latch, only the RESET under way moves it, to disarmed: a TELEMETRY the robot wrote before
+    it latched can be read after its ESTOP's acknowledgement (CI saw ESTOPPED -> ARMED -> ESTOPPED
+    under load), and it un-stops nothing."""
+    if current == LinkState.ESTOPPED and latched:
+        return resetting and reported == LinkState.DISARMED
+    return True
+
+
 class LinkError(RuntimeError):
     """The robot did not answer, refused a command, or the link is down."""
 

@@ -7,7 +7,7 @@ import json
 import pytest
 
 from backend.robot import link, link_types
-from backend.robot.link_types import FROM_ROBOT, SAFE, EstopResult, LinkState, Transition
+from backend.robot.link_types import FROM_ROBOT, SAFE, EstopResult, LinkState, Transition, telemetry_moves
 from backend.robot.messages import RobotState
 
 
@@ -46,3 +46,12 @@ def test_an_estop_result_says_whether_and_when_it_was_acknowledged():
 @pytest.mark.parametrize("name", ["LinkState", "LinkError", "EstopResult", "Transition"])
 def test_callers_get_the_same_types_from_the_link(name):
     assert getattr(link, name) is getattr(link_types, name)
+
+
+@pytest.mark.parametrize("reported", list(LinkState))
+def test_an_estopped_link_under_the_latch_moves_only_for_the_reset_under_way(reported):
+    assert telemetry_moves(LinkState.ESTOPPED, reported, latched=True, resetting=False) is False
+    resetting = telemetry_moves(LinkState.ESTOPPED, reported, latched=True, resetting=True)
+    assert resetting is (reported == LinkState.DISARMED)
+    assert telemetry_moves(LinkState.ESTOPPED, reported, latched=False, resetting=False), "no latch: the robot's word"
+    assert telemetry_moves(LinkState.ARMED, reported, latched=True, resetting=False), "e-stop not yet confirmed"
