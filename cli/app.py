@@ -29,6 +29,7 @@ from cli import (
     serve,
     simulate,
     sweep,
+    viability,
 )
 
 app = typer.Typer(
@@ -47,6 +48,7 @@ COMMANDS = (
     sweep,
     mjtf,
     mfpt,
+    viability,
     pid,
     control_study,
     atlas,
