@@ -101,7 +101,8 @@ class Deadbeat:
     to climb at most ``climb_per_jump`` [l0] a jump toward ``target`` [l0] over the next two
     touchdowns, keeping the section state near the gait's ``state`` (weight ``q_state``), never a
     command the model predicts fails; the leg angle at ``psi0_deg`` (the pitch fed back as in
-    ``pid-pitch``), zeta0 within ``zeta0_range``. ``zeta0`` is the gait's (jumping in place)."""
+    ``pid-pitch``), zeta0 within ``zeta0_range``. ``zeta0`` is the gait's (jumping in place).
+    ``guard``: the design model's viability kernel for these controls, which no command leaves."""
 
     target: float  # [l0]
     psi0_deg: float
@@ -112,6 +113,7 @@ class Deadbeat:
     q_state: float = 1.0  # per (sqrt(g l0))², against l0² of height
     zeta0_range: tuple[float, float] = (HeightController.zeta0_min, HeightController.zeta0_max)
     psi0_range_deg: tuple[float, float] = PSI0_RANGE_DEG
+    guard: tuple[float, ...] = ()  # the viability kernel it never leaves (sim_core.viability_guard); () for none
 
     name = "deadbeat"
 
@@ -126,13 +128,15 @@ class Deadbeat:
         for field, values, size in (("state", self.state, 2), ("model", self.model, 5)):
             if len(values) != size or not all(math.isfinite(value) for value in values):
                 raise ParameterError(field, f"must be {size} finite numbers, got {values!r}")
+        if self.guard and len(self.guard) != 2 + int(self.guard[0]) + int(self.guard[1]) * (1 + int(self.guard[0])):
+            raise ParameterError("guard", "must be a viability guard's layout (sim_core.viability_guard.design_guard)")
 
     def kernel_args(self) -> tuple[int, np.ndarray]:
         """``(kind, parameters)`` for :func:`sim_core.controllers.control_step`, in
         :mod:`sim_core.deadbeat`'s layout."""
         psi0_low, psi0_high = (math.radians(value) for value in self.psi0_range_deg)
         parameters = [self.target, math.radians(self.psi0_deg), self.zeta0, *self.zeta0_range, psi0_low, psi0_high,
-                      self.climb_per_jump, 1.0, *self.model, *self.state, self.q_state]  # fmt: skip
+                      self.climb_per_jump, 1.0, *self.model, *self.state, self.q_state, *self.guard]  # fmt: skip
         return DEADBEAT, np.array(parameters)
 
 

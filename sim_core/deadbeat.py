@@ -19,8 +19,11 @@ so that what follows is the gait again. Candidates are a grid over the leg's ran
 refined by golden section.
 
 The guard: a candidate for which the model predicts jump ``k + 1`` or ``k + 2`` fails is never
-sent; if every candidate fails (or the stance under way is predicted to), the gait's own
-controls go out. A command at the range's end, or sent because nothing else was safe, counts
+sent, nor (with the viability guard, :mod:`sim_core.viability_guard`, on by default) one whose
+jump ``k + 1`` leaves the model's viability kernel for this leg angle and zeta0 range: every
+command is a viable state-action pair, one from which some command sequence goes on forever,
+not merely two jumps. If every candidate is refused (or the stance under way is predicted to
+fail), the gait's own controls go out. A command at the range's end, or sent because nothing else was safe, counts
 as saturated.
 
 Everything runs on the *design* model (a calibrated preset's, or the paper's), which the law
@@ -30,6 +33,7 @@ carries: on the robot it predicts with what it was designed on, not with the hid
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -37,12 +41,13 @@ from sim_core._jit import kernel
 from sim_core.failures import OK
 from sim_core.integrate import STATE_SIZE
 from sim_core.stride import flight, jump, lift_off
+from sim_core.viability_guard import lands_in_kernel
 
 # Parameter layout of the compiled law (sim_core.control_laws.Deadbeat.kernel_args).
 TARGET, PSI0_STAR, ZETA0_STAR, ZETA0_LOW, ZETA0_HIGH, PSI0_LOW, PSI0_HIGH, CLIMB_PER_JUMP, PITCH_GAIN = range(9)
 MODEL = 9  # the design model's (alpha, d_hat, c_zeta, c_psi, mu)
 XDOT_STAR, YDOT_STAR, Q_STATE = 14, 15, 16
-PARAMETER_COUNT = 17
+PARAMETER_COUNT = 17  # then, optionally, the viability guard (sim_core.viability_guard's layout)
 GRID = 13  # candidates over the leg's range
 REFINE = 8  # golden-section steps about the best
 INVPHI = (math.sqrt(5.0) - 1.0) / 2.0
@@ -64,10 +69,16 @@ def horizon_cost(parameters, psi, vx, vy, foot_to_body, next_zeta0, aim_1, aim_2
     status, xdot, ydot, landed, _ = flight(psi, vx, vy, d_hat, psi0_star, next_zeta0)  # landed: above this foot
     if status != OK:
         return math.inf
-    status, xdot, ydot, rise, _, _, _ = jump(xdot, ydot, psi0_star, next_zeta0, psi0_star, zeta0_star, alpha, d_hat,
-                                             c_zeta, c_psi, mu, record)  # fmt: skip
+    # Jump k + 1 (stride.jump, cut at its lift-off for the guard).
+    status, psi_1, vx_1, vy_1, _, _ = lift_off(xdot, ydot, psi0_star, next_zeta0, alpha, c_zeta, c_psi, mu, record)
     if status != OK:
         return math.inf
+    if parameters.size > PARAMETER_COUNT and not lands_in_kernel(parameters, PARAMETER_COUNT, psi_1, vx_1, vy_1, d_hat):
+        return math.inf
+    status, xdot, ydot, touchdown_height, _ = flight(psi_1, vx_1, vy_1, d_hat, psi0_star, zeta0_star)
+    if status != OK:
+        return math.inf
+    rise = touchdown_height - zeta0_star * math.sin(psi0_star)
     second = landed - next_zeta0 * math.sin(psi0_star) + rise + zeta0_star * math.sin(psi0_star)
     status, _, _, _, _, _, _ = jump(xdot, ydot, psi0_star, zeta0_star, psi0_star, zeta0_star, alpha, d_hat, c_zeta,
                                     c_psi, mu, record)  # fmt: skip
@@ -121,15 +132,21 @@ def deadbeat_zeta0(parameters, psi0, zeta0, height, xdot, ydot):
     return best, best <= low + 1e-12 or best >= high - 1e-12
 
 
-def design_deadbeat(model, target: float, psi0_deg: float, zeta0_hover: float, **options):
+def design_deadbeat(
+    model, target: float, psi0_deg: float, zeta0_hover: float, *, viability_guard: bool = True, **options
+):
     """The law holding ``target`` [l0] about the gait of jumping in place at ``psi0_deg`` with
-    ``zeta0_hover``, on ``model`` (its design model); ``options`` as for
-    :class:`sim_core.control_laws.Deadbeat`."""
+    ``zeta0_hover``, on ``model`` (its design model), guarded by that model's viability kernel
+    unless ``viability_guard`` is False; ``options`` as for :class:`sim_core.control_laws.Deadbeat`."""
     from sim_core.control_laws import Deadbeat
     from sim_core.controls import ControlSchedule, LegControl
     from sim_core.gait_search import gait_of
     from sim_core.presets import START_GUESS
+    from sim_core.viability_guard import design_guard
 
     gait = gait_of(model, ControlSchedule.of(LegControl(math.radians(psi0_deg), zeta0_hover)), guess=START_GUESS)
     state = (float(gait.state[0]), float(gait.state[1]))
-    return Deadbeat(target, psi0_deg, zeta0_hover, state, model.kernel_args(), **options)
+    law = Deadbeat(target, psi0_deg, zeta0_hover, state, model.kernel_args(), **options)
+    if not viability_guard:
+        return law
+    return replace(law, guard=design_guard(model, psi0_deg, law.zeta0_range))

@@ -46,7 +46,8 @@ DEFAULT_CHUNK_PAIRS = 200_000  # ~0.5 s of the paper model's stances on two core
 
 @dataclass(frozen=True)
 class ViabilityGrid:
-    """The nodes: one strictly increasing 1-D axis per state dimension, then per action dimension."""
+    """The nodes: one strictly increasing 1-D axis per state dimension (2 nodes at least), then per
+    action dimension (1 at least: a control held fixed)."""
 
     state_axes: tuple[np.ndarray, ...]
     action_axes: tuple[np.ndarray, ...]
@@ -56,11 +57,13 @@ class ViabilityGrid:
             if not 1 <= len(axes) <= MAX_DIMENSIONS:
                 raise ParameterError(side, f"must hold 1 to {MAX_DIMENSIONS} axes, got {len(axes)}")
             checked = []
+            fewest = 2 if side == "state_axes" else 1  # an action axis of one node: a control held fixed
             for number, axis in enumerate(axes):
                 values = np.asarray(axis, dtype=np.float64)
                 field = f"{side}[{number}]"
-                if values.ndim != 1 or values.size < 2:
-                    raise ParameterError(field, f"must be a 1-D axis of at least 2 nodes, got shape {values.shape}")
+                if values.ndim != 1 or values.size < fewest:
+                    message = f"must be a 1-D axis of at least {fewest} nodes, got shape {values.shape}"
+                    raise ParameterError(field, message)
                 if not np.all(np.isfinite(values)) or not np.all(np.diff(values) > 0):
                     raise ParameterError(field, "must be finite and strictly increasing")
                 values.setflags(write=False)

@@ -3,6 +3,7 @@ sends a command the design model predicts fails, and without noise it climbs to 
 targets it was not tuned on."""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -16,9 +17,10 @@ from sim_core.height_controller import HeightController
 from sim_core.integrate import STATE_SIZE
 from sim_core.noise import NoiseModel
 from sim_core.presets import get_preset
-from sim_core.stride import jump, lift_off
+from sim_core.stride import flight, jump, lift_off
 from sim_core.sweep import find_in_place_zeta0
 from sim_core.validation import ParameterError
+from sim_core.viability_guard import lands_in_kernel
 
 MODEL = get_preset("paper").to_model()
 PSI0 = math.radians(35.0)
@@ -38,7 +40,36 @@ def law(hover):
 
 def test_its_parameters_are_laid_out_as_the_kernel_reads_them(law):
     kind, parameters = law.kernel_args()
-    assert kind == DEADBEAT and parameters.shape == (PARAMETER_COUNT,) and law.name == "deadbeat"
+    assert kind == DEADBEAT and law.name == "deadbeat"
+    assert law.guard and parameters.shape == (PARAMETER_COUNT + len(law.guard),)
+    unguarded = design_deadbeat(MODEL, 2.4, 35.0, law.zeta0, viability_guard=False)
+    assert unguarded.kernel_args()[1].shape == (PARAMETER_COUNT,)
+
+
+def test_no_command_leaves_the_viability_kernel_and_a_kernel_that_holds_nothing_sends_the_gaits(law):
+    unguarded = replace(law, guard=())
+    _, parameters = law.kernel_args()
+    _, free = unguarded.kernel_args()
+    rng = np.random.default_rng(5)
+    refused = 0
+    for _ in range(200):
+        xdot, ydot = rng.uniform(-1.6, -0.3), rng.uniform(-1.0, 1.0)
+        zeta0, height = rng.uniform(0.8, 0.98), rng.uniform(0.0, 4.0)
+        _, psi, vx, vy, _, _ = lift_off(xdot, ydot, PSI0, zeta0, *_stance_args(), NO_RECORD)
+        command, guarded = deadbeat_zeta0(parameters, PSI0, zeta0, height, xdot, ydot)
+        if command == law.zeta0 and guarded:
+            continue  # nothing was safe: the gait's own controls
+        # The command's jump, cut at its lift-off, reaches the middle inside the kernel.
+        status, x1, y1, *_ = flight(psi, vx, vy, MODEL.d_hat, PSI0, command)
+        _, psi_1, vx_1, vy_1, _, _ = lift_off(x1, y1, PSI0, command, *_stance_args(), NO_RECORD)
+        assert status == OK and lands_in_kernel(parameters, PARAMETER_COUNT, psi_1, vx_1, vy_1, MODEL.d_hat)
+        refused += deadbeat_zeta0(free, PSI0, zeta0, height, xdot, ydot)[0] != command
+    assert refused > 0, "somewhere the unguarded law's choice leaves the kernel"
+    empty = list(law.guard)
+    empty[2 + int(empty[0]) + int(empty[1]) :] = [0.0] * int(empty[0] * empty[1])
+    _, nothing = replace(law, guard=tuple(empty)).kernel_args()
+    (xdot, ydot), zeta0 = law.state, law.zeta0
+    assert deadbeat_zeta0(nothing, PSI0, zeta0, 1.0, xdot, ydot) == (law.zeta0, True)
 
 
 def test_the_horizon_is_the_maps_own_two_jumps(law, hover):
@@ -60,8 +91,8 @@ def test_the_horizon_is_the_maps_own_two_jumps(law, hover):
 
 
 def test_the_guard_never_sends_a_command_the_model_predicts_fails(law, hover):
-    """Over section states far and near the gait, every command whose jump is predicted to go is
-    one after which the gait's own controls also go; where no candidate goes, the gait's zeta0."""
+    """Over section states far and near the gait, every command but the fallback (the gait's own
+    zeta0, flagged) is one whose jump the model predicts goes, and the gait's controls after it."""
     _, parameters = law.kernel_args()
     rng = np.random.default_rng(27)
     sent = 0
@@ -70,17 +101,15 @@ def test_the_guard_never_sends_a_command_the_model_predicts_fails(law, hover):
         zeta0, height = rng.uniform(0.8, 0.98), rng.uniform(0.0, 4.0)
         if lift_off(xdot, ydot, PSI0, zeta0, *_stance_args(), NO_RECORD)[0] != OK:
             continue
-        command, _ = deadbeat_zeta0(parameters, PSI0, zeta0, height, xdot, ydot)
+        command, guarded = deadbeat_zeta0(parameters, PSI0, zeta0, height, xdot, ydot)
         assert 0.8 <= command <= 0.98
         status, x1, y1, *_ = jump(xdot, ydot, PSI0, zeta0, PSI0, command, *MODEL.kernel_args(), NO_RECORD)
-        if status == OK:
-            sent += 1
-            follow = jump(x1, y1, PSI0, command, PSI0, hover, *MODEL.kernel_args(), NO_RECORD)[0]
-            assert follow == OK, (xdot, ydot, zeta0, command)
-        else:  # then no candidate on the grid goes either
-            assert command == law.zeta0
-            grid = np.linspace(0.8, 0.98, 13)
-            assert all(jump(xdot, ydot, PSI0, zeta0, PSI0, z, *MODEL.kernel_args(), NO_RECORD)[0] != OK for z in grid)
+        if guarded and command == law.zeta0:
+            continue  # nothing went, or nothing stayed in the viability kernel: the gait's own zeta0
+        assert status == OK, (xdot, ydot, zeta0, command)
+        sent += 1
+        follow = jump(x1, y1, PSI0, command, PSI0, hover, *MODEL.kernel_args(), NO_RECORD)[0]
+        assert follow == OK, (xdot, ydot, zeta0, command)
     assert sent > 100
 
 

@@ -137,7 +137,8 @@ def test_the_result_reads_as_numbers_and_answers_for_one_state():
     ("state_axes", "action_axes", "message"),
     [
         ((np.array([0.0, 0.0, 1.0]),), (np.arange(2.0),), r"state_axes\[0\]: must be finite and strictly increasing"),
-        ((np.arange(3.0),), (np.array([1.0]),), r"action_axes\[0\]: must be a 1-D axis of at least 2 nodes"),
+        ((np.array([1.0]),), (np.arange(2.0),), r"state_axes\[0\]: must be a 1-D axis of at least 2 nodes"),
+        ((np.arange(3.0),), (np.array([]),), r"action_axes\[0\]: must be a 1-D axis of at least 1 nodes"),
         ((), (np.arange(2.0),), "state_axes: must hold 1 to 4 axes"),
         ((np.arange(8000.0), np.arange(8000.0)), (np.arange(2.0),), "grid: must hold at most 50,000,000"),
     ],
