@@ -152,6 +152,28 @@ class JobCalls:
         spec |= {"noise": mapping(noise), "grid": grid, "pitch_spacing": pitch_spacing}
         return self.submit_job("mfpt", **spec, model=mapping(model), experiment_id=experiment_id)
 
+    def submit_viability(
+        self,
+        *,
+        states: int | None = None,
+        actions: int | None = None,
+        psi0_low_deg: float | None = None,
+        psi0_high_deg: float | None = None,
+        zeta0_low: float | None = None,
+        zeta0_high: float | None = None,
+        model: Mapping[str, Any] | None = None,
+        experiment_id: int | None = None,
+    ) -> Job:
+        """The viability kernel (``parkour viability``): the mid-chute velocities from which some
+        leg command keeps the robot jumping forever, on ``states`` nodes per velocity axis and
+        ``actions`` per control axis over psi0 ``psi0_low_deg``-``psi0_high_deg`` [deg] and zeta0
+        ``zeta0_low``-``zeta0_high`` [l0]. Its result: ``kernel_fraction``, ``kernel`` and
+        ``measure`` over the states, the axes, and ``viable_pairs`` (base64 bits, see
+        :mod:`backend.services.section_jobs`)."""
+        spec = {"states": states, "actions": actions, "psi0_low_deg": psi0_low_deg, "psi0_high_deg": psi0_high_deg}
+        spec |= {"zeta0_low": zeta0_low, "zeta0_high": zeta0_high}
+        return self.submit_job("viability", **spec, model=mapping(model), experiment_id=experiment_id)
+
     def job(self, job: JobRef) -> Job:
         """A job's state now: ``state``, ``completed`` of ``total``, ``progress`` in [0, 1], ``error``."""
         return self._http.call("GET", f"/api/v1/jobs/{job_id(job)}")

@@ -59,6 +59,7 @@ from backend.schemas.jobs import (
     MJTFLevelOut,
     NoiseIn,
     SweepJobCreate,
+    ViabilityJobCreate,
 )
 from backend.schemas.robot import ClosedLoopIn, EstopLatchOut, RobotConnect, RobotEstopOut, RobotRunCreate, RobotStatus
 from backend.schemas.runs import (
@@ -153,6 +154,7 @@ __all__ = [
     "TouchdownComparison",
     "TrajectoryIn",
     "TrajectoryOut",
+    "ViabilityJobCreate",
     "ViewOut",
     "ViewReplay",
     "ViewerId",

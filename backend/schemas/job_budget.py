@@ -22,6 +22,13 @@ GAIT_SEARCH_JUMPS = 1000  # a gait search's work per guess, at most (Levenberg�
 # the worst case (both grids, the finest rule) stays within the work budget.
 MFPT_MAX_PAIRS = 600_000
 MFPT_MAX_GRID = 60
+# The viability map: one jump a state-action pair; 120² x 40² (23 million pairs, ~3 minutes of
+# the job worker) at most, and its result (kernel, measure, viable pairs as bits) stays a few MB.
+VIABILITY_MAX_STATES = 120
+VIABILITY_MAX_ACTIONS = 40
+# sim_core.viability_section's default control ranges, kept here so that the schemas load no kernels
+VIABILITY_PSI0_DEG = (15.0, 55.0)
+VIABILITY_ZETA0 = (0.70, 0.98)
 
 
 def mfpt_grid_of(job) -> ChainGrid:
@@ -40,6 +47,8 @@ def worst_case_jumps(job) -> tuple[int, str]:
         return job.grid**2 * job.jumps, "grid² x jumps"
     if job.kind == "control-study":
         return len(job.controllers) * job.seeds * job.jumps, "controllers x seeds x jumps"
+    if job.kind == "viability":
+        return job.states**2 * job.actions**2, "states² x actions²"
     if job.kind == "mfpt":
         drifts = job.noise.pitch_drift_deg > 0.0
         return mfpt_grid_of(job).worst_case_jumps(drifts), "2 grids x (pairs x draws + paths x path jumps)"

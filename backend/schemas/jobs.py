@@ -22,7 +22,14 @@ from backend.schemas.common import (
     Strict,
     Zeta0,
 )
-from backend.schemas.job_budget import MFPT_MAX_GRID, within_budget
+from backend.schemas.job_budget import (
+    MFPT_MAX_GRID,
+    VIABILITY_MAX_ACTIONS,
+    VIABILITY_MAX_STATES,
+    VIABILITY_PSI0_DEG,
+    VIABILITY_ZETA0,
+    within_budget,
+)
 from sim_core.climb_records import CHUTE_TOP, FLOOR
 from sim_core.control_laws import KINDS, PSI0_RANGE_DEG
 from sim_core.mfpt_grid import ChainGrid
@@ -203,6 +210,32 @@ class MfptJobCreate(Strict):
         return within_budget(self)
 
 
+ViabilityPsi0 = Annotated[float, Field(ge=1.0, le=89.0, description="leg angle [deg]")]
+ViabilityZeta0 = Annotated[float, Field(ge=0.05, le=0.999, description="leg length [l0]")]
+
+
+class ViabilityJobCreate(Strict):
+    """The viability kernel and its measure (``parkour viability``): ``states`` nodes per mid-chute
+    velocity axis over the default window, ``actions`` per control axis over the given ranges."""
+
+    kind: Literal["viability"]
+    experiment_id: RecordRef | None = None
+    model: ModelIn = ModelIn()
+    states: Annotated[int, Field(ge=4, le=VIABILITY_MAX_STATES, description="nodes per velocity axis")] = 40
+    actions: Annotated[int, Field(ge=2, le=VIABILITY_MAX_ACTIONS, description="nodes per control axis")] = 16
+    psi0_low_deg: ViabilityPsi0 = VIABILITY_PSI0_DEG[0]
+    psi0_high_deg: ViabilityPsi0 = VIABILITY_PSI0_DEG[1]
+    zeta0_low: ViabilityZeta0 = VIABILITY_ZETA0[0]
+    zeta0_high: ViabilityZeta0 = VIABILITY_ZETA0[1]
+
+    @model_validator(mode="after")
+    def _ordered(self) -> ViabilityJobCreate:
+        for low, high in (("psi0_low_deg", "psi0_high_deg"), ("zeta0_low", "zeta0_high")):
+            if not getattr(self, low) < getattr(self, high):
+                raise ValueError(f"{low} must be below {high}")
+        return within_budget(self)
+
+
 def _job_kind(value) -> str:
     """The job's ``kind``; MJTF when absent (the first kind, which clients may leave out)."""
     if isinstance(value, dict):
@@ -216,11 +249,13 @@ JobCreate = Annotated[
     | Annotated[BasinJobCreate, KindTag("basin")]
     | Annotated[GaitSearchJobCreate, KindTag("gaits")]
     | Annotated[ControlStudyJobCreate, KindTag("control-study")]
-    | Annotated[MfptJobCreate, KindTag("mfpt")],
+    | Annotated[MfptJobCreate, KindTag("mfpt")]
+    | Annotated[ViabilityJobCreate, KindTag("viability")],
     Discriminator(_job_kind),
 ]
 JOB_KINDS = {"mjtf": MJTFJobCreate, "sweep": SweepJobCreate, "basin": BasinJobCreate, "gaits": GaitSearchJobCreate,
-             "control-study": ControlStudyJobCreate, "mfpt": MfptJobCreate}  # fmt: skip
+             "control-study": ControlStudyJobCreate, "mfpt": MfptJobCreate,
+             "viability": ViabilityJobCreate}  # fmt: skip
 
 
 class JobOut(BaseModel):

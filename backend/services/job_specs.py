@@ -135,9 +135,21 @@ class MfptSpec:
     kind: str = "mfpt"
 
 
-JobSpec = MJTFSpec | SweepSpec | BasinSpec | GaitSearchSpec | ControlStudySpec | MfptSpec
+@dataclass(frozen=True)
+class ViabilitySpec:
+    model: ModelSpec = field(default_factory=ModelSpec)
+    states: int = 40
+    actions: int = 16
+    psi0_low_deg: float = 15.0
+    psi0_high_deg: float = 55.0
+    zeta0_low: float = 0.7
+    zeta0_high: float = 0.98
+    kind: str = "viability"
+
+
+JobSpec = MJTFSpec | SweepSpec | BasinSpec | GaitSearchSpec | ControlStudySpec | MfptSpec | ViabilitySpec
 SPECS: dict[str, type] = {"mjtf": MJTFSpec, "sweep": SweepSpec, "basin": BasinSpec, "gaits": GaitSearchSpec,
-                          "control-study": ControlStudySpec, "mfpt": MfptSpec}  # fmt: skip
+                          "control-study": ControlStudySpec, "mfpt": MfptSpec, "viability": ViabilitySpec}  # fmt: skip
 _PARTS = {"model": ModelSpec, "noise": NoiseSpec, "guess": StateSpec, "start": StateSpec}
 
 

@@ -128,12 +128,12 @@ def _gait_of(model: ModelParams, schedule: ControlSchedule, period: int | None, 
     (``xdot``, ``ydot``) or None."""
     from sim_core.gait_search import gait_of
 
-    with _no_gait_is_a_parameter_error():
+    with gait_not_found_as_parameter_error():
         return gait_of(model, schedule, period, None if guess is None else (guess.xdot, guess.ydot))
 
 
 @contextmanager
-def _no_gait_is_a_parameter_error() -> Iterator[None]:
+def gait_not_found_as_parameter_error() -> Iterator[None]:
     """A gait search that finds nothing is a 422 naming the controls (a guess may find one)."""
     from sim_core.errors import NoGaitFound
 
@@ -153,15 +153,17 @@ def run_study_here(spec) -> dict:
 
 
 def run_study(spec, chunk_map, progress) -> dict:
-    """A sweep, basin, gait-search, control-study or MFPT job's computation; returns its JSON result."""
+    """A sweep, basin, gait-search, control-study, MFPT or viability job's computation; returns its JSON result."""
     from sim_core.gait_search import search_gaits
     from sim_core.sweep import energy_sweep, zeta0_values
 
     model = model_params(spec.model)
     if spec.kind == "control-study":
         return _control_study(spec, model, chunk_map, progress)
-    if spec.kind == "mfpt":
-        return _mfpt(spec, model, progress)
+    if spec.kind in ("mfpt", "viability"):
+        from backend.services.section_jobs import section_study
+
+        return section_study(spec, model, progress)
     if spec.kind == "sweep":
         psi0 = math.radians(spec.psi0_deg)
         grid = None if spec.basin_grid == 0 else BasinGrid(*DEFAULT_BASIN_WINDOW, spec.basin_grid)
@@ -186,7 +188,7 @@ def run_study(spec, chunk_map, progress) -> dict:
     from experiments.gait_basin import gait_basin
 
     guess = None if spec.guess is None else (spec.guess.xdot, spec.guess.ydot)
-    with _no_gait_is_a_parameter_error():
+    with gait_not_found_as_parameter_error():
         basin = gait_basin(
             model,
             schedule,
@@ -211,26 +213,6 @@ def _control_study(spec, model: ModelParams, chunk_map, progress) -> dict:
                     noise=spec.noise.model())  # fmt: skip
     result = run(model, leg_length, config, chunk_map=chunk_map, progress=progress)
     return {**result.to_dict(), "plots": result.plots()}
-
-
-def _mfpt(spec, model: ModelParams, progress) -> dict:
-    """``parkour mfpt --json`` of the job's controls, noise and grid (both grids in-process: the
-    chain's two solves are one computation, its progress by chunks of pairs)."""
-    from backend.schemas.job_budget import mfpt_grid_of
-    from sim_core.controls import LegControl
-    from sim_core.gait_search import gait_of
-    from sim_core.mfpt import check_chain_inputs, mfpt
-
-    noise = spec.noise.model()
-    check_chain_inputs(model, noise)
-    controls = LegControl.from_degrees(spec.psi0_deg, spec.zeta0)
-    if spec.start is not None:
-        start = (spec.start.xdot, spec.start.ydot)
-    else:
-        guess = None if spec.guess is None else (spec.guess.xdot, spec.guess.ydot)
-        with _no_gait_is_a_parameter_error():
-            start = gait_of(model, ControlSchedule((controls,)), guess=guess).state
-    return mfpt(model, controls, noise, start=start, grid=mfpt_grid_of(spec), progress=progress).to_dict()
 
 
 def simulate_run(body: RunCreate) -> RunRecord:

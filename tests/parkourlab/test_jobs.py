@@ -106,6 +106,10 @@ EVERY_FIELD = {
         psi0_deg=31.0, zeta0=0.93, start=(-0.93, -0.17), guess=(-0.9, -0.2), noise={"velocity": 0.02}, grid=20,
         pitch_spacing=0.7, model={"preset": "paper"}, experiment_id=2,
     ),
+    "viability": lambda c: c.submit_viability(
+        states=30, actions=10, psi0_low_deg=20.0, psi0_high_deg=45.0, zeta0_low=0.75, zeta0_high=0.97,
+        model={"preset": "paper"}, experiment_id=2,
+    ),
 }  # fmt: skip
 
 

@@ -20,6 +20,7 @@ from backend.schemas.jobs import (
     MJTFJobCreate,
     NoiseIn,
     SweepJobCreate,
+    ViabilityJobCreate,
 )
 from sim_core.noise import ASYMMETRY_LIMITS, SIGMA_LIMITS, NoiseModel
 from tests.backend.schemas.refusals import LEG, START, accepted, refusal_messages, refused
@@ -30,7 +31,9 @@ BASIN = {"kind": "basin", "controls": [LEG]}
 GAITS = {"kind": "gaits", "controls": [LEG]}
 CONTROL = {"kind": "control-study"}
 MFPT = {"kind": "mfpt"}
-BODIES = {"mjtf": MJTF, "sweep": SWEEP, "basin": BASIN, "gaits": GAITS, "control-study": CONTROL, "mfpt": MFPT}
+VIABILITY = {"kind": "viability"}
+BODIES = {"mjtf": MJTF, "sweep": SWEEP, "basin": BASIN, "gaits": GAITS, "control-study": CONTROL, "mfpt": MFPT,
+          "viability": VIABILITY}  # fmt: skip
 
 
 @pytest.mark.parametrize("kind", JOB_KINDS)
@@ -236,3 +239,30 @@ def test_an_mfpt_job_at_its_largest_grid_without_drift_is_within_the_budget():
 def test_a_bad_mfpt_job_is_refused_naming_the_field(change, where, says):
     assert refused(MfptJobCreate, MFPT | change) == [where]
     assert says in refusal_messages(MfptJobCreate, MFPT | change)
+
+
+def test_a_viability_job_at_its_largest_grid_is_within_the_budget_and_its_defaults_are_sim_cores():
+    from sim_core.viability_section import DEFAULT_PSI0_DEG, DEFAULT_ZETA0
+
+    job = accepted(ViabilityJobCreate, VIABILITY | {"states": 120, "actions": 40})
+    assert worst_case_jumps(job) == (120**2 * 40**2, "states² x actions²")
+    assert worst_case_jumps(job)[0] <= WORK_BUDGET_JUMPS
+    default = accepted(ViabilityJobCreate, VIABILITY)
+    assert (default.psi0_low_deg, default.psi0_high_deg) == DEFAULT_PSI0_DEG
+    assert (default.zeta0_low, default.zeta0_high) == DEFAULT_ZETA0
+
+
+@pytest.mark.parametrize(
+    ("change", "where", "says"),
+    [
+        ({"states": 121}, ("states",), "less than or equal to 120"),
+        ({"actions": 1}, ("actions",), "greater than or equal to 2"),
+        ({"zeta0_low": 0.01}, ("zeta0_low",), "greater than or equal to 0.05"),
+        ({"psi0_high_deg": 90}, ("psi0_high_deg",), "less than or equal to 89"),
+        ({"psi0_low_deg": 50, "psi0_high_deg": 40}, (), "psi0_low_deg must be below psi0_high_deg"),
+        ({"zeta0_low": 0.9, "zeta0_high": 0.8}, (), "zeta0_low must be below zeta0_high"),
+    ],
+)
+def test_a_bad_viability_job_is_refused_naming_the_field(change, where, says):
+    assert refused(ViabilityJobCreate, VIABILITY | change) == [where]
+    assert says in refusal_messages(ViabilityJobCreate, VIABILITY | change)

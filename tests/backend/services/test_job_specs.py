@@ -11,6 +11,7 @@ from backend.schemas import (
     MfptJobCreate,
     MJTFJobCreate,
     SweepJobCreate,
+    ViabilityJobCreate,
 )
 from backend.services.job_specs import (
     SPEC_VERSION,
@@ -32,6 +33,7 @@ REQUESTS = [
     GaitSearchJobCreate(kind="gaits", controls=LEGS, grid=2),
     ControlStudyJobCreate(kind="control-study", controllers=["lqr", "pid"], seeds=3, noise={"velocity": 0.02}),
     MfptJobCreate(kind="mfpt", zeta0=0.96, start={"xdot": -0.9, "ydot": 0.1}, grid=12, noise={"pitch_drift_deg": 0}),
+    ViabilityJobCreate(kind="viability", states=12, actions=5, psi0_low_deg=20.0, zeta0_high=0.95),
 ]
 
 

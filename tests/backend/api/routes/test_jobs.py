@@ -210,6 +210,29 @@ def test_an_mfpt_job_gives_the_chains_numbers(client, auth):
     assert result["controls"]["zeta0"] == 0.9 and result["noise"]["velocity"] == 0.1
 
 
+def test_a_viability_job_gives_the_engines_kernel_and_every_viable_pair(client, auth):
+    """The job is parkour viability's computation on the same grid; its packed pairs unpack to the
+    engine's own."""
+    import base64
+
+    from sim_core.viability import compute_viability
+    from sim_core.viability_section import section_grid, section_step_map
+
+    spec = {"kind": "viability", "states": 8, "actions": 3, "zeta0_low": 0.8}
+    job = client.post("/api/v1/jobs", json=spec, headers=auth)
+    assert job.status_code == 202, job.text
+    assert _wait(client, job.json()["id"], timeout=300.0)["state"] == "done"
+    result = client.get(f"/api/v1/jobs/{job.json()['id']}/results").json()["result"]
+    model = get_preset("paper").to_model()
+    expected = compute_viability(section_step_map(model), section_grid(states=8, actions=3, zeta0_range=(0.8, 0.98)))
+    assert result["kernel"] == expected.kernel.tolist() and result["measure"] == expected.measure.tolist()
+    bits = np.unpackbits(np.frombuffer(base64.b64decode(result["viable_pairs"]), dtype=np.uint8))
+    shape = tuple(result["viable_pairs_shape"])
+    assert shape == (8, 8, 3, 3)
+    assert np.array_equal(bits[: np.prod(shape)].reshape(shape).astype(bool), expected.viable_pairs)
+    assert result["action_axes"]["zeta0"][0] == 0.8
+
+
 @pytest.mark.parametrize(
     ("change", "field", "says"),
     [
