@@ -5,6 +5,7 @@ import { filedUnder, SQRT_GL0, checked, simControls } from "./forms.js";
 import { draw, layout, plotSweep, plotBasin } from "./plots.js";
 import { element, fillTable, attributes } from "./dom.js";
 import { hideControlStudy, showControlStudy } from "./control_study.js";
+import { hideViability, showViability } from "./viability.js";
 
 const streams = new Map();
 const FINAL = ["done", "cancelled", "failed"];
@@ -15,6 +16,7 @@ export function describeJob(job) {
   if (job.kind === "sweep") return `psi0 ${spec.psi0_deg}°, zeta0 ${spec.zeta0_low}–${spec.zeta0_high}, ${spec.steps} steps`;
   if (job.kind === "control-study") return `${(spec.controllers || []).join(", ")} to ${spec.target_m} m, ${spec.seeds} × ${spec.jumps} jumps`;
   if (job.kind === "mfpt") return `MFPT of ${spec.psi0_deg}°/${spec.zeta0}, grid ${spec.grid}`;
+  if (job.kind === "viability") return `viability, ${spec.states}² states × ${spec.actions}² actions`;
   const legs = (spec.controls || []).map((leg) => `${leg.psi0_deg}°/${leg.zeta0}`).join(", ");
   return job.kind === "basin" ? `${legs}, ${spec.grid}² start states` : legs;
 }
@@ -148,7 +150,17 @@ const JOB_FIELDS = {
     { name: "tolerance", rule: "BasinJobCreate.tolerance", unit: SQRT_GL0 }],
   "control-study": [{ name: "study_target", rule: "ControlStudyJobCreate.target_m", unit: "m" }, { name: "study_seeds", rule: "ControlStudyJobCreate.seeds" },
     { name: "study_jumps", rule: "ControlStudyJobCreate.jumps", unit: "jumps" }, { name: "study_seed0", rule: "ControlStudyJobCreate.seed0" }],
+  mfpt: [{ name: "mfpt_psi0", rule: "MfptJobCreate.psi0_deg", unit: "°" }, { name: "mfpt_zeta0", rule: "MfptJobCreate.zeta0", unit: "l0" },
+    { name: "mfpt_velocity", rule: "NoiseIn.velocity", unit: SQRT_GL0 }, { name: "mfpt_drift", rule: "NoiseIn.pitch_drift_deg", unit: "°" },
+    { name: "mfpt_grid", rule: "MfptJobCreate.grid" }, { name: "mfpt_pitch", rule: "MfptJobCreate.pitch_spacing", unit: "σ" }],
+  viability: [{ name: "viability_states", rule: "ViabilityJobCreate.states" }, { name: "viability_actions", rule: "ViabilityJobCreate.actions" },
+    { name: "viability_psi0_low", rule: "ViabilityJobCreate.psi0_low_deg", unit: "°" }, { name: "viability_psi0_high", rule: "ViabilityJobCreate.psi0_high_deg", unit: "°" },
+    { name: "viability_zeta0_low", rule: "ViabilityJobCreate.zeta0_low", unit: "l0" }, { name: "viability_zeta0_high", rule: "ViabilityJobCreate.zeta0_high", unit: "l0" }],
 };
+const MFPT_LOCATIONS = { psi0_deg: "mfpt_psi0", zeta0: "mfpt_zeta0", grid: "mfpt_grid", pitch_spacing: "mfpt_pitch",
+  "noise.velocity": "mfpt_velocity", "noise.pitch_drift_deg": "mfpt_drift" };
+const VIABILITY_LOCATIONS = { states: "viability_states", actions: "viability_actions", psi0_low_deg: "viability_psi0_low",
+  psi0_high_deg: "viability_psi0_high", zeta0_low: "viability_zeta0_low", zeta0_high: "viability_zeta0_high" };
 const STUDY_LOCATIONS = { controllers: "study_controllers", target_m: "study_target", seeds: "study_seeds", jumps: "study_jumps",
   seed0: "study_seed0" };
 const JOB_LOCATIONS = { psi0_deg: "psi0", zeta0s: "zeta0s", trials: "trials", cap: "cap", seed: "seed", zeta0_low: "zeta0_low",
@@ -167,6 +179,16 @@ async function jobSpec(form) {
     const controllers = [...form.elements.study_controllers.selectedOptions].map((option) => option.value);
     const body = { kind, controllers, target_m: v.study_target, seeds: v.study_seeds, jumps: v.study_jumps, seed0: v.study_seed0 };
     return { body, locations: { ...STUDY_LOCATIONS, ...Object.fromEntries(Object.entries(STUDY_LOCATIONS).map(([field, input]) => [`control-study.${field}`, input])) } };
+  }
+  if (kind === "mfpt") {
+    const body = { kind, psi0_deg: v.mfpt_psi0, zeta0: v.mfpt_zeta0, grid: v.mfpt_grid, pitch_spacing: v.mfpt_pitch,
+      noise: { velocity: v.mfpt_velocity, pitch_drift_deg: v.mfpt_drift } };
+    return { body, locations: MFPT_LOCATIONS };
+  }
+  if (kind === "viability") {
+    const body = { kind, states: v.viability_states, actions: v.viability_actions, psi0_low_deg: v.viability_psi0_low,
+      psi0_high_deg: v.viability_psi0_high, zeta0_low: v.viability_zeta0_low, zeta0_high: v.viability_zeta0_high };
+    return { body, locations: VIABILITY_LOCATIONS };
   }
   if (kind === "sweep") {
     const body = { kind, psi0_deg: v.sweep_psi0, zeta0_low: v.zeta0_low, zeta0_high: v.zeta0_high, steps: v.steps, basin_grid: v.basin_grid };
@@ -216,6 +238,7 @@ export async function showJob(id) {
   const results = await call("GET", `/jobs/${id}/results`);
   const job = results.job;
   hideControlStudy();
+  hideViability();
   if (results.levels) {
     // Only the levels with trials are drawn; a job that is not done says so in the title.
     const missing = results.missing_zeta0s || [];
@@ -235,6 +258,8 @@ export async function showJob(id) {
     plotBasin("job-plot", results.result, `Job ${id}: basin of attraction`);
   } else if (job.kind === "mfpt") {
     showMfpt(id, results.result);
+  } else if (job.kind === "viability") {
+    showViability(id, results.result);
   } else {
     const gaits = results.result.gaits || [];
     say(`Job ${id}: ${gaits.length} gait(s): ${gaits.map((g) => `period ${g.period} at (${g.state.map((v) => v.toFixed(3)).join(", ")}), max |λ| ${g.max_abs_eigenvalue.toFixed(3)}`).join("; ")}.`);

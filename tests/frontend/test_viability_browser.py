@@ -1,0 +1,97 @@
+"""The viability job in the Jobs tab (frontend/panel/viability.js; issue 28), in headless Chromium
+against the real service: scheduled from the form, shown as the kernel's measure over the states,
+and a clicked state's viable commands unpacked from the job's own bits. The MFPT kind is
+scheduled from the same form, with the noise it was given.
+
+Set PARKOUR_SCREENSHOTS=1 to refresh docs/screenshots/viability_job.png from this run.
+"""
+
+import base64
+import time
+
+import httpx
+import numpy as np
+import pytest
+
+from tests.frontend.browser import chromium, panel, screenshot, until
+from tests.helpers import served
+
+pytestmark = pytest.mark.slow  # a browser, a service and a small map: ~20 s
+
+NEWEST = "document.querySelector('#job-table tbody tr:first-child {cell}')?.textContent"
+
+
+@pytest.fixture(scope="module")
+def service(tmp_path_factory):
+    with served(tmp_path_factory.mktemp("viability") / "data") as base_and_token:
+        yield base_and_token
+
+
+def _newest_job(base: str, token: str) -> dict:
+    return httpx.get(f"{base}/api/v1/jobs?limit=1", headers={"Authorization": f"Bearer {token}"}).json()["items"][0]
+
+
+def _done(base: str, job: int) -> dict:
+    deadline = time.monotonic() + 240  # a first compile of the kernels in the job worker
+    while (state := httpx.get(f"{base}/api/v1/jobs/{job}").json())["state"] not in ("done", "failed", "cancelled"):
+        assert time.monotonic() < deadline, state
+        time.sleep(0.5)
+    return state
+
+
+def _schedule(page, kind: str, values: dict) -> None:
+    page.select_option("#job-kind", kind)
+    for name, value in values.items():
+        page.fill(f"#job-form [name={name}]", str(value))
+    page.click("#submit-job")
+
+
+def test_a_viability_job_from_the_form_shows_its_kernel_and_a_states_viable_commands(service):
+    base, token = service
+    with chromium() as browser, panel(browser, base, token, failed_requests=True) as page:
+        page.set_viewport_size({"width": 1360, "height": 1500})
+        page.click("nav [data-tab=jobs]")
+        _schedule(page, "viability", {"viability_states": 12, "viability_actions": 4, "viability_zeta0_low": 0.8})
+        until(page, "document.querySelector('#messages').textContent.includes('scheduled')")
+        job = _newest_job(base, token)
+        assert job["spec"]["states"] == 12 and job["spec"]["zeta0_low"] == 0.8
+        assert _done(base, job["id"])["state"] == "done"
+        result = httpx.get(f"{base}/api/v1/jobs/{job['id']}/results").json()["result"]
+        until(page, f"{NEWEST.format(cell='.state')} === 'done'")
+        assert page.evaluate(NEWEST.format(cell=".what")) == "viability, 12² states × 4² actions"
+        page.click("#job-table tbody tr:first-child .show")
+        until(page, "document.querySelector('#job-plot').data?.length === 3")
+        measure = page.evaluate("document.querySelector('#job-plot').data[2].z")
+        kernel, expected = np.array(result["kernel"]), np.array(result["measure"])
+        drawn = np.array([[np.nan if v is None else v for v in row] for row in measure]).T  # back to [xdot][ydot]
+        assert np.array_equal(np.isnan(drawn), ~kernel)
+        np.testing.assert_allclose(drawn[kernel], expected[kernel])
+        # A state in the kernel, clicked: its viable commands are the job's bits for that state.
+        i, j = (int(v) for v in np.argwhere(kernel & (expected < 1))[0])
+        x, y = result["state_axes"]["xdot"][i], result["state_axes"]["ydot"][j]
+        page.evaluate(f"document.querySelector('#job-plot').emit('plotly_click', {{points: [{{x: {x}, y: {y}}}]}})")
+        until(page, "document.querySelector('#job-plot-actions').data?.length === 1")
+        shown = np.array(page.evaluate("document.querySelector('#job-plot-actions').data[0].z")).T  # [psi0][zeta0]
+        bits = np.unpackbits(np.frombuffer(base64.b64decode(result["viable_pairs"]), dtype=np.uint8))
+        shape = result["viable_pairs_shape"]
+        assert np.array_equal(shown, bits[: np.prod(shape)].reshape(shape)[i, j])
+        title = page.evaluate("document.querySelector('#job-plot-actions').layout.title.text")
+        assert f"{int(shown.sum())} of 16 commands viable" in title
+        screenshot(page, "viability_job", "#jobs")
+
+        _schedule(page, "mfpt", {"mfpt_zeta0": 0.96, "mfpt_velocity": 0.08, "mfpt_grid": 6, "mfpt_pitch": 2})
+        until(page, "document.querySelector('#messages').textContent.includes('MFPT of 30°/0.96')")
+        mfpt = _newest_job(base, token)["spec"]
+        assert mfpt["kind"] == "mfpt" and mfpt["grid"] == 6 and mfpt["pitch_spacing"] == 2
+        assert mfpt["noise"]["velocity"] == 0.08 and mfpt["noise"]["pitch_drift_deg"] == 0
+
+
+def test_a_bad_field_is_marked_at_the_field_and_nothing_is_sent(service):
+    base, token = service
+    with chromium() as browser, panel(browser, base, token) as page:
+        page.click("nav [data-tab=jobs]")
+        before = httpx.get(f"{base}/api/v1/jobs", headers={"Authorization": f"Bearer {token}"}).json()["items"]
+        _schedule(page, "viability", {"viability_states": 500})
+        until(page, "document.querySelector('[name=viability_states]').getAttribute('aria-invalid') === 'true'")
+        after = httpx.get(f"{base}/api/v1/jobs", headers={"Authorization": f"Bearer {token}"}).json()["items"]
+        assert len(after) == len(before)
