@@ -54,15 +54,17 @@ def control_study_command(
     from rich.console import Console
     from rich.table import Table
 
-    table = Table("controller", "failures", "height RMS", "median |error|", "rise [jumps]", "clipped", "µs/jump",
-                  title=f"{seeds} trials × {jumps} jumps to {target:g} m, the same noise for each")  # fmt: skip
+    title = f"{seeds} trials × {jumps} jumps to {target:g} m, the same noise for each"
+    table = Table("controller", "failures", "jumps to failure", "height RMS", "median |error|", "rise [jumps]",
+                  "clipped", "µs/jump", title=title)  # fmt: skip
 
     def cm(value: float | None) -> str:
         return "—" if value is None else f"{value * 100:.2f} cm"
 
     for entry in result["controllers"]:
         rise = "—" if entry["rise_jumps"] is None else f"{entry['rise_jumps']:g}"
-        table.add_row(entry["name"], f"{entry['failures']}/{entry['trials']}", cm(entry["height_rms_m"]),
+        lasted = f"{'≥ ' if entry['survived'] else ''}{entry['mean_jumps_to_failure']:.0f}"
+        table.add_row(entry["name"], f"{entry['failures']}/{entry['trials']}", lasted, cm(entry["height_rms_m"]),
                       cm(entry["height_median_abs_m"]), rise, f"{entry['saturated_fraction']:.1%}",
                       f"{entry['us_per_jump']:.3f}")  # fmt: skip
     Console().print(table)

@@ -25,7 +25,8 @@ from sim_core.failures import OK
 from sim_core.presets import get_preset
 from sim_core.reference import reference_jump
 from sim_core.viability import compute_viability
-from sim_core.viability_section import section_grid, section_step_map
+from sim_core.viability_grid import section_grid
+from sim_core.viability_section import section_step_map
 
 
 def scipy_step(model, state, action) -> tuple[np.ndarray, bool]:

@@ -59,10 +59,19 @@ class ControllerOutcome:
     us_per_jump: float
     failure_jumps: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=np.int64))  # jumps done, per failure
     examples: tuple[np.ndarray, ...] = ()  # the first trials' touchdown heights [l0], up to EXAMPLES
+    jumps: int = 0  # each trial's length: a run that survives it is censored there
 
     @property
     def failures(self) -> int:
         return sum(self.failure_codes.values())
+
+    def jumps_to_failure(self) -> tuple[float, float]:
+        """The mean jumps to failure of the trials, each survivor counted at the trials' length
+        (the restricted mean: the MJTF itself when every trial fails, a lower bound otherwise),
+        and its 95% interval's half-width (normal approximation)."""
+        lasted = np.concatenate([self.failure_jumps, np.full(self.trials - self.failures, self.jumps)]).astype(float)
+        half_width = 1.96 * lasted.std(ddof=1) / math.sqrt(lasted.size) if lasted.size > 1 else math.inf
+        return float(lasted.mean()), float(half_width)
 
     def to_dict(self, leg_length: float) -> dict:
         """The ``parkour control-study --json`` entry; ``leg_length`` [m] converts heights."""
@@ -78,6 +87,9 @@ class ControllerOutcome:
             "rise_jumps": float(np.median(self.rise_jumps)) if self.rise_jumps.size else None,
             "us_per_jump": self.us_per_jump,
             "saturated_fraction": self.saturated / self.commands if self.commands else 0.0,
+            "mean_jumps_to_failure": self.jumps_to_failure()[0],
+            "mean_jumps_to_failure_ci95": self.jumps_to_failure()[1],
+            "survived": self.trials - self.failures,
         }
 
     @classmethod
@@ -97,6 +109,7 @@ class ControllerOutcome:
             us_per_jump=parts[0].us_per_jump if us_per_jump is None else us_per_jump,
             failure_jumps=np.concatenate([part.failure_jumps for part in parts]),
             examples=tuple(example for part in parts for example in part.examples)[:EXAMPLES],
+            jumps=parts[0].jumps,
         )
 
 
@@ -187,6 +200,7 @@ def study_chunk(
         us_per_jump=0.0,
         failure_jumps=np.array(failed_at, dtype=np.int64),
         examples=tuple(examples),
+        jumps=jumps,
     )
 
 

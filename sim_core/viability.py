@@ -35,72 +35,15 @@ import numpy as np
 
 from sim_core.chunks import Progress, chunk_slices
 from sim_core.validation import ParameterError
+from sim_core.viability_grid import ViabilityGrid
 from sim_core.viability_kernels import pair_measures, shrink
+
+__all__ = ["FAILED", "StepMap", "Viability", "ViabilityGrid", "compute_viability", "transition_map"]
+__all__ += ["viability_of_map"]
 
 StepMap = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
 FAILED = -1  # the bin of a failed pair
-MAX_PAIRS = 50_000_000  # 800 MB of bins for a 2-D state: past this the grid is almost certainly a typo
-MAX_DIMENSIONS = 4  # per side: 2**4 corners per bin at most
 DEFAULT_CHUNK_PAIRS = 200_000  # ~0.5 s of the paper model's stances on two cores: steady progress
-
-
-@dataclass(frozen=True)
-class ViabilityGrid:
-    """The nodes: one strictly increasing 1-D axis per state dimension (2 nodes at least), then per
-    action dimension (1 at least: a control held fixed)."""
-
-    state_axes: tuple[np.ndarray, ...]
-    action_axes: tuple[np.ndarray, ...]
-
-    def __post_init__(self):
-        for side, axes in (("state_axes", self.state_axes), ("action_axes", self.action_axes)):
-            if not 1 <= len(axes) <= MAX_DIMENSIONS:
-                raise ParameterError(side, f"must hold 1 to {MAX_DIMENSIONS} axes, got {len(axes)}")
-            checked = []
-            fewest = 2 if side == "state_axes" else 1  # an action axis of one node: a control held fixed
-            for number, axis in enumerate(axes):
-                values = np.asarray(axis, dtype=np.float64)
-                field = f"{side}[{number}]"
-                if values.ndim != 1 or values.size < fewest:
-                    message = f"must be a 1-D axis of at least {fewest} nodes, got shape {values.shape}"
-                    raise ParameterError(field, message)
-                if not np.all(np.isfinite(values)) or not np.all(np.diff(values) > 0):
-                    raise ParameterError(field, "must be finite and strictly increasing")
-                values.setflags(write=False)
-                checked.append(values)
-            object.__setattr__(self, side, tuple(checked))
-        if self.pairs > MAX_PAIRS:
-            raise ParameterError(
-                "grid", f"must hold at most {MAX_PAIRS:,} state-action pairs, got {self.pairs:,} ({self.shape})"
-            )
-
-    @property
-    def state_shape(self) -> tuple[int, ...]:
-        return tuple(axis.size for axis in self.state_axes)
-
-    @property
-    def action_shape(self) -> tuple[int, ...]:
-        return tuple(axis.size for axis in self.action_axes)
-
-    @property
-    def shape(self) -> tuple[int, ...]:
-        return self.state_shape + self.action_shape
-
-    @property
-    def pairs(self) -> int:
-        return int(np.prod(self.shape))
-
-    def states(self) -> np.ndarray:
-        """Every state node, shape (states, ds), in C order of ``state_shape``."""
-        return _nodes(self.state_axes)
-
-    def actions(self) -> np.ndarray:
-        """Every action node, shape (actions, da), in C order of ``action_shape``."""
-        return _nodes(self.action_axes)
-
-
-def _nodes(axes) -> np.ndarray:
-    return np.stack([mesh.ravel() for mesh in np.meshgrid(*axes, indexing="ij")], axis=1)
 
 
 @dataclass(frozen=True)

@@ -23,7 +23,8 @@ from sim_core.failures import OK
 from sim_core.mfpt_kernels import to_middle
 from sim_core.params import ModelParams
 from sim_core.viability import ViabilityGrid, compute_viability
-from sim_core.viability_section import DEFAULT_XDOT, DEFAULT_YDOT, section_step_map
+from sim_core.viability_grid import DEFAULT_XDOT, DEFAULT_YDOT
+from sim_core.viability_section import section_step_map
 
 GUARD_STATES = 60  # nodes per velocity axis: 0.08-0.15 sqrt(g l0) apart over the default window
 GUARD_ACTIONS = 19  # zeta0 nodes over the law's range

@@ -26,9 +26,6 @@ MFPT_MAX_GRID = 60
 # the job worker) at most, and its result (kernel, measure, viable pairs as bits) stays a few MB.
 VIABILITY_MAX_STATES = 120
 VIABILITY_MAX_ACTIONS = 40
-# sim_core.viability_section's default control ranges, kept here so that the schemas load no kernels
-VIABILITY_PSI0_DEG = (15.0, 55.0)
-VIABILITY_ZETA0 = (0.70, 0.98)
 
 
 def mfpt_grid_of(job) -> ChainGrid:

@@ -26,14 +26,13 @@ from backend.schemas.job_budget import (
     MFPT_MAX_GRID,
     VIABILITY_MAX_ACTIONS,
     VIABILITY_MAX_STATES,
-    VIABILITY_PSI0_DEG,
-    VIABILITY_ZETA0,
     within_budget,
 )
 from sim_core.climb_records import CHUTE_TOP, FLOOR
 from sim_core.control_laws import KINDS, PSI0_RANGE_DEG
 from sim_core.mfpt_grid import ChainGrid
 from sim_core.noise import ASYMMETRY_LIMITS, SIGMA_LIMITS, NoiseModel
+from sim_core.viability_grid import DEFAULT_PSI0_DEG, DEFAULT_ZETA0
 
 CLIENT_PATTERN = r"^[\w.:@/-]{1,64}$"  # the X-Parkour-Client header: who submits, for the queue's fairness
 
@@ -223,10 +222,10 @@ class ViabilityJobCreate(Strict):
     model: ModelIn = ModelIn()
     states: Annotated[int, Field(ge=4, le=VIABILITY_MAX_STATES, description="nodes per velocity axis")] = 40
     actions: Annotated[int, Field(ge=2, le=VIABILITY_MAX_ACTIONS, description="nodes per control axis")] = 16
-    psi0_low_deg: ViabilityPsi0 = VIABILITY_PSI0_DEG[0]
-    psi0_high_deg: ViabilityPsi0 = VIABILITY_PSI0_DEG[1]
-    zeta0_low: ViabilityZeta0 = VIABILITY_ZETA0[0]
-    zeta0_high: ViabilityZeta0 = VIABILITY_ZETA0[1]
+    psi0_low_deg: ViabilityPsi0 = DEFAULT_PSI0_DEG[0]
+    psi0_high_deg: ViabilityPsi0 = DEFAULT_PSI0_DEG[1]
+    zeta0_low: ViabilityZeta0 = DEFAULT_ZETA0[0]
+    zeta0_high: ViabilityZeta0 = DEFAULT_ZETA0[1]
 
     @model_validator(mode="after")
     def _ordered(self) -> ViabilityJobCreate:

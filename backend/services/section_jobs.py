@@ -48,7 +48,8 @@ def _mfpt(spec, model: ModelParams, progress) -> dict:
 def _viability(spec, model: ModelParams, progress) -> dict:
     """The kernel and measure over the job's grid, and every viable pair as bits."""
     from sim_core.viability import compute_viability
-    from sim_core.viability_section import section_grid, section_step_map
+    from sim_core.viability_grid import section_grid
+    from sim_core.viability_section import section_step_map
 
     grid = section_grid(
         states=spec.states,

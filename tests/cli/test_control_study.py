@@ -5,7 +5,8 @@ import pytest
 from tests.cli.helpers import invoke, json_of
 
 ENTRY = {"name", "trials", "failures", "failure_rate", "failure_codes", "height_rms_m", "height_median_abs_m",
-         "rise_jumps", "us_per_jump", "saturated_fraction"}  # fmt: skip
+         "rise_jumps", "us_per_jump", "saturated_fraction", "mean_jumps_to_failure", "mean_jumps_to_failure_ci95",
+         "survived"}  # fmt: skip
 
 
 def test_control_study_json_contract():
@@ -18,6 +19,7 @@ def test_control_study_json_contract():
     for entry in payload["controllers"]:
         assert set(entry) == ENTRY and entry["trials"] == 6
         assert entry["failure_rate"] == entry["failures"] / 6 and entry["us_per_jump"] > 0
+        assert entry["survived"] == 6 - entry["failures"] and 0 < entry["mean_jumps_to_failure"] <= 60
 
 
 @pytest.mark.parametrize(

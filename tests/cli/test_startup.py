@@ -14,7 +14,8 @@ import pytest
 # plotting, the 3D view and the MCAP writer with its protobuf schemas.
 HEAVY = ("numba", "scipy", "sqlalchemy", "alembic", "dask", "distributed", "matplotlib", "viser", "fastapi", "uvicorn",
          "mcap", "google.protobuf", "foxglove_schemas_protobuf")  # fmt: skip
-COMMANDS = ("map", "trajectory", "fixed-point", "gaits", "basin", "sweep", "mjtf", "mfpt", "viability", "pid", "atlas", "reproduce")
+COMMANDS = ("map", "trajectory", "fixed-point", "gaits", "basin", "sweep", "mjtf", "mfpt", "viability", "pid", "atlas")
+COMMANDS += ("reproduce",)
 COMMANDS += ("robot-sim", "export", "bench", "serve")
 
 

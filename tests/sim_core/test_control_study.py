@@ -76,6 +76,18 @@ def test_an_outcome_without_a_run_that_rose_reports_none():
     assert entry["failure_rate"] == 1.0 and entry["height_rms_m"] is None and entry["rise_jumps"] is None
 
 
+def test_jumps_to_failure_count_a_survivor_at_the_trials_length():
+    # Four trials of 1000 jumps: failures after 100, 300 and 500 jumps, one survivor.
+    outcome = ControllerOutcome("lqr", 4, {"slip": 2, "no_flight": 1}, np.empty(0), np.empty(0), 4, 0, 0.01,
+                                failure_jumps=np.array([100, 300, 500]), jumps=1000)  # fmt: skip
+    mean, half_width = outcome.jumps_to_failure()
+    assert mean == 475.0 and half_width == pytest.approx(1.96 * np.std([100, 300, 500, 1000], ddof=1) / 2)
+    entry = outcome.to_dict(0.3)
+    assert entry["mean_jumps_to_failure"] == 475.0 and entry["survived"] == 1
+    merged = ControllerOutcome.merged([outcome, outcome])
+    assert merged.jumps == 1000 and merged.jumps_to_failure()[0] == 475.0
+
+
 @pytest.mark.parametrize(("seeds", "seed0", "field"), [(0, 0, "seeds"), (5, -1, "seed0"), (5, 2**32, "seed0")])
 def test_bad_trial_counts_and_seeds_name_the_field(loop, seeds, seed0, field):
     with pytest.raises(ParameterError) as raised:

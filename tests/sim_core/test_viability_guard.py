@@ -10,8 +10,9 @@ from sim_core.failures import OK
 from sim_core.integrate import STATE_SIZE
 from sim_core.stride import lift_off
 from sim_core.viability import ViabilityGrid, compute_viability
+from sim_core.viability_grid import DEFAULT_XDOT, DEFAULT_YDOT
 from sim_core.viability_guard import design_guard, lands_in_kernel
-from sim_core.viability_section import DEFAULT_XDOT, DEFAULT_YDOT, section_step_map
+from sim_core.viability_section import section_step_map
 
 NO_RECORD = np.empty((0, STATE_SIZE))
 PSI0_DEG = 32.0

@@ -10,7 +10,8 @@ from sim_core import ControlSchedule, find_fixed_point
 from sim_core.params import ModelParams
 from sim_core.validation import ParameterError
 from sim_core.viability import compute_viability
-from sim_core.viability_section import degrees_of, section_grid, section_step_map
+from sim_core.viability_grid import degrees_of, section_grid
+from sim_core.viability_section import section_step_map
 
 
 def middle_of(model, touchdown, psi0, zeta0):

@@ -216,7 +216,8 @@ def test_a_viability_job_gives_the_engines_kernel_and_every_viable_pair(client, 
     import base64
 
     from sim_core.viability import compute_viability
-    from sim_core.viability_section import section_grid, section_step_map
+    from sim_core.viability_grid import section_grid
+    from sim_core.viability_section import section_step_map
 
     spec = {"kind": "viability", "states": 8, "actions": 3, "zeta0_low": 0.8}
     job = client.post("/api/v1/jobs", json=spec, headers=auth)
