@@ -131,18 +131,3 @@ def test_the_result_reads_as_numbers_and_answers_for_one_state():
     assert np.array_equal(result.viable_actions(centre)[:, 0], grid.action_axes[0][result.viable_pairs[15]])
     with pytest.raises(ParameterError, match="state: must have 1 components"):
         result.nearest_node([0.0, 1.0])
-
-
-@pytest.mark.parametrize(
-    ("state_axes", "action_axes", "message"),
-    [
-        ((np.array([0.0, 0.0, 1.0]),), (np.arange(2.0),), r"state_axes\[0\]: must be finite and strictly increasing"),
-        ((np.array([1.0]),), (np.arange(2.0),), r"state_axes\[0\]: must be a 1-D axis of at least 2 nodes"),
-        ((np.arange(3.0),), (np.array([]),), r"action_axes\[0\]: must be a 1-D axis of at least 1 nodes"),
-        ((), (np.arange(2.0),), "state_axes: must hold 1 to 4 axes"),
-        ((np.arange(8000.0), np.arange(8000.0)), (np.arange(2.0),), "grid: must hold at most 50,000,000"),
-    ],
-)
-def test_a_bad_grid_is_refused_naming_the_axis(state_axes, action_axes, message):
-    with pytest.raises(ParameterError, match=message):
-        ViabilityGrid(state_axes, action_axes)

@@ -10,7 +10,7 @@ from sim_core import ControlSchedule, find_fixed_point
 from sim_core.params import ModelParams
 from sim_core.validation import ParameterError
 from sim_core.viability import compute_viability
-from sim_core.viability_grid import degrees_of, section_grid
+from sim_core.viability_grid import section_grid
 from sim_core.viability_section import section_step_map
 
 
@@ -50,31 +50,6 @@ def test_a_step_that_cannot_go_on_fails(paper):
     # Rising fast onto a steep, long leg: the stance does not end in a flight across.
     _, failed = section_step_map(paper)(np.array([[0.94, 0.9]]), np.array([[math.radians(55.0), 0.98]]))
     assert failed[0]
-
-
-def test_the_grid_with_a_pitch_axis_is_symmetric_and_actions_read_in_degrees():
-    grid = section_grid(states=4, actions=3, pitch_nodes=5, pitch_deg=2.0)
-    pitch = grid.state_axes[2]
-    np.testing.assert_allclose(pitch, -pitch[::-1], atol=1e-15)
-    assert grid.shape == (4, 4, 5, 3, 3)
-    np.testing.assert_allclose(degrees_of(grid.actions())[:, 0].min(), 15.0)
-
-
-@pytest.mark.parametrize(
-    ("options", "message"),
-    [
-        ({"states": 1}, "states: must be an integer >= 2"),
-        ({"actions": 2.5}, "actions: must be an integer >= 2"),
-        ({"xdot_range": (-1.0, 2.0)}, "xdot_range: must be in"),
-        ({"zeta0_range": (0.9, 0.8)}, "zeta0_range: must be an interval with low < high"),
-        ({"pitch_nodes": 3}, "pitch_deg: must be in"),
-        ({"pitch_nodes": 3, "pitch_deg": 45.0}, "pitch_deg: must be in"),
-        ({"states": 3000, "actions": 100}, "grid: must hold at most"),
-    ],
-)
-def test_a_bad_grid_option_is_named(options, message):
-    with pytest.raises(ParameterError, match=message):
-        section_grid(**options)
 
 
 def test_a_chute_too_narrow_for_a_middle_is_refused():
