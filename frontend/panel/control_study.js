@@ -11,7 +11,9 @@ const EXTRA_PLOTS = ["job-plot-errors", "job-plot-climbs"];
 
 function row(entry) {
   const codes = Object.entries(entry.failure_codes).map(([code, count]) => `${code.replaceAll("_", " ")} ${count}`).join(", ");
-  return element("tr", null, element("td", entry.name), element("td", `${entry.failures}/${entry.trials}`),
+  // Survivors count at the trials' length: then the mean is a lower bound ("≥").
+  const lasted = entry.mean_jumps_to_failure === undefined ? "—" : `${entry.survived ? "≥ " : ""}${Math.round(entry.mean_jumps_to_failure)}`;
+  return element("tr", null, element("td", entry.name), element("td", `${entry.failures}/${entry.trials}`), element("td", lasted),
     element("td", cm(entry.height_rms_m)), element("td", cm(entry.height_median_abs_m)),
     element("td", entry.rise_jumps === null ? "—" : String(entry.rise_jumps)),
     element("td", `${(100 * entry.saturated_fraction).toFixed(1)}%`), element("td", entry.us_per_jump.toPrecision(3)),

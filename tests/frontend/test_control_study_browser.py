@@ -5,6 +5,8 @@ job's own result, and bad input marked at its field with the service's reason.
 Set PARKOUR_SCREENSHOTS=1 to refresh docs/screenshots/control_study.png from this run.
 """
 
+import math
+
 import httpx
 import pytest
 
@@ -50,7 +52,9 @@ def test_a_control_study_is_scheduled_and_shown_as_its_table_and_plots(page, ser
     cells = page.evaluate(f"[...{STUDY_ROWS}].map((row) => [...row.cells].map((cell) => cell.textContent))")
     for shown, entry in zip(cells, result["controllers"], strict=True):
         assert shown[0] == entry["name"] and shown[1] == f"{entry['failures']}/30"
-        assert shown[2] == f"{entry['height_rms_m'] * 100:.2f} cm"
+        bound = "≥ " if entry["survived"] else ""
+        assert shown[2] == f"{bound}{math.floor(entry['mean_jumps_to_failure'] + 0.5)}"  # JavaScript's Math.round
+        assert shown[3] == f"{entry['height_rms_m'] * 100:.2f} cm"
     failures = page.evaluate("document.querySelector('#job-plot').data.map((trace) => trace.y.at(-1))")
     assert failures == [entry["failures"] for entry in result["controllers"]]
     climbs = page.evaluate("document.querySelector('#job-plot-climbs').data.map((trace) => trace.name)")
