@@ -1,9 +1,10 @@
-"""The viability job in the Jobs tab (frontend/panel/viability.js; issue 28), in headless Chromium
-against the real service: scheduled from the form, shown as the kernel's measure over the states,
-and a clicked state's viable commands unpacked from the job's own bits. The MFPT kind is
-scheduled from the same form, with the noise it was given.
+"""The section's jobs in the Jobs tab (issue 28), in headless Chromium against the real service:
+a viability job (frontend/panel/viability.js) scheduled from the form, shown as the kernel's
+measure over the states and a clicked state's viable commands unpacked from the job's own bits;
+an MFPT job scheduled from the form with its noise, listed by what it asks and shown as its
+estimate and each grid's MFPT drawn from the job's own result. One service for both.
 
-Set PARKOUR_SCREENSHOTS=1 to refresh docs/screenshots/viability_job.png from this run.
+Set PARKOUR_SCREENSHOTS=1 to refresh docs/screenshots/viability_job.png and mfpt_job.png.
 """
 
 import base64
@@ -16,7 +17,7 @@ import pytest
 from tests.frontend.browser import chromium, panel, screenshot, until
 from tests.helpers import served
 
-pytestmark = pytest.mark.slow  # a browser, a service and a small map: ~20 s
+pytestmark = pytest.mark.slow  # a browser, a service, a small map and a small chain: ~40 s
 
 NEWEST = "document.querySelector('#job-table tbody tr:first-child {cell}')?.textContent"
 
@@ -79,11 +80,32 @@ def test_a_viability_job_from_the_form_shows_its_kernel_and_a_states_viable_comm
         assert f"{int(shown.sum())} of 16 commands viable" in title
         screenshot(page, "viability_job", "#jobs")
 
-        _schedule(page, "mfpt", {"mfpt_zeta0": 0.96, "mfpt_velocity": 0.08, "mfpt_grid": 6, "mfpt_pitch": 2})
-        until(page, "document.querySelector('#messages').textContent.includes('MFPT of 30°/0.96')")
-        mfpt = _newest_job(base, token)["spec"]
-        assert mfpt["kind"] == "mfpt" and mfpt["grid"] == 6 and mfpt["pitch_spacing"] == 2
-        assert mfpt["noise"]["velocity"] == 0.08 and mfpt["noise"]["pitch_drift_deg"] == 0
+
+def test_an_mfpt_job_from_the_form_is_listed_and_shown_as_its_estimate_and_grids(service):
+    base, token = service
+    with chromium() as browser, panel(browser, base, token, failed_requests=True) as page:
+        page.set_viewport_size({"width": 1360, "height": 1200})
+        page.click("nav [data-tab=jobs]")
+        # Small and quick: no pitch drift (one layer), a coarse grid.
+        _schedule(page, "mfpt", {"mfpt_zeta0": 0.9, "mfpt_velocity": 0.1, "mfpt_grid": 8, "mfpt_pitch": 2})
+        until(page, "document.querySelector('#messages').textContent.includes('MFPT of 30°/0.9,')")
+        job = _newest_job(base, token)
+        spec = job["spec"]
+        assert spec["kind"] == "mfpt" and spec["grid"] == 8 and spec["pitch_spacing"] == 2
+        assert spec["noise"]["velocity"] == 0.1 and spec["noise"]["pitch_drift_deg"] == 0
+        assert _done(base, job["id"])["state"] == "done"
+        result = httpx.get(f"{base}/api/v1/jobs/{job['id']}/results").json()["result"]
+        until(page, f"{NEWEST.format(cell='.state')} === 'done'")
+        assert page.evaluate(NEWEST.format(cell=".what")) == "MFPT of 30°/0.9, grid 8"
+        page.click("#job-table tbody tr:first-child .show")
+        until(page, "document.querySelector('#job-plot').data?.[0]?.y?.length === 2")
+        drawn = page.evaluate("document.querySelector('#job-plot').data[0]")
+        assert drawn["y"] == [grid["mfpt_jumps"] for grid in result["grids"]]
+        assert drawn["x"] == [grid["cells"] for grid in result["grids"]]
+        said = page.evaluate("document.querySelector('#messages').textContent")
+        assert f"Job {job['id']}: MFPT " in said and f"{result['cells']} cells" in said
+        assert page.evaluate("document.querySelector('#job-plot-actions').hidden"), "the viability view is put away"
+        screenshot(page, "mfpt_job", "#jobs")
 
 
 def test_a_bad_field_is_marked_at_the_field_and_nothing_is_sent(service):
