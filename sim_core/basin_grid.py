@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim_core.validation import ParameterError, check_range
+from sim_core.validation import ParameterError, check_interval, check_range
 
 DEFAULT_TOLERANCE = 0.02  # [sqrt(g l0)]: inside the linear region of a stable gait, far above integrator noise
 DEFAULT_JUMPS = 60
@@ -41,11 +41,11 @@ class BasinGrid:
                 "grid", f"must be at most {math.isqrt(MAX_CELLS)} cells per axis ({MAX_CELLS:,} cells), got {cells}"
             )
         object.__setattr__(self, "cells", int(cells))
-        x_low, x_high = _check_interval("xdot_range", self.xdot_range)
+        x_low, x_high = check_interval("xdot_range", self.xdot_range)
         if x_high >= 0.0:
             raise ParameterError("xdot_range", f"must lie below 0 (toward the left wall), got [{x_low:g}, {x_high:g}]")
         object.__setattr__(self, "xdot_range", (x_low, x_high))
-        object.__setattr__(self, "ydot_range", _check_interval("ydot_range", self.ydot_range))
+        object.__setattr__(self, "ydot_range", check_interval("ydot_range", self.ydot_range))
 
     @classmethod
     def around(cls, state, cells: int, half_width: float = DEFAULT_HALF_WIDTH) -> BasinGrid:
@@ -72,15 +72,3 @@ class BasinGrid:
         """Start states, shape (cells * cells, 2), rows in ``[ydot index, xdot index]`` order."""
         xdot, ydot = np.meshgrid(self.xdot, self.ydot)
         return np.column_stack([xdot.ravel(), ydot.ravel()])
-
-
-def _check_interval(field: str, interval) -> tuple[float, float]:
-    try:
-        low, high = (check_range(field, v) for v in interval)
-    except (TypeError, ValueError) as error:
-        if isinstance(error, ParameterError):
-            raise
-        raise ParameterError(field, f"must be a pair (low, high), got {interval!r}") from None
-    if not low < high:
-        raise ParameterError(field, f"must be a non-empty interval with low < high, got [{low:g}, {high:g}]")
-    return low, high

@@ -43,6 +43,22 @@ def check_range(
     return number
 
 
+def check_interval(field: str, interval, low: float = -math.inf, high: float = math.inf) -> tuple[float, float]:
+    """``(low, high)`` of a pair within the open bounds with ``low < high``, else :class:`ParameterError`."""
+    try:
+        first, second = (check_range(field, value, low, high) for value in interval)
+    except (TypeError, ValueError) as error:
+        if isinstance(error, ParameterError):
+            raise
+        raise ParameterError(field, f"must be a pair (low, high), got {interval!r}") from None
+    if not first < second:
+        within = "" if math.isinf(low) and math.isinf(high) else f" within ({_fmt(low)}, {_fmt(high)})"
+        raise ParameterError(
+            field, f"must be a non-empty interval with low < high{within}, got [{first:g}, {second:g}]"
+        )
+    return first, second
+
+
 def _fmt(bound: float) -> str:
     if math.isinf(bound):
         return "inf" if bound > 0 else "-inf"

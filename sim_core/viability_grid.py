@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim_core.validation import ParameterError, check_range
+from sim_core.validation import ParameterError, check_interval, check_range
 
 MAX_PAIRS = 50_000_000  # 800 MB of bins for a 2-D state: past this the grid is almost certainly a typo
 MAX_DIMENSIONS = 4  # per side: 2**4 corners per bin at most
@@ -105,10 +105,10 @@ def section_grid(
     for field, count in (("states", states), ("actions", actions)):
         if isinstance(count, bool) or int(count) != count or count < 2:
             raise ParameterError(field, f"must be an integer >= 2 nodes per axis, got {count!r}")
-    x_low, x_high = _interval("xdot_range", xdot_range, 0.0, 20.0)
-    y_low, y_high = _interval("ydot_range", ydot_range, -20.0, 20.0)
-    p_low, p_high = _interval("psi0_range", psi0_deg_range, 1.0, 89.0)
-    z_low, z_high = _interval("zeta0_range", zeta0_range, 0.05, 0.999)
+    x_low, x_high = check_interval("xdot_range", xdot_range, 0.0, 20.0)
+    y_low, y_high = check_interval("ydot_range", ydot_range, -20.0, 20.0)
+    p_low, p_high = check_interval("psi0_range", psi0_deg_range, 1.0, 89.0)
+    z_low, z_high = check_interval("zeta0_range", zeta0_range, 0.05, 0.999)
     state_axes = [np.linspace(x_low, x_high, int(states)), np.linspace(y_low, y_high, int(states))]
     if pitch_nodes:
         if isinstance(pitch_nodes, bool) or int(pitch_nodes) != pitch_nodes or pitch_nodes < 2:
@@ -119,18 +119,6 @@ def section_grid(
         state_axes.append(np.radians(np.linspace(-limit, limit, int(pitch_nodes))))
     action_axes = (np.radians(np.linspace(p_low, p_high, int(actions))), np.linspace(z_low, z_high, int(actions)))
     return ViabilityGrid(tuple(state_axes), action_axes)
-
-
-def _interval(field: str, interval, low: float, high: float) -> tuple[float, float]:
-    try:
-        first, second = (check_range(field, value, low, high) for value in interval)
-    except (TypeError, ValueError) as error:
-        if isinstance(error, ParameterError):
-            raise
-        raise ParameterError(field, f"must be a pair (low, high), got {interval!r}") from None
-    if not first < second:
-        raise ParameterError(field, f"must be an interval with low < high within [{low:g}, {high:g}]")
-    return first, second
 
 
 def degrees_of(actions: np.ndarray) -> np.ndarray:

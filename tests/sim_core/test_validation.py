@@ -60,3 +60,17 @@ def test_something_not_a_number_is_named_as_given(value):
 
 def test_numeric_strings_are_read_as_numbers():
     assert check_range("alpha", "77.6", 0.0) == 77.6
+
+
+def test_an_interval_is_a_pair_in_order_within_its_bounds():
+    from sim_core.validation import check_interval
+
+    assert check_interval("xdot_range", (0.5, 2)) == (0.5, 2.0)
+    with pytest.raises(ParameterError, match=r"xdot_range: must be a non-empty interval with low < high, got \[2, 1\]"):
+        check_interval("xdot_range", (2, 1))
+    with pytest.raises(ParameterError, match=r"zeta0_range: must be a non-empty interval .* within \(0, 1\)"):
+        check_interval("zeta0_range", (0.9, 0.8), 0.0, 1.0)
+    with pytest.raises(ParameterError, match=r"zeta0_range: must be in \(0, 1\), got 1.5"):
+        check_interval("zeta0_range", (0.5, 1.5), 0.0, 1.0)
+    with pytest.raises(ParameterError, match="psi0_range: must be a pair"):
+        check_interval("psi0_range", 3.0)

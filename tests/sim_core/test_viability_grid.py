@@ -21,7 +21,7 @@ def test_the_grid_with_a_pitch_axis_is_symmetric_and_actions_read_in_degrees():
         ({"states": 1}, "states: must be an integer >= 2"),
         ({"actions": 2.5}, "actions: must be an integer >= 2"),
         ({"xdot_range": (-1.0, 2.0)}, "xdot_range: must be in"),
-        ({"zeta0_range": (0.9, 0.8)}, "zeta0_range: must be an interval with low < high"),
+        ({"zeta0_range": (0.9, 0.8)}, "zeta0_range: must be a non-empty interval with low < high within"),
         ({"pitch_nodes": 3}, "pitch_deg: must be in"),
         ({"pitch_nodes": 3, "pitch_deg": 45.0}, "pitch_deg: must be in"),
         ({"states": 3000, "actions": 100}, "grid: must hold at most"),
