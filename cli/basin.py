@@ -14,6 +14,7 @@ from cli.options import (
     PeriodOption,
     SchedulerOption,
     handles_errors,
+    option_named,
     parse_controls,
     print_json,
     progress_bar,
@@ -33,7 +34,15 @@ def basin_command(
     period: PeriodOption = None,
     guess: GuessOption = None,
     grid: Annotated[int, typer.Option("--grid", help="Cells per axis.")] = 100,
-    jumps: Annotated[int, typer.Option("--jumps", help="Jumps allowed to converge.")] = DEFAULT_JUMPS,
+    jumps: Annotated[int, typer.Option("--jumps", help="Jumps allowed to converge (the first cap).")] = DEFAULT_JUMPS,
+    jump_limit: Annotated[
+        int | None,
+        typer.Option(
+            "--jump-limit",
+            help="Continue the cells still undecided after --jumps, doubling the cap each round, up to this many "
+            "jumps in all. Default: no continuation.",
+        ),
+    ] = None,
     xdot_range: Annotated[
         tuple[float, float] | None,
         typer.Option("--xdot-range", help="LOW HIGH of xdot [sqrt(g l0)], below 0; default: gait ±1.5."),
@@ -54,7 +63,11 @@ def basin_command(
     from experiments.gait_basin import gait_basin
 
     schedule = parse_controls(controls)
-    with chunk_map_for(scheduler_address(scheduler)) as chunk_map, progress_bar(f"basin: {grid}x{grid} cells") as bar:
+    with (
+        option_named("--jump-limit", "jump_limit"),
+        chunk_map_for(scheduler_address(scheduler)) as chunk_map,
+        progress_bar(f"basin: {grid}x{grid} cells") as bar,
+    ):
         basin = gait_basin(
             setup.model,
             schedule,
@@ -65,6 +78,7 @@ def basin_command(
             ydot_range=ydot_range,
             max_jumps=jumps,
             tolerance=tolerance,
+            jump_limit=jump_limit,
             chunk_map=chunk_map,
             progress=bar,
         )
@@ -79,8 +93,12 @@ def basin_command(
     table.add_row("gait state", f"({gait.state[0]:.5f}, {gait.state[1]:.5f}), max |λ| {gait.max_abs_eigenvalue:.4f}")
     table.add_row("xdot range", f"{cells.xdot_range[0]:.3f} … {cells.xdot_range[1]:.3f}")
     table.add_row("ydot range", f"{cells.ydot_range[0]:.3f} … {cells.ydot_range[1]:.3f}")
-    table.add_row("grid", f"{grid} x {grid}, {jumps} jumps, tolerance {tolerance:g}")
+    limit = "" if basin.jump_limit == jumps else f", undecided cells continued up to {basin.jump_limit}"
+    table.add_row("grid", f"{grid} x {grid}, {jumps} jumps{limit}, tolerance {tolerance:g}")
     table.add_row("area (g l0)", f"{basin.area:.4f} ({basin.fraction:.1%} of the window)")
+    if limit:
+        rounds = (f"{r['cap']}: {r['converged']:,} in, {r['undecided']:,} undecided" for r in basin.rounds())
+        table.add_row("by cap (jumps)", "; ".join(rounds))
     for outcome, count in basin.outcome_counts().items():
         if count:
             table.add_row(f"  {outcome}", f"{count:,} cells")

@@ -40,7 +40,17 @@ def sweep_command(
     basin_grid: Annotated[
         int, typer.Option("--basin-grid", help="Cells per axis of each basin; 0 skips the basins.")
     ] = 40,
-    basin_jumps: Annotated[int, typer.Option("--basin-jumps", help="Jumps allowed to converge.")] = DEFAULT_JUMPS,
+    basin_jumps: Annotated[
+        int, typer.Option("--basin-jumps", help="Jumps allowed to converge (the first cap).")
+    ] = DEFAULT_JUMPS,
+    basin_jump_limit: Annotated[
+        int | None,
+        typer.Option(
+            "--basin-jump-limit",
+            help="Continue the basin cells still undecided after --basin-jumps, doubling the cap, up to this many "
+            "jumps in all. Default: no continuation.",
+        ),
+    ] = None,
     scheduler: SchedulerOption = None,
     as_json: JsonOption = False,
 ) -> None:
@@ -52,7 +62,8 @@ def sweep_command(
     fixed = fixed_leg_of(fixed_leg)
     with option_named("--basin-grid", "grid"):
         grid = None if basin_grid == 0 else BasinGrid(*DEFAULT_BASIN_WINDOW, basin_grid)
-    check_convergence_test(basin_jumps, DEFAULT_TOLERANCE)
+    with option_named("--basin-jump-limit", "jump_limit"):
+        check_convergence_test(basin_jumps, DEFAULT_TOLERANCE, basin_jump_limit)
     sweep = over_zeta0(
         energy_sweep,
         f"sweeping {steps} zeta0 values",
@@ -64,6 +75,7 @@ def sweep_command(
         guess,
         basin_grid=grid,
         basin_jumps=basin_jumps,
+        basin_jump_limit=basin_jump_limit,
     )
     if as_json:
         print_json(sweep.to_dict())

@@ -2,25 +2,34 @@
 
 Sweeps zeta0 with psi0 fixed, following the period-1 gait by continuation; plots max |λ| and
 the climb per jump with the zeta0 of jumping in place marked, the basin area on one fixed
-window, and the basins themselves at three energy levels.
+window, and the basins themselves at three energy levels on one colour scale. Basin cells run to
+``basin_jumps``; those still undecided are continued up to ``basin_jump_limit`` (doubling the
+cap each round, :mod:`sim_core.basin_cells`), and what stays undecided is drawn as such. A scan
+over psi0 tests the paper's stable descending gaits (:mod:`experiments.descending`).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from experiments import descending
 from experiments.report import Claim, new_figure
 from sim_core.basin import DEFAULT_JUMPS, BasinGrid, compute_basin
+from sim_core.basin_cells import FALLING_SPEED
 from sim_core.basin_grid import DEFAULT_BASIN_WINDOW
 from sim_core.chunks import ChunkMap, Progress, in_process
 from sim_core.controls import ControlSchedule, LegControl
+from sim_core.failures import Failure
 from sim_core.params import PhysicalParams
 from sim_core.sweep import EnergySweep, energy_sweep, zeta0_values
 
 TITLE = "Fig. 8 — stability and basin vs leg retraction"
+UNDECIDED_COLOUR = "0.55"
+FAILURE_COLOURS = {"slip": "#f6d2a8", "collapse": "#d4c4e6", "no_liftoff": "#b9e0da", "no_flight": "#f4b6bc",
+                   "invalid_state": "#222222"}  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -29,15 +38,24 @@ class Config:
     zeta0_range: tuple[float, float] = (0.80, 0.97)
     steps: int = 35
     basin_grid: int = 60
-    basin_jumps: int = DEFAULT_JUMPS
+    basin_jumps: int = DEFAULT_JUMPS  # the first cap
+    # the undecided cells go on to here: at zeta0 0.96 (max |λ| 0.995) the basin stops growing by 960
+    basin_jump_limit: int = 1000
     shown_basins: tuple[float, ...] = (0.82, 0.88, 0.94)  # zeta0 of the basins drawn in full
     shown_grid: int = 120
     guess: tuple[float, float] = (-0.94, 0.6)  # near the gait at the first zeta0
+    descending_psi0_range: tuple[float, float] = (25.0, 45.0)  # [deg]: the scan for descending gaits
+    descending_psi0_steps: int = 21
 
     @classmethod
     def quick(cls) -> Config:
         """A coarse but real run, for smoke tests."""
-        return cls(steps=6, basin_grid=16, shown_basins=(0.84, 0.94), shown_grid=24)
+        return cls(steps=6, basin_grid=16, basin_jump_limit=240, shown_basins=(0.84, 0.94), shown_grid=24,
+                   descending_psi0_steps=5)  # fmt: skip
+
+    @property
+    def descending_psi0s(self) -> np.ndarray:
+        return np.linspace(*self.descending_psi0_range, self.descending_psi0_steps)
 
 
 @dataclass(frozen=True)
@@ -46,6 +64,7 @@ class Result:
     sweep: EnergySweep
     window: BasinGrid
     shown: tuple  # (zeta0, Basin | None)
+    descending: tuple[descending.DescendingRow, ...]
 
 
 def run(robot: PhysicalParams, config: Config, *, chunk_map: ChunkMap = in_process, progress: Progress | None = None):
@@ -59,6 +78,7 @@ def run(robot: PhysicalParams, config: Config, *, chunk_map: ChunkMap = in_proce
         guess=config.guess,
         basin_grid=window,
         basin_jumps=config.basin_jumps,
+        basin_jump_limit=config.basin_jump_limit,
         chunk_map=chunk_map,
         progress=progress,
     )
@@ -69,9 +89,18 @@ def run(robot: PhysicalParams, config: Config, *, chunk_map: ChunkMap = in_proce
         if point.gait is not None:
             schedule = ControlSchedule.of(LegControl(psi0, point.zeta0))
             grid = BasinGrid(*DEFAULT_BASIN_WINDOW, config.shown_grid)
-            basin = compute_basin(model, schedule, point.gait, grid, max_jumps=config.basin_jumps, chunk_map=chunk_map)
+            basin = compute_basin(
+                model,
+                schedule,
+                point.gait,
+                grid,
+                max_jumps=config.basin_jumps,
+                jump_limit=config.basin_jump_limit,
+                chunk_map=chunk_map,
+            )
         shown.append((point.zeta0, basin))
-    return Result(config, sweep, window, tuple(shown))
+    rows = descending.descending_gaits(model, config.descending_psi0s, guess=config.guess)
+    return Result(config, sweep, window, tuple(shown), rows)
 
 
 def plot(result: Result):
@@ -98,36 +127,65 @@ def plot(result: Result):
     ax.set(xlabel="zeta0 [l0]", ylabel="climb per jump [l0]", title="Climbing rate")
 
     ax = axes[0, 2]
-    ax.plot(zeta0, sweep.basin_area, "o-", color="tab:purple", markersize=3)
+    ax.plot(zeta0, sweep.basin_area, "o-", color="tab:purple", markersize=3, label="basin area")
     mark_in_place(ax)
     grid = result.window
-    ax.set(
-        xlabel="zeta0 [l0]",
-        ylabel="basin area [g l0]",
-        title=f"Basin area ({grid.cells}² cells, {sweep.basin_jumps} jumps)",
-    )
+    config = result.config
+    ax.set(xlabel="zeta0 [l0]", ylabel="basin area [g l0]", title=f"Basin area ({grid.cells}² cells)")
+    twin = ax.twinx()
+    twin.plot(zeta0, sweep.basin_undecided / grid.cells**2, "s--", color=UNDECIDED_COLOUR, markersize=2.5)
+    twin.set(ylabel="undecided share of the window (grey)", ylim=(0.0, 1.0))
+    twin.grid(False)
 
-    for ax, (zeta0_shown, basin) in zip(axes[1], result.shown, strict=False):
+    _draw_basins(figure, axes[1], result.shown, config.basin_jump_limit)
+    figure.suptitle(
+        f"{TITLE}; psi0 = {config.psi0_deg:g}°, paper preset\nbasins: every cell run {config.basin_jumps} jumps, "
+        f"the undecided ones continued (cap doubled each round) up to {config.basin_jump_limit} jumps"
+    )
+    return figure
+
+
+def _draw_basins(figure, axes, shown, limit: int) -> None:
+    """The basins on one logarithmic colour scale of jumps to converge, one colour bar for all;
+    failed cells in a colour per failure, cells undecided at the jump limit in grey."""
+    from matplotlib.colors import ListedColormap, LogNorm
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    basins = [basin for _, basin in shown if basin is not None]
+    longest = max([int(basin.jumps_to_converge.max()) for basin in basins] + [2])
+    norm = LogNorm(vmin=1, vmax=longest)
+    codes = sorted({int(code) for basin in basins for code in np.unique(basin.failure) if code})
+    outcomes = ListedColormap([UNDECIDED_COLOUR, *(FAILURE_COLOURS[Failure(code).code] for code in codes)])
+    image = None
+    for ax, (zeta0_shown, basin) in zip(axes, shown, strict=False):
         title = f"Basin at zeta0 = {zeta0_shown:.2f}"
         if basin is None:
             ax.set_title(f"{title}: no gait")
             continue
-        jumps = np.where(basin.mask, basin.jumps_to_converge, np.nan)
-        image = ax.imshow(
-            jumps,
-            origin="lower",
-            extent=[*basin.grid.xdot_range, *basin.grid.ydot_range],
-            aspect="auto",
-            cmap="viridis_r",
-        )
-        ax.plot(*basin.gait.state, "r+", markersize=10, markeredgewidth=2, label="fixed point")
+        extent = [*basin.grid.xdot_range, *basin.grid.ydot_range]
+        outcome = np.full(basin.failure.shape, np.nan)
+        outcome[basin.undecided] = 0
+        for index, code in enumerate(codes, start=1):
+            outcome[basin.failure == code] = index
+        show = {"origin": "lower", "extent": extent, "aspect": "auto", "interpolation": "nearest"}
+        ax.imshow(outcome, cmap=outcomes, vmin=-0.5, vmax=len(codes) + 0.5, **show)
+        jumps = np.where(basin.mask, np.maximum(basin.jumps_to_converge, 1), np.nan)
+        image = ax.imshow(jumps, cmap="viridis_r", norm=norm, **show)
+        ax.plot(*basin.gait.state, "r+", markersize=10, markeredgewidth=2)
         ax.set(xlabel="xdot [sqrt(g l0)]", ylabel="ydot [sqrt(g l0)]", title=f"{title} (area {basin.area:.2f})")
         ax.grid(False)
-        figure.colorbar(image, ax=ax, label="jumps to converge")
-    for ax in axes[1, len(result.shown) :]:
+    for ax in axes[len(shown) :]:
         ax.set_visible(False)
-    figure.suptitle(f"{TITLE}; psi0 = {result.config.psi0_deg:g}°, paper preset")
-    return figure
+    if image is None:
+        return
+    figure.colorbar(image, ax=list(axes[: len(shown)]), label="jumps to converge (all panels)", pad=0.01)
+    handles = [
+        Patch(color=UNDECIDED_COLOUR, label=f"undecided at the {limit}-jump limit or falling"),
+        *(Patch(color=FAILURE_COLOURS[Failure(code).code], label=f"fails: {Failure(code).code}") for code in codes),
+        Line2D([], [], color="r", marker="+", linestyle="none", markersize=10, markeredgewidth=2, label="fixed point"),
+    ]
+    figure.legend(handles=handles, loc="outside lower center", ncols=len(handles))
 
 
 def table(result: Result) -> dict[str, np.ndarray]:
@@ -141,6 +199,8 @@ def table(result: Result) -> dict[str, np.ndarray]:
         "max_abs_eigenvalue": sweep.max_abs_eigenvalue,
         "climb_per_jump_l0": sweep.climb_per_jump,
         "basin_area_gl0": sweep.basin_area,
+        "basin_undecided_cells": sweep.basin_undecided,
+        **descending.table_columns(result.descending),
     }
 
 
@@ -150,6 +210,7 @@ def data(result: Result) -> dict:
         "shown_basins": [
             None if basin is None else {"zeta0": z, **basin.to_dict(include_grids=False)} for z, basin in result.shown
         ],
+        "descending": [asdict(row) | {"stable": row.stable} for row in result.descending],
     }
 
 
@@ -200,17 +261,31 @@ def claims(result: Result) -> list[Claim]:
         )
     else:
         out.append(Claim("A critical zeta0 of jumping in place", "no sign change of the climb in the sweep", False))
+    out.append(descending.descending_claim(result.descending))
     return out
 
 
 def notes(result: Result) -> list[str]:
-    grid = result.window
-    return [
+    grid, config = result.window, result.config
+    out = [
         f"Basin areas on one window, xdot {grid.xdot_range[0]:g} … {grid.xdot_range[1]:g}, "
         f"ydot {grid.ydot_range[0]:g} … {grid.ydot_range[1]:g} [sqrt(g l0)], so they compare across zeta0; "
         "a cell counts when it comes within 0.02 of the fixed point.",
         "At the highest energies the basin reaches past the window, which caps those areas.",
+        f"Every basin cell runs {config.basin_jumps} jumps; the cells still undecided (neither converged nor "
+        f"failed) go on from where they stopped, the cap doubled each round, up to {config.basin_jump_limit} jumps.",
     ]
+    for zeta0, basin in result.shown:
+        if basin is None:
+            continue
+        first, last = basin.rounds()[0], basin.rounds()[-1]
+        out.append(
+            f"Basin at zeta0 = {zeta0:.2f} ({basin.grid.cells}² cells): {first['converged']:,} cells converged by "
+            f"{first['cap']} jumps, {last['converged']:,} by {last['cap']}; {last['undecided']:,} stay undecided, "
+            f"{np.count_nonzero(basin.falling):,} of them falling down the chute (stopped once past "
+            f"{FALLING_SPEED:g} sqrt(g l0): the model has no floor, so no limit decides them)."
+        )
+    return out
 
 
 def _spearman(x: np.ndarray, y: np.ndarray) -> float:

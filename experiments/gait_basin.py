@@ -28,6 +28,7 @@ def gait_basin(
     ydot_range: tuple[float, float] | None = None,
     max_jumps: int = DEFAULT_JUMPS,
     tolerance: float = DEFAULT_TOLERANCE,
+    jump_limit: int | None = None,
     chunk_map: ChunkMap = in_process,
     progress: Progress | None = None,
 ) -> Basin:
@@ -41,6 +42,8 @@ def gait_basin(
         xdot_range, ydot_range: the window (low, high) [sqrt(g l0)]; each None: the gait's state ± 1.5.
         max_jumps, tolerance: a cell converges if its orbit comes within ``tolerance`` of the gait's
             orbit in at most ``max_jumps`` jumps.
+        jump_limit: cells undecided after ``max_jumps`` go on, the cap doubled each round, up to this
+            many jumps (None: ``max_jumps``; :func:`sim_core.basin.compute_basin`).
 
     Raises:
         ParameterError: naming the field, before any search, for a bad window, grid or convergence test.
@@ -48,10 +51,18 @@ def gait_basin(
     """
     placeholder_x, placeholder_y = _PLACEHOLDER_WINDOW
     BasinGrid(xdot_range or placeholder_x, ydot_range or placeholder_y, grid)
-    check_convergence_test(max_jumps, tolerance)
+    check_convergence_test(max_jumps, tolerance, jump_limit)
     gait = gait_of(model, schedule, period, guess)
     around = BasinGrid.around(gait.state, grid)
     cells = BasinGrid(xdot_range or around.xdot_range, ydot_range or around.ydot_range, grid)
     return compute_basin(
-        model, schedule, gait, cells, max_jumps=max_jumps, tolerance=tolerance, chunk_map=chunk_map, progress=progress
+        model,
+        schedule,
+        gait,
+        cells,
+        max_jumps=max_jumps,
+        tolerance=tolerance,
+        jump_limit=jump_limit,
+        chunk_map=chunk_map,
+        progress=progress,
     )

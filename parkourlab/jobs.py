@@ -61,16 +61,18 @@ class JobCalls:
         psi0_deg: float | None = None,
         basin_grid: int | None = None,
         basin_jumps: int | None = None,
+        basin_jump_limit: int | None = None,
         guess: State | None = None,
         model: Mapping[str, Any] | None = None,
         experiment_id: int | None = None,
     ) -> Job:
         """An energy sweep: the symmetric gait at ``psi0_deg`` [deg] followed over ``steps`` zeta0
         values [l0] from ``zeta0_low`` to ``zeta0_high``, each with its climb, max |λ| and (with
-        ``basin_grid`` > 0) basin area over ``basin_grid``² states, ``basin_jumps`` jumps each.
-        None: the service's default."""
+        ``basin_grid`` > 0) basin area over ``basin_grid``² states, ``basin_jumps`` jumps each (those
+        still undecided continued up to ``basin_jump_limit`` jumps, if given). None: the service's default."""
         spec = {"zeta0_low": zeta0_low, "zeta0_high": zeta0_high, "steps": steps, "psi0_deg": psi0_deg}
-        spec |= {"basin_grid": basin_grid, "basin_jumps": basin_jumps, "guess": state(guess)}
+        spec |= {"basin_grid": basin_grid, "basin_jumps": basin_jumps, "basin_jump_limit": basin_jump_limit}
+        spec |= {"guess": state(guess)}
         return self.submit_job("sweep", **spec, model=mapping(model), experiment_id=experiment_id)
 
     def submit_basin(
@@ -81,15 +83,17 @@ class JobCalls:
         guess: State | None = None,
         grid: int | None = None,
         jumps: int | None = None,
+        jump_limit: int | None = None,
         tolerance: float | None = None,
         model: Mapping[str, Any] | None = None,
         experiment_id: int | None = None,
     ) -> Job:
         """The basin of attraction of the gait of ``controls`` (``(psi0 [deg], zeta0 [l0])`` per
         leg) near ``guess`` ``(xdot, ydot)`` [sqrt(g l0)]: a ``grid`` × ``grid`` of section states,
-        each followed ``jumps`` jumps and counted in when within ``tolerance`` of the gait."""
+        each followed ``jumps`` jumps (those still undecided continued, the cap doubled, up to
+        ``jump_limit``, if given) and counted in when within ``tolerance`` of the gait."""
         spec = {"controls": legs(controls), "period": period, "guess": state(guess)}
-        spec |= {"grid": grid, "jumps": jumps, "tolerance": tolerance}
+        spec |= {"grid": grid, "jumps": jumps, "jump_limit": jump_limit, "tolerance": tolerance}
         return self.submit_job("basin", **spec, model=mapping(model), experiment_id=experiment_id)
 
     def submit_gaits(

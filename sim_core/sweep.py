@@ -19,10 +19,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim_core.basin import NOT_CONVERGED, converge_states
+from sim_core.basin_cells import NOT_CONVERGED, check_jump_limit, converge_states
 from sim_core.basin_grid import DEFAULT_JUMPS, DEFAULT_TOLERANCE, BasinGrid
 from sim_core.chunks import ChunkMap, Progress, in_process
 from sim_core.controls import ControlSchedule, LegControl
+from sim_core.failures import OK
 from sim_core.fixed_points import FixedPoint, FixedPointNotFound, find_fixed_point
 from sim_core.gait_search import gait_of
 from sim_core.params import ModelParams
@@ -40,6 +41,7 @@ class SweepPoint:
     energy: float  # stored spring energy alpha (1 - zeta0)^2 / 2 [m g l0]
     gait: FixedPoint | None
     basin_area: float | None  # [g l0]; None when not computed
+    basin_undecided: int | None = None  # cells neither converged nor failed within the jump limit
 
     @property
     def climb_per_jump(self) -> float:
@@ -57,6 +59,7 @@ class SweepPoint:
             "stable": None if gait is None else gait.stable,
             "climb_per_jump": None if gait is None else self.climb_per_jump,
             "basin_area": self.basin_area,
+            "basin_undecided": self.basin_undecided,
         }
 
 
@@ -70,6 +73,7 @@ class EnergySweep:
         points: one per zeta0, in sweep order.
         in_place_zeta0: the zeta0 values where the climb crosses zero (jumping in place).
         basin_grid: the window and resolution of the basin areas, or None.
+        basin_jumps, basin_jump_limit: the basins' first cap and jump limit (:mod:`sim_core.basin`).
     """
 
     psi0: float
@@ -78,6 +82,7 @@ class EnergySweep:
     in_place_zeta0: tuple[float, ...]
     basin_grid: BasinGrid | None
     basin_jumps: int
+    basin_jump_limit: int | None = None
 
     @property
     def zeta0(self) -> np.ndarray:
@@ -94,6 +99,11 @@ class EnergySweep:
     @property
     def basin_area(self) -> np.ndarray:
         return np.array([math.nan if p.basin_area is None else p.basin_area for p in self.points])
+
+    @property
+    def basin_undecided(self) -> np.ndarray:
+        """Cells of each basin neither converged nor failed within the jump limit (NaN: no basin)."""
+        return np.array([math.nan if p.basin_undecided is None else p.basin_undecided for p in self.points])
 
     def to_dict(self) -> dict:
         """The ``parkour sweep --json`` contract."""
@@ -112,6 +122,7 @@ class EnergySweep:
                 "ydot_range": list(grid.ydot_range),
                 "grid": grid.cells,
                 "jumps": self.basin_jumps,
+                "jump_limit": self.basin_jump_limit or self.basin_jumps,
             },
         }
 
@@ -143,6 +154,7 @@ def energy_sweep(
     basin_grid: BasinGrid | None = None,
     basin_jumps: int = DEFAULT_JUMPS,
     basin_tolerance: float = DEFAULT_TOLERANCE,
+    basin_jump_limit: int | None = None,
     chunk_map: ChunkMap = in_process,
     progress: Progress | None = None,
 ) -> EnergySweep:
@@ -154,6 +166,8 @@ def energy_sweep(
         guess: section state to seed the first solve; default: the most stable gait a search
             finds at the first zeta0 that has one.
         basin_grid: if given, each gait's basin area on this grid (:mod:`sim_core.basin`).
+        basin_jumps, basin_jump_limit: the basins' first cap, and the limit up to which undecided
+            cells are continued (None: ``basin_jumps``).
         chunk_map: runs the basins, one chunk per gait (:mod:`sim_core.chunks`).
         progress: called as ``progress(done, total)`` after each gait and each basin.
     """
@@ -161,6 +175,7 @@ def energy_sweep(
     if not zeta0s:
         raise ParameterError("zeta0", "the sweep needs at least one zeta0")
     LegControl(psi0, zeta0s[0])  # validates psi0 before any work
+    basin_jump_limit = check_jump_limit(basin_jump_limit, basin_jumps)
     period = 1 if fixed_leg is None else 2
     seed = None if guess is None else np.asarray(guess, dtype=float)
     total = len(zeta0s) * (2 if basin_grid is not None else 1)
@@ -173,12 +188,21 @@ def energy_sweep(
         if progress is not None:
             progress(done, total)
     areas: list[float | None] = [None] * len(zeta0s)
+    undecided: list[int | None] = [None] * len(zeta0s)
     if basin_grid is not None:
         # One chunk per gait: the basins are independent, so a cluster runs them side by side.
         found = [i for i, gait in enumerate(gaits) if gait is not None]
         starts = basin_grid.states()
         arguments = [
-            (model, sweep_schedule(psi0, zeta0s[i], fixed_leg), gaits[i].orbit, starts, basin_jumps, basin_tolerance)
+            (
+                model,
+                sweep_schedule(psi0, zeta0s[i], fixed_leg),
+                gaits[i].orbit,
+                starts,
+                basin_jumps,
+                basin_tolerance,
+                basin_jump_limit,
+            )
             for i in found
         ]
         offset = len(zeta0s) + len(zeta0s) - len(found)
@@ -187,13 +211,15 @@ def energy_sweep(
             if progress is not None:
                 progress(offset + done, total)
 
-        for i, (jumps_to_converge, _, _) in zip(
+        for i, (jumps_to_converge, failure, _, _) in zip(
             found, chunk_map(converge_states, arguments, basin_progress), strict=True
         ):
-            areas[i] = float(np.count_nonzero(jumps_to_converge != NOT_CONVERGED)) * basin_grid.cell_area
+            converged = jumps_to_converge != NOT_CONVERGED
+            areas[i] = float(np.count_nonzero(converged)) * basin_grid.cell_area
+            undecided[i] = int(np.count_nonzero(~converged & (failure == OK)))
     points = tuple(
-        SweepPoint(zeta0, LegControl(psi0, zeta0).stored_energy(model.alpha), gait, area)
-        for zeta0, gait, area in zip(zeta0s, gaits, areas, strict=True)
+        SweepPoint(zeta0, LegControl(psi0, zeta0).stored_energy(model.alpha), gait, area, left)
+        for zeta0, gait, area, left in zip(zeta0s, gaits, areas, undecided, strict=True)
     )
     return EnergySweep(
         psi0=psi0,
@@ -202,6 +228,7 @@ def energy_sweep(
         in_place_zeta0=tuple(_in_place_crossings(model, psi0, fixed_leg, points, period)),
         basin_grid=basin_grid,
         basin_jumps=basin_jumps,
+        basin_jump_limit=basin_jump_limit,
     )
 
 

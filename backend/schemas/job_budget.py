@@ -22,6 +22,10 @@ GAIT_SEARCH_JUMPS = 1000  # a gait search's work per guess, at most (Levenberg�
 # the worst case (both grids, the finest rule) stays within the work budget.
 MFPT_MAX_PAIRS = 600_000
 MFPT_MAX_GRID = 60
+# A basin's cells still undecided at its first cap may go on, the cap doubled, up to a jump limit:
+# the limit, not the first cap, is a cell's worst case.
+BASIN_JUMP_LIMIT = 100_000
+JUMP_LIMIT_DESCRIPTION = "cells undecided at the first cap go on up to this many jumps [jumps]; none: no continuation"
 # The viability map: one jump a state-action pair; 120² x 40² (23 million pairs, ~3 minutes of
 # the job worker) at most, and its result (kernel, measure, viable pairs as bits) stays a few MB.
 VIABILITY_MAX_STATES = 120
@@ -39,9 +43,11 @@ def worst_case_jumps(job) -> tuple[int, str]:
     if job.kind == "mjtf":
         return len(job.zeta0s) * job.trials * job.cap, "levels x trials x cap"
     if job.kind == "sweep":
-        return job.steps * job.basin_grid**2 * job.basin_jumps, "steps x basin_grid² x basin_jumps"
+        cell, name = basin_cell_jumps(job.basin_jumps, job.basin_jump_limit, "basin_jumps", "basin_jump_limit")
+        return job.steps * job.basin_grid**2 * cell, f"steps x basin_grid² x {name}"
     if job.kind == "basin":
-        return job.grid**2 * job.jumps, "grid² x jumps"
+        cell, name = basin_cell_jumps(job.jumps, job.jump_limit, "jumps", "jump_limit")
+        return job.grid**2 * cell, f"grid² x {name}"
     if job.kind == "control-study":
         return len(job.controllers) * job.seeds * job.jumps, "controllers x seeds x jumps"
     if job.kind == "viability":
@@ -50,6 +56,16 @@ def worst_case_jumps(job) -> tuple[int, str]:
         drifts = job.noise.pitch_drift_deg > 0.0
         return mfpt_grid_of(job).worst_case_jumps(drifts), "2 grids x (pairs x draws + paths x path jumps)"
     return job.grid**2 * GAIT_SEARCH_JUMPS, f"grid² x {GAIT_SEARCH_JUMPS}"
+
+
+def basin_cell_jumps(first_cap: int, jump_limit: int | None, cap_name: str, limit_name: str) -> tuple[int, str]:
+    """A basin cell's jumps at its worst and the field that sets them: the jump limit, which may
+    not be below the first cap, or the first cap where there is no limit (None)."""
+    if jump_limit is None:
+        return first_cap, cap_name
+    if jump_limit < first_cap:
+        raise ValueError(f"{limit_name} must be at least {cap_name}, got {jump_limit} < {first_cap}")
+    return jump_limit, limit_name
 
 
 def within_budget(job):

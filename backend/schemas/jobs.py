@@ -23,6 +23,8 @@ from backend.schemas.common import (
     Zeta0,
 )
 from backend.schemas.job_budget import (
+    BASIN_JUMP_LIMIT,
+    JUMP_LIMIT_DESCRIPTION,
     MFPT_MAX_GRID,
     VIABILITY_MAX_ACTIONS,
     VIABILITY_MAX_STATES,
@@ -100,6 +102,7 @@ class SweepJobCreate(Strict):
     steps: Annotated[int, Field(ge=2, le=500)] = 30
     basin_grid: Annotated[int, Field(ge=0, le=200)] = 40
     basin_jumps: Annotated[int, Field(ge=1, le=1000)] = 60
+    basin_jump_limit: Annotated[int, Field(ge=1, le=BASIN_JUMP_LIMIT, description=JUMP_LIMIT_DESCRIPTION)] | None = None
     guess: StateIn | None = None
 
     @model_validator(mode="after")
@@ -122,6 +125,7 @@ class BasinJobCreate(Strict):
     guess: StateIn | None = None
     grid: Annotated[int, Field(ge=2, le=1000)] = 100
     jumps: Annotated[int, Field(ge=1, le=1000)] = 60
+    jump_limit: Annotated[int, Field(ge=1, le=BASIN_JUMP_LIMIT, description=JUMP_LIMIT_DESCRIPTION)] | None = None
     tolerance: Annotated[float, Field(gt=0.0, lt=10.0)] = 0.02
 
     @model_validator(mode="after")

@@ -83,6 +83,7 @@ class SweepSpec:
     steps: int = 30
     basin_grid: int = 40
     basin_jumps: int = 60
+    basin_jump_limit: int | None = None
     guess: StateSpec | None = None
     kind: str = "sweep"
 
@@ -95,6 +96,7 @@ class BasinSpec:
     guess: StateSpec | None = None
     grid: int = 100
     jumps: int = 60
+    jump_limit: int | None = None
     tolerance: float = 0.02
     kind: str = "basin"
 

@@ -175,6 +175,7 @@ def run_study(spec, chunk_map, progress) -> dict:
             guess=guess,
             basin_grid=grid,
             basin_jumps=spec.basin_jumps,
+            basin_jump_limit=spec.basin_jump_limit,
             chunk_map=chunk_map,
             progress=progress,
         )
@@ -197,6 +198,7 @@ def run_study(spec, chunk_map, progress) -> dict:
             grid=spec.grid,
             max_jumps=spec.jumps,
             tolerance=spec.tolerance,
+            jump_limit=spec.jump_limit,
             chunk_map=chunk_map,
             progress=progress,
         )

@@ -1,6 +1,6 @@
 """``parkour sweep`` (cli/sweep.py): the JSON contract."""
 
-from tests.cli.helpers import json_of
+from tests.cli.helpers import invoke, json_of
 
 
 def test_sweep_json_contract():
@@ -18,5 +18,22 @@ def test_sweep_json_contract():
         "stable",
         "climb_per_jump",
         "basin_area",
+        "basin_undecided",
     }
     assert len(payload["in_place_zeta0"]) == 1 and payload["basin"]["grid"] == 6
+    assert payload["basin"]["jump_limit"] == payload["basin"]["jumps"] == 60
+
+
+def test_sweep_basins_continue_up_to_the_jump_limit():
+    args = ["--psi0", "30", "--zeta0-range", "0.93", "0.95", "--steps", "2", "--guess", "-0.93", "-0.2"]
+    short = json_of("sweep", *args, "--basin-grid", "6", "--basin-jumps", "10")
+    long = json_of("sweep", *args, "--basin-grid", "6", "--basin-jumps", "10", "--basin-jump-limit", "200")
+    assert long["basin"]["jump_limit"] == 200
+    for cut, continued in zip(short["points"], long["points"], strict=True):
+        assert continued["basin_area"] >= cut["basin_area"] and continued["basin_undecided"] <= cut["basin_undecided"]
+    assert long["points"][1]["basin_area"] > short["points"][1]["basin_area"], "10 jumps cut the basin short"
+
+
+def test_a_basin_limit_below_the_first_cap_is_refused_by_its_option():
+    result = invoke("sweep", "--steps", "2", "--basin-jumps", "20", "--basin-jump-limit", "10")
+    assert result.exit_code == 2 and "error: --basin-jump-limit: must be at least the first cap" in result.output

@@ -90,12 +90,12 @@ EVERY_FIELD = {
         guess=(-0.93, -0.17), model={"preset": "paper", "mu": 0.8}, experiment_id=2,
     ),
     "sweep": lambda c: c.submit_sweep(
-        zeta0_low=0.82, zeta0_high=0.92, steps=5, psi0_deg=30.0, basin_grid=4, basin_jumps=10,
+        zeta0_low=0.82, zeta0_high=0.92, steps=5, psi0_deg=30.0, basin_grid=4, basin_jumps=10, basin_jump_limit=80,
         guess={"xdot": -0.93, "ydot": -0.17}, model={"preset": "paper"}, experiment_id=2,
     ),
     "basin": lambda c: c.submit_basin(
         [(30, 0.87), {"psi0_deg": 30, "zeta0": 0.9}], period=2, guess=(-0.93, -0.17), grid=20, jumps=30,
-        tolerance=0.05, model={"preset": "paper"}, experiment_id=2,
+        jump_limit=240, tolerance=0.05, model={"preset": "paper"}, experiment_id=2,
     ),
     "gaits": lambda c: c.submit_gaits([(30, 0.87), (30, 0.9)], period=2, grid=4, model={"alpha": 2.0}, experiment_id=2),
     "control-study": lambda c: c.submit_control_study(

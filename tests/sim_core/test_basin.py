@@ -1,11 +1,13 @@
-"""Basins of attraction: against the scipy path, the gait's own cell, phases, Fig. 8's trend."""
+"""Basins of attraction: against the scipy path, the gait's own cell, phases, Fig. 8's trend, and
+undecided cells continued up to a jump limit."""
 
 import numpy as np
 import pytest
 
 from sim_core import ControlSchedule, ParameterError, find_fixed_point
 from sim_core.basin import NOT_CONVERGED, compute_basin
-from sim_core.basin_grid import BasinGrid
+from sim_core.basin_cells import FALLING_SPEED
+from sim_core.basin_grid import DEFAULT_BASIN_WINDOW, BasinGrid
 from sim_core.failures import OK
 from sim_core.reference import reference_jump
 
@@ -76,3 +78,56 @@ def test_bad_convergence_test_is_rejected(paper, symmetric, gait):
         compute_basin(paper, symmetric, gait, grid, tolerance=-1.0)
     with pytest.raises(ParameterError, match=r"^jumps:"):
         compute_basin(paper, symmetric, gait, grid, max_jumps=-3)
+
+
+@pytest.fixture(scope="module")
+def period_2(paper, alternating):
+    return find_fixed_point(paper, alternating, 2, (-0.8, -0.15))
+
+
+def test_undecided_cells_continued_decide_as_one_run_to_the_limit(paper, alternating, period_2):
+    """The truth is one run per cell with the larger cap, free of the continuation: cells left
+    undecided at 3 jumps go on at jump 3 (an odd one: the right leg's phase) in rounds of 6, 12,
+    24 and 40 jumps, and must decide, stop and count jumps exactly as one 40-jump run does."""
+    grid = BasinGrid(*DEFAULT_BASIN_WINDOW, 8)
+    continued = compute_basin(paper, alternating, period_2, grid, max_jumps=3, jump_limit=40)
+    single = compute_basin(paper, alternating, period_2, grid, max_jumps=40)
+    np.testing.assert_array_equal(continued.jumps_to_converge, single.jumps_to_converge)
+    np.testing.assert_array_equal(continued.failure, single.failure)
+    np.testing.assert_array_equal(continued.jumps_run, single.jumps_run)
+    np.testing.assert_array_equal(continued.stopped_at, single.stopped_at)
+    late = continued.jumps_to_converge > 3
+    assert late.any() and (continued.jumps_to_converge[late] % 2 == 1).any(), "cells decided in the later rounds"
+    assert [r["cap"] for r in continued.rounds()] == [3, 6, 12, 24, 40]
+
+
+def test_the_jump_limit_is_honoured_and_the_rounds_add_up(paper, symmetric, gait):
+    grid = BasinGrid(*DEFAULT_BASIN_WINDOW, 8)
+    basin = compute_basin(paper, symmetric, gait, grid, max_jumps=2, jump_limit=9)
+    assert basin.jump_limit == 9 and basin.jumps_run.max() == 9
+    assert basin.undecided.any(), "some cells stay undecided at 9 jumps, so the limit binds"
+    running = basin.undecided & ~basin.falling
+    assert (basin.jumps_run[running] == 9).all() and (basin.jumps_run[~running] <= 9).all()
+    # A falling run stops as soon as it falls (past FALLING_SPEED), undecided, and is not continued.
+    assert (
+        basin.falling.any() and (np.hypot(*np.moveaxis(basin.stopped_at[basin.falling], -1, 0)) > FALLING_SPEED).all()
+    )
+    assert basin.to_dict()["falling"] == int(basin.falling.sum())
+    np.testing.assert_array_equal(basin.undecided, ~basin.mask & (basin.failure == OK))
+    rounds = basin.rounds()
+    assert [r["cap"] for r in rounds] == [2, 4, 8, 9]
+    first_cap = compute_basin(paper, symmetric, gait, grid, max_jumps=2).outcome_counts()
+    assert rounds[0] == {"cap": 2, "converged": first_cap["converged"], "undecided": first_cap["not_converged"]}
+    assert rounds[-1]["undecided"] == basin.outcome_counts()["not_converged"] == basin.to_dict()["undecided"]
+    assert basin.jumps_computed == basin.jumps_run.sum()
+
+
+def test_without_a_limit_nothing_is_continued(paper, symmetric, gait):
+    basin = compute_basin(paper, symmetric, gait, BasinGrid(*DEFAULT_BASIN_WINDOW, 4), max_jumps=5)
+    assert basin.jump_limit == 5 and basin.jumps_run.max() <= 5 and len(basin.rounds()) == 1
+
+
+@pytest.mark.parametrize("limit", [4, -1, 2.5, True, 10**7])
+def test_bad_jump_limit_is_rejected(paper, symmetric, gait, limit):
+    with pytest.raises(ParameterError, match=r"^jump_limit:"):
+        compute_basin(paper, symmetric, gait, BasinGrid((-2.0, -0.1), (-1.0, 1.0), 4), max_jumps=5, jump_limit=limit)

@@ -108,10 +108,13 @@ def test_mjtf_levels_are_distinct():
         (SweepJobCreate, SWEEP | {"steps": 500, "basin_grid": 200, "basin_jumps": 25}, {"basin_jumps": 26},
          "steps x basin_grid² x basin_jumps"),
         (BasinJobCreate, BASIN | {"grid": 1000, "jumps": 500}, {"jumps": 501}, "grid² x jumps"),
+        (BasinJobCreate, BASIN | {"grid": 100, "jump_limit": 50_000}, {"jump_limit": 50_001}, "grid² x jump_limit"),
+        (SweepJobCreate, SWEEP | {"steps": 10, "basin_grid": 100, "basin_jump_limit": 5000},
+         {"basin_jump_limit": 5001}, "steps x basin_grid² x basin_jump_limit"),
         (ControlStudyJobCreate, CONTROL | {"controllers": ["pid", "lqr"], "seeds": 50_000, "jumps": 5000},
          {"jumps": 5001}, "controllers x seeds x jumps"),
     ],
-    ids=["mjtf", "sweep", "basin", "control-study"],
+    ids=["mjtf", "sweep", "basin", "basin-limit", "sweep-limit", "control-study"],
 )  # fmt: skip
 def test_a_job_at_the_work_budget_is_taken_and_one_jump_over_is_refused_naming_the_formula(
     schema, at_budget, over, formula
@@ -119,6 +122,17 @@ def test_a_job_at_the_work_budget_is_taken_and_one_jump_over_is_refused_naming_t
     accepted(schema, at_budget)
     message = refusal_messages(schema, at_budget | over)
     assert f"over the limit of {WORK_BUDGET_JUMPS:.3g}" in message and f"({formula})" in message
+
+
+@pytest.mark.parametrize(
+    ("schema", "body", "limit", "first_cap"),
+    [(BasinJobCreate, BASIN, "jump_limit", "jumps"), (SweepJobCreate, SWEEP, "basin_jump_limit", "basin_jumps")],
+)
+def test_a_basin_jump_limit_is_none_or_at_least_the_first_cap(schema, body, limit, first_cap):
+    assert getattr(accepted(schema, body), limit) is None, "no continuation unless asked"
+    assert getattr(accepted(schema, body | {first_cap: 60, limit: 60}), limit) == 60
+    message = refusal_messages(schema, body | {first_cap: 60, limit: 59})
+    assert f"{limit} must be at least {first_cap}, got 59 < 60" in message
 
 
 def test_a_sweep_runs_from_a_lower_to_a_higher_zeta0():
@@ -147,6 +161,8 @@ def test_a_sweeps_basin_grid_is_none_or_at_least_2(grid, taken):
         (BasinJobCreate, BASIN, "tolerance", 9.99, 10.0),
         (BasinJobCreate, BASIN, "tolerance", 1e-9, 0.0),
         (BasinJobCreate, BASIN, "period", 16, 17),
+        (BasinJobCreate, BASIN | {"grid": 2}, "jump_limit", 100_000, 100_001),
+        (SweepJobCreate, SWEEP | {"basin_grid": 2}, "basin_jump_limit", 100_000, 100_001),
         (GaitSearchJobCreate, GAITS, "grid", 20, 21),
         (GaitSearchJobCreate, GAITS, "grid", 1, 0),
         (GaitSearchJobCreate, GAITS, "period", 1, 0),

@@ -29,7 +29,7 @@ LEGS = [{"psi0_deg": 30.0, "zeta0": 0.9}]
 REQUESTS = [
     MJTFJobCreate(zeta0s=[0.88, 0.9], trials=4, guess={"xdot": -0.93, "ydot": -0.2}),
     SweepJobCreate(kind="sweep", steps=3, basin_grid=0),
-    BasinJobCreate(kind="basin", controls=LEGS, grid=4, jumps=5),
+    BasinJobCreate(kind="basin", controls=LEGS, grid=4, jumps=5, jump_limit=20),
     GaitSearchJobCreate(kind="gaits", controls=LEGS, grid=2),
     ControlStudyJobCreate(kind="control-study", controllers=["lqr", "pid"], seeds=3, noise={"velocity": 0.02}),
     MfptJobCreate(kind="mfpt", zeta0=0.96, start={"xdot": -0.9, "ydot": 0.1}, grid=12, noise={"pitch_drift_deg": 0}),
