@@ -238,6 +238,7 @@ def test_the_panel_submits_jobs_as_panel_for_the_queues_share(page, service):
     page.fill("input[name=trials]", "2")
     page.fill("input[name=cap]", "20")
     page.click("#submit-job")
-    until(page, "document.querySelector('#job-table tbody tr .state') !== null")
+    # Said once the service has answered the POST (the table may list earlier tests' jobs already).
+    until(page, "document.querySelector('#messages').textContent.includes('scheduled')")
     newest = httpx.get(f"{base}/api/v1/jobs?limit=1").json()["items"][0]
     assert newest["submitted_by"] == "panel"
