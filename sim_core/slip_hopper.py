@@ -97,63 +97,50 @@ class SlipHopper:
         check_range("stance_step", self.stance_step, 0.0, 0.01)
 
     def kernel_args(self) -> tuple[float, ...]:
-        return (self.mass, self.stiffness, self.resting_length, self.gravity, self.total_energy)
+        return (self.mass, self.stiffness, self.resting_length, self.gravity, self.total_energy,
+                self.stance_step, self.max_time)  # fmt: skip
+
+
+# In the kernels a stance state is ``(x, y, xdot, ydot)`` [m, m/s] of the body and ``leg`` is
+# ``(foot_x, foot_y, k / m, l0, g)``, the foot pinned where it touched down.
 
 
 @kernel
-def _rates(x, y, vx, vy, foot_x, foot_y, spring_rate, resting_length, gravity):
-    """Stance accelerations: the leg force per unit mass along the leg, then gravity."""
-    dx = x - foot_x
-    dy = y - foot_y
-    length = math.hypot(dx, dy)
-    along = spring_rate * (resting_length - length) / length
-    return vx, vy, along * dx, along * dy - gravity
-
-
-@kernel
-def _rk4(state, h, foot_x, foot_y, spring_rate, resting_length, gravity):
-    """One classical Runge-Kutta step of length ``h`` [s] from ``state = (x, y, xdot, ydot)``."""
+def _rates(state, leg):
+    """Stance rates: the leg force per unit mass along the leg, then gravity."""
     x, y, vx, vy = state
-    a = _rates(x, y, vx, vy, foot_x, foot_y, spring_rate, resting_length, gravity)
-    b = _rates(
-        x + 0.5 * h * a[0],
-        y + 0.5 * h * a[1],
-        vx + 0.5 * h * a[2],
-        vy + 0.5 * h * a[3],
-        foot_x,
-        foot_y,
-        spring_rate,
-        resting_length,
-        gravity,
-    )
-    c = _rates(
-        x + 0.5 * h * b[0],
-        y + 0.5 * h * b[1],
-        vx + 0.5 * h * b[2],
-        vy + 0.5 * h * b[3],
-        foot_x,
-        foot_y,
-        spring_rate,
-        resting_length,
-        gravity,
-    )
-    d = _rates(
-        x + h * c[0], y + h * c[1], vx + h * c[2], vy + h * c[3], foot_x, foot_y, spring_rate, resting_length, gravity
-    )
-    sixth = h / 6.0
-    return (
-        x + sixth * (a[0] + 2.0 * b[0] + 2.0 * c[0] + d[0]),
-        y + sixth * (a[1] + 2.0 * b[1] + 2.0 * c[1] + d[1]),
-        vx + sixth * (a[2] + 2.0 * b[2] + 2.0 * c[2] + d[2]),
-        vy + sixth * (a[3] + 2.0 * b[3] + 2.0 * c[3] + d[3]),
-    )
+    foot_x, foot_y, spring_rate, resting_length, gravity = leg
+    length = math.hypot(x - foot_x, y - foot_y)
+    along = spring_rate * (resting_length - length) / length
+    return vx, vy, along * (x - foot_x), along * (y - foot_y) - gravity
 
 
 @kernel
-def _events(state, foot_x, foot_y, resting_length):
+def _moved(state, rate, h):
+    return state[0] + h * rate[0], state[1] + h * rate[1], state[2] + h * rate[2], state[3] + h * rate[3]
+
+
+@kernel
+def _rk4(state, h, leg):
+    """One classical Runge-Kutta step of length ``h`` [s]."""
+    a = _rates(state, leg)
+    b = _rates(_moved(state, a, 0.5 * h), leg)
+    c = _rates(_moved(state, b, 0.5 * h), leg)
+    d = _rates(_moved(state, c, h), leg)
+    mean = (
+        a[0] + 2.0 * (b[0] + c[0]) + d[0],
+        a[1] + 2.0 * (b[1] + c[1]) + d[1],
+        a[2] + 2.0 * (b[2] + c[2]) + d[2],
+        a[3] + 2.0 * (b[3] + c[3]) + d[3],
+    )
+    return _moved(state, mean, h / 6.0)
+
+
+@kernel
+def _events(state, leg):
     """vibly's stance events: the body's height, the leg's length past rest, xdot + 1e-5 [m/s]."""
     x, y, vx, _ = state
-    return y, math.hypot(x - foot_x, y - foot_y) - resting_length, vx + REVERSAL_SPEED
+    return y, math.hypot(x - leg[0], y - leg[1]) - leg[3], vx + REVERSAL_SPEED
 
 
 @kernel
@@ -165,7 +152,7 @@ def _crosses(event, before, after):
 
 
 @kernel
-def _event_time(event, state, h, before, after, foot_x, foot_y, spring_rate, resting_length, gravity):
+def _event_time(event, state, h, before, after, leg):
     """The step length in [0, h] [s] at which ``event`` crosses zero (Illinois on the RK4 step)."""
     low, high, f_low, f_high = 0.0, h, before, after
     if f_low == 0.0:
@@ -177,8 +164,7 @@ def _event_time(event, state, h, before, after, foot_x, foot_y, spring_rate, res
         middle = high - f_high * (high - low) / (f_high - f_low)
         if not low < middle < high:
             middle = 0.5 * (low + high)
-        moved = _rk4(state, middle, foot_x, foot_y, spring_rate, resting_length, gravity)
-        f_middle = _events(moved, foot_x, foot_y, resting_length)[event]
+        f_middle = _events(_rk4(state, middle, leg), leg)[event]
         if f_middle == 0.0:
             return middle
         if (f_middle > 0.0) == (f_high > 0.0):
@@ -195,25 +181,23 @@ def _event_time(event, state, h, before, after, foot_x, foot_y, spring_rate, res
 
 
 @kernel
-def _stance(state, foot_x, foot_y, spring_rate, resting_length, gravity, stance_step, max_time):
-    """Stance from touchdown ``state = (x, y, xdot, ydot)`` to the first event: ``(event, state)``,
-    event -1 when ``max_time`` [s] passed without one."""
-    before = _events(state, foot_x, foot_y, resting_length)
+def _stance(state, leg, stance_step, max_time):
+    """Stance from touchdown to the first event: ``(event, state)``, event -1 when ``max_time`` [s]
+    passed without one."""
+    before = _events(state, leg)
     t = 0.0
     while t < max_time:
         h = min(stance_step, max_time - t)
-        stepped = _rk4(state, h, foot_x, foot_y, spring_rate, resting_length, gravity)
-        after = _events(stepped, foot_x, foot_y, resting_length)
+        stepped = _rk4(state, h, leg)
+        after = _events(stepped, leg)
         first, earliest = -1, h
         for event in range(3):
             if _crosses(event, before[event], after[event]):
-                when = _event_time(
-                    event, state, h, before[event], after[event], foot_x, foot_y, spring_rate, resting_length, gravity
-                )
+                when = _event_time(event, state, h, before[event], after[event], leg)
                 if first < 0 or when < earliest:
                     first, earliest = event, when
         if first >= 0:
-            return first, _rk4(state, earliest, foot_x, foot_y, spring_rate, resting_length, gravity)
+            return first, _rk4(state, earliest, leg)
         state, before = stepped, after
         t += h
     return -1, state
@@ -246,7 +230,8 @@ def _apex_step(s, aoa, mass, stiffness, resting_length, gravity, energy, stance_
     foot_x += vx * t_down
     foot_y = foot_y0 - drop
     state = (vx * t_down, y0 - drop, vx, 0.0 - gravity * t_down)
-    event, state = _stance(state, foot_x, foot_y, stiffness / mass, resting_length, gravity, stance_step, max_time)
+    leg = (foot_x, foot_y, stiffness / mass, resting_length, gravity)
+    event, state = _stance(state, leg, stance_step, max_time)
     if event == TOUCHED_GROUND:
         return FALL, math.nan
     if event == RAN_BACK:
@@ -288,7 +273,7 @@ def slip_outcomes(states: np.ndarray, actions: np.ndarray, hopper: SlipHopper = 
         raise ValueError(f"states and actions must both be (N, 1), got {states.shape} and {actions.shape}")
     reached = np.empty_like(states)
     outcome = np.empty(states.shape[0], dtype=np.int8)
-    _apex_steps(states, actions, *hopper.kernel_args(), hopper.stance_step, hopper.max_time, reached, outcome)
+    _apex_steps(states, actions, *hopper.kernel_args(), reached, outcome)
     return reached, outcome
 
 
