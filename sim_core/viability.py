@@ -123,13 +123,12 @@ def transition_map(
     of ``chunk_pairs`` pairs with ``progress(done, total)`` after each."""
     states, actions = grid.states(), grid.actions()
     count, dimensions = grid.pairs, len(grid.state_axes)
-    state_of = np.arange(count) // actions.shape[0]
-    action_of = np.arange(count) % actions.shape[0]
     failed = np.empty(count, dtype=bool)
     bins = np.empty((count, dimensions), dtype=np.int64)
     slices = chunk_slices(count, chunk_pairs)
     for done, part in enumerate(slices, start=1):
-        reached, part_failed = step_map(states[state_of[part]], actions[action_of[part]])
+        pair = np.arange(part.start, part.stop)  # state-major: pair = state * actions + action
+        reached, part_failed = step_map(states[pair // actions.shape[0]], actions[pair % actions.shape[0]])
         reached = np.asarray(reached, dtype=np.float64).reshape(-1, dimensions)
         part_failed = np.asarray(part_failed, dtype=bool) | ~np.all(np.isfinite(reached), axis=1)
         failed[part] = part_failed
