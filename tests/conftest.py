@@ -36,9 +36,14 @@ def alternating() -> ControlSchedule:
 def compute():
     """The service's compute worker pools, shared by every test's app (a worker's start, about a
     second, is paid once per session); stopped at the end."""
+    from backend.services.simulation import warm_up
     from backend.workers.pools import Compute  # only the tests that use the service load it
 
     pools = Compute()
+    # The kernels a quick call needs, loaded once here with no time limit, as the service's own
+    # warm-up does at start: on an empty numba cache (a fresh CI machine) compiling them inside a
+    # test's first call, beside another worker compiling too, ran past the 60 s a quick call gets.
+    pools.quick.run(warm_up, timeout=None)
     yield pools
     pools.close()
 
