@@ -76,6 +76,7 @@ class ControllerOutcome:
     def to_dict(self, leg_length: float) -> dict:
         """The ``parkour control-study --json`` entry; ``leg_length`` [m] converts heights."""
         errors = self.height_errors
+        lasted, lasted_ci95 = self.jumps_to_failure()
         return {
             "name": self.name,
             "trials": self.trials,
@@ -87,8 +88,8 @@ class ControllerOutcome:
             "rise_jumps": float(np.median(self.rise_jumps)) if self.rise_jumps.size else None,
             "us_per_jump": self.us_per_jump,
             "saturated_fraction": self.saturated / self.commands if self.commands else 0.0,
-            "mean_jumps_to_failure": self.jumps_to_failure()[0],
-            "mean_jumps_to_failure_ci95": self.jumps_to_failure()[1],
+            "mean_jumps_to_failure": lasted,
+            "mean_jumps_to_failure_ci95": lasted_ci95,
             "survived": self.trials - self.failures,
         }
 
