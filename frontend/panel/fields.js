@@ -85,8 +85,9 @@ export const Fields = (() => {
     input.insertAdjacentElement("afterend", note);
   }
 
-  // The numbers of ``fields`` ([{name, rule, unit, list}]) from ``form``, or null after marking
-  // every bad one (the first gets the focus). ``list``: comma-separated numbers.
+  // The numbers of ``fields`` ([{name, rule, unit, list, optional}]) from ``form``, or null after
+  // marking every bad one (the first gets the focus). ``list``: comma-separated numbers;
+  // ``optional``: left empty, it is left out (the API's default).
   async function readFields(form, fields) {
     await ready;
     clear(form);
@@ -94,6 +95,7 @@ export const Fields = (() => {
     let first = null;
     for (const field of fields) {
       const input = form.elements[field.name];
+      if (field.optional && input.value.trim() === "") continue;
       const schema = rule(field.rule);
       const texts = field.list ? input.value.split(",") : [input.value];
       const numbers = [];

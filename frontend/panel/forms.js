@@ -36,11 +36,18 @@ export async function checked(form, fields) {
 
 // The Simulate form's legs and start (and ``jumps`` by ``jumpsRule``), or null.
 export async function simControls(jumpsRule) {
-  const fields = [...LEG_FIELDS, ...START_FIELDS, ...(jumpsRule ? [{ name: "jumps", rule: jumpsRule, unit: "jumps" }] : [])];
+  return (await simControlsWith([], jumpsRule))?.spec ?? null;
+}
+
+// As simControls, with ``extra`` fields of the form checked in the same pass (a pass clears the
+// marks of the one before): {spec, values: every field's value}, or null.
+export async function simControlsWith(extra, jumpsRule) {
+  const fields = [...LEG_FIELDS, ...START_FIELDS, ...(jumpsRule ? [{ name: "jumps", rule: jumpsRule, unit: "jumps" }] : []), ...extra];
   const v = await checked($("#sim-form"), fields);
   if (v === null) return null;
-  return {
+  const spec = {
     controls: [{ psi0_deg: v.psiL, zeta0: v.zetaL }, { psi0_deg: v.psiR, zeta0: v.zetaR }],
     start: { xdot: v.xdot, ydot: v.ydot }, jumps: v.jumps,
   };
+  return { spec, values: v };
 }

@@ -18,7 +18,8 @@ export function describeJob(job) {
   if (job.kind === "mfpt") return `MFPT of ${spec.psi0_deg}°/${spec.zeta0}, grid ${spec.grid}`;
   if (job.kind === "viability") return `viability, ${spec.states}² states × ${spec.actions}² actions`;
   const legs = (spec.controls || []).map((leg) => `${leg.psi0_deg}°/${leg.zeta0}`).join(", ");
-  return job.kind === "basin" ? `${legs}, ${spec.grid}² start states` : legs;
+  const limit = spec.jump_limit ? `, up to ${spec.jump_limit} jumps` : "";
+  return job.kind === "basin" ? `${legs}, ${spec.grid}² start states${limit}` : legs;
 }
 
 const ordinal = (n) => `${n}${[11, 12, 13].includes(n % 100) ? "th" : ({ 1: "st", 2: "nd", 3: "rd" }[n % 10] ?? "th")}`;
@@ -147,7 +148,7 @@ const JOB_FIELDS = {
     { name: "zeta0_high", rule: "SweepJobCreate.zeta0_high", unit: "l0" }, { name: "steps", rule: "SweepJobCreate.steps" },
     { name: "basin_grid", rule: "SweepJobCreate.basin_grid" }],
   basin: [{ name: "grid", rule: "BasinJobCreate.grid" }, { name: "basin_jumps", rule: "BasinJobCreate.jumps", unit: "jumps" },
-    { name: "tolerance", rule: "BasinJobCreate.tolerance", unit: SQRT_GL0 }],
+    { name: "jump_limit", rule: "BasinJobCreate.jump_limit", unit: "jumps", optional: true }, { name: "tolerance", rule: "BasinJobCreate.tolerance", unit: SQRT_GL0 }],
   "control-study": [{ name: "study_target", rule: "ControlStudyJobCreate.target_m", unit: "m" }, { name: "study_seeds", rule: "ControlStudyJobCreate.seeds" },
     { name: "study_jumps", rule: "ControlStudyJobCreate.jumps", unit: "jumps" }, { name: "study_seed0", rule: "ControlStudyJobCreate.seed0" }],
   mfpt: [{ name: "mfpt_psi0", rule: "MfptJobCreate.psi0_deg", unit: "°" }, { name: "mfpt_zeta0", rule: "MfptJobCreate.zeta0", unit: "l0" },
@@ -164,7 +165,7 @@ const VIABILITY_LOCATIONS = { states: "viability_states", actions: "viability_ac
 const STUDY_LOCATIONS = { controllers: "study_controllers", target_m: "study_target", seeds: "study_seeds", jumps: "study_jumps",
   seed0: "study_seed0" };
 const JOB_LOCATIONS = { psi0_deg: "psi0", zeta0s: "zeta0s", trials: "trials", cap: "cap", seed: "seed", zeta0_low: "zeta0_low",
-  zeta0_high: "zeta0_high", steps: "steps", basin_grid: "basin_grid", grid: "grid", jumps: "basin_jumps", tolerance: "tolerance" };
+  zeta0_high: "zeta0_high", steps: "steps", basin_grid: "basin_grid", grid: "grid", jumps: "basin_jumps", jump_limit: "jump_limit", tolerance: "tolerance" };
 
 // The job to schedule from the form — {body, locations: body field -> input} — or null (a bad
 // field is marked).
@@ -196,7 +197,7 @@ async function jobSpec(form) {
   }
   const sim = await simControls();
   if (!sim) return null;
-  const body = { kind, controls: sim.controls, guess: sim.start, grid: v.grid, jumps: v.basin_jumps, tolerance: v.tolerance };
+  const body = { kind, controls: sim.controls, guess: sim.start, grid: v.grid, jumps: v.basin_jumps, jump_limit: v.jump_limit, tolerance: v.tolerance };
   return { body, locations: JOB_LOCATIONS };
 }
 

@@ -45,27 +45,67 @@ export function plotSweep(target, result, title) {
 // Failures in the basin: one grey per kind, each named in the legend (plotly heatmaps have no
 // legend entry of their own, so a marker of the same grey stands in for each).
 const FAILURE_GREYS = ["#6b7280", "#c4c9d1", "#3f4650", "#9aa1ab", "#e3e6ea"];
-const FAILURE_WORDS = { slip: "slips", collapse: "leg collapses", no_liftoff: "no lift-off", no_flight: "no flight", invalid_state: "invalid state" };
+const FAILURE_WORDS = { slip: "slips", collapse: "leg collapses", no_liftoff: "no lift-off", no_flight: "no flight", invalid_state: "invalid state", floor: "fell to the floor" };
+// Undecided cells (neither converged nor failed within the jump limit) in a colour of their own:
+// neither a failure's grey nor on the jumps' scale. The result counts the falling ones among them
+// (faster than sim_core's FALLING_SPEED: no limit decides them) but does not say which cells.
+const UNDECIDED_COLOUR = "#e377c2";
+
+// A heatmap of one colour over the cells where ``where(row, column)`` holds, and its legend entry
+// (one legend group: a click on the entry hides the cells too).
+function patch(xs, ys, cells, where, colour, name, hover) {
+  return [{ type: "heatmap", x: xs, y: ys, z: cells.map((row, i) => row.map((_, j) => (where(i, j) ? 1 : null))), legendgroup: name,
+    colorscale: [[0, colour], [1, colour]], showscale: false, name, hovertemplate: `xdot %{x:.3f}, ydot %{y:.3f}: ${hover}<extra></extra>` },
+  { x: [null], y: [null], mode: "markers", name, legendgroup: name, marker: { symbol: "square", size: 12, color: colour } }];
+}
+
+// A log colour bar's ticks from ``low`` to ``top`` jumps (1, 2, 5, 10, 20, 50, …), at their log10.
+function logTicks(low, top) {
+  const values = [];
+  for (let decade = 1; decade <= top; decade *= 10) values.push(...[1, 2, 5].map((m) => m * decade).filter((v) => v >= low && v <= top));
+  return { tickvals: values.map(Math.log10), ticktext: values.map(String) };
+}
+
+// The convergence test in words: the first cap, the jump limit the undecided cells went on to, and
+// how many are still undecided (``undecided``), how many of those falling where the result says.
+function capWords(result, undecided) {
+  const cap = Number(result.jumps), limit = Number(result.jump_limit ?? cap);
+  const test = limit > cap ? `cap ${cap}, limit ${limit} jumps` : `cap ${cap} jumps, not continued`;
+  const falling = Number.isInteger(result.falling) && result.falling > 0 ? ` (${result.falling} falling)` : "";
+  return { limit, words: `${test}; ${undecided} cell${undecided === 1 ? "" : "s"} undecided${falling}` };
+}
 
 export function plotBasin(target, result, title, start) {
   const [x0, x1] = result.xdot_range, [y0, y1] = result.ydot_range, n = result.grid;
   const axis = (low, high) => Array.from({ length: n }, (_, i) => low + (high - low) * i / (n - 1));
   const xs = axis(x0, x1), ys = axis(y0, y1);
-  const codes = result.failure_codes;
-  const converged = result.jumps_to_converge.map((row) => row.map((jumps) => (jumps < 0 ? null : jumps)));
-  const kinds = [...new Set(result.failure.flat().filter(Boolean))].sort((a, b) => a - b);
+  const codes = result.failure_codes, jumps = result.jumps_to_converge, failure = result.failure;
+  const isUndecided = (i, j) => jumps[i][j] < 0 && !failure[i][j];
+  const undecided = Number.isInteger(result.undecided) ? result.undecided  // a result from before jump limits: counted here
+    : jumps.reduce((sum, row, i) => sum + row.filter((_, j) => isUndecided(i, j)).length, 0);
+  const { limit, words } = capWords(result, undecided);
+  const kinds = [...new Set(failure.flat().filter(Boolean))].sort((a, b) => a - b);
   const traces = [];
   kinds.forEach((kind, i) => {
-    const grey = FAILURE_GREYS[i % FAILURE_GREYS.length], words = FAILURE_WORDS[codes[String(kind)]] ?? codes[String(kind)];
-    traces.push({ type: "heatmap", x: xs, y: ys, z: result.failure.map((row) => row.map((code) => (code === kind ? 1 : null))),
-      colorscale: [[0, grey], [1, grey]], showscale: false, name: `fails: ${words}`,
-      hovertemplate: `xdot %{x:.3f}, ydot %{y:.3f}: fails (${words})<extra></extra>` });
-    traces.push({ x: [null], y: [null], mode: "markers", name: `fails: ${words}`, marker: { symbol: "square", size: 12, color: grey } });
+    const named = FAILURE_WORDS[codes[String(kind)]] ?? codes[String(kind)];
+    traces.push(...patch(xs, ys, failure, (r, c) => failure[r][c] === kind, FAILURE_GREYS[i % FAILURE_GREYS.length], `fails: ${named}`, `fails (${named})`));
   });
-  traces.push({ type: "heatmap", x: xs, y: ys, z: converged, colorscale: "Viridis", reversescale: true, name: "converges",
-    colorbar: { title: { text: "jumps to<br>converge" } }, hovertemplate: "xdot %{x:.3f}, ydot %{y:.3f}: %{z} jumps<extra></extra>" });
-  traces.push({ x: [result.gait.state[0]], y: [result.gait.state[1]], mode: "markers", name: `period-${result.gait.period} gait`, marker: { symbol: "x", size: 12, color: "#d61f1f" } });
-  if (start) traces.push({ x: [start.xdot], y: [start.ydot], mode: "markers", name: "start", marker: { symbol: "circle-open", size: 12, color: "#111" } });
-  draw(target, traces, layout(`${title}: ${(100 * result.fraction).toFixed(1)} % converge`, "xdot at the section [sqrt(g l0)]", "ydot [sqrt(g l0)]",
-    { legend: { orientation: "h", y: -0.32 }, margin: { l: 55, r: 15, t: 40, b: 105 } }));
+  if (undecided > 0) {
+    traces.push(...patch(xs, ys, jumps, isUndecided, UNDECIDED_COLOUR, "undecided at the limit", `undecided after ${limit} jumps`));
+  }
+  // One log colour scale over the jumps to converge that occur (0 jumps, a start already on the
+  // orbit, drawn as 1), a factor of 2 at least.
+  const converged = jumps.flat().filter((v) => v >= 0).map((v) => Math.max(v, 1));
+  const low = converged.length ? converged.reduce((least, v) => Math.min(least, v)) : 1;
+  const top = converged.reduce((most, v) => Math.max(most, v), 2 * low);
+  traces.push({ type: "heatmap", x: xs, y: ys, z: jumps.map((row) => row.map((v) => (v < 0 ? null : Math.log10(Math.max(v, 1))))),
+    text: jumps.map((row) => row.map((v) => (v < 0 ? "" : `${v} jumps`))), zmin: Math.log10(low), zmax: Math.log10(top),
+    colorscale: "Viridis", reversescale: true, name: "converges",
+    colorbar: { title: { text: "jumps to<br>converge<br>(log scale)" }, ...logTicks(low, top) },
+    hovertemplate: "xdot %{x:.3f}, ydot %{y:.3f}: converges in %{text}<extra></extra>" });
+  traces.push({ x: [result.gait.state[0]], y: [result.gait.state[1]], mode: "markers", name: `period-${result.gait.period} gait`, legendgroup: "gait", marker: { symbol: "x", size: 12, color: "#d61f1f" } });
+  if (start) traces.push({ x: [start.xdot], y: [start.ydot], mode: "markers", name: "start", legendgroup: "start", marker: { symbol: "circle-open", size: 12, color: "#111" } });
+  draw(target, traces, layout(`${title}: ${(100 * result.fraction).toFixed(1)} % converge<br>${words}`, "xdot at the section [sqrt(g l0)]", "ydot [sqrt(g l0)]",
+    // Grouped, each entry its own group: a row holds as many entries as their own widths allow.
+    { legend: { orientation: "h", y: -0.22, traceorder: "grouped", tracegroupgap: 0 }, margin: { l: 55, r: 15, t: 60, b: 115 }, height: 420 }));
 }

@@ -1,7 +1,7 @@
 // The Simulate tab: a trajectory, a stored run, the fixed point, and quick basin and sweep jobs.
 import { $, say, call, on } from "./api.js";
 import { Fields } from "./fields.js";
-import { filedUnder, simFields, simControls } from "./forms.js";
+import { filedUnder, simFields, simControls, simControlsWith, SIM_LOCATIONS } from "./forms.js";
 import { draw, layout, plotSweep, plotBasin } from "./plots.js";
 import { queueWords, watch } from "./jobs.js";
 
@@ -69,8 +69,9 @@ const jobStatus = (job) => `${job.kind} job ${job.id}: ${job.state}${queueWords(
   `${job.total ? `, ${job.completed}/${job.total}` : ""}${job.error ? ` — ${job.error}` : ""}`;
 
 // Schedule a job from the Simulate tab, show its progress there, draw its result when done.
-async function analyse(spec, draw) {
-  const job = await call("POST", "/jobs", { ...spec, ...filedUnder($("#sim-form")) });
+// ``fields``: where a 422 is marked (api.js call), if the job takes a field of the form.
+async function analyse(spec, draw, fields) {
+  const job = await call("POST", "/jobs", { ...spec, ...filedUnder($("#sim-form")) }, fields);
   const status = $("#analysis-status");
   status.textContent = jobStatus(job);
   watch(job, async (final) => {
@@ -79,11 +80,19 @@ async function analyse(spec, draw) {
   }, (update) => { status.textContent = jobStatus(update); });
 }
 
+// The basin's jump limit: empty, none (the cells undecided at the first cap stay undecided).
+const BASIN_LIMIT = { name: "basin_jump_limit", rule: "BasinJobCreate.jump_limit", unit: "jumps", optional: true };
+
 on("#run-basin", "click", async () => {
-  const spec = await simControls();
-  if (!spec) return;
-  await analyse({ kind: "basin", controls: spec.controls, guess: spec.start, grid: 80, jumps: 60 },
-    (result) => plotBasin("basin-plot", result, "Basin of attraction", spec.start));
+  const checkedFields = await simControlsWith([BASIN_LIMIT]);
+  if (!checkedFields) return;
+  const { spec, values } = checkedFields;
+  // A rule across the job's fields (the limit below the first cap, the work budget) comes back at
+  // "basin": here, with the grid and the first cap fixed, only the limit can break it.
+  const locations = { ...SIM_LOCATIONS, jump_limit: BASIN_LIMIT.name, basin: BASIN_LIMIT.name };
+  const fields = { ...simFields("Basin"), locations };
+  await analyse({ kind: "basin", controls: spec.controls, guess: spec.start, grid: 80, jumps: 60, jump_limit: values.basin_jump_limit },
+    (result) => plotBasin("basin-plot", result, "Basin of attraction", spec.start), fields);
 });
 
 on("#run-sweep", "click", async () => {

@@ -96,12 +96,46 @@ def test_simulate_shows_plots_and_the_gait(page):
     page.click("nav [data-tab=simulate]")
 
 
+def _posted_job(page, action) -> tuple[dict, int]:
+    """Run ``action`` and give the body of the job it posted, and the job's id."""
+    with page.expect_request(lambda request: request.method == "POST" and request.url.endswith("/api/v1/jobs")) as sent:
+        action()
+    return sent.value.post_data_json, sent.value.response().json()["id"]
+
+
+UNDECIDED = "document.querySelector('{plot}').data.find((t) => t.type === 'heatmap' && t.name.startsWith('undecided'))"
+
+
 def test_basin_and_sweep_are_jobs_drawn_in_simulate(page):
+    """The basin is not cut short unsaid: its jump limit is sent, and the cells still undecided at
+    it have a colour of their own, named in the legend, their count in the title (issue 28)."""
+    page.fill("input[name=basin_jump_limit]", "100001")
+    assert _sent(page, lambda: page.click("#run-basin"), "/api/v1/jobs") == []
+    assert page.inner_text("#basin_jump_limit-error") == "must be at least 1 and at most 100000 jumps"
+    page.fill("input[name=basin_jump_limit]", "30")  # the service's rule across fields: at least the first cap
     page.click("#run-basin")
+    until(page, "document.querySelector('#basin_jump_limit-error')?.textContent.includes('at least jumps')")
+    page.fill("input[name=basin_jump_limit]", "240")
+    assert _posted_job(page, lambda: page.click("#run-basin"))[0]["jump_limit"] == 240
     page.wait_for_selector("#basin-plot .heatmaplayer image", timeout=60_000)
     assert "% converge" in page.inner_text("#basin-plot")
+    title = page.text_content("#basin-plot .gtitle")
+    assert "cap 60, limit 240 jumps;" in title and re.search(r"\d+ cells undecided", title), title
     legend = page.text_content("#basin-plot .legend")  # SVG: text, not an HTML element's inner text
     assert "fails: " in legend and "gait" in legend, f"every colour of the heatmap is named: {legend}"
+    assert "undecided at the limit" in legend, legend
+    undecided = UNDECIDED.format(plot="#basin-plot")
+    colour = page.evaluate(f"{undecided}.colorscale[0][1]")
+    assert colour == "#e377c2", "undecided: neither a failure's grey nor on the jumps' scale"
+    assert page.evaluate(f"{undecided}.z.flat().filter((v) => v === 1).length") > 0
+    colorbar = page.text_content("#basin-plot .colorbar")
+    assert "log scale" in colorbar and "10" in colorbar, colorbar
+    screenshot(page, "basin_undecided", "#basin-plot")
+    page.fill("input[name=basin_jump_limit]", "")
+    body, job = _posted_job(page, lambda: page.click("#run-basin"))
+    assert "jump_limit" not in body, "empty: the API's default"
+    status = "document.querySelector('#analysis-status').textContent"
+    until(page, f"{status}.startsWith('basin job {job}: done')", timeout=60_000)
     page.click("#run-sweep")
     page.wait_for_selector("#sweep-plot .scatterlayer .trace", timeout=60_000)
     assert page.inner_text("#analysis-status").startswith("sweep job") and "done" in page.inner_text("#analysis-status")
@@ -226,7 +260,12 @@ def test_sweep_and_basin_grid_jobs_from_the_jobs_tab(page):
     page.click("#submit-job")
     page.select_option("#job-kind", "basin")
     page.fill("input[name=grid]", "30")
-    page.click("#submit-job")
+    page.fill("input[name=jump_limit]", "0")
+    assert _sent(page, lambda: page.click("#submit-job"), "/api/v1/jobs") == []
+    assert page.inner_text("#jump_limit-error") == "must be at least 1 and at most 100000 jumps"
+    page.fill("input[name=jump_limit]", "120")
+    assert _posted_job(page, lambda: page.click("#submit-job"))[0]["jump_limit"] == 120
+    page.fill("input[name=jump_limit]", "")
     # Newest first: the basin job just scheduled, then the sweep (the Simulate tab's jobs are older).
     row = "document.querySelector('#job-table tbody tr:nth-child({n}) {cell}').textContent"
     newest = [row.format(n=n, cell=cell) for n in (1, 2) for cell in ("td:nth-child(2)", ".state")]
@@ -237,6 +276,8 @@ def test_sweep_and_basin_grid_jobs_from_the_jobs_tab(page):
     )
     page.click("#job-table tbody tr:nth-child(1) .show")
     page.wait_for_selector("#job-plot .heatmaplayer image", timeout=10_000)
+    assert "up to 120 jumps" in page.text_content("#job-table tbody tr:nth-child(1) .what")
+    assert "cap 60, limit 120 jumps;" in page.text_content("#job-plot .gtitle")
     page.click("#job-table tbody tr:nth-child(2) .show")
     until(page, "document.querySelector('#job-plot').textContent.includes('max |λ|')", timeout=10_000)
     page.select_option("#job-kind", "mjtf")
