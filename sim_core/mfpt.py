@@ -10,7 +10,8 @@ states' transition matrix, ``r`` the probability that a state's next jump succee
 largest eigenvalue ``λ₂`` of ``P`` (the second of the chain with its absorbing state, whose first
 is 1) gives the time scale ``1 / (1 - λ₂)`` of leaving the quasi-stationary distribution. Its
 accuracy is the grid's: :func:`mfpt` solves on two grids, one refined from the other, and reports
-their relative difference as the discretisation error.
+their relative difference as the discretisation error. Each grid's chain is cached on disk
+(:mod:`sim_core.mfpt_cache`), so asking again for the same gait, noise and grids only solves.
 
 What it models is exactly MJTF's trial (docs/model.md §5): from the gait's touchdown at zero
 pitch, the first leg's controls noisy, then per jump a pitch step, the next leg's noisy controls
@@ -27,6 +28,7 @@ import numpy as np
 
 from sim_core.chunks import Progress
 from sim_core.controls import ControlSchedule, LegControl
+from sim_core.mfpt_cache import ChainCache, chain_key, enabled
 from sim_core.mfpt_chain import Chain, build_chain, expected_jumps, first_landings, largest_eigenvalue
 from sim_core.mfpt_grid import ChainGrid
 from sim_core.noise import NoiseModel
@@ -36,7 +38,8 @@ from sim_core.validation import ParameterError
 
 @dataclass(frozen=True)
 class MfptEstimate:
-    """One grid's answer: MFPT from the start [jumps], ``λ₂``, the chain's size and time."""
+    """One grid's answer: MFPT from the start [jumps], ``λ₂``, the chain's size and time, and
+    whether its chain was loaded from the cache rather than built."""
 
     mfpt_jumps: float
     lambda2: float
@@ -44,6 +47,7 @@ class MfptEstimate:
     escaped: float
     seconds: float
     grid: ChainGrid
+    cached: bool = False
 
 
 @dataclass(frozen=True)
@@ -56,7 +60,7 @@ class MfptResult:
             time scale [jumps].
         discretisation_error: ``|fine - coarse| / fine`` of the two grids' MFPT.
         cells: states of the finer chain.
-        seconds: wall time of both grids together.
+        seconds: wall time of both grids together (this call's, cached chains or not).
         estimates: (coarse, fine).
     """
 
@@ -86,6 +90,7 @@ class MfptResult:
             "controls": {"psi0_deg": self.controls.psi0_deg, "zeta0": self.controls.zeta0},
             "noise": self.noise.to_dict(),
             "start": self.start.tolist(),
+            "cached": [estimate.cached for estimate in self.estimates],
             "grids": [
                 {
                     **estimate.grid.to_dict(),
@@ -94,6 +99,7 @@ class MfptResult:
                     "cells": estimate.states,
                     "escaped": estimate.escaped,
                     "seconds": estimate.seconds,
+                    "cached": estimate.cached,
                 }
                 for estimate in self.estimates
             ],
@@ -119,10 +125,12 @@ def mfpt(
     start=None,
     grid: ChainGrid | None = None,
     progress: Progress | None = None,
+    cache: ChainCache | bool = True,
 ) -> MfptResult:
     """MFPT of symmetric controls under ``noise``, from the touchdown state ``start`` (default:
     the gait's fixed point, as MJTF starts) at zero pitch, on ``grid`` and on the grid one step
-    coarser (whose difference is the reported error).
+    coarser (whose difference is the reported error). ``cache``: True for the default chain
+    cache (unless ``$PARKOUR_MFPT_CACHE=0``), False for none, or a :class:`ChainCache`.
 
     Raises:
         ParameterError: noise the chain cannot represent, a grid too large, a bad start.
@@ -131,13 +139,14 @@ def mfpt(
     check_chain_inputs(model, noise)
     grid = grid or ChainGrid()
     start = _start_state(model, controls, start)
+    chains = cache if isinstance(cache, ChainCache) else ChainCache() if cache and enabled() else None
     began = time.perf_counter()
     grid = replace(grid, strata=grid.strata_for(noise.pitch_drift_deg > 0.0))
     coarse_grid = grid.refined(1.0 / math.sqrt(2.0))
     estimates = []
     for index, each in enumerate((coarse_grid, grid)):
         report = None if progress is None else _stage_progress(progress, index)
-        estimates.append(solve_on(model, controls, noise, start, each, report))
+        estimates.append(solve_on(model, controls, noise, start, each, report, chains))
     coarse, fine = estimates
     error = abs(fine.mfpt_jumps - coarse.mfpt_jumps) / fine.mfpt_jumps if fine.mfpt_jumps > 0 else math.nan
     return MfptResult(
@@ -178,14 +187,23 @@ def solve_on(
     start: np.ndarray,
     grid: ChainGrid,
     progress: Progress | None = None,
+    cache: ChainCache | None = None,
 ) -> MfptEstimate:
-    """MFPT and ``λ₂`` on one grid."""
+    """MFPT and ``λ₂`` on one grid, its chain from ``cache`` when there (and stored when built)."""
     began = time.perf_counter()
-    chain = build_chain(model, controls, noise, start, grid, progress)
+    key = None if cache is None else chain_key(model, controls, noise, start, grid)
+    chain = None if key is None else cache.load(key)
+    cached = chain is not None
+    if chain is None:
+        chain = build_chain(model, controls, noise, start, grid, progress)
+        if key is not None:
+            cache.store(key, chain)
+    elif progress is not None:
+        progress(1, 1)
     values = expected_jumps(chain)
     mfpt_jumps = first_jump_value(model, controls, noise, start, grid, chain, values)
     return MfptEstimate(
-        mfpt_jumps, largest_eigenvalue(chain), chain.states, chain.escaped, time.perf_counter() - began, grid
+        mfpt_jumps, largest_eigenvalue(chain), chain.states, chain.escaped, time.perf_counter() - began, grid, cached
     )
 
 
