@@ -1,4 +1,5 @@
-"""``parkour mfpt``: mean first-passage time of a noisy gait, from a Markov chain on the section."""
+"""``parkour mfpt``: mean first-passage time of a noisy gait, from a Markov chain on the section, or
+of a closed-loop controller (``--controller``), by splitting on its compiled loop."""
 
 from __future__ import annotations
 
@@ -19,12 +20,15 @@ from cli.options import (
     with_model,
     with_noise,
 )
+from sim_core.control_laws import KINDS
 from sim_core.mfpt_grid import ChainGrid
 from sim_core.noise import NoiseModel
 from sim_core.validation import ParameterError
 
 app = typer.Typer(rich_markup_mode=None)
 DEFAULT_GRID = ChainGrid()
+GAIT_CONTROLS, CLIMB_CONTROLS = "30:0.9", "35:0.9"
+DEFAULT_TARGET_M = 0.55
 
 
 @app.command("mfpt")
@@ -34,21 +38,73 @@ DEFAULT_GRID = ChainGrid()
 def mfpt_command(
     setup: ModelSetup,
     noise: NoiseModel,
-    controls: ControlsOption = "30:0.9",
+    controls: ControlsOption = None,
     grid: Annotated[
-        int, typer.Option("--grid", help="Velocity nodes per axis over where the noisy paths go (4-400).")
-    ] = DEFAULT_GRID.velocity_nodes,
+        int | None,
+        typer.Option(
+            "--grid",
+            help=f"Velocity nodes per axis where the noisy paths go (4-400; default {DEFAULT_GRID.velocity_nodes}).",
+        ),
+    ] = None,
     pitch_spacing: Annotated[
-        float, typer.Option("--pitch-spacing", help="Pitch nodes' spacing, in pitch-step standard deviations.")
-    ] = DEFAULT_GRID.pitch_spacing,
+        float | None,
+        typer.Option(
+            "--pitch-spacing",
+            help=f"Pitch nodes' spacing, in pitch-step standard deviations (default {DEFAULT_GRID.pitch_spacing:g}).",
+        ),
+    ] = None,
     start: Annotated[
         tuple[float, float] | None,
         typer.Option("--start", help="Touchdown state XDOT YDOT to start from; default: the gait's fixed point."),
     ] = None,
     guess: GuessOption = None,
+    no_cache: Annotated[
+        bool, typer.Option("--no-cache", help="Build both chains, neither loading nor storing cached ones.")
+    ] = False,
+    controller: Annotated[
+        str | None,
+        typer.Option(
+            "--controller",
+            help=f"A closed-loop law ({', '.join(KINDS)}): its MFPT by splitting on the compiled loop, no pitch "
+            f"drift; --controls then gives the climb's nominal psi0 and first zeta0 (default {CLIMB_CONTROLS}).",
+        ),
+    ] = None,
+    target: Annotated[
+        float | None,
+        typer.Option("--target", help=f"Height the law holds [m] (with --controller; default {DEFAULT_TARGET_M:g})."),
+    ] = None,
+    replicas: Annotated[
+        int | None, typer.Option("--replicas", help="Splitting: replicas per run (with --controller; default 200).")
+    ] = None,
+    runs: Annotated[
+        int | None, typer.Option("--runs", help="Splitting: independent runs, for the interval (default 16).")
+    ] = None,
+    seed: Annotated[int | None, typer.Option("--seed", help="Splitting: the seed of every draw (default 0).")] = None,
     as_json: JsonOption = False,
 ) -> None:
-    """Mean jumps to failure from a Markov chain on (xdot, ydot, pitch): where Monte-Carlo saturates too."""
+    """Mean jumps to failure where Monte-Carlo saturates: of fixed controls from a Markov chain on
+    (xdot, ydot, pitch), or of a controller holding a height (--controller) by splitting."""
+    if controller is not None:
+        given = {"--grid": grid, "--pitch-spacing": pitch_spacing, "--start": start, "--guess": guess}
+        _refuse_given(
+            given | {"--no-cache": no_cache or None}, "applies to the chain of fixed controls, not with --controller"
+        )
+        from cli.mfpt_loop import controller_mfpt
+
+        splitting = {"replicas": replicas, "runs": runs, "seed": seed}
+        controller_mfpt(setup, noise, controller, controls or CLIMB_CONTROLS, target, splitting, as_json)
+        return
+    _refuse_given({"--target": target, "--replicas": replicas, "--runs": runs, "--seed": seed}, "needs --controller")
+    _chain_mfpt(setup, noise, controls or GAIT_CONTROLS, grid, pitch_spacing, start, guess, no_cache, as_json)
+
+
+def _refuse_given(options: dict, why: str) -> None:
+    for option, value in options.items():
+        if value is not None:
+            raise ParameterError(option, why)
+
+
+def _chain_mfpt(setup, noise, controls, grid, pitch_spacing, start, guess, no_cache, as_json) -> None:
     from sim_core.controls import ControlSchedule
     from sim_core.gait_search import gait_of
     from sim_core.mfpt import check_chain_inputs, mfpt
@@ -56,6 +112,8 @@ def mfpt_command(
     schedule = parse_controls(controls)
     if len(schedule) != 1:
         raise ParameterError("--controls", f"the chain takes one symmetric PSI0:ZETA0 pair, got {controls!r}")
+    grid = DEFAULT_GRID.velocity_nodes if grid is None else grid
+    pitch_spacing = DEFAULT_GRID.pitch_spacing if pitch_spacing is None else pitch_spacing
     with option_named("--grid", "grid.velocity_nodes"), option_named("--pitch-spacing", "grid.pitch_spacing"):
         chain_grid = ChainGrid(velocity_nodes=grid, pitch_spacing=pitch_spacing)
     with (
@@ -66,9 +124,11 @@ def mfpt_command(
     if start is None:
         start = gait_of(setup.model, ControlSchedule(schedule.legs), guess=guess).state
     with progress_bar(f"MFPT: chains of {grid} and fewer velocity nodes") as bar:
-        result = mfpt(setup.model, schedule.legs[0], noise, start=start, grid=chain_grid, progress=bar)
+        result = mfpt(
+            setup.model, schedule.legs[0], noise, start=start, grid=chain_grid, progress=bar, cache=not no_cache
+        )
     if as_json:
-        print_json(result.to_dict())
+        print_json({**result.to_dict(), "method": "chain"})
         return
     from rich.console import Console
     from rich.table import Table

@@ -25,7 +25,7 @@ import numpy as np
 
 from sim_core._jit import kernel
 from sim_core.controls import ControlSchedule, LegControl
-from sim_core.failures import OK, Failure
+from sim_core.failures import FLOOR, FLOOR_HEIGHT, OK, Failure
 from sim_core.height_controller import HeightController
 from sim_core.integrate import STATE_SIZE
 from sim_core.noise import NO_NOISE, NoiseModel
@@ -257,4 +257,6 @@ def pid_loop(
         foot += rise
         now += stance_time + flight_time
         pitch, psi0, zeta0 = next_pitch, next_psi0, next_zeta0
+        if foot + zeta0 * math.sin(psi0) < FLOOR_HEIGHT:  # lost its height, as in sim_core.loop_step
+            return FLOOR, k
     return OK, jumps

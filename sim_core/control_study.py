@@ -32,11 +32,11 @@ from sim_core.control_laws import Controller
 from sim_core.controllers import control_step, start_memory
 from sim_core.failures import OK, Failure
 from sim_core.integrate import STATE_SIZE
+from sim_core.loop_step import LOOP_STATE_SIZE, body_height, loop_jump, start_loop
 from sim_core.noise import NoiseModel
-from sim_core.noise_rules import commanded_controls, disturbed_state, pitch_step, seed_trial
+from sim_core.noise_rules import seed_trial
 from sim_core.params import ModelParams
 from sim_core.poincare import check_jumps, check_section_state
-from sim_core.stride import jump
 from sim_core.validation import check_range
 
 RISE_FRACTION = 0.9  # a run has risen once it has climbed 90% of the way to its target
@@ -261,33 +261,19 @@ def controlled_loop(
     and ``saturated`` per command. Returns ``(status, jumps completed)``."""
     seed_trial(seed)
     no_record = np.empty((0, STATE_SIZE))
-    memory = start_memory(kind, first_psi0, first_zeta0)
-    jumps = height.shape[0] - 1
-    pitch = 0.0
-    psi0, zeta0 = commanded_controls(
-        0, pitch, first_psi0, first_zeta0, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
+    state = np.empty(LOOP_STATE_SIZE)
+    start_loop(
+        state, kind, xdot, ydot, first_psi0, first_zeta0, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
     )
-    foot = 0.0
+    jumps = height.shape[0] - 1
     for k in range(jumps + 1):
-        body = foot + zeta0 * math.sin(psi0)
-        height[k] = body
+        height[k] = body_height(state)
         if k == jumps:
             break
-        # What touchdown k shows (its height, the pitch tracked in its stance) sets touchdown k + 1.
-        command_psi0, command_zeta0, clipped = control_step(
-            kind, parameters, memory, body, pitch, xdot, ydot, (k + 1) % 2 == 0
-        )
-        saturated[k] = clipped
-        next_pitch = pitch_step(pitch, sigma_pitch)
-        next_psi0, next_zeta0 = commanded_controls(
-            k + 1, next_pitch, command_psi0, command_zeta0, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
-        )
-        status, xdot, ydot, rise, _stance_time, _flight_time, _ = jump(
-            xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c_psi, mu, no_record
-        )
+        status, saturated[k] = loop_jump(
+            state, k, kind, parameters, sigma_psi0, sigma_zeta0, sigma_velocity, sigma_pitch, asymmetry_psi0,
+            asymmetry_zeta0, alpha, d_hat, c_zeta, c_psi, mu, no_record,
+        )  # fmt: skip
         if status != OK:
             return status, k
-        xdot, ydot = disturbed_state(xdot, ydot, sigma_velocity)
-        foot += rise
-        pitch, psi0, zeta0 = next_pitch, next_psi0, next_zeta0
     return OK, jumps

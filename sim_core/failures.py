@@ -1,4 +1,4 @@
-"""Failure modes of a jump (docs/model.md §3).
+"""Failure modes of a jump (docs/model.md §3), and the end of a closed loop's run on the floor.
 
 The compiled kernels return small integers (they cannot raise); everything outside the
 kernels speaks :class:`Failure`, whose ``code`` strings are the stable names used in JSON
@@ -16,6 +16,8 @@ COLLAPSE = 2
 NO_LIFTOFF = 3
 NO_FLIGHT = 4
 INVALID_STATE = 5
+FLOOR = 6  # a closed loop's run only: the body came down to the chute's floor
+FLOOR_HEIGHT = 0.0  # [l0] that floor (sim_core.climb_records.FLOOR): where the climb's first foot touched
 
 
 class Failure(IntEnum):
@@ -26,6 +28,7 @@ class Failure(IntEnum):
     NO_LIFTOFF = NO_LIFTOFF
     NO_FLIGHT = NO_FLIGHT
     INVALID_STATE = INVALID_STATE
+    FLOOR = FLOOR
 
     @property
     def code(self) -> str:
@@ -52,4 +55,5 @@ _MESSAGES = {
     Failure.NO_LIFTOFF: "the spring never re-extended: stance exceeded its time cap",
     Failure.NO_FLIGHT: "no flight phase: at lift-off the body does not head for the other wall",
     Failure.INVALID_STATE: "non-finite numbers or a state outside the model's domain",
+    Failure.FLOOR: "the body reached the chute's floor",  # as the climb's end (sim_core.climb_records.ClimbEnd)
 }

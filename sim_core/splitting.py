@@ -1,0 +1,204 @@
+"""Mean first-passage time of a closed loop by splitting: rare failures of a controller that holds
+its height, without a grid.
+
+A law's loop has more state than a section grid can hold (section state, the controls in flight,
+the height error, the law's memory), so its MFPT is estimated on the compiled loop itself, by the
+Hill relation and adaptive multilevel splitting (AMS: Cérou & Guyader 2007; for an MFPT, Lopes &
+Lelièvre 2019):
+
+1. The holding state (:mod:`sim_core.splitting_holding`): a score, the distance from holding;
+   home (``score < a``), exits (a first ``score >= b`` after home) and ``T_loop``, the mean jumps
+   between exits, on a long run; the climb from the start to home on short runs.
+2. ``p``, the chance that an exit fails before it comes home, by AMS: ``replicas`` excursions from
+   the recorded exits; all that rose least are dropped, each replaced by a copy of a survivor cut
+   where it first passed that level and continued with fresh noise, until every replica has
+   failed; ``p`` is the product of the survivors' shares. Unbiased whatever the score (the score
+   sets the variance); ``runs`` independent runs give its error.
+3. From home, failures arrive at rate ``p / T_loop`` (the Hill relation): ``MFPT = climb +
+   (1 - climb failures) T_loop / p``, and ``lambda2 = 1 - p / T_loop``, the second eigenvalue of
+   a metastable loop's chain.
+
+A loop is metastable only without pitch drift: with it the pitch's random walk, unbounded, sets
+the failures when it reaches the leg's range (``parkour control-study`` measures those runs).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+from scipy.stats import t as student_t
+
+from sim_core.chunks import Progress
+from sim_core.control_laws import Controller
+from sim_core.noise import NoiseModel
+from sim_core.params import ModelParams
+from sim_core.splitting_holding import Holding, Loop, measure_holding
+from sim_core.validation import ParameterError, check_range
+
+
+@dataclass(frozen=True)
+class SplittingOptions:
+    """How hard the estimate works: ``replicas`` per AMS run, ``runs`` independent runs, the long
+    run's ``pilot_jumps``, home and exit as quantiles of its scores, the climbs measured, the
+    longest excursion [jumps], the seed of every draw."""
+
+    replicas: int = 200
+    runs: int = 16
+    pilot_jumps: int = 20_000
+    home_quantile: float = 0.5
+    exit_quantile: float = 0.9
+    climbs: int = 200
+    excursion_limit: int = 20_000
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        check_range("replicas", self.replicas, 2, 10_000, low_open=False, high_open=False)
+        check_range("runs", self.runs, 2, 1_000, low_open=False, high_open=False)
+        check_range("pilot_jumps", self.pilot_jumps, 1_000, 10_000_000, low_open=False, high_open=False)
+        check_range("home_quantile", self.home_quantile, 0.0, 1.0)
+        check_range("exit_quantile", self.exit_quantile, self.home_quantile, 1.0)
+        check_range("climbs", self.climbs, 1, 100_000, low_open=False, high_open=False)
+        check_range("excursion_limit", self.excursion_limit, 100, 10_000_000, low_open=False, high_open=False)
+        check_range("seed", self.seed, 0, 2**32, low_open=False, high_open=True)
+
+
+@dataclass(frozen=True)
+class LoopMfpt:
+    """A controller's MFPT [jumps] from the climb's start, its 95% interval, and how it was got."""
+
+    controller: str
+    target: float  # [l0]
+    noise: NoiseModel
+    mfpt_jumps: float
+    ci95: tuple[float, float]
+    probability: float  # p: an exit fails before it comes home (the runs' mean)
+    probabilities: tuple[float, ...]
+    holding: Holding
+    seconds: float
+    options: SplittingOptions
+
+    @property
+    def lambda2_jumps(self) -> float:
+        """``1 / (1 - lambda2) = T_loop / p``: the MFPT from home."""
+        return self.holding.loop_jumps / self.probability if self.probability > 0 else math.inf
+
+    @property
+    def relative_error(self) -> float:
+        """Half the 95% interval over the estimate."""
+        return 0.5 * (self.ci95[1] - self.ci95[0]) / self.mfpt_jumps
+
+    def to_dict(self) -> dict:
+        """``parkour mfpt --controller ... --json``: the chain's keys (no grid: ``cells`` and
+        ``discretisation_error`` are null; an MFPT no run could reach is null) and the splitting's."""
+        finite = math.isfinite(self.mfpt_jumps)
+        holding = self.holding
+        return {
+            "mfpt_jumps": self.mfpt_jumps if finite else None,
+            "lambda2": 1.0 - 1.0 / self.lambda2_jumps,
+            "lambda2_jumps": self.lambda2_jumps if finite else None,
+            "discretisation_error": None,
+            "relative_error": self.relative_error if finite else None,
+            "ci95": list(self.ci95) if finite else None,
+            "cells": None,
+            "seconds": self.seconds,
+            "method": "splitting",
+            "controller": self.controller,
+            "noise": self.noise.to_dict(),
+            "splitting": {
+                "probability": self.probability,
+                "probabilities": list(self.probabilities),
+                "loop_jumps": holding.loop_jumps,
+                "loop_relative_error": holding.loop_relative_error,
+                "climb_jumps": holding.climb_jumps,
+                "climb_failures": holding.climb_failures,
+                "exits": int(holding.exit_states.shape[0]),
+                "home_score": holding.home,
+                "exit_score": holding.exit,
+                "pilot_failures": holding.pilot_failures,
+                **asdict(self.options),
+            },
+        }
+
+
+def check_metastable(noise: NoiseModel) -> None:
+    """Refuse what splitting cannot estimate, naming the field."""
+    if noise.pitch_drift_deg != 0.0:
+        raise ParameterError(
+            "noise.pitch_drift_deg",
+            "must be 0 for a controller's MFPT: with pitch drift the loop is not metastable (the pitch's random "
+            "walk reaches the leg's range); parkour control-study measures its mean jumps to failure",
+        )
+    if noise.velocity == 0.0 and noise.psi0_deg == 0.0 and noise.zeta0 == 0.0:
+        raise ParameterError("noise", "needs some noise: a noiseless loop that holds never fails")
+
+
+def loop_mfpt(
+    model: ModelParams,
+    controller: Controller,
+    start,
+    start_zeta0: float,
+    noise: NoiseModel,
+    options: SplittingOptions | None = None,
+    progress: Progress | None = None,
+) -> LoopMfpt:
+    """MFPT of ``controller``'s loop started as the control study starts it (section state
+    ``start``, the first leg at the law's nominal angle and ``start_zeta0``), under ``noise``.
+
+    Raises:
+        ParameterError: pitch drift or no noise (:func:`check_metastable`), a long run that fails
+            too often or leaves home too rarely to measure, an excursion past ``excursion_limit``.
+    """
+    check_metastable(noise)
+    options = options or SplittingOptions()
+    began = time.perf_counter()
+    rng = np.random.default_rng(options.seed)
+    loop = Loop(model, controller, noise, options.excursion_limit)
+    quantiles = (options.home_quantile, options.exit_quantile)
+    holding = measure_holding(loop, start, start_zeta0, options.pilot_jumps, quantiles, options.climbs, rng)
+    probabilities = []
+    for run in range(options.runs):
+        probabilities.append(failure_probability(loop, holding, options.replicas, rng))
+        if progress is not None:
+            progress(run + 1, options.runs)
+    p = float(np.mean(probabilities))
+    if p == 0.0:
+        mfpt, ci95 = math.inf, (math.inf, math.inf)
+    else:
+        p_error = float(np.std(probabilities, ddof=1)) / math.sqrt(options.runs) / p
+        spread = 1.0 + student_t.ppf(0.975, options.runs - 1) * math.hypot(p_error, holding.loop_relative_error)
+        climb, survives = holding.climb_jumps, 1.0 - holding.climb_failures
+        from_home = holding.loop_jumps / p
+        mfpt = climb + survives * from_home
+        ci95 = (climb + survives * from_home / spread, climb + survives * from_home * spread)
+    return LoopMfpt(controller.name, controller.target, noise, mfpt, ci95, p, tuple(probabilities), holding,
+                    time.perf_counter() - began, options)  # fmt: skip
+
+
+def failure_probability(loop: Loop, holding: Holding, replicas: int, rng: np.random.Generator) -> float:
+    """One AMS run of ``replicas``: the chance that an exit fails before it comes home (0 when
+    every replica came home at the same highest level, which no copy can pass)."""
+    picks = rng.integers(holding.exit_states.shape[0], size=replicas)
+    paths = [loop.excursion(holding.exit_states[i], int(holding.exit_touchdowns[i]), holding, rng) for i in picks]
+    levels = np.array([level for *_, level in paths])
+    log_p = 0.0
+    while not math.isinf(floor := levels.min()):
+        dropped = np.flatnonzero(levels <= floor)
+        if dropped.size == replicas:
+            return 0.0
+        log_p += math.log1p(-dropped.size / replicas)
+        survivors = np.flatnonzero(levels > floor)
+        for i in dropped:
+            states, touchdowns, scores, _ = paths[rng.choice(survivors)]
+            cut = int(np.argmax(scores > floor))  # the survivor's first touchdown past the level
+            on_states, on_touchdowns, on_scores, level = loop.excursion(states[cut], int(touchdowns[cut]), holding, rng)
+            paths[i] = (
+                np.concatenate([states[:cut], on_states]),
+                np.concatenate([touchdowns[:cut], on_touchdowns]),
+                np.concatenate([scores[:cut], on_scores]),
+                max(level, float(scores[: cut + 1].max())),
+            )
+            levels[i] = paths[i][3]
+    return math.exp(log_p)
