@@ -11,7 +11,10 @@ one step for each row. Over a :class:`ViabilityGrid` of state and action axes th
 
 1. maps every (state, action) grid pair once (the *transition map*): failed, or the bin of the
    state reached, ``np.digitize(next, axis)`` per dimension (``0 .. n``: below the first node,
-   between nodes ``i - 1`` and ``i``, past the last);
+   between nodes ``i - 1`` and ``i``, past the last), the grid closed: a state reached exactly
+   on an axis' last node is in the last bin, not past it (``np.digitize`` alone puts it outside,
+   which only an axis the map carries over unchanged meets, as the ParkourBot's pitch; on
+   another axis it has measure zero);
 2. shrinks the viable set to its greatest fixed point: a pair is viable while it does not fail
    and every grid node at the corners of the bin it reaches is in the kernel. The kernel is
    the set of states with at least one viable action. This is vibly's ``compute_QV``:
@@ -133,10 +136,17 @@ def transition_map(
         part_failed = np.asarray(part_failed, dtype=bool) | ~np.all(np.isfinite(reached), axis=1)
         failed[part] = part_failed
         for d, axis in enumerate(grid.state_axes):
-            bins[part, d] = np.where(part_failed, FAILED, np.digitize(np.nan_to_num(reached[:, d]), axis))
+            bins[part, d] = np.where(part_failed, FAILED, closed_bins(np.nan_to_num(reached[:, d]), axis))
         if progress is not None:
             progress(done, len(slices))
     return failed.reshape(grid.shape), bins.reshape((*grid.shape, dimensions))
+
+
+def closed_bins(values: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """``np.digitize(values, axis)``, a value on the last node in the last bin."""
+    bins = np.digitize(values, axis)
+    bins[values == axis[-1]] = axis.size - 1
+    return bins
 
 
 def viability_of_map(

@@ -37,6 +37,26 @@ def test_the_kernel_of_an_expanding_map_is_its_known_interval_within_the_grid_er
     assert result.sweeps > 1
 
 
+def test_an_axis_the_map_carries_unchanged_keeps_the_kernel_of_the_others():
+    """A state the map carries over as it is (the ParkourBot's pitch, in the noiseless map) lands
+    on its own node: on the last node too, which the closed grid keeps in its last bin (plain
+    np.digitize would put it past the grid, and the kernel would empty from there down)."""
+    gain, reach = 2.0, 0.5
+    states = np.linspace(-1.5, 1.5, 61)
+    expanding = linear_step(gain, 4.0)
+
+    def step(states, actions):  # x' = g x + a, c' = c
+        reached, failed = expanding(states[:, :1], actions)
+        return np.column_stack([reached[:, 0], states[:, 1]]), failed
+
+    grid = ViabilityGrid((states, np.linspace(0.0, 1.0, 3)), (np.linspace(-reach, reach, 21),))
+    carried = compute_viability(step, grid)
+    alone = compute_viability(expanding, ViabilityGrid((states,), (np.linspace(-reach, reach, 21),)))
+    for node in range(3):
+        np.testing.assert_array_equal(carried.kernel[:, node], alone.kernel)
+    assert alone.kernel.any()
+
+
 def vibly_viable_pairs(failed, bins, state_shape, edges_extend):
     """vibly's compute_QV written out plainly: keep a pair while it does not fail and every
     existing node around the bin it reaches is in the kernel; repeat until nothing changes."""

@@ -35,6 +35,23 @@ def test_a_gaits_flight_is_a_fixed_point_and_in_the_kernel(paper, psi0_deg, zeta
     assert 0.0 < result.kernel_fraction < 1.0, "the default window shows the kernel's edge"
 
 
+def test_a_calibrated_models_kernel_is_its_own(paper):
+    """The step map of a model a calibration fitted (here: a stiffer spring, less damping, a
+    narrower chute, as `parkour calibrate` might return) is that model's: its gait's flight is a
+    fixed point inside its kernel, and the kernel is not the paper's."""
+    calibrated = ModelParams(alpha=1.08 * paper.alpha, d_hat=2.3, c_zeta=0.22, c_psi=0.25, mu=1.6)
+    gait = find_fixed_point(calibrated, ControlSchedule.from_degrees([(30.0, 0.9)]), 1, (-0.93, -0.2))
+    psi0 = math.radians(30.0)
+    middle = middle_of(calibrated, gait.state, psi0, 0.9)
+    reached, failed = section_step_map(calibrated)(middle[None, :], np.array([[psi0, 0.9]]))
+    assert not failed[0]
+    np.testing.assert_allclose(reached[0], middle, atol=1e-9)
+    grid = section_grid(states=20, actions=8)
+    own, papers = (compute_viability(section_step_map(model), grid) for model in (calibrated, paper))
+    assert own.kernel[own.nearest_node(middle)]
+    assert 0.0 < own.kernel_fraction < 1.0 and not np.array_equal(own.kernel, papers.kernel)
+
+
 def test_the_pitch_turns_the_coming_leg_and_changes_sign_for_the_next(paper):
     pitch = math.radians(2.0)
     state = np.array([[1.0, 0.5, pitch]])
