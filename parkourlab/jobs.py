@@ -1,5 +1,6 @@
-"""Batch jobs through the client: submit (MJTF, sweep, basin, gait search, control study), follow, wait, read
-results, cancel. The part of :class:`parkourlab.Client` that deals with ``/api/v1/jobs``."""
+"""Batch jobs through the client: submit (MJTF, sweep, basin, gait search, control study, MFPT of a
+gait or a controller, viability), follow, wait, read results, cancel. The part of
+:class:`parkourlab.Client` that deals with ``/api/v1/jobs``."""
 
 from __future__ import annotations
 
@@ -24,9 +25,10 @@ class JobCalls:
     _http: Http
 
     def submit_job(self, kind: str, **spec: Any) -> Job:
-        """Queue a job of ``kind`` (``mjtf``, ``sweep``, ``basin``, ``gaits``, ``control-study``) with ``spec`` as its
-        body (the API's field names; docs/service.md). Returns it queued (202). The typed
-        ``submit_*`` methods below are the same with each field named."""
+        """Queue a job of ``kind`` (``mjtf``, ``sweep``, ``basin``, ``gaits``, ``control-study``,
+        ``mfpt``, ``loop-mfpt``, ``viability``) with ``spec`` as its body (the API's field names;
+        docs/service.md). Returns it queued (202). The typed ``submit_*`` methods below are the
+        same with each field named."""
         body = {"kind": kind} | present(spec)
         return self._http.call("POST", "/api/v1/jobs", body=body)
 
@@ -155,6 +157,30 @@ class JobCalls:
         spec = {"psi0_deg": psi0_deg, "zeta0": zeta0, "start": state(start), "guess": state(guess)}
         spec |= {"noise": mapping(noise), "grid": grid, "pitch_spacing": pitch_spacing}
         return self.submit_job("mfpt", **spec, model=mapping(model), experiment_id=experiment_id)
+
+    def submit_loop_mfpt(
+        self,
+        controller: str,
+        *,
+        target_m: float | None = None,
+        psi0_deg: float | None = None,
+        start_zeta0: float | None = None,
+        noise: Mapping[str, float] | None = None,
+        replicas: int | None = None,
+        runs: int | None = None,
+        seed: int | None = None,
+        model: Mapping[str, Any] | None = None,
+        experiment_id: int | None = None,
+    ) -> Job:
+        """A controller's mean first-passage time (``parkour mfpt --controller``): ``controller``
+        (``pid``, ``pid-pitch``, ``lqr``, ``deadbeat``) holding ``target_m`` [m] after the control
+        study's climb from ``psi0_deg`` [deg], ``start_zeta0`` [l0], under ``noise`` without pitch
+        drift, by ``runs`` splitting runs of ``replicas`` each (replicas × runs bounded), every draw
+        from ``seed``. Its result: ``mfpt_jumps``, ``ci95``, ``lambda2``, ``relative_error`` and the
+        ``splitting``'s numbers (``probabilities``: each run's). None: the service's default."""
+        spec = {"controller": controller, "target_m": target_m, "psi0_deg": psi0_deg, "start_zeta0": start_zeta0}
+        spec |= {"noise": mapping(noise), "replicas": replicas, "runs": runs, "seed": seed}
+        return self.submit_job("loop-mfpt", **spec, model=mapping(model), experiment_id=experiment_id)
 
     def submit_viability(
         self,

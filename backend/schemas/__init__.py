@@ -54,13 +54,13 @@ from backend.schemas.jobs import (
     JobPage,
     JobResults,
     JobState,
-    MfptJobCreate,
     MJTFJobCreate,
     MJTFLevelOut,
-    NoiseIn,
     SweepJobCreate,
     ViabilityJobCreate,
 )
+from backend.schemas.mfpt_jobs import ControllerKind, LoopMfptJobCreate, LoopNoiseIn, MfptJobCreate
+from backend.schemas.noise import NoiseIn
 from backend.schemas.robot import ClosedLoopIn, EstopLatchOut, RobotConnect, RobotEstopOut, RobotRunCreate, RobotStatus
 from backend.schemas.runs import (
     RunAggregate,
@@ -100,6 +100,7 @@ __all__ = [
     "CalibrationOut",
     "ClosedLoopIn",
     "ControlStudyJobCreate",
+    "ControllerKind",
     "EstopLatchOut",
     "ExperimentBase",
     "ExperimentCreate",
@@ -119,6 +120,8 @@ __all__ = [
     "JobState",
     "Label",
     "LegIn",
+    "LoopMfptJobCreate",
+    "LoopNoiseIn",
     "MJTFJobCreate",
     "MJTFLevelOut",
     "MapIn",

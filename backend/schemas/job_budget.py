@@ -30,6 +30,16 @@ JUMP_LIMIT_DESCRIPTION = "cells undecided at the first cap go on up to this many
 # the job worker) at most, and its result (kernel, measure, viable pairs as bits) stays a few MB.
 VIABILITY_MAX_STATES = 120
 VIABILITY_MAX_ACTIONS = 40
+# A controller's MFPT by splitting (sim_core.splitting): its work is AMS runs of replicas, each
+# replica's excursions ended home, at a failure or at SplittingOptions' excursion_limit (20,000
+# jumps). One replica's share of a run is counted at that limit, the long run and climbs that
+# measure the holding state before them at theirs (pilot_jumps + climbs x excursion_limit, the
+# defaults): far above what they take (0.8-24 ms a replica-run measured, pid to deadbeat at velocity
+# noise 0.05, 2 cores: 100-3,300 jumps at the job rate) but a rarer failure takes more levels. So
+# replicas x runs is bounded, and the worst case stays within the work budget.
+LOOP_MFPT_REPLICA_JUMPS = 20_000
+LOOP_MFPT_SETUP_JUMPS = 20_000 + 200 * 20_000
+LOOP_MFPT_MAX_REPLICA_RUNS = 20_000
 
 
 def mfpt_grid_of(job) -> ChainGrid:
@@ -52,6 +62,9 @@ def worst_case_jumps(job) -> tuple[int, str]:
         return len(job.controllers) * job.seeds * job.jumps, "controllers x seeds x jumps"
     if job.kind == "viability":
         return job.states**2 * job.actions**2, "states² x actions²"
+    if job.kind == "loop-mfpt":
+        jumps = job.replicas * job.runs * LOOP_MFPT_REPLICA_JUMPS + LOOP_MFPT_SETUP_JUMPS
+        return jumps, f"replicas x runs x {LOOP_MFPT_REPLICA_JUMPS} + {LOOP_MFPT_SETUP_JUMPS} for the holding state"
     if job.kind == "mfpt":
         drifts = job.noise.pitch_drift_deg > 0.0
         return mfpt_grid_of(job).worst_case_jumps(drifts), "2 grids x (pairs x draws + paths x path jumps)"

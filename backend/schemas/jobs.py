@@ -1,5 +1,6 @@
 """Batch jobs: the kinds a client can ask for (MJTF, energy sweep, basin, gait search, control
-study, MFPT), each bounded by a work budget, and what a job and its results look like."""
+study, the MFPT of a gait or of a controller (backend/schemas/mfpt_jobs.py), viability), each
+bounded by a work budget, and what a job and its results look like."""
 
 from __future__ import annotations
 
@@ -25,15 +26,14 @@ from backend.schemas.common import (
 from backend.schemas.job_budget import (
     BASIN_JUMP_LIMIT,
     JUMP_LIMIT_DESCRIPTION,
-    MFPT_MAX_GRID,
     VIABILITY_MAX_ACTIONS,
     VIABILITY_MAX_STATES,
     within_budget,
 )
+from backend.schemas.mfpt_jobs import LoopMfptJobCreate, MfptJobCreate
+from backend.schemas.noise import NoiseIn
 from sim_core.climb_records import CHUTE_TOP, FLOOR
 from sim_core.control_laws import KINDS, PSI0_RANGE_DEG
-from sim_core.mfpt_grid import ChainGrid
-from sim_core.noise import ASYMMETRY_LIMITS, SIGMA_LIMITS, NoiseModel
 from sim_core.viability_grid import DEFAULT_PSI0_DEG, DEFAULT_ZETA0
 
 CLIENT_PATTERN = r"^[\w.:@/-]{1,64}$"  # the X-Parkour-Client header: who submits, for the queue's fairness
@@ -46,22 +46,6 @@ class JobState(enum.StrEnum):
     CANCELLED = "cancelled"
     DONE = "done"
     FAILED = "failed"
-
-
-_NOISE = NoiseModel()  # the noise's defaults; its ranges: SIGMA_LIMITS, ASYMMETRY_LIMITS (sim_core.noise)
-
-
-class NoiseIn(Strict):
-    psi0_deg: Annotated[float, Field(ge=0.0, lt=SIGMA_LIMITS["psi0_deg"])] = _NOISE.psi0_deg
-    zeta0: Annotated[float, Field(ge=0.0, lt=SIGMA_LIMITS["zeta0"])] = _NOISE.zeta0
-    velocity: Annotated[float, Field(ge=0.0, lt=SIGMA_LIMITS["velocity"])] = _NOISE.velocity
-    pitch_drift_deg: Annotated[float, Field(ge=0.0, lt=SIGMA_LIMITS["pitch_drift_deg"])] = _NOISE.pitch_drift_deg
-    asymmetry_psi0_deg: Annotated[
-        float, Field(gt=-ASYMMETRY_LIMITS["asymmetry_psi0_deg"], lt=ASYMMETRY_LIMITS["asymmetry_psi0_deg"])
-    ] = _NOISE.asymmetry_psi0_deg
-    asymmetry_zeta0: Annotated[
-        float, Field(gt=-ASYMMETRY_LIMITS["asymmetry_zeta0"], lt=ASYMMETRY_LIMITS["asymmetry_zeta0"])
-    ] = _NOISE.asymmetry_zeta0
 
 
 class MJTFJobCreate(Strict):
@@ -181,38 +165,6 @@ class ControlStudyJobCreate(Strict):
         return within_budget(self)
 
 
-class MfptJobCreate(Strict):
-    """The mean first-passage time of symmetric controls under noise (``parkour mfpt``), from the
-    gait's fixed point (or ``start``), on a grid of ``grid`` velocity nodes and one √2 coarser."""
-
-    kind: Literal["mfpt"]
-    experiment_id: RecordRef | None = None
-    model: ModelIn = ModelIn()
-    psi0_deg: Psi0Deg = 30.0
-    zeta0: Zeta0 = 0.9
-    start: StateIn | None = None
-    guess: StateIn | None = None
-    noise: NoiseIn = NoiseIn()
-    grid: Annotated[
-        int, Field(ge=4, le=MFPT_MAX_GRID, description="velocity nodes per axis over where noisy paths go")
-    ] = ChainGrid().velocity_nodes
-    pitch_spacing: Annotated[
-        float, Field(ge=0.25, le=2.0, description="pitch nodes' spacing [standard deviations of the pitch step]")
-    ] = ChainGrid().pitch_spacing
-
-    @field_validator("noise")
-    @classmethod
-    def _symmetric(cls, noise: NoiseIn) -> NoiseIn:
-        for field in ASYMMETRY_LIMITS:
-            if getattr(noise, field) != 0.0:
-                raise ValueError(f"{field} must be 0 for the MFPT chain (an L/R asymmetry needs the wall in the state)")
-        return noise
-
-    @model_validator(mode="after")
-    def _within_budget(self) -> MfptJobCreate:
-        return within_budget(self)
-
-
 ViabilityPsi0 = Annotated[float, Field(ge=1.0, le=89.0, description="leg angle [deg]")]
 ViabilityZeta0 = Annotated[float, Field(ge=0.05, le=0.999, description="leg length [l0]")]
 
@@ -253,11 +205,12 @@ JobCreate = Annotated[
     | Annotated[GaitSearchJobCreate, KindTag("gaits")]
     | Annotated[ControlStudyJobCreate, KindTag("control-study")]
     | Annotated[MfptJobCreate, KindTag("mfpt")]
+    | Annotated[LoopMfptJobCreate, KindTag("loop-mfpt")]
     | Annotated[ViabilityJobCreate, KindTag("viability")],
     Discriminator(_job_kind),
 ]
 JOB_KINDS = {"mjtf": MJTFJobCreate, "sweep": SweepJobCreate, "basin": BasinJobCreate, "gaits": GaitSearchJobCreate,
-             "control-study": ControlStudyJobCreate, "mfpt": MfptJobCreate,
+             "control-study": ControlStudyJobCreate, "mfpt": MfptJobCreate, "loop-mfpt": LoopMfptJobCreate,
              "viability": ViabilityJobCreate}  # fmt: skip
 
 

@@ -138,6 +138,20 @@ class MfptSpec:
 
 
 @dataclass(frozen=True)
+class LoopMfptSpec:
+    controller: str = "lqr"
+    model: ModelSpec = field(default_factory=ModelSpec)
+    target_m: float = 0.55
+    psi0_deg: float = 35.0
+    start_zeta0: float = 0.9
+    noise: NoiseSpec = field(default_factory=lambda: NoiseSpec(pitch_drift_deg=0.0))
+    replicas: int = 100
+    runs: int = 64
+    seed: int = 0
+    kind: str = "loop-mfpt"
+
+
+@dataclass(frozen=True)
 class ViabilitySpec:
     model: ModelSpec = field(default_factory=ModelSpec)
     states: int = 40
@@ -149,9 +163,10 @@ class ViabilitySpec:
     kind: str = "viability"
 
 
-JobSpec = MJTFSpec | SweepSpec | BasinSpec | GaitSearchSpec | ControlStudySpec | MfptSpec | ViabilitySpec
+JobSpec = MJTFSpec | SweepSpec | BasinSpec | GaitSearchSpec | ControlStudySpec | MfptSpec | LoopMfptSpec | ViabilitySpec
 SPECS: dict[str, type] = {"mjtf": MJTFSpec, "sweep": SweepSpec, "basin": BasinSpec, "gaits": GaitSearchSpec,
-                          "control-study": ControlStudySpec, "mfpt": MfptSpec, "viability": ViabilitySpec}  # fmt: skip
+                          "control-study": ControlStudySpec, "mfpt": MfptSpec, "loop-mfpt": LoopMfptSpec,
+                          "viability": ViabilitySpec}  # fmt: skip
 _PARTS = {"model": ModelSpec, "noise": NoiseSpec, "guess": StateSpec, "start": StateSpec}
 
 

@@ -1,5 +1,11 @@
 """The jobs that study the section as a whole rather than one orbit: the MFPT chain (``parkour
-mfpt``) and the viability kernel (``parkour viability``), run in the job worker.
+mfpt``) and the viability kernel (``parkour viability``), run in the job worker; and, the MFPT's
+other half, a closed-loop controller's by splitting (``parkour mfpt --controller``), which has no
+section grid (the law's state is more than a grid holds) but the same figures.
+
+A controller's MFPT reports its progress per splitting run (the runner stops the worker on a
+cancel, or, on a Dask cluster, the progress call raises between runs); its draws all come from
+the job's seed, so a restart recomputes the same result.
 
 A viability job's result is ``parkour viability --json``'s figures and grids, with the viable
 state-action pairs packed as bits (``viable_pairs``: base64 of ``numpy.packbits`` over the C-order
@@ -13,15 +19,18 @@ import base64
 
 import numpy as np
 
+from backend.services.models import resolve_model
 from backend.services.simulation import gait_not_found_as_parameter_error
 from sim_core.controls import ControlSchedule
 from sim_core.params import ModelParams
 
 
 def section_study(spec, model: ModelParams, progress) -> dict:
-    """An MFPT or viability job's computation; its JSON result."""
+    """An MFPT (of a gait or a controller) or viability job's computation; its JSON result."""
     if spec.kind == "viability":
         return _viability(spec, model, progress)
+    if spec.kind == "loop-mfpt":
+        return _loop_mfpt(spec, model, progress)
     return _mfpt(spec, model, progress)
 
 
@@ -43,6 +52,18 @@ def _mfpt(spec, model: ModelParams, progress) -> dict:
         with gait_not_found_as_parameter_error():
             start = gait_of(model, ControlSchedule((controls,)), guess=guess).state
     return mfpt(model, controls, noise, start=start, grid=mfpt_grid_of(spec), progress=progress).to_dict()
+
+
+def _loop_mfpt(spec, model: ModelParams, progress) -> dict:
+    """``parkour mfpt --controller --json`` of the job's law, target, climb, noise and splitting."""
+    from experiments.loop_mfpt import Config, run
+    from sim_core.splitting import SplittingOptions
+
+    leg_length = resolve_model(None, spec.model.preset).robot.leg_length  # a stored preset is resolved already
+    options = SplittingOptions(replicas=spec.replicas, runs=spec.runs, seed=spec.seed)
+    config = Config(controller=spec.controller, target_m=spec.target_m, psi0_deg=spec.psi0_deg,
+                    start_zeta0=spec.start_zeta0, noise=spec.noise.model(), options=options)  # fmt: skip
+    return run(model, leg_length, config, progress=progress)
 
 
 def _viability(spec, model: ModelParams, progress) -> dict:

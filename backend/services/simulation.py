@@ -153,14 +153,14 @@ def run_study_here(spec) -> dict:
 
 
 def run_study(spec, chunk_map, progress) -> dict:
-    """A sweep, basin, gait-search, control-study, MFPT or viability job's computation; returns its JSON result."""
+    """A sweep, basin, gait-search, control-study, MFPT (chain or loop) or viability job's computation; its JSON."""
     from sim_core.gait_search import search_gaits
     from sim_core.sweep import energy_sweep, zeta0_values
 
     model = model_params(spec.model)
     if spec.kind == "control-study":
         return _control_study(spec, model, chunk_map, progress)
-    if spec.kind in ("mfpt", "viability"):
+    if spec.kind in ("mfpt", "loop-mfpt", "viability"):
         from backend.services.section_jobs import section_study
 
         return section_study(spec, model, progress)

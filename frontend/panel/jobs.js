@@ -6,6 +6,7 @@ import { draw, layout, plotSweep, plotBasin } from "./plots.js";
 import { element, fillTable, attributes } from "./dom.js";
 import { hideControlStudy, showControlStudy } from "./control_study.js";
 import { hideViability, showViability } from "./viability.js";
+import { hideLoopMfpt, showLoopMfpt } from "./loop_mfpt.js";
 
 const streams = new Map();
 const FINAL = ["done", "cancelled", "failed"];
@@ -16,6 +17,7 @@ export function describeJob(job) {
   if (job.kind === "sweep") return `psi0 ${spec.psi0_deg}°, zeta0 ${spec.zeta0_low}–${spec.zeta0_high}, ${spec.steps} steps`;
   if (job.kind === "control-study") return `${(spec.controllers || []).join(", ")} to ${spec.target_m} m, ${spec.seeds} × ${spec.jumps} jumps`;
   if (job.kind === "mfpt") return `MFPT of ${spec.psi0_deg}°/${spec.zeta0}, grid ${spec.grid}`;
+  if (job.kind === "loop-mfpt") return `MFPT of ${spec.controller} at ${spec.target_m} m, ${spec.runs} runs × ${spec.replicas} replicas`;
   if (job.kind === "viability") return `viability, ${spec.states}² states × ${spec.actions}² actions`;
   const legs = (spec.controls || []).map((leg) => `${leg.psi0_deg}°/${leg.zeta0}`).join(", ");
   const limit = spec.jump_limit ? `, up to ${spec.jump_limit} jumps` : "";
@@ -154,12 +156,19 @@ const JOB_FIELDS = {
   mfpt: [{ name: "mfpt_psi0", rule: "MfptJobCreate.psi0_deg", unit: "°" }, { name: "mfpt_zeta0", rule: "MfptJobCreate.zeta0", unit: "l0" },
     { name: "mfpt_velocity", rule: "NoiseIn.velocity", unit: SQRT_GL0 }, { name: "mfpt_drift", rule: "NoiseIn.pitch_drift_deg", unit: "°" },
     { name: "mfpt_grid", rule: "MfptJobCreate.grid" }, { name: "mfpt_pitch", rule: "MfptJobCreate.pitch_spacing", unit: "σ" }],
+  "loop-mfpt": [{ name: "loop_target", rule: "LoopMfptJobCreate.target_m", unit: "m" }, { name: "loop_velocity", rule: "LoopNoiseIn.velocity", unit: SQRT_GL0 },
+    { name: "loop_runs", rule: "LoopMfptJobCreate.runs" }, { name: "loop_replicas", rule: "LoopMfptJobCreate.replicas" }, { name: "loop_seed", rule: "LoopMfptJobCreate.seed" }],
   viability: [{ name: "viability_states", rule: "ViabilityJobCreate.states" }, { name: "viability_actions", rule: "ViabilityJobCreate.actions" },
     { name: "viability_psi0_low", rule: "ViabilityJobCreate.psi0_low_deg", unit: "°" }, { name: "viability_psi0_high", rule: "ViabilityJobCreate.psi0_high_deg", unit: "°" },
     { name: "viability_zeta0_low", rule: "ViabilityJobCreate.zeta0_low", unit: "l0" }, { name: "viability_zeta0_high", rule: "ViabilityJobCreate.zeta0_high", unit: "l0" }],
 };
 const MFPT_LOCATIONS = { psi0_deg: "mfpt_psi0", zeta0: "mfpt_zeta0", grid: "mfpt_grid", pitch_spacing: "mfpt_pitch",
   "noise.velocity": "mfpt_velocity", "noise.pitch_drift_deg": "mfpt_drift" };
+const LOOP_FIELDS = { controller: "loop_controller", target_m: "loop_target", "noise.velocity": "loop_velocity", runs: "loop_runs",
+  replicas: "loop_replicas", seed: "loop_seed" };
+// Under its kind too (the API's 422 names it first); the rule across fields (replicas × runs) is marked at replicas.
+const LOOP_LOCATIONS = { ...LOOP_FIELDS, ...Object.fromEntries(Object.entries(LOOP_FIELDS).map(([field, input]) => [`loop-mfpt.${field}`, input])),
+  "loop-mfpt": "loop_replicas" };
 const VIABILITY_LOCATIONS = { states: "viability_states", actions: "viability_actions", psi0_low_deg: "viability_psi0_low",
   psi0_high_deg: "viability_psi0_high", zeta0_low: "viability_zeta0_low", zeta0_high: "viability_zeta0_high" };
 const STUDY_LOCATIONS = { controllers: "study_controllers", target_m: "study_target", seeds: "study_seeds", jumps: "study_jumps",
@@ -185,6 +194,11 @@ async function jobSpec(form) {
     const body = { kind, psi0_deg: v.mfpt_psi0, zeta0: v.mfpt_zeta0, grid: v.mfpt_grid, pitch_spacing: v.mfpt_pitch,
       noise: { velocity: v.mfpt_velocity, pitch_drift_deg: v.mfpt_drift } };
     return { body, locations: MFPT_LOCATIONS };
+  }
+  if (kind === "loop-mfpt") {
+    const body = { kind, controller: form.elements.loop_controller.value, target_m: v.loop_target, noise: { velocity: v.loop_velocity, pitch_drift_deg: 0 },
+      runs: v.loop_runs, replicas: v.loop_replicas, seed: v.loop_seed };
+    return { body, locations: LOOP_LOCATIONS };
   }
   if (kind === "viability") {
     const body = { kind, states: v.viability_states, actions: v.viability_actions, psi0_low_deg: v.viability_psi0_low,
@@ -240,6 +254,7 @@ export async function showJob(id) {
   const job = results.job;
   hideControlStudy();
   hideViability();
+  hideLoopMfpt();
   if (results.levels) {
     // Only the levels with trials are drawn; a job that is not done says so in the title.
     const missing = results.missing_zeta0s || [];
@@ -259,6 +274,8 @@ export async function showJob(id) {
     plotBasin("job-plot", results.result, `Job ${id}: basin of attraction`);
   } else if (job.kind === "mfpt") {
     showMfpt(id, results.result);
+  } else if (job.kind === "loop-mfpt") {
+    showLoopMfpt(id, results.result);
   } else if (job.kind === "viability") {
     showViability(id, results.result);
   } else {

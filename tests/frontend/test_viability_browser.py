@@ -2,9 +2,12 @@
 a viability job (frontend/panel/viability.js) scheduled from the form, shown as the kernel's
 measure over the states and a clicked state's viable commands unpacked from the job's own bits;
 an MFPT job scheduled from the form with its noise, listed by what it asks and shown as its
-estimate and each grid's MFPT drawn from the job's own result. One service for both.
+estimate and each grid's MFPT drawn from the job's own result; a controller's MFPT by splitting
+(frontend/panel/loop_mfpt.js) from the form, its fields checked against the API's ranges, shown as
+its estimate in words and each run's failure probability. One service for all.
 
-Set PARKOUR_SCREENSHOTS=1 to refresh docs/screenshots/viability_job.png and mfpt_job.png.
+Set PARKOUR_SCREENSHOTS=1 to refresh docs/screenshots/viability_job.png, mfpt_job.png and
+loop_mfpt_job.png.
 """
 
 import base64
@@ -106,6 +109,43 @@ def test_an_mfpt_job_from_the_form_is_listed_and_shown_as_its_estimate_and_grids
         assert f"Job {job['id']}: MFPT " in said and f"{result['cells']} cells" in said
         assert page.evaluate("document.querySelector('#job-plot-actions').hidden"), "the viability view is put away"
         screenshot(page, "mfpt_job", "#jobs")
+
+
+def test_a_controllers_mfpt_job_from_the_form_is_shown_in_words_and_each_runs_probability(service):
+    base, token = service
+    with chromium() as browser, panel(browser, base, token, failed_requests=True) as page:
+        page.set_viewport_size({"width": 1360, "height": 1300})
+        page.click("nav [data-tab=jobs]")
+        page.select_option("#job-kind", "loop-mfpt")
+        page.select_option("#job-form [name=loop_controller]", "lqr")
+        # Checked against the API's range before anything is sent.
+        _schedule(page, "loop-mfpt", {"loop_replicas": 1001})
+        until(page, "document.querySelector('[name=loop_replicas]').getAttribute('aria-invalid') === 'true'")
+        assert "at most 1000" in page.evaluate("document.querySelector('#loop_replicas-error').textContent")
+        # Small and quick: a few runs of a few replicas, velocity noise only, no pitch drift.
+        _schedule(page, "loop-mfpt", {"loop_replicas": 40, "loop_runs": 8, "loop_velocity": 0.05, "loop_seed": 2})
+        until(page, "document.querySelector('#messages').textContent.includes('MFPT of lqr at 0.55 m, 8 runs × 40')")
+        job = _newest_job(base, token)
+        spec = job["spec"]
+        assert spec["kind"] == "loop-mfpt" and spec["controller"] == "lqr" and spec["target_m"] == 0.55
+        assert (spec["replicas"], spec["runs"], spec["seed"]) == (40, 8, 2)
+        assert spec["noise"]["velocity"] == 0.05 and spec["noise"]["pitch_drift_deg"] == 0
+        assert _done(base, job["id"])["state"] == "done"
+        result = httpx.get(f"{base}/api/v1/jobs/{job['id']}/results").json()["result"]
+        until(page, f"{NEWEST.format(cell='.state')} === 'done'")
+        assert page.evaluate(NEWEST.format(cell=".progress")).endswith("8/8"), "progress: one a splitting run"
+        page.click("#job-table tbody tr:first-child .show")
+        until(page, "document.querySelector('#job-plot').data?.[0]?.y?.length === 8")
+        drawn = page.evaluate("document.querySelector('#job-plot').data[0]")
+        assert drawn["y"] == result["splitting"]["probabilities"] and drawn["x"] == list(range(1, 9))
+        words = page.evaluate("document.querySelector('#job-summary').textContent")
+        mfpt, low, high = (f"{round(value):,}" for value in (result["mfpt_jumps"], *result["ci95"]))
+        assert f"Job {job['id']}: lqr holds 0.55 m for about {mfpt} jumps (95%: {low}–{high})" in words
+        assert "by splitting; λ₂ " in words and f"{result['lambda2']:.6f}" in words
+        screenshot(page, "loop_mfpt_job", "#jobs")
+        if page.locator("#job-table tbody tr .show").count() > 1:  # another job's view puts the words away
+            page.click("#job-table tbody tr:nth-child(2) .show")
+            until(page, "document.querySelector('#job-summary').hidden")
 
 
 def test_a_bad_field_is_marked_at_the_field_and_nothing_is_sent(service):

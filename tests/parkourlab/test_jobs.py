@@ -106,6 +106,10 @@ EVERY_FIELD = {
         psi0_deg=31.0, zeta0=0.93, start=(-0.93, -0.17), guess=(-0.9, -0.2), noise={"velocity": 0.02}, grid=20,
         pitch_spacing=0.7, model={"preset": "paper"}, experiment_id=2,
     ),
+    "loop-mfpt": lambda c: c.submit_loop_mfpt(
+        "deadbeat", target_m=0.6, psi0_deg=34.0, start_zeta0=0.88, noise={"velocity": 0.05, "pitch_drift_deg": 0.0},
+        replicas=50, runs=8, seed=4, model={"preset": "paper"}, experiment_id=2,
+    ),
     "viability": lambda c: c.submit_viability(
         states=30, actions=10, psi0_low_deg=20.0, psi0_high_deg=45.0, zeta0_low=0.75, zeta0_high=0.97,
         model={"preset": "paper"}, experiment_id=2,
@@ -196,3 +200,8 @@ def test_wait_raises_for_a_failed_job_unless_told_not_to():
             client.wait(7, poll_interval=0)
         assert raised.value.job == failed
         assert client.wait(7, poll_interval=0, check=False) == failed
+
+
+def test_a_controllers_mfpt_names_the_law_and_leaves_the_rest_to_the_service():
+    body = submitted(lambda c: c.submit_loop_mfpt("lqr", noise={"velocity": 0.05}, replicas=20, runs=2))
+    assert body == {"kind": "loop-mfpt", "controller": "lqr", "noise": {"velocity": 0.05}, "replicas": 20, "runs": 2}

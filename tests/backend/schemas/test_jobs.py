@@ -33,7 +33,7 @@ CONTROL = {"kind": "control-study"}
 MFPT = {"kind": "mfpt"}
 VIABILITY = {"kind": "viability"}
 BODIES = {"mjtf": MJTF, "sweep": SWEEP, "basin": BASIN, "gaits": GAITS, "control-study": CONTROL, "mfpt": MFPT,
-          "viability": VIABILITY}  # fmt: skip
+          "loop-mfpt": {"kind": "loop-mfpt"}, "viability": VIABILITY}  # fmt: skip
 
 
 @pytest.mark.parametrize("kind", JOB_KINDS)

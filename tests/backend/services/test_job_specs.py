@@ -8,6 +8,7 @@ from backend.schemas import (
     BasinJobCreate,
     ControlStudyJobCreate,
     GaitSearchJobCreate,
+    LoopMfptJobCreate,
     MfptJobCreate,
     MJTFJobCreate,
     SweepJobCreate,
@@ -16,6 +17,7 @@ from backend.schemas import (
 from backend.services.job_specs import (
     SPEC_VERSION,
     LegSpec,
+    LoopMfptSpec,
     MJTFSpec,
     NoiseSpec,
     StateSpec,
@@ -33,6 +35,7 @@ REQUESTS = [
     GaitSearchJobCreate(kind="gaits", controls=LEGS, grid=2),
     ControlStudyJobCreate(kind="control-study", controllers=["lqr", "pid"], seeds=3, noise={"velocity": 0.02}),
     MfptJobCreate(kind="mfpt", zeta0=0.96, start={"xdot": -0.9, "ydot": 0.1}, grid=12, noise={"pitch_drift_deg": 0}),
+    LoopMfptJobCreate(kind="loop-mfpt", controller="pid", target_m=0.5, noise={"velocity": 0.05}, replicas=20, seed=7),
     ViabilityJobCreate(kind="viability", states=12, actions=5, psi0_low_deg=20.0, zeta0_high=0.95),
 ]
 
@@ -71,3 +74,10 @@ def test_parts_decode_to_their_types():
     spec = decode(encode(spec_of(REQUESTS[2])))
     assert spec.controls == (LegSpec(30.0, 0.9),) and spec.guess is None
     assert decode(encode(spec_of(REQUESTS[0]))).guess == StateSpec(-0.93, -0.2)
+
+
+def test_a_controllers_mfpt_spec_keeps_its_law_splitting_and_no_pitch_drift():
+    spec = decode(encode(spec_of(REQUESTS[6])))
+    assert spec == LoopMfptSpec(controller="pid", target_m=0.5, noise=NoiseSpec(velocity=0.05, pitch_drift_deg=0.0),
+                                replicas=20, seed=7)  # fmt: skip
+    assert decode({"version": 1, "kind": "loop-mfpt"}).noise.pitch_drift_deg == 0.0, "its default: no drift"

@@ -254,3 +254,44 @@ def test_bad_control_studies_are_a_422_naming_the_field(client, auth, change, fi
     errors = response.json()["detail"]
     assert any(field in map(str, error["loc"]) and says in error["msg"] for error in errors), errors
     assert client.get("/api/v1/jobs").json()["items"] == []
+
+
+def test_a_controllers_mfpt_job_gives_the_splittings_numbers_for_its_seed(client, auth):
+    """The job is parkour mfpt --controller's computation (experiments.loop_mfpt.run) with the same
+    options and seed, to the last digit; its progress counts splitting runs."""
+    from experiments.loop_mfpt import Config, run
+    from sim_core.splitting import SplittingOptions
+
+    spec = {"kind": "loop-mfpt", "controller": "lqr", "target_m": 0.55, "replicas": 20, "runs": 2, "seed": 3,
+            "noise": {"velocity": 0.05, "pitch_drift_deg": 0.0}}  # fmt: skip
+    job = client.post("/api/v1/jobs", json=spec, headers=auth)
+    assert job.status_code == 202, job.text
+    done = _wait(client, job.json()["id"], timeout=300.0)  # a first compile of the loop's kernels
+    assert done["state"] == "done" and done["completed"] == done["total"] == 2, done
+    result = client.get(f"/api/v1/jobs/{job.json()['id']}/results").json()["result"]
+    preset = get_preset("paper")
+    config = Config(controller="lqr", target_m=0.55, noise=NoiseModel(velocity=0.05, pitch_drift_deg=0.0),
+                    options=SplittingOptions(replicas=20, runs=2, seed=3))  # fmt: skip
+    expected = run(preset.to_model(), preset.leg_length, config)
+    for key in ("mfpt_jumps", "lambda2", "lambda2_jumps"):
+        assert result[key] == pytest.approx(expected[key], rel=1e-9), key
+    assert result["ci95"][0] == pytest.approx(expected["ci95"][0], rel=1e-9)
+    assert result["ci95"][1:] == expected["ci95"][1:] == [None], "two runs: a t interval open above"
+    assert result["splitting"]["probabilities"] == pytest.approx(expected["splitting"]["probabilities"], rel=1e-9)
+    assert result["method"] == "splitting" and result["controller"] == "lqr" and result["splitting"]["seed"] == 3
+
+
+@pytest.mark.parametrize(
+    ("change", "field", "says"),
+    [
+        ({"controller": "mpc"}, "controller", "'pid', 'pid-pitch', 'lqr' or 'deadbeat'"),
+        ({"noise": {"velocity": 0.05, "pitch_drift_deg": 0.5}}, "pitch_drift_deg", "must be 0 for a controller's MFPT"),
+        ({"replicas": 1000, "runs": 64}, "loop-mfpt", "replicas x runs must be at most"),
+    ],
+)
+def test_bad_controller_mfpts_are_a_422_naming_the_field_never_a_500(client, auth, change, field, says):
+    response = client.post("/api/v1/jobs", json={"kind": "loop-mfpt", **change}, headers=auth)
+    assert response.status_code == 422, response.text
+    errors = response.json()["detail"]
+    assert any(field in map(str, error["loc"]) and says in error["msg"] for error in errors), errors
+    assert client.get("/api/v1/jobs").json()["items"] == []
