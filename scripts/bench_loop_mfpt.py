@@ -60,7 +60,7 @@ def case(model, leg_length: float, name: str, velocity: float, trials: int, jump
         "mfpt_jumps": split.mfpt_jumps,
         "mfpt_ci95": list(split.ci95),
         "mfpt_seconds": time.perf_counter() - began,
-        "probability": split.probability,
+        "rate": split.rate,
         "runs_extinct": sum(p == 0.0 for p in split.probabilities),
     }
     if with_mc:

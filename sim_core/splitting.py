@@ -13,10 +13,12 @@ Lelièvre 2019):
    the recorded exits; all that rose least are dropped, each replaced by a copy of a survivor cut
    where it first passed that level and continued with fresh noise, until every replica has
    failed; ``p`` is the product of the survivors' shares. Unbiased whatever the score (the score
-   sets the variance); ``runs`` independent runs give its error.
-3. From home, failures arrive at rate ``p / T_loop`` (the Hill relation): ``MFPT = climb +
-   (1 - climb failures) T_loop / p``, and ``lambda2 = 1 - p / T_loop``, the second eigenvalue of
-   a metastable loop's chain.
+   sets the variance).
+3. From home, failures arrive at rate ``p / T_loop`` (the Hill relation). ``runs`` independent
+   runs each do 1 and 2 (their own long run, so the interval counts its sampling too: one long
+   run shared by all read 10-30% off in its exits and ``T_loop`` beyond an interval of the AMS
+   alone); with ``r`` the runs' mean rate, ``MFPT = climb + (1 - climb failures) / r`` with a t
+   interval on ``r``, and ``lambda2 = 1 - r``, the second eigenvalue of a metastable loop's chain.
 
 A loop is metastable only without pitch drift: with it the pitch's random walk, unbounded, sets
 the failures when it reaches the leg's range (``parkour control-study`` measures those runs).
@@ -41,16 +43,16 @@ from sim_core.validation import ParameterError, check_range
 
 @dataclass(frozen=True)
 class SplittingOptions:
-    """How hard the estimate works: ``replicas`` per AMS run, ``runs`` independent runs, the long
-    run's ``pilot_jumps``, home and exit as quantiles of its scores, the climbs measured, the
-    longest excursion [jumps], the seed of every draw."""
+    """How hard the estimate works: ``runs`` independent runs, each with its own long run of
+    ``pilot_jumps``, home and exit at quantiles of its scores, ``climbs`` climbs measured and one
+    AMS of ``replicas``; the longest excursion [jumps]; the seed of every draw."""
 
-    replicas: int = 200
-    runs: int = 16
-    pilot_jumps: int = 20_000
+    replicas: int = 100
+    runs: int = 64  # many runs, fewer replicas: p's spread over runs is skewed, its interval needs them
+    pilot_jumps: int = 5_000
     home_quantile: float = 0.5
     exit_quantile: float = 0.9
-    climbs: int = 200
+    climbs: int = 4
     excursion_limit: int = 20_000
     seed: int = 0
 
@@ -74,16 +76,20 @@ class LoopMfpt:
     noise: NoiseModel
     mfpt_jumps: float
     ci95: tuple[float, float]
-    probability: float  # p: an exit fails before it comes home (the runs' mean)
-    probabilities: tuple[float, ...]
-    holding: Holding
+    probabilities: tuple[float, ...]  # p of each run: an exit fails before it comes home
+    holdings: tuple[Holding, ...]  # each run's holding state
     seconds: float
     options: SplittingOptions
 
     @property
+    def rate(self) -> float:
+        """Failures per jump from home: the runs' mean of ``p / T_loop``."""
+        return float(np.mean([p / h.loop_jumps for p, h in zip(self.probabilities, self.holdings, strict=True)]))
+
+    @property
     def lambda2_jumps(self) -> float:
         """``1 / (1 - lambda2) = T_loop / p``: the MFPT from home."""
-        return self.holding.loop_jumps / self.probability if self.probability > 0 else math.inf
+        return 1.0 / self.rate if self.rate > 0 else math.inf
 
     @property
     def relative_error(self) -> float:
@@ -94,30 +100,29 @@ class LoopMfpt:
         """``parkour mfpt --controller ... --json``: the chain's keys (no grid: ``cells`` and
         ``discretisation_error`` are null; an MFPT no run could reach is null) and the splitting's."""
         finite = math.isfinite(self.mfpt_jumps)
-        holding = self.holding
+        holdings = self.holdings
         return {
             "mfpt_jumps": self.mfpt_jumps if finite else None,
             "lambda2": 1.0 - 1.0 / self.lambda2_jumps,
             "lambda2_jumps": self.lambda2_jumps if finite else None,
             "discretisation_error": None,
-            "relative_error": self.relative_error if finite else None,
-            "ci95": list(self.ci95) if finite else None,
+            "relative_error": self.relative_error if math.isfinite(self.relative_error) else None,
+            "ci95": [bound if math.isfinite(bound) else None for bound in self.ci95] if finite else None,
             "cells": None,
             "seconds": self.seconds,
             "method": "splitting",
             "controller": self.controller,
             "noise": self.noise.to_dict(),
             "splitting": {
-                "probability": self.probability,
+                "rate": self.rate,
                 "probabilities": list(self.probabilities),
-                "loop_jumps": holding.loop_jumps,
-                "loop_relative_error": holding.loop_relative_error,
-                "climb_jumps": holding.climb_jumps,
-                "climb_failures": holding.climb_failures,
-                "exits": int(holding.exit_states.shape[0]),
-                "home_score": holding.home,
-                "exit_score": holding.exit,
-                "pilot_failures": holding.pilot_failures,
+                "loop_jumps": [holding.loop_jumps for holding in holdings],
+                "climb_jumps": _mean(holding.climb_jumps for holding in holdings),
+                "climb_failures": _mean(holding.climb_failures for holding in holdings),
+                "exits": [int(holding.exit_states.shape[0]) for holding in holdings],
+                "home_score": _mean(holding.home for holding in holdings),
+                "exit_score": _mean(holding.exit for holding in holdings),
+                "pilot_failures": sum(holding.pilot_failures for holding in holdings),
                 **asdict(self.options),
             },
         }
@@ -157,24 +162,29 @@ def loop_mfpt(
     rng = np.random.default_rng(options.seed)
     loop = Loop(model, controller, noise, options.excursion_limit)
     quantiles = (options.home_quantile, options.exit_quantile)
-    holding = measure_holding(loop, start, start_zeta0, options.pilot_jumps, quantiles, options.climbs, rng)
-    probabilities = []
-    for run in range(options.runs):
+    holdings, probabilities = [], []
+    for run in range(options.runs):  # each run its own long run: the interval counts its sampling too
+        holding = measure_holding(loop, start, start_zeta0, options.pilot_jumps, quantiles, options.climbs, rng)
+        holdings.append(holding)
         probabilities.append(failure_probability(loop, holding, options.replicas, rng))
         if progress is not None:
             progress(run + 1, options.runs)
-    p = float(np.mean(probabilities))
-    if p == 0.0:
+    rates = np.array([p / holding.loop_jumps for p, holding in zip(probabilities, holdings, strict=True)])
+    climb = _mean(holding.climb_jumps for holding in holdings)
+    survives = 1.0 - _mean(holding.climb_failures for holding in holdings)
+    rate = float(rates.mean())
+    if rate == 0.0:
         mfpt, ci95 = math.inf, (math.inf, math.inf)
     else:
-        p_error = float(np.std(probabilities, ddof=1)) / math.sqrt(options.runs) / p
-        spread = 1.0 + student_t.ppf(0.975, options.runs - 1) * math.hypot(p_error, holding.loop_relative_error)
-        climb, survives = holding.climb_jumps, 1.0 - holding.climb_failures
-        from_home = holding.loop_jumps / p
-        mfpt = climb + survives * from_home
-        ci95 = (climb + survives * from_home / spread, climb + survives * from_home * spread)
-    return LoopMfpt(controller.name, controller.target, noise, mfpt, ci95, p, tuple(probabilities), holding,
+        half = float(student_t.ppf(0.975, options.runs - 1) * rates.std(ddof=1) / math.sqrt(options.runs))
+        mfpt = climb + survives / rate
+        ci95 = (climb + survives / (rate + half), climb + survives / (rate - half) if rate > half else math.inf)
+    return LoopMfpt(controller.name, controller.target, noise, mfpt, ci95, tuple(probabilities), tuple(holdings),
                     time.perf_counter() - began, options)  # fmt: skip
+
+
+def _mean(values) -> float:
+    return float(np.mean(list(values)))
 
 
 def failure_probability(loop: Loop, holding: Holding, replicas: int, rng: np.random.Generator) -> float:
