@@ -74,10 +74,10 @@ def mfpt_command(
         typer.Option("--target", help=f"Height the law holds [m] (with --controller; default {DEFAULT_TARGET_M:g})."),
     ] = None,
     replicas: Annotated[
-        int | None, typer.Option("--replicas", help="Splitting: replicas per run (with --controller; default 200).")
+        int | None, typer.Option("--replicas", help="Splitting: replicas per run (with --controller; default 100).")
     ] = None,
     runs: Annotated[
-        int | None, typer.Option("--runs", help="Splitting: independent runs, for the interval (default 16).")
+        int | None, typer.Option("--runs", help="Splitting: independent runs, for the interval (default 64).")
     ] = None,
     seed: Annotated[int | None, typer.Option("--seed", help="Splitting: the seed of every draw (default 0).")] = None,
     as_json: JsonOption = False,

@@ -37,9 +37,10 @@ def controller_mfpt(
     if as_json:
         print_json(payload)
         return
-    low, high = payload["ci95"] or (None, None)
     if payload["mfpt_jumps"] is None:
         print(f"{controller}: no splitting run reached a failure; MFPT beyond what they can reach")
         return
-    print(f"{controller}: MFPT {payload['mfpt_jumps']:.4g} jumps (95% {low:.3g} - {high:.3g}), "
+    low, high = payload["ci95"]
+    upper = "inf" if high is None else f"{high:.3g}"  # a t interval on the rate open above
+    print(f"{controller}: MFPT {payload['mfpt_jumps']:.4g} jumps (95% {low:.3g} - {upper}), "
           f"lambda2 {payload['lambda2']:.8f}, {payload['seconds']:.1f} s")  # fmt: skip

@@ -11,14 +11,14 @@ Lelièvre 2019):
    between exits, on a long run; the climb from the start to home on short runs.
 2. ``p``, the chance that an exit fails before it comes home, by AMS: ``replicas`` excursions from
    the recorded exits; all that rose least are dropped, each replaced by a copy of a survivor cut
-   where it first passed that level and continued with fresh noise, until every replica has
-   failed; ``p`` is the product of the survivors' shares. Unbiased whatever the score (the score
-   sets the variance).
+   where it first passed that level and continued with fresh noise (copied whole when it passed
+   the level only by failing), until every replica has failed; ``p`` is the product of the
+   survivors' shares. Unbiased whatever the score (the score sets the variance).
 3. From home, failures arrive at rate ``p / T_loop`` (the Hill relation). ``runs`` independent
-   runs each do 1 and 2 (their own long run, so the interval counts its sampling too: one long
-   run shared by all read 10-30% off in its exits and ``T_loop`` beyond an interval of the AMS
-   alone); with ``r`` the runs' mean rate, ``MFPT = climb + (1 - climb failures) / r`` with a t
-   interval on ``r``, and ``lambda2 = 1 - r``, the second eigenvalue of a metastable loop's chain.
+   runs each do 1 and 2 (each its own long run, so the interval counts its sampling too); with
+   ``r`` the runs' mean rate, ``MFPT = climb + (1 - climb failures) / r`` with a t interval on
+   ``r``, and ``lambda2 = 1 - r``, the second eigenvalue of a metastable loop's chain. (The Hill
+   relation's ``T_loop / p`` leaves out the failing excursion's own length: small where p is.)
 
 A loop is metastable only without pitch drift: with it the pitch's random walk, unbounded, sets
 the failures when it reaches the leg's range (``parkour control-study`` measures those runs).
@@ -201,8 +201,13 @@ def failure_probability(loop: Loop, holding: Holding, replicas: int, rng: np.ran
         log_p += math.log1p(-dropped.size / replicas)
         survivors = np.flatnonzero(levels > floor)
         for i in dropped:
-            states, touchdowns, scores, _ = paths[rng.choice(survivors)]
-            cut = int(np.argmax(scores > floor))  # the survivor's first touchdown past the level
+            parent = paths[rng.choice(survivors)]
+            states, touchdowns, scores, _ = parent
+            above = scores > floor
+            if not above.any():  # the survivor crossed the level by failing: the copy fails with it
+                paths[i], levels[i] = parent, parent[3]
+                continue
+            cut = int(np.argmax(above))  # the survivor's first touchdown past the level
             on_states, on_touchdowns, on_scores, level = loop.excursion(states[cut], int(touchdowns[cut]), holding, rng)
             paths[i] = (
                 np.concatenate([states[:cut], on_states]),

@@ -5,8 +5,9 @@ A long run from the climb's start (its first :data:`SETTLE_JUMPS` left out; a fa
 again) gives the features' mean and covariance per wall, hence the score, the Mahalanobis distance
 from holding (:mod:`sim_core.splitting_kernels`). Home is ``score < a`` and an exit the first
 ``score >= b`` after home, ``a`` and ``b`` quantiles of the run's scores; ``T_loop`` is the
-run's jumps per exit, its error from ten batches. The climb from the start to home is measured
-on its own short runs: their mean length and the share that fail before home.
+run's jumps per exit (its sampling error shows in the spread of :mod:`sim_core.splitting`'s
+independent runs). The climb from the start to home is measured on its own short runs: their
+mean length and the share that fail before home.
 """
 
 from __future__ import annotations
@@ -26,14 +27,13 @@ from sim_core.validation import ParameterError
 
 SETTLE_JUMPS = 50  # the climb's first jumps, left out of the holding state's statistics
 MIN_EXITS = 30  # a long run with fewer exits than this cannot measure T_loop
-BATCHES = 10  # T_loop's error: the exits counted in this many stretches of the run
 
 
 @dataclass(frozen=True)
 class Holding:
     """The score (per-wall ``mean`` and ``whitening``), the ``home`` and ``exit`` levels, the
-    exits the long run recorded (loop states and touchdown indices), ``T_loop`` [jumps] and its
-    relative standard error, the long run's restarts after a failure, and the climb: its mean
+    exits the long run recorded (loop states and touchdown indices), ``T_loop`` [jumps], the long
+    run's restarts after a failure, and the climb: its mean
     jumps to home (a failed climb counted to its failure) and the share failing before home."""
 
     mean: np.ndarray
@@ -43,7 +43,6 @@ class Holding:
     exit_states: np.ndarray
     exit_touchdowns: np.ndarray
     loop_jumps: float
-    loop_relative_error: float
     pilot_failures: int
     climb_jumps: float
     climb_failures: float
@@ -114,18 +113,16 @@ def measure_holding(
     mean, whitening = _whitening(pieces, loop.target)
     scores = [scores_of(states, k0, loop.target, mean, whitening) for states, k0 in pieces]
     home, exit_level = (float(level) for level in np.quantile(np.concatenate(scores), quantiles))
-    exits, touchdowns, counts = [], [], []
+    exits, touchdowns = [], []
     for (states, k0), score in zip(pieces, scores, strict=True):
         at = _exits(score, home, exit_level)
         exits.append(states[at])
         touchdowns.append(k0 + at)
-        counts.append(np.histogram(at, bins=BATCHES, range=(0, score.size))[0] * BATCHES / score.size)
     count = sum(at.size for at in touchdowns)
     if count < MIN_EXITS:
         raise ParameterError("pilot_jumps", f"the long run left home {count} times: at least {MIN_EXITS} needed")
-    rates = np.concatenate(counts)  # exits per jump, per stretch
     holding = Holding(mean, whitening, home, exit_level, np.concatenate(exits), np.concatenate(touchdowns),
-                      recorded / count, float(rates.std(ddof=1) / math.sqrt(rates.size) / rates.mean()), failures,
+                      recorded / count, failures,
                       math.nan, math.nan)  # fmt: skip
     return _with_climb(loop, holding, start, start_zeta0, climbs, rng)
 

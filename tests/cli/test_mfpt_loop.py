@@ -15,6 +15,13 @@ def test_a_controllers_mfpt_keeps_the_chains_keys():
     assert payload["splitting"]["runs"] == 2 and payload["splitting"]["replicas"] == 20
 
 
+def test_the_words_say_an_interval_open_above():
+    """Two runs: the t interval on the rate reaches 0, so its upper end is infinite (null in JSON)."""
+    result = invoke("mfpt", "--controller", "pid", *QUICK)
+    assert result.exit_code == 0, result.output
+    assert result.output.startswith("pid: MFPT ") and "- inf), lambda2 " in result.output
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [

@@ -11,7 +11,7 @@ from sim_core.control_study import control_study
 from sim_core.loop_step import LOOP_STATE_SIZE
 from sim_core.noise import NoiseModel
 from sim_core.presets import get_preset
-from sim_core.splitting import LoopMfpt, SplittingOptions, check_metastable, loop_mfpt
+from sim_core.splitting import LoopMfpt, SplittingOptions, check_metastable, failure_probability, loop_mfpt
 from sim_core.splitting_holding import Holding
 from sim_core.validation import ParameterError
 
@@ -47,6 +47,41 @@ def test_splitting_agrees_with_monte_carlo_of_the_same_loop(name, seed):
     assert len(payload["splitting"]["probabilities"]) == len(payload["splitting"]["loop_jumps"]) == 16
 
 
+class RandomWalk:
+    """A toy loop for the AMS alone: the score walks by N(0, 0.3) a step from the exit at 0.5, home
+    below 0; a step fails with chance 0.03 whatever the score (a failure from a low score, which
+    no level leads to), and at 2."""
+
+    def excursion(self, state, touchdown, holding, rng):
+        scores, failed = [float(state[0])], False
+        while True:
+            if rng.random() < 0.03:
+                failed = True
+                break
+            scores.append(scores[-1] + rng.normal(0.0, 0.3))
+            if scores[-1] >= 2.0:
+                failed = True
+                break
+            if scores[-1] < 0.0:
+                break
+        scores = np.array(scores)
+        level = math.inf if failed else float(scores.max())
+        return scores[:, None], touchdown + np.arange(scores.size), scores, level
+
+
+def test_splitting_estimates_a_known_chance_without_bias():
+    """p by AMS against plain sampling of the same excursions: a survivor that crossed the level
+    by failing is copied whole (cloning it from its start instead biased p low: 0.07 for 0.18)."""
+    rng = np.random.default_rng(4)
+    walk = RandomWalk()
+    holding = type("Exits", (), {"exit_states": np.array([[0.5]]), "exit_touchdowns": np.array([0])})()
+    sampled = [math.isinf(walk.excursion(np.array([0.5]), 0, holding, rng)[3]) for _ in range(20_000)]
+    truth, truth_error = np.mean(sampled), np.std(sampled) / math.sqrt(len(sampled))
+    estimates = [failure_probability(walk, holding, 20, rng) for _ in range(300)]
+    error = math.hypot(np.std(estimates) / math.sqrt(len(estimates)), truth_error)
+    assert abs(np.mean(estimates) - truth) < 4 * error, (np.mean(estimates), truth, error)
+
+
 def test_pitch_drift_is_refused_naming_the_field():
     with pytest.raises(ParameterError, match="not metastable") as caught:
         check_metastable(NoiseModel())
@@ -67,7 +102,7 @@ def test_options_out_of_range_name_the_field(field, value):
 
 def test_no_failure_reached_is_said_as_null_not_a_number():
     exits, touchdowns = np.zeros((1, LOOP_STATE_SIZE)), np.zeros(1, dtype=int)
-    holding = Holding(np.zeros((2, 5)), np.zeros((2, 5, 5)), 1.0, 2.0, exits, touchdowns, 20.0, 0.05, 0, 10.0, 0.0)
+    holding = Holding(np.zeros((2, 5)), np.zeros((2, 5, 5)), 1.0, 2.0, exits, touchdowns, 20.0, 0, 10.0, 0.0)
     result = LoopMfpt("lqr", 2.0, NoiseModel(pitch_drift_deg=0.0), math.inf, (math.inf, math.inf), (0.0, 0.0),
                       (holding, holding), 1.0, SplittingOptions())  # fmt: skip
     payload = result.to_dict()
