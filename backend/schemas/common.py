@@ -9,6 +9,9 @@ from typing import Annotated, Generic, Literal, TypeVar
 
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field
 
+from sim_core.climb_records import CHUTE_TOP, FLOOR
+from sim_core.control_laws import PSI0_RANGE_DEG
+
 
 def _inside_in_radians(psi0_deg: float) -> float:
     # The kernel takes radians: an angle a hair inside (0, 90) degrees (5e-324) must not become 0 there.
@@ -37,6 +40,13 @@ def _iso_8601(value: object) -> object:
 
 IsoDateTime = Annotated[datetime.datetime, BeforeValidator(_iso_8601)]
 Zeta0 = Annotated[float, Field(gt=0.0, lt=1.0, description="leg length at touchdown [l0], in (0, 1)")]
+# A controller's climb (the control study's and a controller's MFPT): the height it holds, its leg angle.
+TargetHeightM = Annotated[
+    float, Field(gt=FLOOR, le=CHUTE_TOP, description="height to hold [m], above the floor, within the chute")
+]
+NominalPsi0Deg = Annotated[
+    float, Field(ge=PSI0_RANGE_DEG[0], le=PSI0_RANGE_DEG[1], description="nominal leg angle [deg]")
+]
 Label = Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[\w.:/-]+$")]  # a tag
 Tags = Annotated[list[Label], Field(max_length=32)]
 Notes = Annotated[str, Field(max_length=100_000)]

@@ -16,11 +16,13 @@ from backend.schemas.common import (
     MAX_TRIALS,
     LegIn,
     ModelIn,
+    NominalPsi0Deg,
     Page,
     Psi0Deg,
     RecordRef,
     StateIn,
     Strict,
+    TargetHeightM,
     Zeta0,
 )
 from backend.schemas.job_budget import (
@@ -32,8 +34,7 @@ from backend.schemas.job_budget import (
 )
 from backend.schemas.mfpt_jobs import LoopMfptJobCreate, MfptJobCreate
 from backend.schemas.noise import NoiseIn
-from sim_core.climb_records import CHUTE_TOP, FLOOR
-from sim_core.control_laws import KINDS, PSI0_RANGE_DEG
+from sim_core.control_laws import KINDS
 from sim_core.viability_grid import DEFAULT_PSI0_DEG, DEFAULT_ZETA0
 
 CLIENT_PATTERN = r"^[\w.:@/-]{1,64}$"  # the X-Parkour-Client header: who submits, for the queue's fairness
@@ -138,12 +139,8 @@ class ControlStudyJobCreate(Strict):
     controllers: Annotated[
         list[str], Field(min_length=1, max_length=8, description=f"names, each once, of: {', '.join(KINDS)}")
     ] = ["pid", "pid-pitch", "lqr", "deadbeat"]
-    target_m: Annotated[
-        float, Field(gt=FLOOR, le=CHUTE_TOP, description="height to hold [m], above the floor, within the chute")
-    ] = 0.55
-    psi0_deg: Annotated[
-        float, Field(ge=PSI0_RANGE_DEG[0], le=PSI0_RANGE_DEG[1], description="nominal leg angle [deg]")
-    ] = 35.0
+    target_m: TargetHeightM = 0.55
+    psi0_deg: NominalPsi0Deg = 35.0
     start_zeta0: Zeta0 = 0.9
     jumps: Annotated[int, Field(ge=1, le=100_000)] = 400
     seeds: Annotated[int, Field(ge=1, le=MAX_TRIALS)] = 200

@@ -14,11 +14,10 @@ from typing import Annotated, Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from backend.schemas.common import ModelIn, Psi0Deg, RecordRef, StateIn, Strict, Zeta0
+from backend.schemas.common import ModelIn, NominalPsi0Deg, Psi0Deg, RecordRef, StateIn, Strict, TargetHeightM, Zeta0
 from backend.schemas.job_budget import LOOP_MFPT_MAX_REPLICA_RUNS, MFPT_MAX_GRID, within_budget
 from backend.schemas.noise import NoiseIn
-from sim_core.climb_records import CHUTE_TOP, FLOOR
-from sim_core.control_laws import KINDS, PSI0_RANGE_DEG
+from sim_core.control_laws import KINDS
 from sim_core.errors import ParameterError
 from sim_core.mfpt_grid import ChainGrid
 from sim_core.noise import ASYMMETRY_LIMITS, SIGMA_LIMITS, NoiseModel
@@ -100,12 +99,8 @@ class LoopMfptJobCreate(Strict):
     experiment_id: RecordRef | None = None
     model: ModelIn = ModelIn()
     controller: ControllerKind = ControllerKind.LQR
-    target_m: Annotated[
-        float, Field(gt=FLOOR, le=CHUTE_TOP, description="height to hold [m], above the floor, within the chute")
-    ] = 0.55
-    psi0_deg: Annotated[
-        float, Field(ge=PSI0_RANGE_DEG[0], le=PSI0_RANGE_DEG[1], description="nominal leg angle [deg]")
-    ] = 35.0
+    target_m: TargetHeightM = 0.55
+    psi0_deg: NominalPsi0Deg = 35.0
     start_zeta0: Zeta0 = 0.9
     noise: LoopNoiseIn = LoopNoiseIn()
     replicas: Annotated[int, Field(ge=2, le=1000, description="replicas per splitting run")] = 100
