@@ -213,7 +213,7 @@ def failure_probability(loop: Loop, holding: Holding, replicas: int, rng: np.ran
                 np.concatenate([states[:cut], on_states]),
                 np.concatenate([touchdowns[:cut], on_touchdowns]),
                 np.concatenate([scores[:cut], on_scores]),
-                max(level, float(scores[: cut + 1].max())),
+                level,  # the prefix stays at or below the floor, and the continuation starts above it
             )
             levels[i] = paths[i][3]
     return math.exp(log_p)

@@ -143,10 +143,11 @@ def _seed(rng: np.random.Generator) -> int:
 def _whitening(pieces, target: float) -> tuple[np.ndarray, np.ndarray]:
     """Per wall (touchdown parity): the features' mean and ``W`` with ``|W d|^2 = d' C^+ d``;
     a direction the run never varies is left out."""
+    features = np.concatenate([features_table(states, target) for states, _ in pieces])
+    sides = np.concatenate([(k0 + np.arange(len(states))) % 2 for states, k0 in pieces])
     mean, whitening = [], []
     for side in (0, 1):
-        rows = np.concatenate([features_table(states, target)[(k0 + np.arange(len(states))) % 2 == side]
-                               for states, k0 in pieces])  # fmt: skip
+        rows = features[sides == side]
         mean.append(rows.mean(axis=0))
         values, vectors = np.linalg.eigh(np.cov(rows, rowvar=False))
         kept = values > 1e-12 * values.max()
