@@ -4,8 +4,9 @@
 frames whole and bounded). A reader thread decodes frames and tracks the robot's state from its
 telemetry and acknowledgements; a heartbeat thread keeps the robot armed. Silence from the robot
 for ``heartbeat_timeout`` is a lost link: the state becomes ``disconnected`` and the ``on_lost``
-callbacks run (a live run aborts, keeping what it recorded). Leg commands are checked against the
-servo limits before they are sent. Every state change is kept in ``transitions``.
+callbacks run (a live run aborts, keeping what it recorded). Leg commands are checked against the servo
+limits; commands are resent until acknowledged (:mod:`~backend.robot.link_acks`). Every state change,
+and a restart of the robot (:mod:`~backend.robot.link_restarts`), is kept in ``transitions``.
 
 Faults a lab meets are bounded and counted, never raised into a caller's lap: only Receive Packets from
 ``robot_address`` are heard (another radio's are ``foreign_frames``), and the radio's own Transmit Statuses
@@ -27,7 +28,9 @@ import serial
 
 from backend.robot.latch import EstopLatch
 from backend.robot.limits import ServoLimits
+from backend.robot.link_acks import COMMAND_MARGIN, Acknowledgements, confirm, describe
 from backend.robot.link_port import WRITE_TIMEOUT, LinkPort
+from backend.robot.link_restarts import restart_reason
 from backend.robot.link_types import FROM_ROBOT, SAFE, EstopResult, LinkError, LinkState, Transition, telemetry_moves
 from backend.robot.messages import Ack, Command, Kind, Leg, ProtocolError, Result, SetLeg, Telemetry, decode
 from backend.robot.xbee import ROBOT_ADDRESS, TX_STATUS, FrameError, FrameParser, parse_rx_packet, parse_tx_status
@@ -36,7 +39,7 @@ from backend.robot.xbee import ROBOT_ADDRESS, TX_STATUS, FrameError, FrameParser
 # keeps the rule; the robot's watchdog allows 1 s.
 HEARTBEAT_PERIOD = 0.1
 HEARTBEAT_TIMEOUT = 1.0  # [s]
-COMMAND_TIMEOUT = 0.5  # [s] for an acknowledgement
+COMMAND_TIMEOUT = 0.5  # [s] for the telemetry showing an acknowledged command's effect
 ESTOP_TIMEOUT = 0.15  # [s] an e-stop's whole budget, blocked writes included: the API answers within 200 ms
 ESTOP_REPEAT = 0.02  # [s] between e-stop repeats until acknowledged
 
@@ -56,11 +59,8 @@ class RobotLink:
         robot_address: int = ROBOT_ADDRESS,
         latch: EstopLatch | None = None,
     ):
-        self.url = url
-        self.baud = baud
-        self.limits = limits or ServoLimits()
-        self.heartbeat_timeout = heartbeat_timeout
-        self.robot_address = robot_address
+        self.url, self.baud, self.robot_address = url, baud, robot_address
+        self.limits, self.heartbeat_timeout = limits or ServoLimits(), heartbeat_timeout
         self.state = LinkState.DISCONNECTED
         self.transitions: list[Transition] = []
         self.telemetry: Telemetry | None = None
@@ -73,7 +73,9 @@ class RobotLink:
         self.on_lost: list[Callable[[str], None]] = []
         self.port = LinkPort(url, baud, robot_address)  # frames out, whole and bounded, and their counts
         self._seq = 0
-        self._acks: dict[int, tuple[threading.Event, list[Ack]]] = {}
+        self._acks = Acknowledgements()  # awaited, by seq; and the commands' resends
+        self.restarts, self.last_restart = 0, None  # the robot's restarts since this link was made; the last's reason
+        self._last_telemetry: Telemetry | None = None  # the last heard, on any connection (the reader's)
         self._lock = threading.Lock()
         self._last_heard = 0.0
         self._stop = threading.Event()
@@ -92,9 +94,7 @@ class RobotLink:
         self.telemetry = None
         self.parser = FrameParser()
         self._forget_estop()
-        if self.latch.held:
-            self.latch.unconfirmed()  # the robot may have restarted, or never heard it
-            self._pending_estop = Command(self._next_seq(), Kind.ESTOP)
+        self._estop_first()  # the robot may have restarted, or never heard it
         self.port.open()
         self._stop.clear()
         self._last_heard = time.monotonic()
@@ -104,12 +104,12 @@ class RobotLink:
         ]
         for thread in self._threads:
             thread.start()
-        deadline = time.monotonic() + timeout
-        while self.telemetry is None:
-            if time.monotonic() > deadline:
-                self.close()
-                raise LinkError(f"no telemetry from the robot at {self.url} within {timeout:g} s")
-            time.sleep(0.005)
+        try:
+            confirm(lambda: self.telemetry is not None, timeout,
+                    lambda: f"no telemetry from the robot at {self.url} within {timeout:g} s")  # fmt: skip
+        except LinkError:
+            self.close()
+            raise
         return self.state
 
     def reconnect(self, timeout: float = 1.0) -> LinkState:
@@ -147,20 +147,10 @@ class RobotLink:
         refuses DISARM and is as safe); raises LinkError if neither is confirmed in time."""
         if self.state == LinkState.DISCONNECTED:
             raise LinkError("the link is down: the robot's watchdog disarms it")
-        message = Command(self._next_seq(), Kind.DISARM)
-        event, box = self._expect(message.seq)
-        try:
-            self._write(message)
-            if not event.wait(COMMAND_TIMEOUT):
-                raise LinkError(f"no acknowledgement for DISARM within {COMMAND_TIMEOUT:g} s")
-        finally:
-            self._acks.pop(message.seq, None)
+        ack = self._acknowledged(Command(self._next_seq(), Kind.DISARM))
         heard = self._telemetry_heard  # telemetry counted from here on was sent after the DISARM's ack
-        deadline = time.monotonic() + COMMAND_TIMEOUT
-        while self._telemetry_heard == heard or self.telemetry.state not in SAFE:
-            if time.monotonic() > deadline:
-                raise LinkError(f"DISARM answered {box[0].result.name.lower()} but no telemetry confirms it")
-            time.sleep(0.001)
+        confirm(lambda: self._telemetry_heard != heard and self.telemetry.state in SAFE, COMMAND_TIMEOUT,
+                lambda: f"DISARM answered {ack.result.name.lower()} but no telemetry confirms it")  # fmt: skip
         return FROM_ROBOT[self.telemetry.state]
 
     def reset(self) -> None:
@@ -197,7 +187,7 @@ class RobotLink:
         deadline = started + timeout
         write_by = deadline - WRITE_TIMEOUT  # a write started by then ends, even blocked, by the deadline
         message = Command(self._next_seq(), Kind.ESTOP)
-        event, _box = self._expect(message.seq)
+        event, _box = self._acks.expect(message.seq)
         reason = None
         self._forget_estop()  # this e-stop supersedes one still repeated in the background
         self.latch.engage()  # the line is the e-stop's; heartbeats resume only once acknowledged
@@ -216,7 +206,7 @@ class RobotLink:
                             break  # closed: nothing to retry on
                 event.wait(min(ESTOP_REPEAT, max(0.0, deadline - time.monotonic())))
         finally:
-            self._acks.pop(message.seq, None)
+            self._acks.forget(message.seq)
         latency = time.monotonic() - started
         if event.is_set():
             self.latch.acknowledged()
@@ -242,7 +232,8 @@ class RobotLink:
         this link was made (the rest). ``frames_out``: Transmit Requests written whole;
         ``transmit_status``: Transmit Statuses heard, ``delivery_failures`` of them not delivered
         (the last: :attr:`last_delivery_failure`); ``retries``: the radio's retries as its
-        statuses report them plus the link's ESTOP repeats (in :meth:`estop` and the background)."""
+        statuses report them plus the link's ESTOP repeats (in :meth:`estop` and the background);
+        ``command_resends``: the other commands' copies after the first (:mod:`~backend.robot.link_acks`)."""
         stats = self.parser.stats
         return {
             "frames_in": stats.frames,
@@ -258,6 +249,7 @@ class RobotLink:
             "transmit_status": self.port.transmits.statuses,
             "delivery_failures": self.port.transmits.failures,
             "retries": self.port.transmits.retries + self.estop_repeats,
+            "command_resends": self._acks.resends,
         }
 
     # Internals ------------------------------------------------------------------------------
@@ -271,28 +263,22 @@ class RobotLink:
         """Send, wait for the acknowledgement, and (``expect``) for the telemetry showing its effect."""
         if self.state == LinkState.DISCONNECTED:
             raise LinkError("the link is down; connect first")
-        event, box = self._expect(message.seq)
-        try:
-            self._write(message)
-            if not event.wait(COMMAND_TIMEOUT):
-                raise LinkError(f"no acknowledgement for {type(message).__name__} within {COMMAND_TIMEOUT:g} s")
-        finally:
-            self._acks.pop(message.seq, None)
-        ack = box[0]
-        name = message.kind.name if isinstance(message, Command) else type(message).__name__
+        ack = self._acknowledged(message)
         if ack.result != Result.OK:
-            raise LinkError(f"the robot refused {name}: {ack.result.name.lower()}")
-        deadline = time.monotonic() + COMMAND_TIMEOUT
-        while expect is not None and self.state != expect:
-            if time.monotonic() > deadline:
-                raise LinkError(f"{name} acknowledged but the robot reports {self.state.value}, not {expect.value}")
-            time.sleep(0.001)
+            raise LinkError(f"the robot refused {describe(message)}: {ack.result.name.lower()}")
+        if expect is not None:  # and the telemetry that shows its effect
+            why = f"{message.kind.name} acknowledged but the robot reports {{}}, not {expect.value}"
+            confirm(lambda: self.state == expect, COMMAND_TIMEOUT, lambda: why.format(self.state.value))
         return ack
 
-    def _expect(self, seq: int) -> tuple[threading.Event, list[Ack]]:
-        entry = (threading.Event(), [])
-        self._acks[seq] = entry
-        return entry
+    def _acknowledged(self, message) -> Ack:
+        """Send ``message`` until the robot acknowledges it, the link is lost (the reason it went: a
+        command is sent only on a link that was up) or its bound passes. No copy goes while an
+        unacknowledged ESTOP owns the line: it would feed the robot's watchdog instead."""
+        return self._acks.send(
+            message, self._write, bound=self.heartbeat_timeout + COMMAND_MARGIN, quiet=lambda: self.latch.state.pending,
+            gone=lambda: self.transitions[-1].reason if self.state == LinkState.DISCONNECTED else None,
+        )  # fmt: skip
 
     def _write(self, message, deadline: float | None = None) -> None:
         self.port.write(message, deadline)
@@ -332,25 +318,39 @@ class RobotLink:
 
     def _handle(self, message) -> None:
         if isinstance(message, Ack):
-            entry = self._acks.get(message.acked)
-            if entry is not None:
-                entry[1].append(message)
-                entry[0].set()
+            self._acks.heard(message)
             if self._pending_estop is not None:
                 self._estop_acknowledged(message.acked)
         elif isinstance(message, Telemetry):
-            self.telemetry = message
+            restart = restart_reason(self._last_telemetry, message)
+            self._last_telemetry = self.telemetry = message
             self._telemetry_heard += 1
             state = FROM_ROBOT[message.state]
-            if telemetry_moves(self.state, state, latched=self.latch.held, resetting=self._resetting):
-                self._move(state, "telemetry")
+            if restart is not None:  # counted before the state moves (a run sees both at once), and
+                self._restarted(restart)  # recorded even where the latch holds the link's state
+            moves = telemetry_moves(self.state, state, latched=self.latch.held, resetting=self._resetting)
+            if moves or restart is not None:
+                self._move(state if moves else self.state, restart or "telemetry", always=restart is not None)
+
+    def _restarted(self, reason: str) -> None:
+        self.restarts, self.last_restart = self.restarts + 1, reason
+        self._estop_first()  # it forgot its e-stop: e-stopped again before anything else
+
+    def _estop_first(self) -> None:
+        """Under a held latch, the ESTOP goes in place of heartbeats until the robot acknowledges it."""
+        if self.latch.held:
+            self.latch.unconfirmed()
+            estop = Command(self._next_seq(), Kind.ESTOP)
+            with self._lock:
+                self._pending_estop = estop
 
     def _heartbeat_loop(self) -> None:
         # An unacknowledged ESTOP goes instead of the heartbeat, so a line that clears still
         # delivers the stop. Any frame feeds the firmware's watchdog, ESTOP too; that keeps no
         # robot going: ESTOP latches it e-stopped, which only RESET leaves.
         # Each is due a period after the previous one was due, not after it was written: a late
-        # wake-up shortens the next wait instead of pushing every later heartbeat back.
+        # wake-up shortens the next wait instead of pushing every later heartbeat back. A heartbeat
+        # gives way to a command waiting for the port (a frame too), or a blocked line starves it.
         due = time.monotonic()
         while not self._stop.wait(max(0.0, due - time.monotonic())):
             due += HEARTBEAT_PERIOD
@@ -360,7 +360,7 @@ class RobotLink:
                 message = self._pending_estop
                 if message is not None:
                     self.estop_repeats += 1
-                elif self.send_heartbeats and not self.latch.state.pending:
+                elif self.send_heartbeats and not self.latch.state.pending and not self._acks.writing:
                     message = Command(self._next_seq(), Kind.HEARTBEAT)
                 else:
                     continue
@@ -392,9 +392,9 @@ class RobotLink:
         for callback in list(self.on_lost):
             callback(reason)
 
-    def _move(self, state: LinkState, reason: str) -> None:
+    def _move(self, state: LinkState, reason: str, *, always: bool = False) -> None:  # always: even unchanged
         with self._lock:
-            if state == self.state:
+            if state == self.state and not always:
                 return
             self.transitions.append(Transition(time.time(), self.state, state, reason))
             self.state = state

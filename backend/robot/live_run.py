@@ -1,11 +1,13 @@
 """A live run on the robot: its control loop, the one thread that owns the run's data.
 
 The loop sets the legs, arms and starts the robot, then watches the tracker: each touchdown it
-detects is recorded and, closed loop, its height goes through the simulator's PID
-(:func:`sim_core.closed_loop.pid_step`) to the leg of the touchdown after next — the one the
-robot positions during the coming stance. It ends when its jumps or time are used up, when
-stopped, or when anything goes wrong (e-stop, fall, lost link); whatever ended it, it then
-disarms the robot, confirmed by telemetry (:meth:`RobotLink.make_safe`).
+detects is recorded and, closed loop, its height goes through the run's law
+(:mod:`backend.robot.live_law`) to the leg of the touchdown after next — the one the robot
+positions during the coming stance. It ends when its jumps or time are used up, when stopped, or
+when anything goes wrong (e-stop, a fall, a restart of the robot, a lost link; closed loop, the
+tracker going blind: :mod:`backend.robot.tracker_watch`), each named
+(:mod:`backend.robot.run_endings`); whatever ended it, it then disarms the robot, confirmed by
+telemetry (:meth:`RobotLink.make_safe`). An open loop goes on through tracker gaps, each recorded.
 
 Only the loop's thread writes the run's records. Everyone else sees them two ways, neither of
 which shares anything mutable: :attr:`LiveRun.snapshot`, an immutable :class:`RunSnapshot`
@@ -25,21 +27,24 @@ from dataclasses import dataclass, field, replace
 from backend.robot.link import LinkError, LinkState, RobotLink
 from backend.robot.live_law import LiveLaw, pitch_at
 from backend.robot.messages import Leg
+from backend.robot.run_endings import CLEAN_ENDINGS, LINK_LOST, end_safely, fault_names, robot_ending
 from backend.robot.touchdown import PITCH_LOOKBACK, Touchdown, scan_touchdowns
 from backend.robot.tracker import PoseHistory, pose_arrays
+from backend.robot.tracker_watch import TRACKER_TIMEOUT_MS, TrackerWatch, frames_heard
 from sim_core.controls import LegControl
 from sim_core.errors import ParameterError
 from sim_core.walls import wall_of
 
 POLL = 0.005  # [s] how often the loop looks at new poses
-CLEAN_ENDINGS = ("jumps done", "stopped", "time limit")  # a run that ended so is "done", else "failed"
+
+__all__ = ["CLEAN_ENDINGS", "LiveRun", "Record", "RunSnapshot", "end_safely", "execute", "telemetry_dict"]
 
 
 @dataclass(frozen=True)
 class Record:
     """One thing the run recorded, for its journal: ``kind`` is ``touchdown`` (``value`` is the
-    :class:`Touchdown` and the :class:`LegControl` it was made with), ``command`` or ``telemetry``
-    (a dict); ``value`` is never changed after it is made."""
+    :class:`Touchdown` and the :class:`LegControl` it was made with), ``command``, ``telemetry`` or
+    ``tracker_gap`` (a dict); ``value`` is never changed after it is made."""
 
     kind: str
     value: object
@@ -63,6 +68,8 @@ class RunSnapshot:
     disarm: str | None = None  # how the ending left the robot: "disarmed", "estopped" or why unconfirmed
     started_by: str | None = None  # who started it, as other panels are told
     first_pose: int = 0  # the tracker's index of the run's first frame (its trail starts there)
+    tracker_gaps: tuple[dict, ...] = ()  # stretches without a pose past the run's tracker timeout
+    robot_faults: tuple[str, ...] = ()  # the robot's faults in its last telemetry at the end
 
     def command_for(self, leg: Leg) -> LegControl | None:
         return dict(self.commanded).get(leg)
@@ -81,6 +88,9 @@ class RunSnapshot:
             "end_reason": self.end_reason,
             "disarm": self.disarm,
             "stored_run_id": self.run_id,
+            "tracker_gaps": len(self.tracker_gaps),
+            "longest_tracker_gap_ms": max((gap["ms"] for gap in self.tracker_gaps), default=None),
+            "robot_faults": list(self.robot_faults),
         }
 
 
@@ -96,11 +106,14 @@ class LiveRun:
     started: float = field(default_factory=time.time)
     first_pose: int = 0  # the tracker's index of the run's first frame
     started_by: str | None = None  # who started it (the operator's name, or the client's address)
+    tracker_timeout: float = TRACKER_TIMEOUT_MS / 1000.0  # [s] closed loop: the longest without a pose
     touchdowns: list[Touchdown] = field(default_factory=list)
     touchdown_controls: list[LegControl] = field(default_factory=list)
     commanded: dict[Leg, LegControl] = field(default_factory=dict)
     commands: list[dict] = field(default_factory=list)
     telemetry: list[dict] = field(default_factory=list)
+    tracker_gaps: list[dict] = field(default_factory=list)
+    robot_faults: tuple[str, ...] = ()
     end_reason: str | None = None
     disarm: str | None = None
     journal: queue.SimpleQueue[Record] = field(default_factory=queue.SimpleQueue)
@@ -145,6 +158,8 @@ class LiveRun:
             commands=len(self.commands),
             end_reason=self.end_reason,
             disarm=self.disarm,
+            tracker_gaps=tuple(self.tracker_gaps),
+            robot_faults=self.robot_faults,
             **changes,
         )
 
@@ -185,15 +200,19 @@ def execute(
         send(Leg.RIGHT, legs[1], "start")
         if link.state == LinkState.DISARMED:
             link.arm()
+        restarts = link.restarts  # a restart of the robot from here on ends the run, named
         link.start()
         deadline = time.monotonic() + run.max_seconds
+        watch = TrackerWatch(run.tracker_timeout, time.monotonic(), frames_heard(tracker))
         while run.end_reason is None:
-            run.end_reason = _ending(run, link, deadline)
+            _record_telemetry(run, link)  # first: a fall's telemetry is the run's record of it
+            run.end_reason = _ending(run, link, restarts, deadline)
+            gap = watch.look(time.monotonic(), tracker.arrived(), frames_heard(tracker), tracker.waiting())
+            _record_gaps(run, watch)
+            if run.end_reason is None and gap is not None and controller is not None:
+                run.end_reason = gap.reason(watch.bound_s)  # a closed loop never runs blind
             if run.end_reason is not None:
                 break
-            telemetry = link.telemetry
-            if telemetry is not None and (not run.telemetry or run.telemetry[-1]["seq"] != telemetry.seq):
-                run.record("telemetry", {"time": time.time(), **telemetry_dict(telemetry)}, run.telemetry)
             if tracker.count() == seen_poses:
                 time.sleep(POLL)  # nothing new to analyse
                 continue
@@ -218,10 +237,14 @@ def execute(
                 if len(run.touchdowns) >= run.jumps:
                     run.end_reason = "jumps done"
             time.sleep(POLL)
+        _record_gaps(run, watch, ending=True)
     except (LinkError, ParameterError) as error:
-        run.end_reason = run.end_reason or f"error: {error}"
+        lost = link.state == LinkState.DISCONNECTED
+        run.end_reason = run.end_reason or (f"{LINK_LOST}: {error}" if lost else f"error: {error}")
     finally:
         run.end_reason = run.end_reason or "error: the control loop failed"
+        _record_telemetry(run, link)
+        run.robot_faults = tuple(fault_names(run.telemetry[-1]["faults"])) if run.telemetry else ()
         run.disarm = end_safely(link)  # whatever ended it, and whatever the link believes
         run.publish()
         try:
@@ -231,28 +254,35 @@ def execute(
             run.done.set()
 
 
-def _ending(run: LiveRun, link: RobotLink, deadline: float) -> str | None:
-    """Why the run must end now, or None."""
+def _ending(run: LiveRun, link: RobotLink, restarts: int, deadline: float) -> str | None:
+    """Why the run must end now, or None. ``restarts``: the link's count of the robot's restarts
+    when the run started it."""
     asked = run.stop_reason()
     if asked is not None:
         return asked
     if link.state != LinkState.RUNNING:
-        return {
-            LinkState.DISCONNECTED: "link lost",
-            LinkState.ESTOPPED: "e-stop",
-        }.get(link.state, "robot disarmed (fell or timed out)")
+        faults = link.telemetry.faults if link.telemetry is not None else 0
+        restart = link.last_restart if link.restarts > restarts else None
+        return robot_ending(link.state, faults, restart, len(run.touchdowns))
     if time.monotonic() > deadline:
         return "time limit"
     return None
 
 
-def end_safely(link: RobotLink) -> str:
-    """A run's ending: DISARM confirmed by telemetry (:meth:`RobotLink.make_safe`), or why not — a
-    lost link's robot disarms itself by its watchdog, and the supervisor disarms it when it is back."""
-    try:
-        return link.make_safe().value
-    except LinkError as error:
-        return f"not confirmed: {error}"
+def _record_telemetry(run: LiveRun, link: RobotLink) -> None:
+    """The robot's latest telemetry, if it is new, into the run's record."""
+    telemetry = link.telemetry
+    if telemetry is not None and (not run.telemetry or run.telemetry[-1]["seq"] != telemetry.seq):
+        run.record("telemetry", {"time": time.time(), **telemetry_dict(telemetry)}, run.telemetry)
+
+
+def _record_gaps(run: LiveRun, watch: TrackerWatch, *, ending: bool = False) -> None:
+    """Tracker gaps past the bound that have ended (``ending``: the one going on too) into the record."""
+    now = time.monotonic()
+    gaps = watch.closed(now) if ending else watch.gaps
+    for gap in gaps[len(run.tracker_gaps) :]:
+        run.record("tracker_gap", gap.to_record(now, time.time()), run.tracker_gaps)
+        run.publish()
 
 
 def telemetry_dict(telemetry) -> dict:

@@ -8,7 +8,7 @@ PC → robot:  SET_LEG (a leg's angle and retraction for its next touchdown), AR
 launch and keep jumping), DISARM, ESTOP (latching; sent repeatedly), RESET (clears an e-stop),
 HEARTBEAT.
 Robot → PC:  ACK (of a command's sequence number, with a result code), TELEMETRY (state, servo
-positions, battery, fault flags), HEARTBEAT.
+positions, battery, fault flags — BOOTED after a boot, until the first ARM), HEARTBEAT.
 
 :func:`decode` raises :class:`ProtocolError` on anything malformed; the link counts and drops it.
 """
@@ -84,6 +84,7 @@ class Fault(IntEnum):
     SERVO_LIMIT = 1 << 2
     BROWNOUT = 1 << 3
     FELL = 1 << 4  # a jump failed (slip, no flight, ...): the robot is down
+    BOOTED = 1 << 5  # the firmware started (power-up, brown-out, reset) and no ARM was accepted since
 
 
 @dataclass(frozen=True)

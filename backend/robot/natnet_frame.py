@@ -23,22 +23,28 @@ After the message's header (``u16 id, u16 byte count``) a frame of data is
   from 3.0 ``f32`` residual;
 - force plates (2.9+) and devices (2.11+): count, then each ``u32 id, u32 channels``, each channel
   ``u32 n, n × f32``;
-- suffix: before 3.0 ``f32`` software latency [ms], then ``u32`` timecode, ``u32`` sub-timecode,
-  timestamp [s] (``f32``, ``f64`` from 2.7), from 3.0 three ``u64`` high-resolution stamps, from 4.1
-  the ``u32, u32`` precision timestamp (the SDK's samples disagree whether 4.0 has it: both are
-  accepted there), ``u16`` parameters;
+- suffix: before 3.0 ``f32`` software latency [ms] (optional, below), then ``u32`` timecode, ``u32``
+  sub-timecode, timestamp [s] (``f32``, ``f64`` from 2.7), from 3.0 three ``u64`` high-resolution
+  stamps, from 4.1 the ``u32, u32`` precision timestamp (the SDK's samples disagree whether 4.0 has
+  it: both are accepted there), ``u16`` parameters;
 - then, optionally, the ``u32`` end-of-data tag that PacketClient.cpp reads after the parameters
   (the SDK never checks its value; NatNetClient.py stops before it, so a frame without it is
   accepted as well).
 
-The software latency is read from 2.x streams as the 2.x and 3.x SDKs' samples (PacketClient.cpp,
-NatNetClient.py: "removed in version 3.0") and field readers of real 2.x servers do; the 4.x
-samples no longer read it because they no longer talk to such servers.
+The 2.x software latency: the 2.x SDK's samples (PacketClient.cpp, NatNetClient.py 2.10), the 3.x
+PacketClient.cpp ("removed in version 3.0") and field readers of real 2.x servers read it; the 3.x
+and 4.x NatNetClient.py, a later PacketClient.cpp and the ``natnet`` package do not, so a sender
+written from them leaves it out. Both are read, each with or without the tag: the suffix's size
+tells them apart, but for a latency without a tag and a tag without a latency (the same 4 bytes
+more). There the SDK's layout (the latency) is taken unless its timestamp is not plausible (outside
+:data:`PLAUSIBLE`: read 4 bytes off, it is a subnormal, NaN or absurd number) and the other
+reading's is (or is zero). A 2.x suffix just the size of one without both is accepted only with
+such a timestamp, which keeps refusing a frame cut 4 bytes short.
 
 From 4.1 each block's count is followed by a ``u32`` byte size of the block's elements; it is
-checked against what was read. A frame must fill its message exactly, but for the end-of-data tag;
-anything else (truncated, oversized, a count that cannot fit, a non-finite timestamp) raises
-:class:`~backend.robot.natnet.NatNetError`.
+checked against what was read. A frame must fill its message exactly, but for the end-of-data tag
+(and a 2.x frame's latency); anything else (truncated, oversized, a count that cannot fit, a
+non-finite timestamp) raises :class:`~backend.robot.natnet.NatNetError`.
 """
 
 from __future__ import annotations
@@ -62,6 +68,7 @@ from backend.robot.natnet import (
 )
 
 END_TAG_SIZE = 4  # [bytes] the optional end-of-data tag after a frame's parameters
+PLAUSIBLE = (2.0**-20, 2.0**40)  # [s] a timestamp that tells a 2.x frame's latency from its tag (_has_latency)
 _POSE = struct.Struct("<I3f4f")  # id, position, quaternion (x, y, z, w)
 
 
@@ -168,7 +175,7 @@ def _channels(reader: Reader, what: str) -> None:
 
 
 def _suffix(reader: Reader, version: Version) -> float:
-    if version < (3, 0):
+    if version < (3, 0) and _has_latency(reader, version):
         reader.skip(4, "software latency")
     reader.skip(8, "timecode")
     timestamp = reader.take(F64 if version >= (2, 7) else F32, "timestamp")[0]
@@ -186,6 +193,44 @@ def _suffix(reader: Reader, version: Version) -> float:
     if not math.isfinite(timestamp):
         raise NatNetError(f"timestamp {timestamp} is not finite")
     return timestamp
+
+
+def _has_latency(reader: Reader, version: Version) -> bool:
+    """Whether a 2.x frame's suffix begins with the software latency: told by the bytes left (the
+    suffix, with or without the latency, with or without the tag), and where the latency without a
+    tag and a tag without the latency take the same bytes, by the timestamp each reading gives: the
+    latency's (the SDK's layout) unless its timestamp is not plausible and the other's is."""
+    stamp = F64 if version >= (2, 7) else F32
+    rest = 8 + stamp.size + 2  # timecode, sub-timecode, timestamp, parameters
+    left = reader.left
+    if left == rest + 4 + END_TAG_SIZE:
+        return True
+    if left < rest:
+        raise NatNetError(
+            f"truncated at byte {reader.offset}: the frame's suffix needs {rest} bytes "
+            f"({rest + 4} with the software latency), {left} left"
+        )
+    if left not in (rest, rest + 4):
+        raise NatNetError(
+            f"{left} bytes after the frame's blocks (a NatNet {format_version(version)} frame?): its suffix "
+            f"takes {rest}, {rest + 4} with the software latency; only a {END_TAG_SIZE}-byte end-of-data tag may follow"
+        )
+    without = stamp.unpack_from(reader.data, reader.offset + 8)[0]  # the timestamp, were no latency there
+    if left == rest + 4:  # the latency and no tag, or the tag and no latency
+        with_latency = stamp.unpack_from(reader.data, reader.offset + 12)[0]
+        return _plausible(with_latency) or not (without == 0.0 or _plausible(without))
+    if without == 0.0 or _plausible(without):
+        return False
+    raise NatNetError(
+        f"the frame's suffix is {rest} bytes, as without the software latency and the end-of-data tag, "
+        f"but its timestamp would be {without} (a frame cut short?)"
+    )
+
+
+def _plausible(timestamp: float) -> bool:
+    """A camera software's clock [s]: from a microsecond (a stamp read from the wrong bytes is mostly a
+    tiny, huge, negative or non-finite number) to 2**40 s; zero is told apart by its callers."""
+    return PLAUSIBLE[0] <= timestamp < PLAUSIBLE[1]
 
 
 def encode_frame(number: int, timestamp: float, body: RigidBody, version: Version) -> bytes:

@@ -14,7 +14,10 @@ receives the frames there, sending a keep-alive every second. In both modes a co
 goes to the server each second until it answers; its answer (``NAT_SERVERINFO``) names the
 stream's NatNet version, which is used unless a version was configured (the V100 rig's old
 software: configure it when its server does not answer). Frames that arrive while the version is
-still unknown, or that lack the rigid body or say it is untracked, are counted as ``ignored``.
+still unknown, or that lack the rigid body or say it is untracked, are counted as ``ignored``. A
+malformed packet is counted in ``malformed`` only: the whole frame is decoded (and its pose checked)
+before its number reaches :class:`~backend.robot.tracker.TrackerStats`, and the number it leaves out
+is not counted ``dropped`` as well.
 
 A ``NAT_SERVERINFO`` is taken only from the configured server's address and command port, and
 only while its answer is awaited (after a connect request, before the first answer): any other
@@ -50,7 +53,7 @@ from backend.robot.natnet import (
     message_id,
 )
 from backend.robot.natnet_frame import decode_frame
-from backend.robot.tracker import Calibration, Pose, PoseHistory, TrackerStats
+from backend.robot.tracker import Calibration, Pose, PoseHistory, TrackerStats, readable
 
 log = logging.getLogger("parkourlab.robot")
 REQUEST_EVERY = 1.0  # [s] connect requests until the server answers; a unicast client's keep-alives
@@ -115,6 +118,10 @@ class NatNetPoseSource(PoseHistory):
     def version(self) -> str | None:
         """The stream's NatNet version as ``"M.m"``, None while it is not known."""
         return None if self.stream_version is None else format_version(self.stream_version)
+
+    def waiting(self) -> bool:
+        sockets = {self.command, self.data}
+        return readable(*sockets)
 
     def close(self) -> None:
         self._stop.set()

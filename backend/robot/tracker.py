@@ -23,14 +23,16 @@ from __future__ import annotations
 
 import bisect
 import math
+import select
 import socket
 import struct
 import threading
 import time
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numpy as np
 
+from backend.robot.tracker_stats import FRAME_JUMP, LATE_FRAMES, TrackerCounts, TrackerStats  # noqa: F401 (re-exported)
 from sim_core.validation import check_range
 
 DATAGRAM = struct.Struct(">4sIdddd")
@@ -82,77 +84,6 @@ def decode_datagram(data: bytes) -> tuple[int, Pose]:
     return frame, Pose(t, x, y, pitch)
 
 
-FRAME_JUMP = 1000  # frames: ~3 s at 360 Hz, 10 s at 100 Hz; a longer forward gap is a jump, not loss
-LATE_FRAMES = 16  # frames: a number this far behind the newest is a late (reordered) datagram, not a restart
-
-
-@dataclass(frozen=True)
-class TrackerCounts:
-    """Tracker figures at one moment, or over a stretch (:meth:`since`): frames ``received``,
-    ``dropped`` (gaps in the frame numbers), ``malformed`` packets, well-formed frames ``ignored``
-    (no pose in them), and ``restarts`` of the numbering (it went back, or jumped ahead further than
-    :data:`FRAME_JUMP`)."""
-
-    received: int = 0
-    dropped: int = 0
-    malformed: int = 0
-    ignored: int = 0
-    restarts: int = 0
-
-    @property
-    def loss(self) -> float:
-        """Fraction of frames lost (dropped / expected)."""
-        expected = self.received + self.dropped
-        return self.dropped / expected if expected else 0.0
-
-    def since(self, earlier: TrackerCounts) -> TrackerCounts:
-        """The counts from ``earlier`` (a snapshot of the same stats) to these, e.g. over one run."""
-        return TrackerCounts(*(getattr(self, f.name) - getattr(earlier, f.name) for f in fields(self)))
-
-
-@dataclass
-class TrackerStats:
-    """A source's running counts (see :class:`TrackerCounts`), updated by its receiving thread.
-
-    Frame numbers: a gap of up to :data:`FRAME_JUMP` counts as dropped frames. A longer jump ahead,
-    or a number more than :data:`LATE_FRAMES` behind the newest (the camera software restarted, or
-    its 32-bit numbers wrapped), counts as a restart: the new numbering is followed from there, and
-    the frames between are not counted lost. A number just behind the newest is a late datagram."""
-
-    received: int = 0
-    dropped: int = 0  # frame-number gaps
-    malformed: int = 0
-    ignored: int = 0  # well-formed frames without a pose (NatNet: the rigid body not in it, or not tracked)
-    restarts: int = 0  # the numbering went back, or jumped ahead by more than FRAME_JUMP
-    last_frame: int | None = None
-
-    def frame(self, number: int) -> None:
-        """Count a frame received, and the frames lost before it (late ones are not counted twice)."""
-        last = self.last_frame
-        if last is None:
-            self.last_frame = number
-        elif number > last:
-            if number - last - 1 > FRAME_JUMP:
-                self.restarts += 1
-            else:
-                self.dropped += number - last - 1
-            self.last_frame = number
-        elif number < last - LATE_FRAMES:
-            self.restarts += 1
-            self.last_frame = number
-        self.received += 1
-
-    @property
-    def loss(self) -> float:
-        """Fraction of frames lost (dropped / expected)."""
-        return self.snapshot().loss
-
-    def snapshot(self) -> TrackerCounts:
-        """The counts now. Cheap; read while the receiving thread counts, so one field may be a frame
-        ahead of another, never more."""
-        return TrackerCounts(self.received, self.dropped, self.malformed, self.ignored, self.restarts)
-
-
 class PoseHistory:
     """Poses in time order with thread-safe appends and reads. The newest HISTORY are kept; an
     index (:meth:`count`, :meth:`poses_from`) counts every pose received, so it stays valid when
@@ -188,6 +119,16 @@ class PoseHistory:
         if pose is None or (time.monotonic() if now is None else now) - arrived > self.stale_after:
             return None
         return pose
+
+    def arrived(self) -> float:
+        """When the newest pose arrived (``time.monotonic()``; ``-inf`` before the first): a live
+        run's watch on its eyes (:mod:`backend.robot.tracker_watch`)."""
+        with self._lock:
+            return self._arrived
+
+    def waiting(self) -> bool:
+        """Whether datagrams wait unread (a source's receiving thread behind); a recorded history: never."""
+        return False
 
     def count(self) -> int:
         """Poses received so far, all of them (an index for :meth:`poses_from`)."""
@@ -247,6 +188,9 @@ class UdpPoseSource(PoseHistory):
         self._thread.join(2)
         self.socket.close()
 
+    def waiting(self) -> bool:
+        return readable(self.socket)
+
     def _receive(self) -> None:
         while not self._stop.is_set():
             try:
@@ -271,3 +215,11 @@ def recorded_poses(columns: dict[str, np.ndarray]) -> PoseHistory:
     for t, x, y, p in zip(columns["time"], columns["x"], columns["y"], pitch, strict=True):
         history.add(Pose(float(t), float(x), float(y), float(p)))
     return history
+
+
+def readable(*sockets: socket.socket) -> bool:
+    """Whether a datagram waits on any of ``sockets`` (False once closed)."""
+    try:
+        return bool(select.select(sockets, [], [], 0)[0])
+    except (OSError, ValueError):
+        return False

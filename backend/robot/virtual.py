@@ -8,6 +8,9 @@ the firmware is running, and the camera's view of it streams there over UDP.
 The radio answers a Transmit Request with a non-zero frame id as an XBee does, with a Transmit
 Status ahead of anything the robot replies: delivered (0x00, no retries) when it is addressed to
 the robot's radio, else "address not found" (0x24) and the robot never sees it.
+
+The robot powers up when made (:meth:`Firmware.boot`: BOOTED until the PC's first ARM), and
+:meth:`VirtualRobot.reboot` restarts it as a brown-out or a reset would, on the same connection.
 """
 
 from __future__ import annotations
@@ -50,8 +53,8 @@ class VirtualRobot:
     ):
         """``tracker_to``: where to stream the body's tracker datagrams (None: no motion, radio only).
         ``climber_options`` go to :class:`backend.robot.climber.Climber` (noise, speed, seed, the
-        camera's ``tracker_protocol``: PKT1 or NatNet ...)."""
-        self.firmware = firmware or Firmware()
+        camera's ``tracker_protocol``: PKT1 or NatNet ...). Without ``firmware``, one just powered up."""
+        self.firmware = firmware or Firmware.boot()
         self.server = socket.create_server((host, port))
         self.address = self.server.getsockname()
         self.lock = threading.Lock()  # the firmware is shared by the reader and the ticker
@@ -89,6 +92,18 @@ class VirtualRobot:
         with self._send_lock:
             if self._connection is not None:
                 self._connection.sendall(data)
+
+    def reboot(self, brown_out: bool = False) -> None:
+        """The robot restarts (a reset, or a brown-out: ``brown_out``): its firmware replaced by one as
+        at power-up (disarmed, the legs at their defaults, its sequence from 1, BOOTED, and BROWNOUT if
+        asked), its configuration kept. The radio keeps its association: the PC's connection stays.
+        The body stops where it is, as the firmware that ran the climb is gone (it falls)."""
+        with self.lock:
+            old = self.firmware
+            self.firmware = Firmware.boot(
+                brown_out=brown_out, limits=old.limits, heartbeat_timeout=old.heartbeat_timeout,
+                battery_mv=old.battery_mv,
+            )  # fmt: skip
 
     def _legs(self) -> dict:
         with self.lock:

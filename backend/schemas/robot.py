@@ -9,6 +9,7 @@ from pydantic import BaseModel, Field, ValidationInfo, field_validator
 
 from backend.robot.natnet import COMMAND_PORT, MULTICAST_GROUP, parse_version
 from backend.robot.ports import check_port
+from backend.robot.tracker_watch import TRACKER_TIMEOUT_MS, TRACKER_TIMEOUT_RANGE_MS
 from backend.robot.xbee import ROBOT_ADDRESS
 from backend.schemas.common import LegIn, Psi0Deg, RecordRef, Strict, Tags, Zeta0
 from sim_core.climb_records import CHUTE_TOP, FLOOR
@@ -143,6 +144,15 @@ class RobotRunCreate(Strict):
     jumps: Annotated[int, Field(ge=1, le=10_000)] = 20
     max_seconds: Annotated[float, Field(gt=0.0, le=3600.0)] = 60.0
     closed_loop: ClosedLoopIn | None = None
+    tracker_timeout_ms: Annotated[
+        float,
+        Field(
+            ge=TRACKER_TIMEOUT_RANGE_MS[0],
+            le=TRACKER_TIMEOUT_RANGE_MS[1],
+            description="the longest without a pose of the robot [ms]: a closed loop ends then, disarmed "
+            "(tracker silent, or the body lost); an open loop goes on and records the gap",
+        ),
+    ] = TRACKER_TIMEOUT_MS
     tags: Tags = []
     operator: Annotated[
         str | None,
@@ -157,6 +167,7 @@ class EstopLatchOut(BaseModel):
     acknowledged: bool = Field(description="the robot has confirmed the ESTOP on this connection")
     since: float | int | None = Field(description="when it was pressed [Unix time, s], or null")
     reason: str | None
+    durable: bool = Field(True, description="the latch as it is now is saved: a restart of the service finds it")
 
 
 class RobotStatus(BaseModel):

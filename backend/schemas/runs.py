@@ -113,7 +113,9 @@ class RunOut(RunBase):
     has_trajectory: bool
     end_reason: str | None = Field(
         None, description='how a robot run ended, as it recorded it: "jumps done", "stopped", "time limit", "e-stop", '
-        '"link lost", "robot disarmed (fell or timed out)", "error: …", "interrupted: …"; null for simulations',
+        '"link lost", "fell: …", "robot restarted: …", "robot disarmed itself: …", "tracker silent: …", '
+        '"tracker lost the body: …", "error: …", "interrupted: …" (before 2026-12: "robot disarmed (fell or '
+        'timed out)"); null for simulations',
     )  # fmt: skip
     loop: RunLoop = Field(RunLoop.OPEN, description="closed: a robot run holding a height (a replay: as its run)")
     controller: str | None = Field(None, description="the closed loop's law (pid, lqr, ...); null when open")

@@ -21,6 +21,7 @@ from backend.errors import Conflict
 from backend.repositories import calibrations as stored_presets
 from backend.repositories import runs as stored_runs
 from backend.robot.messages import Fault
+from backend.robot.run_endings import fell
 from backend.schemas.calibrations import (
     PRESET_PATTERN,
     CalibrationCreate,
@@ -41,7 +42,6 @@ from sim_core.touchdown_series import TouchdownSeries, finite_rms, pitch_at
 from sim_core.walls import Wall
 
 CALIBRATED_KINDS = ("robot", "replay")
-SELF_DISARMED = "robot disarmed (fell or timed out)"  # backend.robot.live_run's ending
 PRESET_NAME = re.compile(PRESET_PATTERN)
 MAX_RUNS = 100
 Fitter = Callable[[list[TouchdownSeries], ModelParams], CalibrationFit]
@@ -78,12 +78,15 @@ def touchdown_series(session: Session, run: Run, robot: PhysicalParams) -> Touch
 
 
 def run_fell(run: Run) -> bool:
-    """Whether a robot run ended in a fall: its telemetry reported the firmware's FELL fault, or,
-    without telemetry, it ended as a robot that disarmed itself does."""
-    telemetry = run.results.get("telemetry") or []
-    if telemetry:
-        return bool(np.bitwise_or.reduce([int(t.get("faults", 0)) for t in telemetry]) & Fault.FELL)
-    return run.results.get("end_reason") == SELF_DISARMED
+    """Whether a robot run ended in a fall, as it was stored: its record says so (``fell``, from its
+    end reason and the robot's faults), or, stored before that record, its telemetry carried the
+    firmware's FELL fault or it ended as a robot that disarmed itself did."""
+    results = run.results
+    if "fell" in results:
+        return bool(results["fell"])
+    telemetry = results.get("telemetry") or []
+    reported = np.bitwise_or.reduce([int(t.get("faults", 0)) for t in telemetry]) if telemetry else 0
+    return bool(reported & Fault.FELL) or fell(results.get("end_reason"), None)
 
 
 def fit_touchdowns(series: list[TouchdownSeries], base: ModelParams) -> CalibrationFit:

@@ -15,17 +15,19 @@ from __future__ import annotations
 import asyncio
 import concurrent.futures
 import threading
+import time
 from pathlib import Path
 
 from backend.errors import NotFound
 from backend.robot.latch import EstopLatch
 from backend.robot.limits import ServoLimits
-from backend.robot.link import EstopResult, LinkError, LinkState, RobotLink
+from backend.robot.link import LinkError, LinkState, RobotLink
 from backend.robot.live_law import LiveLaw, live_law_for
 from backend.robot.live_run import LiveRun, RunSnapshot, execute, telemetry_dict
 from backend.robot.supervisor import LinkSupervisor
 from backend.schemas import RobotConnect, RobotRunCreate
 from backend.services.models import resolve_model
+from backend.services.robot_estop import LATCH_SAVE_WAIT, latch_status, press
 from backend.services.robot_journal import JournalWriter
 from backend.services.robot_records import open_robot_run, recover_interrupted
 from backend.services.robot_tracker import PoseSource, TrackerSlot
@@ -33,7 +35,8 @@ from experiments.manifest import json_safe
 from sim_core.controls import LegControl
 from sim_core.presets import get_preset
 
-ESTOP_ANSWER = 0.17  # [s] the longest an e-stop request waits for its answer (the link gives up at 0.15 s)
+ESTOP_ANSWER = 0.17  # [s] the longest an e-stop waits for the robot (the link gives up at 0.15 s)
+ANSWER_WAIT = ESTOP_ANSWER + LATCH_SAVE_WAIT  # [s] the longest a press waits: the robot, then the latch file
 STOP_WAIT = 10.0  # [s] the longest a stop or a disconnect waits for the run to end and be stored
 
 
@@ -139,7 +142,7 @@ class RobotService:
                 "url": None if link is None else link.url,
                 "robot_address": None if link is None else f"0x{link.robot_address:016X}",
                 "counters": None if link is None else {**link.counters(), "reconnects": self.supervisor.reconnects},
-                "estop": _estop_latch(self.latch, link),
+                "estop": latch_status(self.latch, link),
                 "last_delivery_failure": None if link is None else link.last_delivery_failure,
                 "telemetry": None if link is None or link.telemetry is None else telemetry_dict(link.telemetry),
                 "tracker": None
@@ -156,6 +159,7 @@ class RobotService:
                     "version": tracker.version,
                     "error": tracker.error,
                     "latest": None if pose is None else vars(pose),
+                    "last_pose_age_ms": _age_ms(tracker.arrived()),
                 },
                 "run": None if run is None else run.to_status(),
                 "transitions": [] if link is None else [t.to_dict() for t in link.transitions[-20:]],
@@ -193,35 +197,29 @@ class RobotService:
         return self.status()
 
     def estop(self) -> dict:
-        """Emergency stop at any moment, bounded (the link gives up after ESTOP_TIMEOUT): ends a live
-        run (still stored) whether or not the robot acknowledges. Answers ``acknowledged`` and
-        ``latency_ms``; not acknowledged, a ``reason`` — the robot's watchdog then disarms it, as
-        the link has stopped its heartbeats. Takes no lock: it must not wait for anything that moves."""
-        link, run = self.link, self._run
-        if run is not None and not run.done.is_set():
-            run.stop("e-stop")  # before the e-stop: the control loop sends nothing more
-        result = EstopResult(False, 0.0, "the robot is not connected") if link is None else link.estop()
-        answer = {"acknowledged": result.acknowledged, "latency_ms": result.latency * 1000.0}
-        if not result.acknowledged:
-            answer["reason"] = result.reason
-        return {**answer, **self.status()}
+        """Emergency stop at any moment, bounded, connected or not (:func:`robot_estop.press`): ends
+        a live run (still stored) whether or not the robot acknowledges, and latches. Answers
+        ``acknowledged`` and ``latency_ms``; not acknowledged, a ``reason`` — the robot's watchdog
+        then disarms it, as the link has stopped its heartbeats. Takes no lock: it must not wait
+        for anything that moves."""
+        return {**press(self.latch, self.link, self._run), **self.status()}
 
     async def estop_now(self) -> dict:
         """:meth:`estop` on the service's e-stop thread, for an ``async`` route: answers within
-        ESTOP_ANSWER whatever the link, the request pool or the locks are doing."""
+        ANSWER_WAIT whatever the link, the request pool or the locks are doing."""
         with self._estop_guard:
             if self._estop_pending is None or self._estop_pending.done():
                 self._estop_pending = self._estop_executor.submit(self.estop)
             pending = self._estop_pending
         waiting = asyncio.wrap_future(pending)
-        done, _ = await asyncio.wait({waiting}, timeout=ESTOP_ANSWER)  # wait() never cancels it
+        done, _ = await asyncio.wait({waiting}, timeout=ANSWER_WAIT)  # wait() never cancels it
         if done and waiting.exception() is None:
             return waiting.result()
         if done:  # a bug, not a fault of the line: still an answer, never a 500 for an e-stop
             reason = f"the e-stop failed: {waiting.exception()!r}"
         else:
-            reason = f"the e-stop did not finish within {ESTOP_ANSWER * 1000:.0f} ms (still trying)"
-        return {"acknowledged": False, "latency_ms": ESTOP_ANSWER * 1000.0, "reason": reason, **self.status()}
+            reason = f"the e-stop did not finish within {ANSWER_WAIT * 1000:.0f} ms (still trying)"
+        return {"acknowledged": False, "latency_ms": ANSWER_WAIT * 1000.0, "reason": reason, **self.status()}
 
     # Live runs -------------------------------------------------------------------------------
     def start_run(self, body: RobotRunCreate, started_by: str | None = None) -> RunSnapshot:
@@ -247,7 +245,13 @@ class RobotService:
                 )
             target_m = None if body.closed_loop is None else body.closed_loop.target_m
             run = LiveRun(
-                body.jumps, body.max_seconds, target_m, run_id=run_id, first_pose=tracker.count(), started_by=started_by
+                body.jumps,
+                body.max_seconds,
+                target_m,
+                run_id=run_id,
+                first_pose=tracker.count(),
+                started_by=started_by,
+                tracker_timeout=body.tracker_timeout_ms / 1000.0,
             )
             journal = JournalWriter(self.sessions, run, tracker, link, self.robot).start()
             self._run = run
@@ -284,12 +288,6 @@ class RobotService:
         return self.status()
 
 
-def _estop_latch(latch: EstopLatch, link: RobotLink | None) -> dict:
-    """The e-stop latch for the status: held until a RESET is acknowledged (``acknowledged``: the
-    robot has confirmed the ESTOP on this connection; until then it goes in place of heartbeats).
-    A robot that reports itself e-stopped is latched on its side whatever the PC's latch says."""
-    state = latch.state
-    if not state.held and link is not None and link.state == LinkState.ESTOPPED:
-        return {"latched": True, "acknowledged": True, "since": None,
-                "reason": "the robot reports itself e-stopped; it holds until a reset"}  # fmt: skip
-    return {"latched": state.held, "acknowledged": state.acknowledged, "since": state.since, "reason": state.reason()}
+def _age_ms(arrived: float) -> float | None:
+    """How long ago [ms] a ``time.monotonic()`` arrival was; None if never."""
+    return None if arrived == float("-inf") else (time.monotonic() - arrived) * 1000.0

@@ -64,7 +64,7 @@ class JournalWriter:
         try:
             with self.sessions() as session:
                 fold_journal(session, run.run_id, status=status, end_reason=run.end_reason,
-                             disarm=run.disarm, robot=self.robot)  # fmt: skip
+                             disarm=run.disarm, robot=self.robot, faults=run.robot_faults)  # fmt: skip
         except SQLAlchemyError:
             # The entries are stored: the next start folds them as an interrupted run.
             log.exception("could not store the end of robot run %s; it is folded at the next start", run.run_id)
@@ -90,6 +90,7 @@ class JournalWriter:
                 "touchdowns": [_touchdown_entry(*r.value) for r in records if r.kind == "touchdown"],
                 "commands": [r.value for r in records if r.kind == "command"],
                 "telemetry": [r.value for r in records if r.kind == "telemetry"],
+                "tracker_gaps": [r.value for r in records if r.kind == "tracker_gap"],
                 "transitions": [transition.to_dict() for transition in transitions],
                 "tracker": {
                     **asdict(counts),

@@ -24,6 +24,7 @@ from backend.errors import Conflict, NotFound
 from backend.repositories import experiments as stored_experiments
 from backend.repositories import robot_runs
 from backend.repositories import runs as stored_runs
+from backend.robot.run_endings import fault_names, fell
 from backend.robot.touchdown import Touchdown, detect_touchdowns, height_gains
 from backend.schemas import RunDetail
 from backend.services.runs import run_detail
@@ -61,6 +62,7 @@ def open_robot_run(
                 "started_by": started_by,
                 "link": link,
                 "calibration": asdict(calibration),
+                "tracker_timeout_ms": request.tracker_timeout_ms,
                 "closed_loop": None if request.closed_loop is None else request.closed_loop.model_dump(),
             }
         ),
@@ -71,14 +73,18 @@ def open_robot_run(
     return run.id
 
 
-def fold_journal(session, run_id: int, *, status: str, end_reason: str, disarm: str | None, robot=None) -> Run:
+def fold_journal(
+    session, run_id: int, *, status: str, end_reason: str, disarm: str | None, robot=None, faults=()
+) -> Run:
     """The run's journal entries folded into the run (results, tracker frames, the touchdown
-    columns) and deleted, in one transaction; ``status`` and ``end_reason`` say how it ended."""
+    columns) and deleted, in one transaction; ``status`` and ``end_reason`` say how it ended,
+    ``faults`` the robot's at the end (names). The results say whether it ``fell`` (its end reason,
+    or a FELL fault at the end or in any telemetry it recorded): calibration leaves its fall out."""
     robot = robot or get_preset("paper")
     run = stored_runs.find(session, run_id)
     entries = robot_runs.journal(session, run_id)
     frames = {name: [] for name in FRAME_COLUMNS}
-    touchdowns, controls, commands, telemetry, transitions, tracker = [], [], [], [], [], None
+    touchdowns, controls, commands, telemetry, transitions, gaps, tracker = [], [], [], [], [], [], None
     for entry in entries:
         data = entry.data
         for name in FRAME_COLUMNS:
@@ -89,6 +95,7 @@ def fold_journal(session, run_id: int, *, status: str, end_reason: str, disarm: 
         commands.extend(data["commands"])
         telemetry.extend(data["telemetry"])
         transitions.extend(data["transitions"])
+        gaps.extend(data.get("tracker_gaps", []))  # entries written before gaps were recorded have none
         tracker = data["tracker"] or tracker
     analysis = touchdown_results(touchdowns, controls, robot)
     run.status = status
@@ -105,6 +112,8 @@ def fold_journal(session, run_id: int, *, status: str, end_reason: str, disarm: 
             "telemetry": telemetry,
             "transitions": transitions,
             "tracker": {"frames": len(frames["time"]), **(tracker or {"dropped": 0, "loss": 0.0})},
+            "tracker_gaps": gaps,
+            **robot_ending_record(end_reason, faults, telemetry),
         }
     )
     for name, value in touchdown_columns(touchdowns, analysis).items():
@@ -115,6 +124,16 @@ def fold_journal(session, run_id: int, *, status: str, end_reason: str, disarm: 
     robot_runs.delete_journal(session, run_id)
     session.commit()
     return run
+
+
+def robot_ending_record(end_reason: str, faults, telemetry: list[dict]) -> dict:
+    """``robot_faults``: the robot's faults at the end, by name, and every one its telemetry reported
+    during the run; ``fell``: whether the run ended in a fall (:func:`run_endings.fell`)."""
+    reported = set(faults)
+    for entry in telemetry:
+        reported.update(fault_names(int(entry.get("faults", 0))))
+    names = sorted(reported)
+    return {"robot_faults": names, "fell": fell(end_reason, names)}
 
 
 def recover_interrupted(sessions, robot=None) -> list[int]:

@@ -11,20 +11,17 @@ from __future__ import annotations
 
 from collections import defaultdict
 
-import numpy as np
 from sqlalchemy.orm import Session
 
 from backend.errors import Conflict
 from backend.repositories import runs as stored_runs
-from backend.robot.messages import Fault
-from backend.services.calibrations import get_stored_preset, preset_params, touchdown_series
+from backend.services.calibrations import get_stored_preset, preset_params, run_fell, touchdown_series
 from backend.store.models import Run
 from sim_core.errors import ParameterError
 from sim_core.presets import get_preset
 
 MAX_TRIALS = 5000
 MAX_CAP = 100_000
-SELF_DISARMED = "robot disarmed (fell or timed out)"  # backend.robot.live_run's ending
 
 
 def robustness(
@@ -49,7 +46,7 @@ def robustness(
             continue
         seen.add(run.id)
         series.append(touchdown_series(session, run, base))
-        tries[_legs(run)].append((run.jumps_completed, _fell(run)))
+        tries[_legs(run)].append((run.jumps_completed, run_fell(run)))
     drift = pitch_drift_deg(series)
     noise = noise_of(stored.fit["noise"], drift, offsets)
     groups = {
@@ -75,10 +72,3 @@ def _legs(run: Run) -> tuple:
     """The gait commanded: ((psi0_deg, zeta0) left, right); one pair is both legs'."""
     pairs = [tuple(float(v) for v in pair) for pair in run.controls]
     return (pairs[0], pairs[-1])
-
-
-def _fell(run: Run) -> bool:
-    telemetry = run.results.get("telemetry") or []
-    if telemetry:
-        return bool(np.bitwise_or.reduce([int(t.get("faults", 0)) for t in telemetry]) & Fault.FELL)
-    return run.results.get("end_reason") == SELF_DISARMED

@@ -18,6 +18,9 @@ const clock = (epochSeconds) => new Date(epochSeconds * 1000).toLocaleTimeString
 // Who started a run, when the service says (``started_by``: absent from an older one, or null).
 const startedBy = (run) => (typeof run.started_by === "string" && run.started_by ? ` by ${run.started_by}` : "");
 
+// How long ago the tracker's last pose of the robot arrived: a silent tracker shows at once.
+const lastPose = (ms) => (ms < 1000 ? `${Math.round(ms)} ms ago` : `${(ms / 1000).toFixed(1)} s ago (tracker silent)`);
+
 // The "run" entry of the status: its id (the entry's name says "run" already), how it stands, …
 function describeRun(run) {
   if (!run) return "—";
@@ -26,6 +29,8 @@ function describeRun(run) {
   if (run.jumps !== undefined) parts.push(`jumps ${run.jumps}`);  // as the service counts them
   if (typeof run.started === "number") parts.push(`started ${clock(run.started)}${startedBy(run)}`);
   if (run.max_seconds !== undefined) parts.push(`time limit ${run.max_seconds} s`);
+  if (run.tracker_gaps) parts.push(`tracker gaps: ${run.tracker_gaps} (longest ${Math.round(run.longest_tracker_gap_ms)} ms)`);
+  if (!run.active && Array.isArray(run.robot_faults) && run.robot_faults.length) parts.push(`robot faults: ${run.robot_faults.join(", ")}`);
   if (!run.active && run.disarm) parts.push(`disarm: ${run.disarm}`);
   if (run.stored_run_id !== undefined && run.stored_run_id !== null) parts.push(`stored as run ${run.stored_run_id}`);
   return parts.join(", ");
@@ -45,6 +50,7 @@ export function showStatus(status) {
     ["faults", telemetry.faults ?? "—"],
     ["tracker frames", tracker.received ?? "—"],
     ["tracker loss", typeof tracker.loss === "number" ? `${(100 * tracker.loss).toFixed(1)} %` : "—"],
+    ["last pose", typeof tracker.last_pose_age_ms === "number" ? lastPose(tracker.last_pose_age_ms) : "—"],
     ["run", describeRun(status.run)],
   ]));
   const counters = status.counters ? Object.entries(status.counters) : [];
@@ -192,10 +198,11 @@ $("#closed-loop").dispatchEvent(new Event("change"));
 // A live run's fields, checked against the robot run's request body (fields.js); the gains only
 // when the loop is closed.
 const ROBOT_RUN_FIELDS = [...LEG_FIELDS, { name: "jumps", rule: "RobotRunCreate.jumps", unit: "jumps" },
-  { name: "max_seconds", rule: "RobotRunCreate.max_seconds", unit: "s" }];
+  { name: "max_seconds", rule: "RobotRunCreate.max_seconds", unit: "s" },
+  { name: "tracker_timeout_ms", rule: "RobotRunCreate.tracker_timeout_ms", unit: "ms" }];
 const CLOSED_LOOP_FIELDS = [{ name: "target_m", rule: "ClosedLoopIn.target_m", unit: "m" }, { name: "kp", rule: "ClosedLoopIn.kp" },
   { name: "ki", rule: "ClosedLoopIn.ki" }, { name: "kd", rule: "ClosedLoopIn.kd" }];
-const ROBOT_RUN_LOCATIONS = { ...SIM_LOCATIONS, max_seconds: "max_seconds", "closed_loop.target_m": "target_m",
+const ROBOT_RUN_LOCATIONS = { ...SIM_LOCATIONS, max_seconds: "max_seconds", tracker_timeout_ms: "tracker_timeout_ms", "closed_loop.target_m": "target_m",
   "closed_loop.kp": "kp", "closed_loop.ki": "ki", "closed_loop.kd": "kd", "closed_loop.controller": "controller" };
 
 on("#robot-run-form", "submit", async (event) => {
@@ -203,7 +210,8 @@ on("#robot-run-form", "submit", async (event) => {
   const closed = event.target.elements.closed_loop.checked;
   const v = await checked(event.target, closed ? [...ROBOT_RUN_FIELDS, ...CLOSED_LOOP_FIELDS] : ROBOT_RUN_FIELDS);
   if (v === null) return;
-  const body = { controls: [{ psi0_deg: v.psiL, zeta0: v.zetaL }, { psi0_deg: v.psiR, zeta0: v.zetaR }], jumps: v.jumps, max_seconds: v.max_seconds };
+  const body = { controls: [{ psi0_deg: v.psiL, zeta0: v.zetaL }, { psi0_deg: v.psiR, zeta0: v.zetaR }], jumps: v.jumps, max_seconds: v.max_seconds,
+    tracker_timeout_ms: v.tracker_timeout_ms };
   if (closed) body.closed_loop = { controller: event.target.elements.controller.value, target_m: v.target_m, kp: v.kp, ki: v.ki, kd: v.kd };
   Object.assign(body, filedUnder(event.target));
   // The robot's state now, not as last shown: a disarmed robot is armed by the run and jumps.

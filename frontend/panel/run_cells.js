@@ -7,6 +7,11 @@ import { element, attributes } from "./dom.js";
 const ALARMS = [
   ["e-stop", "e-stop", "estop"],
   ["robot disarmed (fell or timed out)", "fell", "fall"],
+  ["fell", "fell", "fall"],
+  ["robot restarted", "restarted", "fall"],
+  ["robot disarmed itself", "disarmed itself", "fall"],
+  ["tracker silent", "tracker silent", "link"],
+  ["tracker lost the body", "body lost", "link"],
   ["link lost", "link lost", "link"],
   ["error", "error", "error"],
   ["interrupted", "interrupted", "interrupted"],

@@ -5,7 +5,9 @@ is checked against another reading of the layout, not against itself.
 Versions are numbers ``100 * major + minor`` here (2.9 is 209, 4.1 is 401). A scene holds something
 in every block the version has, so a decoder that misplaces one block misreads everything after it.
 The suffix follows PacketClient.cpp: a 2.x frame's software latency before the timecode, and (when
-``end_tag`` is given) the 4-byte end-of-data tag after the frame parameters.
+``end_tag`` is given) the 4-byte end-of-data tag after the frame parameters. ``latency=False`` writes a
+2.x frame as the SDK's NatNetClient.py 3.x/4.x, its later PacketClient.cpp and the ``natnet`` package
+read one: without the software latency (what an independent sender written from them sends).
 """
 
 from __future__ import annotations
@@ -78,9 +80,10 @@ def _channels(things, v: int) -> bytes:
     return _section(v, len(things), content)
 
 
-def frame_packet(scene: Scene, v: int, end_tag: int | None = None) -> bytes:
+def frame_packet(scene: Scene, v: int, end_tag: int | None = None, *, latency: bool = True) -> bytes:
     """The NAT_FRAMEOFDATA message of ``scene`` as a server of version ``v`` sends it, ending with the
-    end-of-data tag ``end_tag`` (a u32) unless it is None."""
+    end-of-data tag ``end_tag`` (a u32) unless it is None; a 2.x frame without its software latency
+    when ``latency`` is False."""
     p = struct.pack("<i", scene.frame)
     sets = b"".join(
         name.encode() + b"\0" + struct.pack("<i", n) + struct.pack("<fff", 1, 2, 3) * n for name, n in scene.marker_sets
@@ -114,7 +117,7 @@ def frame_packet(scene: Scene, v: int, end_tag: int | None = None) -> bytes:
         p += _channels(scene.force_plates, v)
     if v >= 211:
         p += _channels(scene.devices, v)
-    if v < 300:
+    if v < 300 and latency:
         p += struct.pack("<f", 4.5)  # software latency [ms]
     p += struct.pack("<II", 0x01020304, 5)  # timecode, sub-timecode
     p += struct.pack("<d" if v >= 207 else "<f", scene.timestamp)

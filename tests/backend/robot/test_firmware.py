@@ -2,7 +2,9 @@
 until RESET, commands outside the servo limits are refused, silence disarms, and the heartbeat and
 telemetry go out on their periods (docs/protocol.md §3)."""
 
-from backend.robot.firmware import HEARTBEAT_PERIOD, TELEMETRY_PERIOD, Firmware
+import itertools
+
+from backend.robot.firmware import HEARTBEAT_PERIOD, REPEAT_WINDOW, TELEMETRY_PERIOD, Firmware
 from backend.robot.messages import Ack, Command, Fault, Kind, Leg, Result, RobotState, SetLeg, Telemetry
 
 
@@ -10,9 +12,13 @@ def _send(firmware: Firmware, message, now: float = 0.0) -> list:
     return firmware.receive(message, now)
 
 
+_SEQ = itertools.count(100)  # each command its own sequence number, as the PC sends them: one reused is a repeat
+
+
 def _result(firmware: Firmware, kind: Kind, now: float = 0.0) -> Result:
-    ack = _send(firmware, Command(1, kind), now)[0]
-    assert isinstance(ack, Ack) and ack.acked == 1
+    seq = next(_SEQ)
+    ack = _send(firmware, Command(seq, kind), now)[0]
+    assert isinstance(ack, Ack) and ack.acked == seq
     return ack.result
 
 
@@ -119,3 +125,105 @@ def test_heartbeats_and_telemetry_go_out_on_their_periods():
     assert kinds(TELEMETRY_PERIOD / 2) == []
     assert kinds(TELEMETRY_PERIOD) == ["telemetry"]
     assert kinds(HEARTBEAT_PERIOD) == ["heartbeat", "telemetry"]
+
+
+# A resent command (docs/protocol.md §3): the same message, same sequence number, after its
+# acknowledgement went missing. Acknowledged again with the same result, never applied twice.
+
+
+def _acks(replies: list) -> list[tuple[int, Result]]:
+    return [(m.acked, m.result) for m in replies if isinstance(m, Ack)]
+
+
+def test_a_resent_start_is_acknowledged_again_and_not_applied_twice():
+    firmware = _armed()
+    start = Command(7, Kind.START)
+    assert _acks(firmware.receive(start, 0.0)) == [(7, Result.OK)] and firmware.state == RobotState.RUNNING
+    assert firmware.receive(Command(8, Kind.HEARTBEAT), 0.05) == [], "a heartbeat between them changes nothing"
+    again = firmware.receive(start, 0.1)
+    assert _acks(again) == [(7, Result.OK)], "the same answer: not refused as a START while running"
+    assert isinstance(again[1], Telemetry) and again[1].state == RobotState.RUNNING, "and telemetry, as the first"
+    assert firmware.state == RobotState.RUNNING
+
+
+def test_a_repeat_gets_the_first_answer_even_when_it_was_a_refusal():
+    firmware = Firmware()
+    outside = SetLeg(3, Leg.RIGHT, 30.0, 0.99)
+    assert _acks(firmware.receive(outside, 0.0)) == [(3, Result.REJECTED_LIMITS)]
+    firmware.faults = 0
+    assert _acks(firmware.receive(outside, 0.1)) == [(3, Result.REJECTED_LIMITS)]
+    assert firmware.faults == 0, "not checked again: its fault was raised once"
+
+
+def test_only_the_same_message_is_a_repeat():
+    firmware = Firmware()
+    firmware.receive(SetLeg(5, Leg.LEFT, 30.5, 0.9), 0.0)
+    firmware.receive(SetLeg(6, Leg.LEFT, 35.0, 0.88), 0.1)
+    assert firmware.legs[Leg.LEFT] == (35.0, 0.88), "a new sequence number is a new command, applied"
+    firmware.receive(SetLeg(6, Leg.LEFT, 35.0, 0.88), 0.2)
+    firmware.receive(SetLeg(5, Leg.LEFT, 30.5, 0.9), 0.3)
+    assert firmware.legs[Leg.LEFT] == (35.0, 0.88), "a late repeat of the older command undoes nothing"
+    firmware.receive(SetLeg(5, Leg.LEFT, 40.0, 0.85), 0.4)
+    assert firmware.legs[Leg.LEFT] == (40.0, 0.85), "the same number with another body (a new PC link): applied"
+
+
+def test_a_late_reset_does_not_clear_a_newer_estop():
+    firmware = _armed()
+    firmware.receive(Command(10, Kind.ESTOP), 0.0)
+    reset = Command(11, Kind.RESET)
+    firmware.receive(reset, 0.1)
+    assert firmware.state == RobotState.DISARMED
+    firmware.receive(Command(12, Kind.ESTOP), 0.2)
+    assert _acks(firmware.receive(reset, 0.3)) == [(11, Result.OK)]
+    assert firmware.state == RobotState.ESTOPPED, "the repeat was answered, not applied"
+
+
+def test_estop_and_disarm_are_always_applied():
+    firmware = _armed()
+    estop = Command(20, Kind.ESTOP)
+    firmware.receive(estop, 0.0)
+    firmware.receive(Command(21, Kind.RESET), 0.1)
+    assert _acks(firmware.receive(estop, 0.2)) == [(20, Result.OK)]
+    assert firmware.state == RobotState.ESTOPPED, "a stop never waits on a memory"
+    firmware.receive(Command(22, Kind.RESET), 0.3)
+    disarm = Command(23, Kind.DISARM)
+    firmware.receive(disarm, 0.4)
+    firmware.receive(Command(24, Kind.ARM), 0.5)
+    assert _acks(firmware.receive(disarm, 0.6)) == [(23, Result.OK)] and firmware.state == RobotState.DISARMED
+
+
+def test_a_command_is_remembered_for_a_while_only():
+    firmware = Firmware()
+    arm = Command(30, Kind.ARM)
+    firmware.receive(arm, 0.0)
+    firmware.receive(Command(31, Kind.DISARM), 0.1)
+    firmware.receive(arm, REPEAT_WINDOW / 2)
+    assert firmware.state == RobotState.DISARMED, "within the window: a repeat"
+    firmware.receive(arm, REPEAT_WINDOW + 0.5)
+    assert firmware.state == RobotState.ARMED, "long after: a new command that happens to match"
+
+
+# A boot (power-up, brown-out): BOOTED until the PC's first ARM, the sequence from 1.
+
+
+def test_a_booted_firmware_says_so_until_the_first_arm():
+    firmware = Firmware.boot()
+    assert firmware.state == RobotState.DISARMED and firmware.faults == Fault.BOOTED
+    first = firmware.tick(0.0)
+    assert [m.seq for m in first] == [1, 2], "its sequence starts at 1"
+    assert all(m.faults == Fault.BOOTED for m in first if isinstance(m, Telemetry))
+    ack, telemetry = firmware.receive(Command(1, Kind.ARM), 0.1)
+    assert ack.result == Result.OK and not telemetry.faults & Fault.BOOTED, "cleared by the ARM, seen before it"
+
+
+def test_a_brown_out_boot_says_so_too():
+    firmware = Firmware.boot(brown_out=True, heartbeat_timeout=0.3)
+    assert firmware.faults == Fault.BOOTED | Fault.BROWNOUT and firmware.heartbeat_timeout == 0.3
+    assert Firmware().faults == 0, "a firmware made without a boot has none: the PC has seen its boot"
+
+
+def test_a_reset_clears_booted_with_the_other_faults():
+    firmware = Firmware.boot()
+    firmware.receive(Command(1, Kind.ESTOP), 0.0)
+    firmware.receive(Command(2, Kind.RESET), 0.1)
+    assert firmware.state == RobotState.DISARMED and firmware.faults == 0

@@ -64,3 +64,34 @@ def test_changes_reach_the_file_in_their_order(tmp_path):
     latch.engage()
     latch.flush()
     assert json.loads(path.read_text())["held"] is True
+
+
+def test_a_change_is_durable_only_once_its_file_is_written(tmp_path, monkeypatch):
+    """The press never waits for the disk, and says when the file has it: a slow disk is held up
+    here until the test lets it write."""
+    import threading
+
+    path = tmp_path / "estop-latch.json"
+    latch = EstopLatch(path)
+    disk = threading.Event()
+    write = latch._write
+    monkeypatch.setattr(latch, "_write", lambda *args: (disk.wait(5), write(*args)))
+    latch.engage()  # returns at once
+    assert latch.held and not latch.state.durable and not path.exists()
+    assert latch.flush(timeout=0.05) is False, "not on disk yet"
+    disk.set()
+    assert latch.flush() is True and latch.state.durable
+    assert json.loads(path.read_text())["held"] is True
+
+
+def test_a_write_that_fails_leaves_it_held_not_durable_and_says_why(tmp_path):
+    latch = EstopLatch(tmp_path / "no-such-folder" / "estop-latch.json")
+    latch.engage()
+    assert latch.flush() is False and latch.held and not latch.state.durable
+    assert "could not save the e-stop latch" in latch.save_error
+
+
+def test_a_latch_kept_in_memory_is_durable_at_once():
+    latch = EstopLatch()
+    latch.engage()
+    assert latch.state.durable and latch.flush(timeout=1) is True

@@ -1,13 +1,15 @@
 """The PC's link against the virtual robot over a real TCP socket (pyserial ``socket://``)."""
 
 import itertools
+import re
 import socket
 import time
 
 import pytest
 
+from backend.robot.firmware import Firmware
 from backend.robot.link import HEARTBEAT_PERIOD, WRITE_TIMEOUT, EstopLatched, LinkError, LinkState, RobotLink
-from backend.robot.messages import Fault, Kind, Leg, RobotState
+from backend.robot.messages import Ack, Fault, Kind, Leg, RobotState, SetLeg
 from backend.robot.virtual import VirtualRobot
 from sim_core import ParameterError
 from tests.helpers import answer_within
@@ -16,6 +18,8 @@ from tests.robot_rig import FOREIGN, PtyRobot, received_frame, telemetry
 NETWORK_ACK_FAILURE = 0x21  # a Transmit Status: the robot's radio did not acknowledge the frame
 ADDRESS_NOT_FOUND = 0x24
 JAMMED_ANSWER_S = 2.0  # [s] "answers instead of hanging": a generous bound, not a latency claim
+# [s] the same for a command, which tries again for its whole bound (the heartbeat timeout and a margin)
+COMMAND_ANSWER_S = 6.0
 
 
 @pytest.fixture
@@ -144,7 +148,7 @@ def test_a_blocked_write_is_a_counted_link_error(jammed):
             jammed.set_leg(Leg.LEFT, 30.0, 0.9)
         return True
 
-    assert answer_within(JAMMED_ANSWER_S, set_leg)
+    assert answer_within(COMMAND_ANSWER_S, set_leg)
     assert jammed.write_timeouts >= 1 and jammed.counters()["write_timeouts"] == jammed.write_timeouts
     assert jammed.port.serial.write_timeout == WRITE_TIMEOUT
 
@@ -231,8 +235,11 @@ def test_a_jammed_line_that_clears_still_delivers_the_estop():
 
 def test_a_failed_reset_keeps_repeating_the_estop(lossy):
     rig, link = lossy
-    with pytest.raises(LinkError, match="no acknowledgement for Command"):
+    before = len(rig.sent)
+    with pytest.raises(LinkError, match=r"no acknowledgement for RESET \(seq \d+\) in [\d.]+ s after 1 sends"):
         link.reset()  # lost on the air too
+    resets = _kinds(rig.sent[before:]).count(Kind.RESET)
+    assert resets == 1, "not resent: the e-stop, not yet acknowledged, owns the line"
     rig.delivery_status = 0x00
     _wait_for(lambda: link.state == LinkState.ESTOPPED)
     assert rig.state == RobotState.ESTOPPED
@@ -354,7 +361,7 @@ def test_make_safe_accepts_an_estopped_robot(robot, link):
 
 
 def test_make_safe_says_when_it_cannot_confirm(jammed):
-    error = answer_within(JAMMED_ANSWER_S, _raises_link_error, jammed.make_safe)
+    error = answer_within(COMMAND_ANSWER_S, _raises_link_error, jammed.make_safe)
     assert "jammed" in str(error) or "no acknowledgement" in str(error), error
     jammed.close()
     with pytest.raises(LinkError, match="down"):
@@ -367,3 +374,192 @@ def _raises_link_error(call):
     except LinkError as error:
         return error
     pytest.fail(f"{call.__name__} did not raise LinkError")
+
+
+# Late acknowledgements (docs/protocol.md §3): a command is resent, the same message with the same
+# sequence number, until acknowledged; a run ends only when the link is really gone.
+
+
+class LosingAcks(Firmware):
+    """The virtual robot's firmware, the acknowledgements of its commands of ``kind`` lost on the
+    air: the first ``lose`` of them (None: every one). Keeps each it got, and counts each applied."""
+
+    def __init__(self, kind: Kind, lose: int | None = 1, **fields):
+        super().__init__(**fields)
+        self.kind, self.lose = kind, lose
+        self.got: list = []
+        self.applied = 0
+
+    def receive(self, message, now):
+        replies = super().receive(message, now)
+        if _kind_of(message) != self.kind:
+            return replies
+        self.got.append(message)
+        if self.lose is None or len(self.got) <= self.lose:
+            return [reply for reply in replies if not isinstance(reply, Ack)]
+        return replies
+
+    def _set_leg(self, message):
+        self.applied += self.kind == Kind.SET_LEG
+        return super()._set_leg(message)
+
+    def _command(self, kind):
+        self.applied += kind == self.kind
+        return super()._command(kind)
+
+
+class Mute(Firmware):
+    """The firmware, its radio silent (both its answers and its own heartbeats and telemetry) once
+    ``silent`` is set."""
+
+    silent = False
+
+    def receive(self, message, now):
+        replies = super().receive(message, now)
+        return [] if self.silent else replies
+
+    def tick(self, now):
+        out = super().tick(now)
+        return [] if self.silent else out
+
+
+def _kind_of(message) -> Kind:
+    return Kind.SET_LEG if isinstance(message, SetLeg) else message.kind
+
+
+def _linked(firmware: Firmware, **link_options):
+    robot = VirtualRobot(firmware=firmware).start()
+    link = RobotLink(robot.url, **link_options)
+    link.connect()
+    return robot, link
+
+
+def test_a_set_leg_whose_acknowledgement_is_lost_is_resent_and_applied_once():
+    firmware = LosingAcks(Kind.SET_LEG)
+    robot, link = _linked(firmware)
+    try:
+        answer_within(COMMAND_ANSWER_S, link.set_leg, Leg.RIGHT, 35.0, 0.88)
+        assert len(firmware.got) >= 2 and set(firmware.got) == {firmware.got[0]}, "the same message, same seq"
+        assert firmware.applied == 1 and firmware.legs[Leg.RIGHT] == (35.0, 0.88), "applied once"
+        _wait_for(lambda: link.counters()["command_resends"] == len(firmware.got) - 1)
+        assert link.state == LinkState.DISARMED
+    finally:
+        link.close()
+        robot.stop()
+
+
+def test_a_command_never_acknowledged_names_itself_and_how_long_it_waited():
+    firmware = LosingAcks(Kind.SET_LEG, lose=None)
+    robot, link = _linked(firmware, heartbeat_timeout=0.5)
+    try:
+        error = answer_within(COMMAND_ANSWER_S, _raises_link_error, lambda: link.set_leg(Leg.RIGHT, 35.0, 0.88))
+        match = re.fullmatch(
+            r"no acknowledgement for SET_LEG \(right leg, psi0 35\.00°, zeta0 0\.8800, seq (\d+)\) "
+            r"in ([\d.]+) s after (\d+) sends",
+            str(error),
+        )
+        assert match, error
+        seq, seconds, sends = int(match[1]), float(match[2]), int(match[3])
+        assert seconds >= link.heartbeat_timeout, "given at least as long as a silent robot would be"
+        _wait_for(lambda: len(firmware.got) == sends)
+        assert sends >= 2 and {m.seq for m in firmware.got} == {seq} and firmware.applied == 1
+        assert link.counters()["command_resends"] == sends - 1
+        assert link.state == LinkState.DISARMED, "the robot kept talking: the link is not lost"
+    finally:
+        link.close()
+        robot.stop()
+
+
+def test_a_command_to_a_robot_gone_silent_says_the_link_was_lost():
+    firmware = Mute()
+    robot, link = _linked(firmware, heartbeat_timeout=0.3)
+    try:
+        firmware.silent = True
+        error = answer_within(COMMAND_ANSWER_S, _raises_link_error, link.arm)
+        assert str(error).startswith("no acknowledgement for ARM (seq "), error
+        assert "the link was lost (no heartbeat from the robot for 0.3 s)" in str(error), error
+        assert link.state == LinkState.DISCONNECTED
+    finally:
+        link.close()
+        robot.stop()
+
+
+def test_make_safe_resends_its_disarm():
+    firmware = LosingAcks(Kind.DISARM)
+    robot, link = _linked(firmware)
+    try:
+        link.arm()
+        assert answer_within(COMMAND_ANSWER_S, link.make_safe) == LinkState.DISARMED
+        assert len(firmware.got) >= 2 and set(firmware.got) == {firmware.got[0]}
+        assert robot.firmware.state == RobotState.DISARMED
+    finally:
+        link.close()
+        robot.stop()
+
+
+# A restart of the robot (docs/protocol.md §3): named, counted, recorded.
+
+REBOOTED_SEQ = 3 * 16  # the robot's sequence well past the window before it reboots (about 3 s of its traffic)
+
+
+def test_a_reboot_mid_run_is_named_and_counted(robot, link):
+    link.arm()
+    link.start()
+    assert link.state == LinkState.RUNNING and link.restarts == 0
+    _wait_for(lambda: link.telemetry.seq > REBOOTED_SEQ, timeout=10.0)
+    robot.reboot()
+    _wait_for(lambda: link.restarts == 1)
+    assert re.fullmatch(r"robot restarted \(its sequence went back from \d+ to [1-3]\)", link.last_restart)
+    _wait_for(lambda: link.state == LinkState.DISARMED)
+    restarted = [t for t in link.transitions if t.reason == link.last_restart]
+    assert [(t.before, t.after) for t in restarted] == [(LinkState.RUNNING, LinkState.DISARMED)]
+    assert link.telemetry.faults & Fault.BOOTED
+    time.sleep(0.3)
+    assert link.restarts == 1, "one restart, counted once"
+
+
+def test_a_brown_out_reboot_says_brown_out(robot, link):
+    link.arm()
+    robot.reboot(brown_out=True)
+    _wait_for(lambda: link.restarts == 1)
+    assert link.last_restart.startswith("robot restarted (brown-out"), link.last_restart
+    _wait_for(lambda: link.state == LinkState.DISARMED)
+    assert link.transitions[-1].reason == link.last_restart
+
+
+def test_a_fresh_connect_to_a_booted_robot_is_no_restart(robot, link):
+    assert link.telemetry.faults & Fault.BOOTED, "the virtual robot has just powered up"
+    assert link.restarts == 0 and link.last_restart is None
+    link.arm()
+    _wait_for(lambda: not link.telemetry.faults & Fault.BOOTED)  # the ARM cleared it
+    time.sleep(0.2)
+    assert link.restarts == 0 and link.last_restart is None
+
+
+def test_a_second_boot_before_any_arm_is_seen_by_its_sequence(robot, link):
+    _wait_for(lambda: link.telemetry.seq > REBOOTED_SEQ, timeout=10.0)
+    robot.reboot()
+    _wait_for(lambda: link.restarts == 1)
+    assert "its sequence went back" in link.last_restart
+    assert link.transitions[-1].reason == link.last_restart
+    assert (link.transitions[-1].before, link.transitions[-1].after) == (LinkState.DISARMED, LinkState.DISARMED)
+
+
+def test_a_reboot_while_the_link_was_down_is_counted_on_reconnecting(robot, link):
+    link.arm()
+    link.close()
+    robot.reboot()
+    link.connect()
+    assert link.restarts == 1 and link.last_restart.startswith("robot restarted")
+    assert link.transitions[-1].after == LinkState.DISARMED and link.transitions[-1].reason == link.last_restart
+
+
+@pytest.mark.realtime
+def test_a_robot_that_reboots_under_the_latch_is_estopped_again(robot, link):
+    link.arm()
+    assert link.estop().acknowledged
+    robot.reboot()
+    _wait_for(lambda: link.restarts == 1)
+    _wait_for(lambda: robot.firmware.state == RobotState.ESTOPPED)
+    assert link.state == LinkState.ESTOPPED and link.latch.held
+    _wait_for(lambda: link.latch.state.acknowledged)

@@ -7,6 +7,7 @@ from hypothesis import strategies as st
 from backend.robot.messages import (
     Ack,
     Command,
+    Fault,
     Kind,
     Leg,
     ProtocolError,
@@ -84,3 +85,11 @@ def test_legs_convert_to_and_from_walls(wall):
     leg = Leg.of(wall)
     assert leg.wall is wall
     assert int(leg) == (0 if wall is Wall.LEFT else 1), "the wire values stay 0 (left), 1 (right)"
+
+
+def test_fault_bits_are_distinct_and_booted_is_bit_5():
+    assert Fault.BOOTED == 1 << 5 and Fault.BROWNOUT == 1 << 3
+    bits = [int(fault) for fault in Fault]
+    assert all(bit & (bit - 1) == 0 for bit in bits) and len(set(bits)) == len(bits), "one bit each"
+    booted = Telemetry(2, RobotState.DISARMED, (30.0, 30.0), (0.9, 0.9), 7400, Fault.BOOTED | Fault.BROWNOUT)
+    assert encode(booted)[-2:] == bytes.fromhex("0028") and decode(encode(booted)) == booted

@@ -2,6 +2,7 @@
 the production encoder agreeing with the published layout, and bad packets refused, never crashing."""
 
 import contextlib
+import itertools
 import math
 import struct
 
@@ -109,11 +110,12 @@ def test_every_truncation_of_every_version_is_refused():
 
 def test_a_frame_read_with_the_wrong_version_is_refused():
     """All pairs but 2.6 and 2.7: their frames differ only in the timestamp's size (f32, f64), by 4 bytes,
-    as much as the optional end-of-data tag, so a configured version must name the stream's exactly."""
+    as much as the optional end-of-data tag, so a configured version must name the stream's exactly.
+    2.x frames without the software latency alike."""
     alike = {(206, 207), (207, 206)}
     for v in VERSIONS:
-        for tag in (None, *END_TAGS):
-            packet = frame_packet(SCENE, v, end_tag=tag)
+        for tag, latency in itertools.product((None, *END_TAGS), (True, False)):
+            packet = frame_packet(SCENE, v, end_tag=tag, latency=latency)
             for other in VERSIONS:
                 same_layout = frame_packet(SCENE, other) == frame_packet(SCENE, v)
                 if not same_layout and (v, other) not in alike:
@@ -172,3 +174,65 @@ def test_an_encoded_body_reads_back_as_it_was_written(v):
     assert read.position == body.position and read.orientation == pytest.approx(body.orientation, abs=1e-7)
     assert read.tracked is (v < 206), "no tracking flag before 2.6: tracked"
     assert read.mean_error == 0.0, "an unknown (NaN) mean error is sent as 0"
+
+
+def _f32(x: float) -> float:
+    return struct.unpack("<f", struct.pack("<f", x))[0]
+
+
+_F32 = st.floats(-100.0, 100.0, width=32)
+_BODIES = st.lists(
+    st.builds(
+        Body,
+        id=st.integers(0, 2**31 - 1),
+        position=st.tuples(_F32, _F32, _F32),
+        quaternion=st.tuples(_F32, _F32, _F32, _F32),
+        markers=st.lists(st.tuples(_F32, _F32, _F32), max_size=3).map(tuple),
+        error=st.floats(0.0, 2**-7, width=32),
+        valid=st.booleans(),
+    ),
+    max_size=4,
+    unique_by=lambda body: body.id,
+).map(tuple)
+
+
+@pytest.mark.parametrize("v", VERSIONS)
+@settings(max_examples=60, deadline=None)
+@given(
+    bodies=_BODIES,
+    number=st.integers(0, 2**31 - 1),
+    timestamp=st.just(0.0) | st.floats(1e-3, 1e7),
+    tag=st.sampled_from((None, *END_TAGS)),
+    latency=st.booleans(),
+)
+def test_any_frame_of_any_version_reads_back_with_or_without_the_tag_and_the_2x_latency(
+    v, bodies, number, timestamp, tag, latency
+):
+    """Every version, with and without the end-of-data tag, a 2.x frame with the SDK's software latency
+    (PacketClient.cpp) and without it (NatNetClient.py 3.x/4.x, the ``natnet`` package): the frame
+    number, the timestamp (f32 before 2.7) and every rigid body as written. Without latency and tag a
+    2.x frame used to be refused as truncated; with the tag, its timestamp was read 4 bytes off."""
+    frame = decode_frame(frame_packet(Scene(number, timestamp, bodies), v, tag, latency=latency), _version(v))
+    assert frame.number == number
+    assert frame.timestamp == (timestamp if v >= 207 else _f32(timestamp))
+    assert [body.id for body in frame.rigid_bodies] == [body.id for body in bodies]
+    for read, body in zip(frame.rigid_bodies, bodies, strict=True):
+        assert (read.position, read.orientation) == (body.position, body.quaternion)
+        assert read.mean_error == body.error if v >= 200 else math.isnan(read.mean_error)
+        assert read.tracked is (body.valid or v < 206)
+
+
+@pytest.mark.parametrize("v", [v for v in VERSIONS if v < 300])
+def test_a_2x_frame_without_the_latency_is_cut_like_any_other(v):
+    """Without the latency, as with it: a cut of a frame is refused (the header fixed to match), but the
+    one that takes off exactly the tag; and bytes after it other than a tag are refused."""
+    plain = frame_packet(SCENE, v, latency=False)
+    assert decode_frame(plain, _version(v)) == decode_frame(frame_packet(SCENE, v), _version(v))
+    tagged = frame_packet(SCENE, v, 0, latency=False)
+    for n in range(4, len(tagged)):
+        if tagged[4:n] != plain[4:]:
+            with pytest.raises(NatNetError):
+                decode_frame(struct.pack("<HH", 7, n - 4) + tagged[4:n], _version(v))
+    for extra in (1, 2, 3, 5, 6, 7, 9):
+        with pytest.raises(NatNetError, match="end-of-data tag"):
+            decode_frame(struct.pack("<HH", 7, len(plain) - 4 + extra) + plain[4:] + bytes(extra), _version(v))

@@ -6,6 +6,8 @@ import socket
 import time
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from backend.robot.tracker import (
     FRAME_JUMP,
@@ -114,3 +116,24 @@ def test_counts_over_a_run_are_the_difference_of_two_snapshots():
     assert before == TrackerCounts(received=3, dropped=2, malformed=3, ignored=1), "a snapshot does not move"
     assert stats.loss == stats.snapshot().loss == pytest.approx(4 / 11)
     assert TrackerCounts().loss == 0.0
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.sampled_from(("ok", "malformed", "lost")), max_size=60), st.integers(0, 2**32 - 61))
+def test_a_malformed_frame_is_counted_once_never_also_as_dropped(fates, first):
+    """Frames numbered ``first`` on: each arrives, arrives malformed (counted as both sources count one)
+    or is lost. Dropped: only the lost ones between the first and last frame received."""
+    stats = TrackerStats()
+    for number, fate in enumerate(fates, first):
+        if fate == "ok":
+            stats.frame(number)
+        elif fate == "malformed":
+            stats.malformed += 1
+    received = [k for k, fate in enumerate(fates) if fate == "ok"]
+    lost = fates[received[0] : received[-1]].count("lost") if received else 0
+    assert (stats.received, stats.malformed, stats.dropped, stats.restarts) == (
+        len(received),
+        fates.count("malformed"),
+        lost,
+        0,
+    )

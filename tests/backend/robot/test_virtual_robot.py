@@ -4,7 +4,8 @@ the firmware behind it. Its body's climb is the climber's (test_climber.py)."""
 import socket
 import time
 
-from backend.robot.messages import Ack, Command, Kind, RobotState, decode, encode
+from backend.robot.firmware import Firmware
+from backend.robot.messages import Ack, Command, Fault, Kind, Leg, RobotState, SetLeg, Telemetry, decode, encode
 from backend.robot.virtual import VirtualRobot
 from backend.robot.xbee import (
     ROBOT_ADDRESS,
@@ -56,3 +57,74 @@ def test_the_radio_answers_transmit_status_as_an_xbee_does():
     assert not isinstance(answers[0], Ack) and isinstance(answers[1], Ack), "the status comes before the reply"
     assert [a.acked for a in answers if isinstance(a, Ack)] == [1], "HEARTBEAT has no ack, the ESTOP never arrived"
     assert robot.firmware.state == RobotState.ARMED
+
+
+def _booted_telemetry(connection: socket.socket, timeout: float = 3.0) -> Telemetry:
+    """The first TELEMETRY that says the robot booted."""
+    parser = FrameParser()
+    deadline = time.monotonic() + timeout
+    while True:
+        assert time.monotonic() < deadline, "no telemetry with BOOTED"
+        for data in parser.feed(connection.recv(4096)):
+            if data[0] != TX_STATUS:
+                message = decode(parse_rx_packet(data).payload)
+                if isinstance(message, Telemetry) and message.faults & Fault.BOOTED:
+                    return message
+
+
+def test_the_virtual_robot_powers_up_booted():
+    robot = VirtualRobot()
+    assert robot.firmware.faults == Fault.BOOTED and robot.firmware.state == RobotState.DISARMED
+    robot.server.close()
+
+
+def test_a_reboot_is_a_fresh_firmware_on_the_same_connection():
+    robot = VirtualRobot(firmware=Firmware(heartbeat_timeout=5.0)).start()
+    try:
+        with socket.create_connection(robot.address, timeout=3.0) as connection:
+            connection.sendall(
+                _request(Command(1, Kind.ARM), frame_id=1)
+                + _request(SetLeg(2, Leg.LEFT, 40.0, 0.85), frame_id=2)
+                + _request(Command(3, Kind.START), frame_id=3)
+            )
+            _answers(connection, until_status=3)
+            assert robot.firmware.state == RobotState.RUNNING and robot.firmware.legs[Leg.LEFT] == (40.0, 0.85)
+            before = robot.firmware
+            robot.reboot(brown_out=True)
+            firmware = robot.firmware
+            assert firmware is not before and firmware.state == RobotState.DISARMED
+            assert firmware.faults == Fault.BOOTED | Fault.BROWNOUT
+            assert firmware.legs == Firmware().legs, "the legs at their power-up defaults"
+            assert firmware.heartbeat_timeout == 5.0, "its configuration kept"
+            telemetry = _booted_telemetry(connection)
+            assert telemetry.seq <= 3 and telemetry.state == RobotState.DISARMED, "its sequence begins again"
+            connection.sendall(_request(Command(4, Kind.ARM), frame_id=4))
+            assert [a.acked for a in _answers(connection, until_status=4) if isinstance(a, Ack)] == [4]
+            assert robot.firmware.state == RobotState.ARMED, "the same connection reaches the new firmware"
+    finally:
+        robot.stop()
+
+
+def test_a_reboot_stops_the_body():
+    tracker = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    tracker.bind(("127.0.0.1", 0))
+    # A long watchdog: this PC sends no heartbeats, and the first launch may take a while on a busy machine.
+    robot = VirtualRobot(firmware=Firmware.boot(heartbeat_timeout=60.0), tracker_to=tracker.getsockname(), speed=4.0)
+    robot.start()
+    try:
+        with socket.create_connection(robot.address, timeout=3.0) as connection:
+            start = _request(Command(1, Kind.ARM), frame_id=1) + _request(Command(2, Kind.START), frame_id=2)
+            connection.sendall(start)
+            _answers(connection, until_status=2)
+            deadline = time.monotonic() + 30.0
+            while robot.climber.frames_sent < 20:
+                assert time.monotonic() < deadline, "the body never moved"
+                time.sleep(0.01)
+            robot.reboot()
+            time.sleep(0.1)  # a frame under way goes out
+            sent = robot.climber.frames_sent
+            time.sleep(0.3)
+            assert robot.climber.frames_sent == sent, "the firmware that ran the climb is gone: the body stops"
+    finally:
+        robot.stop()
+        tracker.close()

@@ -18,7 +18,7 @@ from backend.robot.live_run import LiveRun, RunSnapshot
 from backend.robot.messages import Fault, RobotState
 from backend.robot.virtual import VirtualRobot
 from backend.schemas import LegIn, RobotConnect, RobotRunCreate
-from backend.services.robot import ESTOP_ANSWER, RobotUnavailable
+from backend.services.robot import ANSWER_WAIT, RobotUnavailable
 from backend.services.robot_records import replay_run, touchdown_results
 from backend.services.simulation import unpack_trajectory
 from sim_core import ParameterError, get_preset
@@ -47,8 +47,9 @@ def test_without_a_robot_nothing_moves(service):
     for command in (service.arm, service.disarm, service.reset):
         with pytest.raises(RobotUnavailable, match="not connected"):
             command()
-    stopped = service.estop()  # always answers: stopping is always allowed
-    assert (stopped["acknowledged"], stopped["reason"]) == (False, "the robot is not connected")
+    stopped = service.estop()  # always answers: stopping is always allowed, and latches
+    assert stopped["acknowledged"] is False and stopped["reason"].startswith("the robot is not connected")
+    assert stopped["estop"]["latched"] is True
     with pytest.raises(RobotUnavailable):
         service.start_run(RobotRunCreate(controls=LEGS))
     with pytest.raises(errors.NotFound):
@@ -191,7 +192,7 @@ def test_estop_now_answers_even_when_the_estop_thread_is_stuck(service, monkeypa
     release.set()
     for answer in answers:
         assert answer["acknowledged"] is False and "did not finish" in answer["reason"]
-        assert answer["latency_ms"] == pytest.approx(ESTOP_ANSWER * 1000)
+        assert answer["latency_ms"] == pytest.approx(ANSWER_WAIT * 1000)
     assert len(calls) == 1, "a press during an e-stop joins it"
 
 

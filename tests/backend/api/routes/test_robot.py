@@ -115,7 +115,8 @@ def test_estop_answers_while_the_request_pool_is_full(client, auth, connected, m
 
 def test_estop_without_a_robot_says_so(client):
     stopped = client.post("/api/v1/robot/estop").json()
-    assert (stopped["acknowledged"], stopped["reason"]) == (False, "the robot is not connected")
+    assert stopped["acknowledged"] is False and stopped["reason"].startswith("the robot is not connected")
+    assert stopped["estop"]["latched"] is True and stopped["estop"]["durable"] is True, "it latches all the same"
 
 
 def test_estop_on_a_jammed_line_answers_without_hanging(client, auth):
