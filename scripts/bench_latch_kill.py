@@ -53,7 +53,8 @@ def one_try(data_dir: Path, robot_port: int | None, tracker_port: int, tree: Pat
                 body = {"url": f"socket://127.0.0.1:{robot_port}", "tracker_port": tracker_port}
                 client.post(f"{base}/robot/connect", json=body, headers=auth).raise_for_status()
                 if client.get(f"{base}/robot").json()["estop"]["latched"]:
-                    client.post(f"{base}/robot/reset", headers=auth).raise_for_status()
+                    reset = client.post(f"{base}/robot/reset", headers=auth)
+                    assert reset.status_code == 200, reset.text
             else:
                 (data_dir / "estop-latch.json").unlink(missing_ok=True)  # released before the press
             answer = client.post(f"{base}/robot/estop").json()
@@ -67,6 +68,7 @@ def one_try(data_dir: Path, robot_port: int | None, tracker_port: int, tree: Pat
         "answer_latched": answer["estop"]["latched"],
         "answer_durable": answer["estop"].get("durable"),
         "file_held": bool(saved and saved.get("held")),
+        "reason": answer.get("reason"),  # why not acknowledged (None when it was)
     }
 
 

@@ -52,8 +52,6 @@ import argparse
 import json
 import math
 import socket
-import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -65,7 +63,7 @@ from sim_core.calibration_fit import PARAMETERS, vector_of
 from sim_core.controls import LegControl
 from sim_core.touchdown_series import FALL_PAIRS, TouchdownSeries, pitch_at
 from sim_core.walls import Wall
-from tests.helpers import ROOT, free_port, start_robot_sim, stop_processes
+from tests.helpers import free_port, start_robot_sim, start_service, stop_processes
 from tests.tracked_climbs import PAPER, VARIED_LEGS, Truth
 
 # Hidden truths of this script's own: lighter damping or a stiffer leg than the paper's robot (alpha
@@ -82,7 +80,6 @@ TRUTHS = {
 UNITS = {"alpha": "%", "c_zeta": "", "c_psi": "", "psi0_offset_deg.left": "deg", "psi0_offset_deg.right": "deg",
          "zeta0_offset.left": "l0", "zeta0_offset.right": "l0"}  # fmt: skip
 SECONDS_PER_JUMP = 0.56  # [s] the virtual robot in real time
-START_TIMEOUT_S = 60.0
 TIMEOUT_S = 120.0  # [s] any one request (a calibration's fit included): a bound, not a measurement
 
 
@@ -94,22 +91,6 @@ def sim_options(truth: Truth, seed: int) -> list[str]:
             "--psi0-offset-deg", *map(number, offsets.psi0_offset_deg),
             "--zeta0-offset", *map(number, offsets.zeta0_offset),
             "--noise", "on", "--seed", str(seed)]  # fmt: skip
-
-
-def start_service(data_dir: Path, port: int, log: Path) -> subprocess.Popen:
-    """``parkour serve --no-view`` over ``data_dir``, its stderr in ``log``; returned once it answers."""
-    command = [sys.executable, "-m", "cli", "serve", "--no-view", "--data-dir", str(data_dir), "--port", str(port)]
-    process = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=log.open("wb"))
-    deadline = time.monotonic() + START_TIMEOUT_S
-    while time.monotonic() < deadline:
-        try:
-            if httpx.get(f"http://127.0.0.1:{port}/api/v1/health", timeout=1).status_code == 200:
-                return process
-        except httpx.HTTPError:
-            time.sleep(0.2)
-    process.kill()
-    process.wait()
-    raise SystemExit(f"the service did not start within {START_TIMEOUT_S:g} s:\n{tail(log)}")
 
 
 def tail(log: Path, lines: int = 40) -> str:
@@ -319,7 +300,7 @@ def main() -> None:
     data = Path(tempfile.mkdtemp(prefix="parkour-live-falls-"))
     log = data / "service.log"
     port = free_port()
-    service = start_service(data / "data", port, log)
+    service = start_service(data / "data", port, "--no-view", log=log)
     rows = []
     try:
         api = Api(f"http://127.0.0.1:{port}", (data / "data" / "api_token").read_text().strip(), log)

@@ -35,14 +35,17 @@ def free_port(kind: socket.SocketKind = socket.SOCK_STREAM) -> int:
         return probe.getsockname()[1]
 
 
-def start_service(data_dir: Path, port: int, *options: str, tree: Path | None = None) -> subprocess.Popen:
+def start_service(
+    data_dir: Path, port: int, *options: str, tree: Path | None = None, log: Path | None = None
+) -> subprocess.Popen:
     """``parkour serve --data-dir DATA_DIR --port PORT OPTIONS...`` in a subprocess, returned once
     ``/api/v1/health`` answers; the caller ends it (``terminate``, or ``SIGKILL`` to test a crash).
     ``tree``: the service's code from another checkout (a benchmark's base revision), run with this
-    venv."""
+    venv; ``log``: a file for its stderr (default: none kept)."""
     command = [sys.executable, "-m", "cli", "serve", "--data-dir", str(data_dir), "--port", str(port), *options]
     env = None if tree is None else dict(os.environ, PYTHONPATH=str(tree))
-    process = subprocess.Popen(command, cwd=tree, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    stderr = subprocess.DEVNULL if log is None else log.open("wb")
+    process = subprocess.Popen(command, cwd=tree, env=env, stdout=subprocess.DEVNULL, stderr=stderr)
     deadline = time.monotonic() + SERVICE_START_TIMEOUT
     while time.monotonic() < deadline:
         try:

@@ -106,6 +106,10 @@ class Firmware:
             self._next_seq(), self.state, (left[0], right[0]), (left[1], right[1]), self.battery_mv, self.faults
         )
 
+    def forget_repeats(self) -> None:
+        """A new PC (the radio associated anew): nothing it sends is a repeat of the last one's."""
+        self._applied.clear()
+
     def _once(self, message: Message, now: float, apply) -> Result:
         """``apply()``'s result, or, for a repeat of a command applied within REPEAT_WINDOW (the same
         message: type, sequence number and body), the result it had, without applying it again."""

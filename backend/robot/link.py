@@ -20,6 +20,7 @@ latched ESTOP first, ARM and START are refused (:class:`EstopLatched`) and the l
 
 from __future__ import annotations
 
+import random
 import threading
 import time
 from collections.abc import Callable
@@ -72,7 +73,7 @@ class RobotLink:
         self.estop_repeats = 0  # ESTOPs written again for an e-stop already sent (counted in "retries")
         self.on_lost: list[Callable[[str], None]] = []
         self.port = LinkPort(url, baud, robot_address)  # frames out, whole and bounded, and their counts
-        self._seq = 0
+        self._seq = random.SystemRandom().randrange(0x10000)  # no new link's seq repeats one the robot recalls (§3)
         self._acks = Acknowledgements()  # awaited, by seq; and the commands' resends
         self.restarts, self.last_restart = 0, None  # the robot's restarts since this link was made; the last's reason
         self._last_telemetry: Telemetry | None = None  # the last heard, on any connection (the reader's)
@@ -293,7 +294,6 @@ class RobotLink:
             try:
                 chunk = self.port.read()
             except (serial.SerialException, OSError):
-                chunk = b""
                 self._lost("read failed")
                 return
             for data in self.parser.feed(chunk):

@@ -130,6 +130,8 @@ class VirtualRobot:
                 self._close_connection()
                 self._connection = connection
                 self.parser = FrameParser()
+                with self.lock:  # a new association: a new PC, whose commands are none of the old one's
+                    self.firmware.forget_repeats()
             elif ready:
                 self._exchange(ready[0])
             if time.monotonic() >= next_tick:

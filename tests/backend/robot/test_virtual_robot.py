@@ -128,3 +128,26 @@ def test_a_reboot_stops_the_body():
     finally:
         robot.stop()
         tracker.close()
+
+
+def test_a_new_pc_is_no_repeat_of_the_last_ones_commands():
+    """A service killed and started again begins its sequence afresh: its RESET, the same bytes as
+    the last service's RESET a moment before, is a new command (found: the robot answered it from
+    its repeat memory, applied nothing, and stayed e-stopped). The PC starts each link at a random
+    seq; the radio's new association clears the memory too, shown here with equal seqs."""
+    from backend.robot.link import RobotLink
+
+    robot = VirtualRobot().start()
+    try:
+        for _ in range(2):
+            link = RobotLink(robot.url)
+            link._seq = 0  # both links as a PC that always began at 1 would
+            link.connect()
+            link.estop()
+            link.reset()
+            assert robot.firmware.state == RobotState.DISARMED
+            link.close()
+        seqs = {RobotLink(robot.url)._seq for _ in range(8)}
+        assert len(seqs) > 1, "each link begins its sequence at a random number"
+    finally:
+        robot.stop()
