@@ -155,3 +155,29 @@ def test_a_robot_that_restarts_mid_run_is_named(connected, virtual, session, bro
     assert run.disarm == "disarmed" and "booted" in run.robot_faults
     stored = _stored(session, run)
     assert stored.status == "failed" and stored.results["fell"] is False
+
+
+def test_one_late_acknowledgement_is_resent_not_the_end_of_the_run(connected, virtual, session, monkeypatch):
+    """The robot's answer to one SET_LEG is lost on the air: the link sends the same command again
+    (same seq, applied once) and the run goes on to its jumps (it ended the run before)."""
+    from backend.robot.messages import SetLeg, decode
+
+    robot, _ = virtual
+    service = connected
+    receive, lost = robot._receive, []
+
+    def lose_one_answer(payload: bytes) -> list:
+        replies = receive(payload)
+        if isinstance(decode(payload), SetLeg) and not lost:
+            lost.append(decode(payload).seq)
+            return []
+        return replies
+
+    monkeypatch.setattr(robot, "_receive", lose_one_answer)
+    service.start_run(RobotRunCreate(controls=LEGS, jumps=4))
+    run = service.wait_run(RUN_WAIT_S)
+    assert run.end_reason == "jumps done", run.end_reason
+    counters = service.status()["counters"]
+    assert lost and counters["command_resends"] >= 1
+    stored = _stored(session, run)
+    assert stored.status == "done" and len(stored.results["touchdowns"]) == 4
