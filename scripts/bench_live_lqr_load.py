@@ -53,7 +53,7 @@ from pathlib import Path
 import numpy as np
 
 from scripts.calibration_live_falls import TRUTHS as FALLS_TRUTHS
-from scripts.calibration_live_falls import Api, compared, flat, sim_options, tail
+from scripts.calibration_live_falls import Api, compared, flat, run_row, sim_options, tail
 from scripts.calibration_truths import TRUTHS as FIT_TRUTHS
 from sim_core.calibration_fit import PARAMETERS
 from tests.helpers import free_port, start_map_load, start_robot_sim, start_service, stop_map_load, stop_processes
@@ -111,11 +111,7 @@ def calibrate(api: Api, truth_name: str, seed: int, jumps: int, *, quiet: bool) 
     """Four open-loop live runs and their calibration, stored as a preset: its name and fit."""
     runs = []
     for legs in VARIED_LEGS:
-        stored = api.live_run(legs, jumps)
-        results = stored["results"]
-        run = {"id": stored["id"], "legs": [list(leg) for leg in legs], "status": stored["status"],
-               "end_reason": results.get("end_reason"), "fell": results.get("fell"),
-               "touchdowns": len(results.get("touchdowns") or [])}  # fmt: skip
+        run = run_row(api.live_run(legs, jumps), legs)
         runs.append(run)
         if not quiet:
             print(f"  open loop, run {run['id']} {legs}: {run['status']}, {run['touchdowns']} touchdowns, "

@@ -207,6 +207,15 @@ def offline_fit(series: list[TouchdownSeries], truth: Truth) -> dict:
     }
 
 
+def run_row(stored: dict, legs) -> dict:
+    """A stored live run as the reports list it: id, gait, how it ended, whether it fell, touchdowns."""
+    results = stored["results"]
+    return {"id": stored["id"], "legs": [list(leg) for leg in legs], "status": stored["status"],
+            "end_reason": results.get("end_reason"), "fell": results.get("fell"),
+            "robot_faults": results.get("robot_faults"),
+            "touchdowns": len(results.get("touchdowns") or [])}  # fmt: skip
+
+
 def measure(api: Api, name: str, seed: int, jumps: int, *, quiet: bool) -> dict:
     truth, _ = TRUTHS[name]
     robot_port, tracker_port = free_port(), free_port(socket.SOCK_DGRAM)
@@ -217,11 +226,7 @@ def measure(api: Api, name: str, seed: int, jumps: int, *, quiet: bool) -> dict:
         runs = []
         for legs in VARIED_LEGS:
             stored = api.live_run(legs, jumps)
-            results = stored["results"]
-            run = {"id": stored["id"], "legs": [list(leg) for leg in legs], "status": stored["status"],
-                   "end_reason": results.get("end_reason"), "fell": results.get("fell"),
-                   "robot_faults": results.get("robot_faults"), "touchdowns": len(results.get("touchdowns") or []),
-                   "stored": stored}  # fmt: skip
+            run = {**run_row(stored, legs), "stored": stored}
             series = series_of(stored, fell=bool(run["fell"]))
             run["consecutive_pairs"] = series.pairs  # less than touchdowns - 1 where a touchdown was missed
             run["last_rises"] = np.round(np.diff(series.foot_height[-6:]), 3).tolist()  # [l0]: a fall shows here
