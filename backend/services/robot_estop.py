@@ -14,6 +14,9 @@ from __future__ import annotations
 from backend.robot.latch import EstopLatch
 from backend.robot.link import EstopResult, LinkState, RobotLink
 
+NOT_CONNECTED_LATCH = (
+    "emergency stop, no robot connected: the next connect sends it before anything else; it holds until a reset"
+)
 LATCH_SAVE_WAIT = 0.5  # [s] the longest a press waits for the latch file after the ESTOP went out
 NOT_CONNECTED = (
     "the robot is not connected: the e-stop latch holds, and the next connect sends ESTOP before anything else"
@@ -47,6 +50,8 @@ def latch_status(latch: EstopLatch, link: RobotLink | None) -> dict:
         return {"latched": True, "acknowledged": True, "since": None, "durable": state.durable,
                 "reason": "the robot reports itself e-stopped; it holds until a reset"}  # fmt: skip
     reason = state.reason()
+    if state.pending and (link is None or link.state == LinkState.DISCONNECTED):
+        reason = NOT_CONNECTED_LATCH
     if state.held and not state.durable:
         failed = latch.save_error
         reason += f"; not saved, a restart would forget it ({failed})" if failed else "; being saved"

@@ -34,6 +34,7 @@ def test_a_press_with_no_robot_connected_latches_and_the_next_connect_stops_the_
         answer = service.estop()
         assert answer["acknowledged"] is False and answer["reason"] == NOT_CONNECTED
         assert answer["estop"]["latched"] is True and answer["estop"]["durable"] is True
+        assert answer["estop"]["reason"].startswith("emergency stop, no robot connected: the next connect sends it")
         assert json.loads(latch_path.read_text())["held"] is True, "on disk when it answered"
     finally:
         service.close()
