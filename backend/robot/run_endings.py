@@ -65,3 +65,13 @@ def end_safely(link) -> str:
         return link.make_safe().value
     except LinkError as error:
         return f"not confirmed: {error}"
+
+
+def robot_ending_record(end_reason: str | None, faults, telemetry: list[dict]) -> dict:
+    """``robot_faults``: the robot's faults at the end, by name, and every one its telemetry reported
+    during the run (``telemetry``: as a run stores it); ``fell``: whether the run ended in a fall (:func:`fell`)."""
+    reported = set(faults)
+    for entry in telemetry:
+        reported.update(fault_names(int(entry.get("faults", 0))))
+    names = sorted(reported)
+    return {"robot_faults": names, "fell": fell(end_reason, names)}

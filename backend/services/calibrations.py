@@ -20,8 +20,7 @@ from sqlalchemy.orm import Session
 from backend.errors import Conflict
 from backend.repositories import calibrations as stored_presets
 from backend.repositories import runs as stored_runs
-from backend.robot.messages import Fault
-from backend.robot.run_endings import fell
+from backend.robot.run_endings import robot_ending_record
 from backend.schemas.calibrations import (
     PRESET_PATTERN,
     CalibrationCreate,
@@ -84,9 +83,7 @@ def run_fell(run: Run) -> bool:
     results = run.results
     if "fell" in results:
         return bool(results["fell"])
-    telemetry = results.get("telemetry") or []
-    reported = np.bitwise_or.reduce([int(t.get("faults", 0)) for t in telemetry]) if telemetry else 0
-    return bool(reported & Fault.FELL) or fell(results.get("end_reason"), None)
+    return robot_ending_record(results.get("end_reason"), (), results.get("telemetry") or [])["fell"]
 
 
 def fit_touchdowns(series: list[TouchdownSeries], base: ModelParams) -> CalibrationFit:

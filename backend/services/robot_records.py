@@ -24,7 +24,7 @@ from backend.errors import Conflict, NotFound
 from backend.repositories import experiments as stored_experiments
 from backend.repositories import robot_runs
 from backend.repositories import runs as stored_runs
-from backend.robot.run_endings import fault_names, fell
+from backend.robot.run_endings import robot_ending_record
 from backend.robot.touchdown import Touchdown, detect_touchdowns, height_gains
 from backend.schemas import RunDetail
 from backend.services.runs import run_detail
@@ -124,16 +124,6 @@ def fold_journal(
     robot_runs.delete_journal(session, run_id)
     session.commit()
     return run
-
-
-def robot_ending_record(end_reason: str, faults, telemetry: list[dict]) -> dict:
-    """``robot_faults``: the robot's faults at the end, by name, and every one its telemetry reported
-    during the run; ``fell``: whether the run ended in a fall (:func:`run_endings.fell`)."""
-    reported = set(faults)
-    for entry in telemetry:
-        reported.update(fault_names(int(entry.get("faults", 0))))
-    names = sorted(reported)
-    return {"robot_faults": names, "fell": fell(end_reason, names)}
 
 
 def recover_interrupted(sessions, robot=None) -> list[int]:

@@ -4,7 +4,7 @@ import pytest
 
 from backend.robot.link_types import LinkError, LinkState
 from backend.robot.messages import Fault
-from backend.robot.run_endings import CLEAN_ENDINGS, end_safely, fault_names, fell, robot_ending
+from backend.robot.run_endings import CLEAN_ENDINGS, end_safely, fault_names, fell, robot_ending, robot_ending_record
 
 RESTART = "robot restarted (brown-out; its sequence went back from 42 to 2)"  # as the link words it
 
@@ -59,3 +59,12 @@ class _Link:
 def test_every_ending_says_how_it_left_the_robot():
     assert end_safely(_Link(LinkState.DISARMED)) == "disarmed"
     assert end_safely(_Link(LinkError("the link is down"))) == "not confirmed: the link is down"
+
+
+def test_a_runs_fall_record_reads_its_ending_its_faults_and_its_telemetry():
+    """One record for a stored run and for one stored before it (calibrations.run_fell reads both)."""
+    assert robot_ending_record("jumps done", (), [{"faults": 0}]) == {"robot_faults": [], "fell": False}
+    assert robot_ending_record("jumps done", (), [{"faults": int(Fault.FELL)}])["fell"] is True
+    assert robot_ending_record("robot disarmed (fell or timed out)", (), []) == {"robot_faults": [], "fell": True}
+    record = robot_ending_record("e-stop", ("booted",), [{"faults": int(Fault.HEARTBEAT_LOST)}])
+    assert record == {"robot_faults": ["booted", "heartbeat_lost"], "fell": False}
