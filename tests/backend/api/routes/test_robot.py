@@ -391,3 +391,13 @@ def test_a_closed_loop_designed_on_a_stored_calibration_takes_its_leg_offsets_of
         control, _ = twin.command(touchdown, math.nan, 0.0)
         assert command["psi0_deg"] == pytest.approx(control.psi0_deg, abs=1e-9)
         assert command["zeta0"] == pytest.approx(control.zeta0, abs=1e-12)
+
+
+@pytest.mark.parametrize(("value", "says"), [(10, "greater than or equal to 30"), (1000, "less than or equal to 250")])
+def test_a_tracker_timeout_outside_its_safe_range_is_a_422_naming_it(client, auth, connected, value, says):
+    body = {"controls": CONTROLS, "jumps": 5, "tracker_timeout_ms": value}
+    response = client.post("/api/v1/robot/runs", json=body, headers=auth)
+    assert response.status_code == 422, response.text
+    detail = response.json()["detail"][0]
+    assert detail["loc"] == ["body", "tracker_timeout_ms"] and says in detail["msg"], detail
+    assert connected.firmware.state.name == "DISARMED" and client.get("/api/v1/robot").json()["run"] is None
