@@ -20,6 +20,7 @@ latched ESTOP first, ARM and START are refused (:class:`EstopLatched`) and the l
 
 from __future__ import annotations
 
+import contextlib
 import random
 import threading
 import time
@@ -30,15 +31,14 @@ import serial
 from backend.robot.latch import EstopLatch
 from backend.robot.limits import ServoLimits
 from backend.robot.link_acks import COMMAND_MARGIN, Acknowledgements, confirm, describe
+from backend.robot.link_cadence import keep_cadence
 from backend.robot.link_port import WRITE_TIMEOUT, LinkPort
 from backend.robot.link_restarts import restart_reason
 from backend.robot.link_types import FROM_ROBOT, SAFE, EstopResult, LinkError, LinkState, Transition, telemetry_moves
 from backend.robot.messages import Ack, Command, Kind, Leg, ProtocolError, Result, SetLeg, Telemetry, decode
+from backend.robot.process_port import ProcessPort
 from backend.robot.xbee import ROBOT_ADDRESS, TX_STATUS, FrameError, FrameParser, parse_rx_packet, parse_tx_status
 
-# [s] between the PC's heartbeats: half the protocol's 0.2 s, so a late one (a loaded machine) still
-# keeps the rule; the robot's watchdog allows 1 s.
-HEARTBEAT_PERIOD = 0.1
 HEARTBEAT_TIMEOUT = 1.0  # [s]
 COMMAND_TIMEOUT = 0.5  # [s] for the telemetry showing an acknowledged command's effect
 ESTOP_TIMEOUT = 0.15  # [s] an e-stop's whole budget, blocked writes included: the API answers within 200 ms
@@ -59,6 +59,7 @@ class RobotLink:
         heartbeat_timeout: float = HEARTBEAT_TIMEOUT,
         robot_address: int = ROBOT_ADDRESS,
         latch: EstopLatch | None = None,
+        radio_process: bool = False,
     ):
         self.url, self.baud, self.robot_address = url, baud, robot_address
         self.limits, self.heartbeat_timeout = limits or ServoLimits(), heartbeat_timeout
@@ -72,7 +73,8 @@ class RobotLink:
         self.estops_unacknowledged = 0
         self.estop_repeats = 0  # ESTOPs written again for an e-stop already sent (counted in "retries")
         self.on_lost: list[Callable[[str], None]] = []
-        self.port = LinkPort(url, baud, robot_address)  # frames out, whole and bounded, and their counts
+        # Frames out, whole and bounded, and their counts; in a radio process of its own, the heartbeats' time too.
+        self.port = (ProcessPort if radio_process else LinkPort)(url, baud, robot_address)
         self._seq = random.SystemRandom().randrange(0x10000)  # no new link's seq repeats one the robot recalls (§3)
         self._acks = Acknowledgements()  # awaited, by seq; and the commands' resends
         self.restarts, self.last_restart = 0, None  # the robot's restarts since this link was made; the last's reason
@@ -159,6 +161,9 @@ class RobotLink:
         unacknowledged ESTOP stop before the RESET is sent (none may follow it), and resume if it is not confirmed."""
         with self.port.write_lock:  # not between the heartbeat thread's pick of a repeat and its write
             pending = self._forget_estop()
+            if self.port.keeps_time:  # the repeats queued in the radio process too (gone with it if it ended)
+                with contextlib.suppress(LinkError):
+                    self.port.drop_queued()
         self._resetting = True  # the robot's telemetry may now take the link out of e-stopped
         try:
             self._command(Command(self._next_seq(), Kind.RESET), expect=LinkState.DISARMED)
@@ -199,8 +204,8 @@ class RobotLink:
                     if tries:
                         self.estop_repeats += 1
                     tries += 1
-                    try:
-                        self._write(message, deadline=write_by)
+                    try:  # the heartbeats queued in a radio process go: the line is the e-stop's
+                        self.port.write(message, write_by, clear_queue=True)
                     except LinkError as error:
                         reason = str(error)
                         if not self.port.is_open:
@@ -277,12 +282,10 @@ class RobotLink:
         command is sent only on a link that was up) or its bound passes. No copy goes while an
         unacknowledged ESTOP owns the line: it would feed the robot's watchdog instead."""
         return self._acks.send(
-            message, self._write, bound=self.heartbeat_timeout + COMMAND_MARGIN, quiet=lambda: self.latch.state.pending,
+            message, self.port.write, bound=self.heartbeat_timeout + COMMAND_MARGIN,
+            quiet=lambda: self.latch.state.pending,
             gone=lambda: self.transitions[-1].reason if self.state == LinkState.DISCONNECTED else None,
         )  # fmt: skip
-
-    def _write(self, message, deadline: float | None = None) -> None:
-        self.port.write(message, deadline)
 
     def _next_seq(self) -> int:
         with self._lock:
@@ -348,28 +351,18 @@ class RobotLink:
         # An unacknowledged ESTOP goes instead of the heartbeat, so a line that clears still
         # delivers the stop. Any frame feeds the firmware's watchdog, ESTOP too; that keeps no
         # robot going: ESTOP latches it e-stopped, which only RESET leaves.
-        # Each is due a period after the previous one was due, not after it was written: a late
-        # wake-up shortens the next wait instead of pushing every later heartbeat back. A heartbeat
-        # gives way to a command waiting for the port (a frame too), or a blocked line starves it.
-        due = time.monotonic()
-        while not self._stop.wait(max(0.0, due - time.monotonic())):
-            due += HEARTBEAT_PERIOD
-            if due <= time.monotonic():  # more than a period late: start the cadence afresh
-                due = time.monotonic() + HEARTBEAT_PERIOD
-            with self.port.write_lock:  # picked and written at once: reset() forgets the repeat under it
-                message = self._pending_estop
-                if message is not None:
-                    self.estop_repeats += 1
-                elif self.send_heartbeats and not self.latch.state.pending and not self._acks.writing:
-                    message = Command(self._next_seq(), Kind.HEARTBEAT)
-                else:
-                    continue
-                try:
-                    self._write(message)
-                except LinkError:
-                    if not self.port.is_open:
-                        return
-                    # Blocked (counted): the next one may pass; if none does, the robot disarms itself.
+        keep_cadence(self.port, self._stop, self._cadence_frame)
+
+    def _cadence_frame(self) -> Command | None:
+        """The next frame of the heartbeat's cadence: the unacknowledged ESTOP's copy, a heartbeat,
+        or None — none while an e-stop is under way, tests starve the robot, or a command's copy
+        waits for the port (it is a frame too, or a blocked line would starve it)."""
+        message = self._pending_estop
+        if message is not None:
+            self.estop_repeats += 1
+        elif self.send_heartbeats and not self.latch.state.pending and not self._acks.writing:
+            message = Command(self._next_seq(), Kind.HEARTBEAT)
+        return message
 
     def _forget_estop(self) -> Command | None:
         """Stop repeating the pending e-stop: returns it, or None."""

@@ -69,10 +69,12 @@ class LinkPort:
         port = self._serial
         return port.read(port.in_waiting or 1) if port is not None else b""
 
-    def write(self, message, deadline: float | None = None) -> None:
+    keeps_time = False  # the link's heartbeat thread writes each heartbeat (a ProcessPort keeps the cadence itself)
+
+    def write(self, message, deadline: float | None = None, *, clear_queue: bool = False) -> None:
         """Send one message as a frame, blocking at most WRITE_TIMEOUT once the port is ours; waits
         for the write lock until ``deadline`` (monotonic), or without one as long as another
-        writer's bounded write."""
+        writer's bounded write. ``clear_queue``: nothing queued here (a ProcessPort's is)."""
         payload = encode(message)
         wait = -1 if deadline is None else max(0.0, deadline - time.monotonic())
         if not self.write_lock.acquire(timeout=wait):

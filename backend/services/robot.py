@@ -46,10 +46,13 @@ class RobotUnavailable(RuntimeError):
 
 class RobotService:
     """``latch_path``: where the e-stop latch is kept (the data directory's ``estop-latch.json`` in
-    the service), so a restart finds it held; None keeps it in memory."""
+    the service), so a restart finds it held; None keeps it in memory. ``radio_process``: each link's
+    port in a radio process of its own, which keeps the heartbeats' time whatever this interpreter
+    does (:mod:`backend.robot.radio_process`); False keeps it in a thread here (tests that reach into it)."""
 
-    def __init__(self, sessions, robot=None, *, latch_path: Path | None = None):
+    def __init__(self, sessions, robot=None, *, latch_path: Path | None = None, radio_process: bool = True):
         self.sessions = sessions
+        self.radio_process = radio_process
         self.robot = robot or get_preset("paper")  # the robot's physical parameters
         self.supervisor = LinkSupervisor()  # the link's one owner (backend/robot/supervisor.py)
         self.latch = EstopLatch(latch_path)  # outlives every link: held until a RESET is acknowledged
@@ -89,8 +92,9 @@ class RobotService:
             limits = ServoLimits(tuple(body.psi0_limits_deg), tuple(body.zeta0_limits))
             tracker = self._trackers.open_beside(body)
             link = RobotLink(
-                body.url, baud=body.baud, limits=limits, robot_address=int(body.robot_address, 16), latch=self.latch
-            )
+                body.url, baud=body.baud, limits=limits, robot_address=int(body.robot_address, 16), latch=self.latch,
+                radio_process=self.radio_process,
+            )  # fmt: skip
             try:
                 self.supervisor.connect(link)
             except LinkError:

@@ -8,7 +8,8 @@ import time
 import pytest
 
 from backend.robot.firmware import Firmware
-from backend.robot.link import HEARTBEAT_PERIOD, WRITE_TIMEOUT, EstopLatched, LinkError, LinkState, RobotLink
+from backend.robot.link import WRITE_TIMEOUT, EstopLatched, LinkError, LinkState, RobotLink
+from backend.robot.link_cadence import HEARTBEAT_PERIOD
 from backend.robot.messages import Ack, Fault, Kind, Leg, RobotState, SetLeg
 from backend.robot.virtual import VirtualRobot
 from sim_core import ParameterError
