@@ -31,7 +31,7 @@ import serial
 from backend.robot.latch import EstopLatch
 from backend.robot.limits import ServoLimits
 from backend.robot.link_acks import COMMAND_MARGIN, Acknowledgements, confirm, describe
-from backend.robot.link_cadence import keep_cadence
+from backend.robot.link_cadence import keep_cadence, top_up
 from backend.robot.link_port import WRITE_TIMEOUT, LinkPort
 from backend.robot.link_restarts import restart_reason
 from backend.robot.link_types import FROM_ROBOT, SAFE, EstopResult, LinkError, LinkState, Transition, telemetry_moves
@@ -161,9 +161,10 @@ class RobotLink:
         unacknowledged ESTOP stop before the RESET is sent (none may follow it), and resume if it is not confirmed."""
         with self.port.write_lock:  # not between the heartbeat thread's pick of a repeat and its write
             pending = self._forget_estop()
-            if self.port.keeps_time:  # the repeats queued in the radio process too (gone with it if it ended)
-                with contextlib.suppress(LinkError):
+            if self.port.keeps_time:  # the repeats queued in the radio process too (gone with it if it ended),
+                with contextlib.suppress(LinkError):  # and heartbeats queued in their place at once
                     self.port.drop_queued()
+                    top_up(self.port, self._cadence_frame)
         self._resetting = True  # the robot's telemetry may now take the link out of e-stopped
         try:
             self._command(Command(self._next_seq(), Kind.RESET), expect=LinkState.DISARMED)
@@ -171,6 +172,9 @@ class RobotLink:
             with self._lock:
                 if self._pending_estop is None:
                     self._pending_estop = pending
+            if pending is not None and self.port.keeps_time:  # its repeats go next, not the heartbeats queued
+                with contextlib.suppress(LinkError):
+                    self.port.drop_queued()
             raise
         finally:
             self._resetting = False

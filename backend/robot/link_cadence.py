@@ -34,16 +34,21 @@ def keep_cadence(port, stop: threading.Event, next_frame: Callable[[], object | 
                     if message is not None:
                         port.write(message)
                     continue
-                # One each period renews the lease (and says how many are queued); then topped up,
-                # with at most LEASE_FRAMES requests (a jammed line drains the queue as fast as it fills).
-                for _ in range(LEASE_FRAMES):
-                    message = next_frame()
-                    if message is None:
-                        break
-                    port.queue(message)
-                    if port.queued >= LEASE_FRAMES:
-                        break
+                top_up(port, next_frame)
             except LinkError:
                 if not port.is_open:
                     return
                 # Blocked (counted): the next one may pass; if none does, the robot disarms itself.
+
+
+def top_up(port, next_frame: Callable[[], object | None]) -> None:
+    """Hand a radio process' port one frame, which renews its lease (and says how many are queued),
+    then more until LEASE_FRAMES are queued, in at most LEASE_FRAMES requests (a jammed line drains
+    the queue as fast as it fills). Raises LinkError as the port does."""
+    for _ in range(LEASE_FRAMES):
+        message = next_frame()
+        if message is None:
+            return
+        port.queue(message)
+        if port.queued >= LEASE_FRAMES:
+            return

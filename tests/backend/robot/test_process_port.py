@@ -147,6 +147,7 @@ def test_the_link_through_a_radio_process_arms_commands_and_stops_the_robot():
         assert link.estop().acknowledged and link.state == LinkState.ESTOPPED
         link.reset()
         assert link.state == LinkState.DISARMED and robot.firmware.state.name == "DISARMED"
+        assert link.port.queued >= 1, "heartbeats queued at the reset, not at the heartbeat thread's next turn"
         counters = link.counters()
         assert counters["frames_out"] >= 3 and counters["write_timeouts"] == 0
     finally:
