@@ -61,6 +61,7 @@ def panel(browser, base: str, token: str, *, failed_requests: bool = False) -> I
         )
     try:
         page.goto(f"{base}/")
+        page.evaluate(KEEP_MESSAGES)
         page.fill("#token", token)
         page.dispatch_event("#token", "change")
         until(page, TOKEN_ACCEPTED)
@@ -81,6 +82,22 @@ def until(page, expression: str, timeout: float = 30_000) -> None:
             shown = page.evaluate("[...document.querySelectorAll('.message')].map((m) => m.textContent)")
             pytest.fail(f"not true within {timeout / 1000:g} s: {expression} (messages shown: {shown})")
         time.sleep(0.05)
+
+
+# Every message the panel shows, kept in the page as it is added: an "ok" message goes after 4 s,
+# which a loaded machine's test can spend between its click and its first look.
+KEEP_MESSAGES = """(() => {
+  window.__said = [];
+  new MutationObserver((changes) => changes.forEach((change) => change.addedNodes.forEach(
+    (node) => window.__said.push(node.textContent)))).observe(document.querySelector('#messages'), {childList: true});
+})()"""
+
+
+def said(page, words: str, timeout: float = 30_000) -> str:
+    """Wait until the panel has shown a message with ``words`` in it since it opened (gone or not); the latest such."""
+    found = f"window.__said.filter((text) => text.includes({words!r})).at(-1)"
+    until(page, f"{found} !== undefined", timeout)
+    return page.evaluate(found)
 
 
 def screenshot(page, name: str, selector: str | None = None) -> None:

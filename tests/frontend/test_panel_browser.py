@@ -18,9 +18,9 @@ from PIL import Image
 
 from backend.robot.virtual import VirtualRobot
 from backend.store.database import make_engine, session_factory, sqlite_url
-from sim_core.noise import NO_NOISE
+from sim_core.model.noise import NO_NOISE
 from tests.backend.api.bodies import RUN
-from tests.frontend.browser import CSP_LISTENER, chromium, panel, screenshot, until
+from tests.frontend.browser import CSP_LISTENER, chromium, panel, said, screenshot, until
 from tests.helpers import free_port, served
 from tests.robot_runs import store_robot_run
 
@@ -340,8 +340,7 @@ def test_runs_and_jobs_filed_under_an_experiment_appear_on_its_page(page, servic
     page.fill("input[name=trials]", "4")
     page.fill("input[name=cap]", "20")
     page.click("#submit-job")
-    until(page, "document.querySelector('.message.ok')?.textContent.includes('scheduled')")
-    job_id = int(page.inner_text(".message.ok").split()[1])
+    job_id = int(said(page, "scheduled").split()[1])
     page.click("nav [data-tab=history]")
     page.click("#experiments-box summary")
     page.click(f"#experiment-table button[data-experiment='{experiment}']")
@@ -1195,7 +1194,7 @@ CALIBRATION_TRUTH = dict(alpha=72.0, c_zeta=1.25, c_psi=0.8, psi0_offset_deg=(0.
 @pytest.fixture(scope="module")
 def varied_runs(service, data_dir):
     """Robot runs of a robot unlike the paper's at four gaits, stored beside the service; their ids."""
-    from sim_core.noise import NoiseModel
+    from sim_core.model.noise import NoiseModel
     from tests.tracked_climbs import Truth, store_varied_runs
 
     engine = make_engine(sqlite_url(data_dir))

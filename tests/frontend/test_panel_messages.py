@@ -10,7 +10,7 @@ import time
 import httpx
 import pytest
 
-from tests.frontend.browser import chromium, panel, until
+from tests.frontend.browser import chromium, panel, said, until
 from tests.helpers import served
 
 pytestmark = pytest.mark.slow  # a browser and a service
@@ -80,8 +80,7 @@ def test_save_run_keeps_a_long_runs_path_at_a_rate_that_fits(page, service):
     base, _token = service
     page.fill("#sim-form input[name=jumps]", "2000")
     page.click("#save-run")
-    until(page, f"{BANNER}.includes('stored')", timeout=60_000)
-    message = page.inner_text(".message")
+    message = said(page, "stored", timeout=60_000)
     assert "its path thinned to 50 samples per √(l0/g) (from 60: a stored path is held to rate × jumps ≤ 100,000)" in (
         message
     ), message
@@ -239,6 +238,6 @@ def test_the_panel_submits_jobs_as_panel_for_the_queues_share(page, service):
     page.fill("input[name=cap]", "20")
     page.click("#submit-job")
     # Said once the service has answered the POST (the table may list earlier tests' jobs already).
-    until(page, "document.querySelector('#messages').textContent.includes('scheduled')")
+    said(page, "scheduled")
     newest = httpx.get(f"{base}/api/v1/jobs?limit=1").json()["items"][0]
     assert newest["submitted_by"] == "panel"

@@ -17,7 +17,7 @@ import httpx
 import numpy as np
 import pytest
 
-from tests.frontend.browser import chromium, panel, screenshot, until
+from tests.frontend.browser import chromium, panel, said, screenshot, until
 from tests.helpers import served
 
 pytestmark = pytest.mark.slow  # a browser, a service, a small map and a small chain: ~40 s
@@ -56,7 +56,7 @@ def test_a_viability_job_from_the_form_shows_its_kernel_and_a_states_viable_comm
         page.set_viewport_size({"width": 1360, "height": 1500})
         page.click("nav [data-tab=jobs]")
         _schedule(page, "viability", {"viability_states": 12, "viability_actions": 4, "viability_zeta0_low": 0.8})
-        until(page, "document.querySelector('#messages').textContent.includes('scheduled')")
+        said(page, "scheduled")
         job = _newest_job(base, token)
         assert job["spec"]["states"] == 12 and job["spec"]["zeta0_low"] == 0.8
         assert _done(base, job["id"])["state"] == "done"

@@ -1,0 +1,145 @@
+"""How the noise of :mod:`sim_core.model.noise` is drawn: each rule once, compiled, and two samplers.
+
+Each rule is written once, as a compiled function of the draws (:func:`noisy_controls`,
+:func:`drifted_pitch`, :func:`disturbed`; docs/model.md §5.1). Two samplers feed them: the kernels
+here (:func:`perturbed_controls`, :func:`pitch_step`, :func:`disturbed_state`; numba's generator,
+seeded once per trial, so MJTF and the PID study depend only on their seed, never on the number
+of threads or workers), and :class:`NoiseSampler` (a numpy ``Generator``), which the climb
+sequencer (:mod:`sim_core.climb.sequencer`) uses for the virtual robot. Both draw in the same order: a
+pitch step, then ``psi0``, then ``zeta0`` of the next leg; after the jump, ``xdot`` then ``ydot``;
+a zero standard deviation draws nothing.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from sim_core._jit import kernel
+from sim_core.model.controls import PSI0_COLUMN, ZETA0_COLUMN, LegControl
+from sim_core.model.noise import PSI0_MAX, PSI0_MIN, ZETA0_MAX, ZETA0_MIN, NoiseModel
+from sim_core.model.walls import Wall
+
+
+@kernel
+def seed_trial(seed):
+    """Seed numba's generator (per thread) at the start of a trial."""
+    np.random.seed(seed)
+
+
+# The rules, as functions of the draws ------------------------------------------------------------
+@kernel
+def noisy_controls(psi0, zeta0, right_leg, pitch, asymmetry_psi0, asymmetry_zeta0, psi0_draw, zeta0_draw):
+    """A leg's controls as the robot realises them: ``(psi0, zeta0)`` [rad, l0].
+
+    The pitch turns the left wall's leg by ``+pitch`` and the right wall's by ``-pitch``; the
+    right leg carries the asymmetry offsets; the draws (zero-mean noise) are added last and the
+    result is clamped to :data:`sim_core.model.noise.PSI0_LIMITS` and :data:`~sim_core.model.noise.ZETA0_LIMITS`.
+    """
+    psi0 = psi0 + (-pitch if right_leg else pitch)
+    if right_leg:
+        psi0 += asymmetry_psi0
+        zeta0 += asymmetry_zeta0
+    psi0 += psi0_draw
+    zeta0 += zeta0_draw
+    return min(max(psi0, PSI0_MIN), PSI0_MAX), min(max(zeta0, ZETA0_MIN), ZETA0_MAX)
+
+
+@kernel
+def drifted_pitch(pitch, draw):
+    """The pitch random walk's step: the next jump's pitch [rad]."""
+    return pitch + draw
+
+
+@kernel
+def disturbed(xdot, ydot, xdot_draw, ydot_draw):
+    """The section state after a jump with process noise on each component."""
+    return xdot + xdot_draw, ydot + ydot_draw
+
+
+# The compiled sampler (numba's generator) -------------------------------------------------------
+@kernel
+def _draw(sigma):
+    return np.random.normal(0.0, sigma) if sigma > 0.0 else 0.0
+
+
+@kernel
+def perturbed_controls(schedule, k, pitch, base_zeta0, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0):
+    """Controls ``(psi0, zeta0)`` of jump ``k`` with pitch ``pitch`` and fresh noise.
+
+    ``base_zeta0`` replaces the schedule's zeta0 when finite (the closed loop's command).
+    """
+    row = k % schedule.shape[0]
+    zeta0 = schedule[row, ZETA0_COLUMN] if math.isnan(base_zeta0) else base_zeta0
+    return commanded_controls(
+        k, pitch, schedule[row, PSI0_COLUMN], zeta0, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
+    )
+
+
+@kernel
+def commanded_controls(k, pitch, psi0, zeta0, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0):
+    """Controls ``(psi0, zeta0)`` of jump ``k`` commanded ``(psi0, zeta0)``, with pitch ``pitch``
+    and fresh noise (the draws in the order :func:`perturbed_controls` takes them)."""
+    right_leg = k % 2 == 1  # sim_core.model.walls.wall_of(k) is Wall.RIGHT, spelled for numba
+    psi0_draw = _draw(sigma_psi0)
+    zeta0_draw = _draw(sigma_zeta0)
+    return noisy_controls(psi0, zeta0, right_leg, pitch, asymmetry_psi0, asymmetry_zeta0, psi0_draw, zeta0_draw)
+
+
+@kernel
+def disturbed_state(xdot, ydot, sigma_velocity):
+    """The section state with measurement-free process noise added to each component."""
+    xdot_draw = _draw(sigma_velocity)
+    ydot_draw = _draw(sigma_velocity)
+    return disturbed(xdot, ydot, xdot_draw, ydot_draw)
+
+
+@kernel
+def pitch_step(pitch, sigma_pitch):
+    return drifted_pitch(pitch, _draw(sigma_pitch))
+
+
+# The Python sampler (a numpy Generator) ----------------------------------------------------------
+class NoiseSampler:
+    """The same rules drawn from a numpy ``Generator``, one leg at a time (the climb sequencer's).
+
+    Args:
+        noise: the disturbances; rng: the generator (seed it for a reproducible climb).
+    """
+
+    def __init__(self, noise: NoiseModel, rng: np.random.Generator):
+        self.noise, self.rng = noise, rng
+        (self._psi0, self._zeta0, self._velocity, self._pitch, self._asymmetry_psi0, self._asymmetry_zeta0) = (
+            noise.kernel_args()
+        )
+
+    def _draw(self, sigma: float) -> float:
+        return float(self.rng.normal(0.0, sigma)) if sigma > 0.0 else 0.0
+
+    def pitch_step(self, pitch: float) -> float:
+        """The next jump's pitch [rad]."""
+        return float(drifted_pitch(pitch, self._draw(self._pitch)))
+
+    def controls(self, commanded: LegControl, wall: Wall, pitch: float) -> LegControl:
+        """The controls the leg on ``wall`` touches down with, commanded ``commanded``, at ``pitch`` [rad]."""
+        psi0_draw = self._draw(self._psi0)
+        zeta0_draw = self._draw(self._zeta0)
+        psi0, zeta0 = noisy_controls(
+            commanded.psi0,
+            commanded.zeta0,
+            wall == Wall.RIGHT,
+            pitch,
+            self._asymmetry_psi0,
+            self._asymmetry_zeta0,
+            psi0_draw,
+            zeta0_draw,
+        )
+        return LegControl(float(psi0), float(zeta0))
+
+    def state(self, state) -> tuple[float, float]:
+        """A section state ``(xdot, ydot)`` after a jump, with process noise."""
+        xdot_draw = self._draw(self._velocity)
+        ydot_draw = self._draw(self._velocity)
+        xdot, ydot = disturbed(float(state[0]), float(state[1]), xdot_draw, ydot_draw)
+        return float(xdot), float(ydot)
