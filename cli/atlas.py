@@ -19,9 +19,9 @@ from cli.options import (
     with_model,
 )
 from cli.studies import run_study
-from sim_core.controls import ControlSchedule
-from sim_core.errors import ParameterError
-from sim_core.validation import check_range
+from sim_core.model.controls import ControlSchedule
+from sim_core.model.errors import ParameterError
+from sim_core.model.validation import check_range
 
 app = typer.Typer(rich_markup_mode=None)
 
@@ -51,9 +51,9 @@ def atlas_command(
     as_json: JsonOption = False,
 ) -> None:
     """Where stable gaits live over a grid of controls: period and climb of the most stable gait."""
-    from sim_core.atlas import gait_atlas
-    from sim_core.poincare import check_jumps
-    from sim_core.sweep import zeta0_values
+    from sim_core.basins.sweep import zeta0_values
+    from sim_core.model.poincare import check_jumps
+    from sim_core.section.atlas import gait_atlas
 
     rows_count, columns_count = grid
     if plot is not None and plot.suffix not in (".png", ".svg"):

@@ -20,7 +20,7 @@ from cli.options import (
     progress_bar,
     with_model,
 )
-from sim_core.basin_grid import DEFAULT_JUMPS, DEFAULT_TOLERANCE
+from sim_core.basins.grid import DEFAULT_JUMPS, DEFAULT_TOLERANCE
 
 app = typer.Typer(rich_markup_mode=None)
 

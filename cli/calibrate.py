@@ -8,8 +8,8 @@ from typing import Annotated
 import typer
 
 from cli.options import DataDirOption, JsonOption, handles_errors, note, print_json, store_sessions
-from sim_core.errors import ParameterError
-from sim_core.presets import DEFAULT_PRESET
+from sim_core.model.errors import ParameterError
+from sim_core.model.presets import DEFAULT_PRESET
 
 app = typer.Typer(rich_markup_mode=None)
 

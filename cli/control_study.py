@@ -8,8 +8,8 @@ import typer
 
 from cli.options import JsonOption, ModelSetup, SchedulerOption, handles_errors, print_json, with_model, with_noise
 from cli.studies import run_study
-from sim_core.control_laws import KINDS
-from sim_core.noise import NoiseModel
+from sim_core.control.laws import KINDS
+from sim_core.model.noise import NoiseModel
 
 app = typer.Typer(rich_markup_mode=None)
 

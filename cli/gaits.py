@@ -32,7 +32,7 @@ def fixed_point_command(
     as_json: JsonOption = False,
 ) -> None:
     """Find a period-n fixed point, its eigenvalues, stability and climb per period."""
-    from sim_core.gait_search import gait_of
+    from sim_core.section.gait_search import gait_of
 
     schedule = parse_controls(controls)
     gait = gait_of(setup.model, schedule, period or len(schedule), guess)
@@ -53,7 +53,7 @@ def gaits_command(
     as_json: JsonOption = False,
 ) -> None:
     """Search a grid of guesses for distinct period-n gaits (climbing, in place, descending)."""
-    from sim_core.gait_search import search_gaits
+    from sim_core.section.gait_search import search_gaits
 
     schedule = parse_controls(controls)
     period = period or len(schedule)

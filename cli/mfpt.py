@@ -20,10 +20,10 @@ from cli.options import (
     with_model,
     with_noise,
 )
-from sim_core.control_laws import KINDS
-from sim_core.mfpt_grid import ChainGrid
-from sim_core.noise import NoiseModel
-from sim_core.validation import ParameterError
+from sim_core.control.laws import KINDS
+from sim_core.model.noise import NoiseModel
+from sim_core.model.validation import ParameterError
+from sim_core.robustness.mfpt_grid import ChainGrid
 
 app = typer.Typer(rich_markup_mode=None)
 DEFAULT_GRID = ChainGrid()
@@ -105,9 +105,9 @@ def _refuse_given(options: dict, why: str) -> None:
 
 
 def _chain_mfpt(setup, noise, controls, grid, pitch_spacing, start, guess, no_cache, as_json) -> None:
-    from sim_core.controls import ControlSchedule
-    from sim_core.gait_search import gait_of
-    from sim_core.mfpt import check_chain_inputs, mfpt
+    from sim_core.model.controls import ControlSchedule
+    from sim_core.robustness.mfpt import check_chain_inputs, mfpt
+    from sim_core.section.gait_search import gait_of
 
     schedule = parse_controls(controls)
     if len(schedule) != 1:

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 from cli.options import ModelSetup, option_named, parse_controls, print_json, progress_bar
-from sim_core.noise import NoiseModel
-from sim_core.validation import ParameterError
+from sim_core.model.noise import NoiseModel
+from sim_core.model.validation import ParameterError
 
 
 def controller_mfpt(
@@ -13,8 +13,8 @@ def controller_mfpt(
 ) -> None:  # fmt: skip
     """Run and print; ``splitting``: the options given (None: the default)."""
     from experiments.loop_mfpt import Config, run
-    from sim_core.control_laws import KINDS
-    from sim_core.splitting import SplittingOptions
+    from sim_core.control.laws import KINDS
+    from sim_core.robustness.splitting import SplittingOptions
 
     if controller not in KINDS:
         raise ParameterError("--controller", f"must be one of {', '.join(KINDS)}, got {controller!r}")

@@ -19,7 +19,7 @@ from cli.options import (
     with_noise,
 )
 from cli.studies import fixed_leg_of, over_zeta0
-from sim_core.noise import NoiseModel
+from sim_core.model.noise import NoiseModel
 
 app = typer.Typer(rich_markup_mode=None)
 
@@ -47,8 +47,8 @@ def mjtf_command(
     as_json: JsonOption = False,
 ) -> None:
     """Mean Jumps To Failure under noise, per energy level (zeta0)."""
-    from sim_core.mjtf import CAPPED, check_trials, mjtf_study
-    from sim_core.sweep import zeta0_values
+    from sim_core.basins.sweep import zeta0_values
+    from sim_core.robustness.mjtf import CAPPED, check_trials, mjtf_study
 
     with option_named("--levels", "steps"):
         zeta0s = zeta0_values(*zeta0_range, levels)

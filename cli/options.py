@@ -2,7 +2,7 @@
 
 Model options (``--preset`` and nondimensional overrides) are added to a command by
 :func:`with_model`, which hands the command a :class:`ModelSetup`; noise options by
-:func:`with_noise`, which hands it a :class:`~sim_core.noise.NoiseModel`. Errors the user can fix
+:func:`with_noise`, which hands it a :class:`~sim_core.model.noise.NoiseModel`. Errors the user can fix
 become one line on stderr and exit code 2 (:func:`handles_errors`).
 
 Light by design: this module and the command modules import typer and the light parts of
@@ -26,11 +26,11 @@ import typer
 
 from experiments.cluster import SCHEDULER_ENV
 from experiments.manifest import json_safe
-from sim_core.controls import ControlSchedule
-from sim_core.errors import FixedPointNotFound, ParameterError
-from sim_core.noise import NoiseModel
-from sim_core.params import ModelParams, PhysicalParams
-from sim_core.presets import DEFAULT_PRESET, PRESETS, get_preset
+from sim_core.model.controls import ControlSchedule
+from sim_core.model.errors import FixedPointNotFound, ParameterError
+from sim_core.model.noise import NoiseModel
+from sim_core.model.params import ModelParams, PhysicalParams
+from sim_core.model.presets import DEFAULT_PRESET, PRESETS, get_preset
 
 EXIT_USAGE = 2
 
@@ -176,7 +176,7 @@ _NOISE_PARAMETERS = [
 
 def with_noise(command: Callable) -> Callable:
     """Add the noise model's options (``--noise-psi0 ... --asymmetry-zeta0``, docs/model.md §5.1) to
-    ``command``; it receives ``noise``, a :class:`~sim_core.noise.NoiseModel`."""
+    ``command``; it receives ``noise``, a :class:`~sim_core.model.noise.NoiseModel`."""
 
     def build(**values: float) -> NoiseModel:
         return NoiseModel(**{field: values[name] for name, field, _flag, _help in _NOISE_OPTIONS})

@@ -7,8 +7,8 @@ from typing import Annotated
 import typer
 
 from cli.options import JsonOption, ModelSetup, SeedOption, handles_errors, print_json, with_model, with_noise
-from sim_core.height_controller import HeightController
-from sim_core.noise import NO_NOISE, NoiseModel
+from sim_core.control.height_controller import HeightController
+from sim_core.model.noise import NO_NOISE, NoiseModel
 
 app = typer.Typer(rich_markup_mode=None)
 

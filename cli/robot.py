@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 
 from cli.options import ModelSetup, handles_errors, note, with_model
-from sim_core.errors import ParameterError
+from sim_core.model.errors import ParameterError
 
 app = typer.Typer(rich_markup_mode=None)
 
@@ -62,8 +62,8 @@ def robot_sim_command(
     (docs/calibration.md).
     """
     from backend.robot.virtual import VirtualRobot
-    from sim_core.controls import LegOffsets
-    from sim_core.noise import NO_NOISE
+    from sim_core.model.controls import LegOffsets
+    from sim_core.model.noise import NO_NOISE
 
     imperfections = {} if noise is Noise.on else {"noise": NO_NOISE, "tracker_noise": 0.0, "drop_rate": 0.0}
     offsets = LegOffsets(psi0_offset_deg=psi0_offset_deg, zeta0_offset=zeta0_offset)

@@ -21,7 +21,7 @@ from cli.options import (
     print_json,
     with_model,
 )
-from sim_core.errors import ParameterError
+from sim_core.model.errors import ParameterError
 
 app = typer.Typer(rich_markup_mode=None)
 
@@ -46,7 +46,7 @@ def map_command(
     as_json: JsonOption = False,
 ) -> None:
     """Apply the Poincaré map JUMPS times: section states and height gain per jump."""
-    from sim_core.poincare import iterate_map
+    from sim_core.model.poincare import iterate_map
 
     orbit = iterate_map(setup.model, parse_controls(controls), state, jumps)
     if as_json:
@@ -84,13 +84,13 @@ def trajectory_command(
     as_json: JsonOption = False,
 ) -> None:
     """Sample the full path in wall coordinates (un-flipped) and write it to a file."""
-    from sim_core.trajectory import simulate_trajectory
+    from sim_core.model.trajectory import simulate_trajectory
 
     if out.suffix not in (".csv", ".json"):
         raise ParameterError("out", f"must end in .csv or .json, got {out.name!r}")
     schedule = parse_controls(controls)
     if state is None:
-        from sim_core.gait_search import gait_of
+        from sim_core.section.gait_search import gait_of
 
         gait = gait_of(setup.model, schedule)
         state = tuple(gait.state.tolist())

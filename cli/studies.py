@@ -5,8 +5,8 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from cli.options import ModelSetup, parse_controls, progress_bar
-from sim_core.controls import LegControl
-from sim_core.errors import ParameterError
+from sim_core.model.controls import LegControl
+from sim_core.model.errors import ParameterError
 
 
 def run_study(study: Callable, description: str, scheduler: str | None, *args, **kwargs):

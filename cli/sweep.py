@@ -17,7 +17,7 @@ from cli.options import (
     with_model,
 )
 from cli.studies import fixed_leg_of, over_zeta0
-from sim_core.basin_grid import DEFAULT_BASIN_WINDOW, DEFAULT_JUMPS, DEFAULT_TOLERANCE, BasinGrid
+from sim_core.basins.grid import DEFAULT_BASIN_WINDOW, DEFAULT_JUMPS, DEFAULT_TOLERANCE, BasinGrid
 
 app = typer.Typer(rich_markup_mode=None)
 
@@ -55,8 +55,8 @@ def sweep_command(
     as_json: JsonOption = False,
 ) -> None:
     """Follow a gait over zeta0: max |λ|, climb, basin area, and the zeta0 of jumping in place."""
-    from sim_core.basin import check_convergence_test
-    from sim_core.sweep import energy_sweep, zeta0_values
+    from sim_core.basins.basin import check_convergence_test
+    from sim_core.basins.sweep import energy_sweep, zeta0_values
 
     zeta0s = zeta0_values(*zeta0_range, steps)
     fixed = fixed_leg_of(fixed_leg)

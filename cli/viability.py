@@ -7,7 +7,7 @@ from typing import Annotated
 import typer
 
 from cli.options import JsonOption, ModelSetup, handles_errors, option_named, print_json, progress_bar, with_model
-from sim_core.viability_grid import (
+from sim_core.viability.grid import (
     DEFAULT_ACTIONS,
     DEFAULT_PSI0_DEG,
     DEFAULT_STATES,
@@ -46,9 +46,9 @@ def viability_command(
     """The states from which some leg command keeps the robot jumping forever, and how many do."""
     import numpy as np
 
-    from sim_core.viability import compute_viability
-    from sim_core.viability_grid import degrees_of, section_grid
-    from sim_core.viability_section import section_step_map
+    from sim_core.viability.engine import compute_viability
+    from sim_core.viability.grid import degrees_of, section_grid
+    from sim_core.viability.step_map import section_step_map
 
     with (
         option_named("--states", "states"),

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from experiments.report import STYLE, new_figure, pyplot
-from sim_core.atlas import GaitAtlas
+from sim_core.section.atlas import GaitAtlas
 
 
 def plot_atlas(atlas: GaitAtlas, title: str):

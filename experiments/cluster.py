@@ -17,7 +17,7 @@ from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 
 from sim_core.chunks import ChunkMap, Progress, in_process
-from sim_core.validation import ParameterError
+from sim_core.model.validation import ParameterError
 
 SCHEDULER_ENV = "PARKOUR_DASK_SCHEDULER"
 CONNECT_TIMEOUT = "10s"

@@ -3,7 +3,7 @@ command line, the job and the panel show of it.
 
 ``parkour control-study`` and the service's ``control-study`` job both call :func:`run`; the laws
 are built here once (:func:`laws_for`): the PIDs about the in-place zeta0 of Fig. 12's loop, the
-LQR designed on the model's own return map (:func:`sim_core.return_map_lqr.design_lqr`), so a
+LQR designed on the model's own return map (:func:`sim_core.control.return_map_lqr.design_lqr`), so a
 calibrated preset gets its own.
 """
 
@@ -16,13 +16,13 @@ import numpy as np
 from experiments.fig12 import Config as ClimbConfig
 from experiments.fig12 import PidClimb
 from sim_core.chunks import ChunkMap, Progress, in_process
-from sim_core.climb_records import CHUTE_TOP, FLOOR
-from sim_core.control_design import design_law
-from sim_core.control_laws import KINDS, Controller
-from sim_core.control_study import ControllerOutcome, control_study
-from sim_core.noise import NoiseModel
-from sim_core.params import ModelParams
-from sim_core.validation import ParameterError, check_range
+from sim_core.climb.records import CHUTE_TOP, FLOOR
+from sim_core.control.design import design_law
+from sim_core.control.laws import KINDS, Controller
+from sim_core.control.study import ControllerOutcome, control_study
+from sim_core.model.noise import NoiseModel
+from sim_core.model.params import ModelParams
+from sim_core.model.validation import ParameterError, check_range
 
 FAILURE_CURVE_POINTS = 41  # failures counted at this many jumps, 0 .. jumps
 ERROR_BINS = 40  # the height error's histogram, over ±ERROR_SPAN_M
@@ -115,7 +115,7 @@ def run(
     chunk_map: ChunkMap = in_process,
     progress: Progress | None = None,
 ) -> Result:
-    """Every controller of ``config`` on the same noise draws (:func:`sim_core.control_study.control_study`)."""
+    """Every controller of ``config`` on the same noise draws (:func:`sim_core.control.study.control_study`)."""
     loop, laws = laws_for(model, config, leg_length)
     outcomes = control_study(model, laws, loop.start, config.start_zeta0, config.jumps, config.seed0, config.seeds,
                              config.noise, chunk_map=chunk_map, progress=progress)  # fmt: skip

@@ -1,7 +1,7 @@
 """The paper's stable *descending* period-1 gaits (Fig. 8's text), tested over the leg angle.
 
 For each psi0 of a scan, the symmetric period-1 gait is followed over zeta0 by continuation
-(:func:`sim_core.sweep.energy_sweep`) on a coarse sweep that locates its zeta0 of jumping in
+(:func:`sim_core.basins.sweep.energy_sweep`) on a coarse sweep that locates its zeta0 of jumping in
 place, then on a fine sweep from there up to ``span`` past it, where the gait descends (climb per
 jump < 0). The psi0 holds stable descending gaits when a point of the fine sweep past jumping in
 place descends with max |λ| < 1; the row keeps max |λ| just past jumping in place and the
@@ -17,8 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from experiments.report import Claim
-from sim_core.params import ModelParams
-from sim_core.sweep import energy_sweep, zeta0_values
+from sim_core.basins.sweep import energy_sweep, zeta0_values
+from sim_core.model.params import ModelParams
 
 COARSE_ZETA0 = (0.80, 0.99)  # where the coarse sweep looks for the zeta0 of jumping in place
 ZETA0_CEILING = 0.999  # the fine sweep stops short of a leg at full length

@@ -2,7 +2,7 @@
 
 Like the robot experiment — ten energy levels, eight trials each — plus a converged estimate
 with many more trials per level and its 95% confidence interval. The disturbances are
-:class:`sim_core.noise.NoiseModel`'s defaults (our choice: the paper gives no numbers).
+:class:`sim_core.model.noise.NoiseModel`'s defaults (our choice: the paper gives no numbers).
 """
 
 from __future__ import annotations
@@ -13,11 +13,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from experiments.report import Claim, new_figure
+from sim_core.basins.sweep import zeta0_values
 from sim_core.chunks import ChunkMap, Progress, in_process
-from sim_core.mjtf import CAPPED, MJTFStudy, mjtf_study
-from sim_core.noise import NoiseModel
-from sim_core.params import PhysicalParams
-from sim_core.sweep import zeta0_values
+from sim_core.model.noise import NoiseModel
+from sim_core.model.params import PhysicalParams
+from sim_core.robustness.mjtf import CAPPED, MJTFStudy, mjtf_study
 
 TITLE = "Fig. 11 — Mean Jumps To Failure vs leg retraction"
 

@@ -1,6 +1,6 @@
 """Paper Fig. 12: closed-loop climbing to a height of 55 cm.
 
-A PID on the touchdown height sets the next zeta0 (:mod:`sim_core.closed_loop`). Shown: the
+A PID on the touchdown height sets the next zeta0 (:mod:`sim_core.control.closed_loop`). Shown: the
 path between the walls and the height over time, noise-free and under the noise model.
 """
 
@@ -12,18 +12,18 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from experiments.report import Claim, new_figure
+from sim_core.basins.sweep import find_in_place_zeta0
 from sim_core.chunks import ChunkMap, Progress, in_process
-from sim_core.closed_loop import ClosedLoopRun, closed_loop_climb
-from sim_core.controls import ControlSchedule, LegControl
-from sim_core.gait_search import gait_of
-from sim_core.height_controller import HeightController
-from sim_core.noise import NO_NOISE, NoiseModel
-from sim_core.params import ModelParams, PhysicalParams
-from sim_core.poincare import check_jumps
-from sim_core.presets import START_GUESS
-from sim_core.sweep import find_in_place_zeta0
-from sim_core.trajectory import Trajectory, simulate_trajectory
-from sim_core.validation import check_range
+from sim_core.control.closed_loop import ClosedLoopRun, closed_loop_climb
+from sim_core.control.height_controller import HeightController
+from sim_core.model.controls import ControlSchedule, LegControl
+from sim_core.model.noise import NO_NOISE, NoiseModel
+from sim_core.model.params import ModelParams, PhysicalParams
+from sim_core.model.poincare import check_jumps
+from sim_core.model.presets import START_GUESS
+from sim_core.model.trajectory import Trajectory, simulate_trajectory
+from sim_core.model.validation import check_range
+from sim_core.section.gait_search import gait_of
 
 TITLE = "Fig. 12 — closed-loop climbing to 55 cm"
 

@@ -15,14 +15,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from experiments.report import Claim, new_figure
+from sim_core.basins.sweep import energy_sweep
 from sim_core.chunks import ChunkMap, Progress, in_process
-from sim_core.controls import ControlSchedule, LegControl
-from sim_core.fixed_points import FixedPoint, FixedPointNotFound, find_fixed_point
-from sim_core.params import PhysicalParams
-from sim_core.poincare import iterate_map
-from sim_core.presets import PAPER_GAITS
-from sim_core.sweep import energy_sweep
-from sim_core.trajectory import Trajectory, simulate_trajectory
+from sim_core.model.controls import ControlSchedule, LegControl
+from sim_core.model.params import PhysicalParams
+from sim_core.model.poincare import iterate_map
+from sim_core.model.presets import PAPER_GAITS
+from sim_core.model.trajectory import Trajectory, simulate_trajectory
+from sim_core.section.fixed_points import FixedPoint, FixedPointNotFound, find_fixed_point
 
 TITLE = "Fig. 7 — stable gaits of period 1, 2 and 4"
 ATTRACTOR_DIGITS = 6  # distinct attractor points differ in the 6th decimal at least

@@ -4,7 +4,7 @@ Sweeps zeta0 with psi0 fixed, following the period-1 gait by continuation; plots
 the climb per jump with the zeta0 of jumping in place marked, the basin area on one fixed
 window, and the basins themselves at three energy levels on one colour scale. Basin cells run to
 ``basin_jumps``; those still undecided are continued up to ``basin_jump_limit`` (doubling the
-cap each round, :mod:`sim_core.basin_cells`), and what stays undecided is drawn as such. A scan
+cap each round, :mod:`sim_core.basins.cells`), and what stays undecided is drawn as such. A scan
 over psi0 tests the paper's stable descending gaits (:mod:`experiments.descending`).
 """
 
@@ -17,14 +17,14 @@ import numpy as np
 
 from experiments import descending
 from experiments.report import Claim, new_figure
-from sim_core.basin import DEFAULT_JUMPS, BasinGrid, compute_basin
-from sim_core.basin_cells import FALLING_SPEED
-from sim_core.basin_grid import DEFAULT_BASIN_WINDOW
+from sim_core.basins.basin import DEFAULT_JUMPS, BasinGrid, compute_basin
+from sim_core.basins.cells import FALLING_SPEED
+from sim_core.basins.grid import DEFAULT_BASIN_WINDOW
+from sim_core.basins.sweep import EnergySweep, energy_sweep, zeta0_values
 from sim_core.chunks import ChunkMap, Progress, in_process
-from sim_core.controls import ControlSchedule, LegControl
-from sim_core.failures import Failure
-from sim_core.params import PhysicalParams
-from sim_core.sweep import EnergySweep, energy_sweep, zeta0_values
+from sim_core.model.controls import ControlSchedule, LegControl
+from sim_core.model.failures import Failure
+from sim_core.model.params import PhysicalParams
 
 TITLE = "Fig. 8 — stability and basin vs leg retraction"
 UNDECIDED_COLOUR = "0.55"

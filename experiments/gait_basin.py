@@ -7,12 +7,12 @@ spec before the (slow) gait search, and both default the window to the gait's st
 
 from __future__ import annotations
 
-from sim_core.basin import Basin, check_convergence_test, compute_basin
-from sim_core.basin_grid import DEFAULT_JUMPS, DEFAULT_TOLERANCE, BasinGrid
+from sim_core.basins.basin import Basin, check_convergence_test, compute_basin
+from sim_core.basins.grid import DEFAULT_JUMPS, DEFAULT_TOLERANCE, BasinGrid
 from sim_core.chunks import ChunkMap, Progress, in_process
-from sim_core.controls import ControlSchedule
-from sim_core.gait_search import gait_of
-from sim_core.params import ModelParams
+from sim_core.model.controls import ControlSchedule
+from sim_core.model.params import ModelParams
+from sim_core.section.gait_search import gait_of
 
 _PLACEHOLDER_WINDOW = ((-2.0, -1.0), (-1.0, 1.0))  # stands in for a default range while the spec is checked
 
@@ -32,7 +32,7 @@ def gait_basin(
     chunk_map: ChunkMap = in_process,
     progress: Progress | None = None,
 ) -> Basin:
-    """The basin of the gait of ``schedule`` (:func:`sim_core.gait_search.gait_of`: from ``guess``,
+    """The basin of the gait of ``schedule`` (:func:`sim_core.section.gait_search.gait_of`: from ``guess``,
     else a grid search) on ``grid`` x ``grid`` cells; the answer holds the gait (``.gait``) and the
     window run (``.grid``).
 
@@ -43,7 +43,7 @@ def gait_basin(
         max_jumps, tolerance: a cell converges if its orbit comes within ``tolerance`` of the gait's
             orbit in at most ``max_jumps`` jumps.
         jump_limit: cells undecided after ``max_jumps`` go on, the cap doubled each round, up to this
-            many jumps (None: ``max_jumps``; :func:`sim_core.basin.compute_basin`).
+            many jumps (None: ``max_jumps``; :func:`sim_core.basins.basin.compute_basin`).
 
     Raises:
         ParameterError: naming the field, before any search, for a bad window, grid or convergence test.

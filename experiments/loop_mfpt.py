@@ -1,6 +1,6 @@
 """A controller's mean first-passage time, as the control study sets its climb up: the law named,
 designed for the model (:func:`experiments.control_study.laws_for`), started where the study's
-trials start, its MFPT estimated by splitting (:mod:`sim_core.splitting`).
+trials start, its MFPT estimated by splitting (:mod:`sim_core.robustness.splitting`).
 
 ``parkour mfpt --controller NAME`` calls :func:`run`.
 """
@@ -12,9 +12,9 @@ from dataclasses import dataclass, field
 from experiments.control_study import Config as StudyConfig
 from experiments.control_study import laws_for
 from sim_core.chunks import Progress
-from sim_core.noise import NoiseModel
-from sim_core.params import ModelParams
-from sim_core.splitting import LoopMfpt, SplittingOptions, check_metastable, loop_mfpt
+from sim_core.model.noise import NoiseModel
+from sim_core.model.params import ModelParams
+from sim_core.robustness.splitting import LoopMfpt, SplittingOptions, check_metastable, loop_mfpt
 
 
 @dataclass(frozen=True)
@@ -31,7 +31,7 @@ class Config:
 
 
 def run(model: ModelParams, leg_length: float, config: Config, progress: Progress | None = None) -> dict:
-    """The ``parkour mfpt --controller`` JSON: :meth:`sim_core.splitting.LoopMfpt.to_dict` with the
+    """The ``parkour mfpt --controller`` JSON: :meth:`sim_core.robustness.splitting.LoopMfpt.to_dict` with the
     climb's controls, start and target in metres. ``leg_length`` [m] converts the target.
 
     Raises:

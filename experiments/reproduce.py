@@ -17,8 +17,8 @@ from types import ModuleType
 from experiments.manifest import code_version, metadata
 from experiments.report import markdown_section, write_outputs
 from sim_core.chunks import ChunkMap, in_process
-from sim_core.params import PhysicalParams
-from sim_core.validation import ParameterError
+from sim_core.model.params import PhysicalParams
+from sim_core.model.validation import ParameterError
 
 FIGURES = ("fig7", "fig8", "fig11", "fig12")  # each a module experiments.<name>, in report order
 

@@ -2,7 +2,7 @@
 
 Per gait the robot was run at, the robot's jumps to failure come from its runs: a run that ended
 in a fall failed after its jumps; one stopped first (its jumps done, a person's stop) is censored —
-it would have gone on. The model's come from MJTF trials (:func:`sim_core.mjtf_trials.run_trials`) of the
+it would have gone on. The model's come from MJTF trials (:func:`sim_core.robustness.mjtf_trials.run_trials`) of the
 calibrated model, its legs' offsets applied to the commanded gait, with the noise the calibration
 estimated from the same runs; trials reaching ``cap`` are censored alike.
 
@@ -19,9 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim_core.controls import ControlSchedule, LegControl, LegOffsets
-from sim_core.noise import NoiseModel, trial_seeds
-from sim_core.params import ModelParams
+from sim_core.model.controls import ControlSchedule, LegControl, LegOffsets
+from sim_core.model.noise import NoiseModel, trial_seeds
+from sim_core.model.params import ModelParams
 
 CONFIDENCE = 0.95
 
@@ -81,8 +81,8 @@ def simulated(
     """MJTF trials of the gait commanded ``legs`` ((psi0_deg, zeta0) left, right): both legs carry
     the left leg's offset in the schedule, the right leg the difference as the noise's asymmetry."""
     from sim_core import gait_of
-    from sim_core.mjtf_trials import run_trials
-    from sim_core.presets import START_GUESS
+    from sim_core.model.presets import START_GUESS
+    from sim_core.robustness.mjtf_trials import run_trials
 
     left = LegOffsets(psi0_offset_deg=(offsets.psi0_offset_deg[0],) * 2, zeta0_offset=(offsets.zeta0_offset[0],) * 2)
     commanded = [LegControl.from_degrees(*pair) for pair in legs]

@@ -14,9 +14,9 @@ import time
 
 from backend.schemas import WORK_BUDGET_JUMPS
 from sim_core import get_preset
-from sim_core.mjtf import level_starts
-from sim_core.mjtf_trials import run_trials
-from sim_core.noise import NoiseModel, trial_seeds
+from sim_core.model.noise import NoiseModel, trial_seeds
+from sim_core.robustness.mjtf import level_starts
+from sim_core.robustness.mjtf_trials import run_trials
 
 
 def main() -> None:

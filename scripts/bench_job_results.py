@@ -20,7 +20,7 @@ from backend.schemas import MJTFJobCreate
 from backend.services import jobs
 from backend.store.database import make_engine, migrate, session_factory, sqlite_url
 from backend.store.models import Trial
-from sim_core.failures import Failure
+from sim_core.model.failures import Failure
 
 
 def main() -> None:

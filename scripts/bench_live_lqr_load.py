@@ -55,7 +55,7 @@ import numpy as np
 from scripts.calibration_live_falls import TRUTHS as FALLS_TRUTHS
 from scripts.calibration_live_falls import Api, compared, flat, run_row, sim_options, tail
 from scripts.calibration_truths import TRUTHS as FIT_TRUTHS
-from sim_core.calibration_fit import PARAMETERS
+from sim_core.calibration.fit import PARAMETERS
 from tests.helpers import free_port, start_map_load, start_robot_sim, start_service, stop_map_load, stop_processes
 from tests.tracked_climbs import VARIED_LEGS
 

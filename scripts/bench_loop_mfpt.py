@@ -1,5 +1,5 @@
-"""A controller's MFPT by splitting (sim_core.splitting) side by side with Monte-Carlo trials of the
-same loop (sim_core.control_study, the same law, climb, noise and start): values, 95% intervals,
+"""A controller's MFPT by splitting (sim_core.robustness.splitting) side by side with Monte-Carlo trials of the
+same loop (sim_core.control.study, the same law, climb, noise and start): values, 95% intervals,
 seconds each.
 
 Cases are CONTROLLER:VELOCITY[:TRIALS] (the per-jump velocity noise, the other sigmas default, no
@@ -26,10 +26,10 @@ import time
 from scipy.stats import chi2
 
 from experiments.control_study import Config, laws_for
-from sim_core.control_study import control_study
-from sim_core.noise import NoiseModel
-from sim_core.presets import get_preset
-from sim_core.splitting import loop_mfpt
+from sim_core.control.study import control_study
+from sim_core.model.noise import NoiseModel
+from sim_core.model.presets import get_preset
+from sim_core.robustness.splitting import loop_mfpt
 
 CASES = ",".join(f"{name}:{velocity}" for velocity in (0.05, 0.03, 0.02, 0.01) for name in ("pid", "lqr", "deadbeat"))
 

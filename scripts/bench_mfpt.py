@@ -1,4 +1,4 @@
-"""MFPT (the Markov chain, sim_core.mfpt) side by side with Monte-Carlo MJTF (sim_core.mjtf), the
+"""MFPT (the Markov chain, sim_core.robustness.mfpt) side by side with Monte-Carlo MJTF (sim_core.robustness.mjtf), the
 same model, controls, noise and start: values, Monte-Carlo's 95% interval, and seconds each.
 
 The Fig. 11 levels (psi0 30 deg, zeta0 0.84 / 0.90 / 0.96, default noise) and levels no test uses
@@ -18,11 +18,11 @@ import json
 import math
 import time
 
-from sim_core.controls import LegControl
-from sim_core.mfpt import mfpt
-from sim_core.mjtf import level_starts, mjtf_study
-from sim_core.noise import NoiseModel
-from sim_core.presets import get_preset
+from sim_core.model.controls import LegControl
+from sim_core.model.noise import NoiseModel
+from sim_core.model.presets import get_preset
+from sim_core.robustness.mfpt import mfpt
+from sim_core.robustness.mjtf import level_starts, mjtf_study
 
 FIG11 = "30:0.84,30:0.90,30:0.96"
 UNSEEN = "30:0.87,30:0.93,33:0.90"

@@ -37,7 +37,7 @@ from backend.robot.virtual import VirtualRobot
 from backend.schemas import ClosedLoopIn, LegIn, RobotConnect, RobotRunCreate
 from backend.services.robot import RobotService
 from backend.store.database import make_engine, migrate, session_factory, sqlite_url
-from sim_core.noise import NO_NOISE
+from sim_core.model.noise import NO_NOISE
 from tests.helpers import free_port
 from tests.tracker_relay import TrackerRelay
 

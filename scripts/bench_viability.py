@@ -1,7 +1,7 @@
 """The viability map's speed: the issue's 60² x 20² state x action grid on the paper model, the
-compiled engine (sim_core.viability with sim_core.viability_section's step map) side by side with
+compiled engine (sim_core.viability.engine with sim_core.viability.step_map's step map) side by side with
 the same steps done the way a Python tool does them (scipy's solve_ivp per pair, through
-sim_core.reference), on a random sample of the grid's pairs timed and scaled to the whole grid.
+sim_core.model.reference), on a random sample of the grid's pairs timed and scaled to the whole grid.
 
 It prints: compile time (once per source change; numba caches it), the map's and the fixed
 point's seconds, pairs per second, the baseline's seconds per pair and the ratio, and how many
@@ -20,18 +20,18 @@ import time
 
 import numpy as np
 
-from sim_core.controls import LegControl
-from sim_core.failures import OK
-from sim_core.presets import get_preset
-from sim_core.reference import reference_jump
-from sim_core.viability import compute_viability
-from sim_core.viability_grid import section_grid
-from sim_core.viability_section import section_step_map
+from sim_core.model.controls import LegControl
+from sim_core.model.failures import OK
+from sim_core.model.presets import get_preset
+from sim_core.model.reference import reference_jump
+from sim_core.viability.engine import compute_viability
+from sim_core.viability.grid import section_grid
+from sim_core.viability.step_map import section_step_map
 
 
 def scipy_step(model, state, action) -> tuple[np.ndarray, bool]:
     """One mid-chute step with scipy: fly to the wall (closed form), the jump by
-    :func:`sim_core.reference.reference_jump` with the same leg next, back to the middle."""
+    :func:`sim_core.model.reference.reference_jump` with the same leg next, back to the middle."""
     xdot, ydot = state
     psi0, zeta0 = action
     leg = LegControl(psi0, zeta0)

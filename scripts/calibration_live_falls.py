@@ -10,12 +10,12 @@ within their jumps (the issue's truth had two of four fallen). Each stored run's
 reason, ``fell``, faults and touchdowns are printed. Then:
 
 - **after** — ``POST /api/v1/calibrations`` of the four runs: the service reads each run's ``fell``
-  and leaves out the jump into the fall (``FALL_PAIRS`` per fallen run, sim_core/touchdown_series.py;
+  and leaves out the jump into the fall (``FALL_PAIRS`` per fallen run, sim_core/calibration/touchdown_series.py;
   docs/calibration.md, "Falls");
 - **before** — the same stored runs, read back through the API (``GET /api/v1/runs/{id}`` and its
   ``/trajectory``), built into sim_core ``TouchdownSeries`` as backend/services/calibrations.py
   builds them but with ``fell=False`` (the fall kept, as calibration did before runs recorded their
-  falls), fitted with ``sim_core.calibration.calibrate``. The same build with ``fell`` as stored
+  falls), fitted with ``sim_core.calibration.calibrate.calibrate``. The same build with ``fell`` as stored
   (``offline after``) must give the service's fit: its largest difference is printed as a check.
 
 Per parameter: the fitted value, the truth, the error (percent for ``alpha``, else in its unit) and
@@ -59,10 +59,10 @@ from pathlib import Path
 import httpx
 import numpy as np
 
-from sim_core.calibration_fit import PARAMETERS, vector_of
-from sim_core.controls import LegControl
-from sim_core.touchdown_series import FALL_PAIRS, TouchdownSeries, pitch_at
-from sim_core.walls import Wall
+from sim_core.calibration.fit import PARAMETERS, vector_of
+from sim_core.calibration.touchdown_series import FALL_PAIRS, TouchdownSeries, pitch_at
+from sim_core.model.controls import LegControl
+from sim_core.model.walls import Wall
 from tests.helpers import free_port, start_robot_sim, start_service, stop_processes
 from tests.tracked_climbs import PAPER, VARIED_LEGS, Truth
 
@@ -195,7 +195,7 @@ def compared(values, stderrs, truth: Truth) -> dict:
 
 
 def offline_fit(series: list[TouchdownSeries], truth: Truth) -> dict:
-    from sim_core.calibration import calibrate
+    from sim_core.calibration.calibrate import calibrate
 
     fit = calibrate(series, PAPER.to_model())
     return {

@@ -19,11 +19,11 @@ import math
 
 import numpy as np
 
-from sim_core.calibration import calibrate
-from sim_core.calibration_fit import PARAMETERS, CalibrationFit, vector_of
-from sim_core.noise import NoiseModel
-from sim_core.touchdown_series import TouchdownSeries, pitch_at
-from sim_core.walls import Wall
+from sim_core.calibration.calibrate import calibrate
+from sim_core.calibration.fit import PARAMETERS, CalibrationFit, vector_of
+from sim_core.calibration.touchdown_series import TouchdownSeries, pitch_at
+from sim_core.model.noise import NoiseModel
+from sim_core.model.walls import Wall
 from tests.tracked_climbs import PAPER, VARIED_LEGS, TrackedClimb, Truth, tracked_climb
 
 TRUTHS = {

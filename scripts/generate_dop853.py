@@ -1,11 +1,11 @@
-"""Write ``sim_core/_dop853.py``: one DOP853 step, unrolled, for the stance equations.
+"""Write ``sim_core/model/_dop853.py``: one DOP853 step, unrolled, for the stance equations.
 
 The step is straight-line code over scalars — the tableau's 50 non-zero stage coefficients
 written in as literals, zero terms dropped, the state held in a tuple — which numba compiles
 to about half the time of the loop-over-arrays version of the same arithmetic. Writing it by
 hand would mean typing ~150 coefficients; generating it from scipy's own table
 (``scipy.integrate._ivp.dop853_coefficients``) keeps the kernel and the baseline on one
-tableau. ``tests/sim_core/test_dop853.py`` fails when the file is out of date.
+tableau. ``tests/sim_core/model/test_dop853.py`` fails when the file is out of date.
 
 Usage: python scripts/generate_dop853.py [--check]
 """
@@ -18,8 +18,8 @@ from pathlib import Path
 
 from scipy.integrate._ivp import dop853_coefficients as tableau
 
-TARGET = Path(__file__).resolve().parent.parent / "sim_core" / "_dop853.py"
-STATE_SIZE = 7  # sim_core.stance_equations.STATE_SIZE; checked by the test
+TARGET = Path(__file__).resolve().parent.parent / "sim_core" / "model" / "_dop853.py"
+STATE_SIZE = 7  # sim_core.model.stance_equations.STATE_SIZE; checked by the test
 
 HEADER = '''"""One step of the 8th-order Dormand–Prince method (DOP853) on the stance equations.
 
@@ -33,7 +33,7 @@ from __future__ import annotations
 import math
 
 from sim_core._jit import kernel
-from sim_core.stance_equations import rates
+from sim_core.model.stance_equations import rates
 
 
 @kernel

@@ -1,9 +1,9 @@
-"""Cross-check of the viability engine (sim_core.viability) against sheim/vibly, the reference
+"""Cross-check of the viability engine (sim_core.viability.engine) against sheim/vibly, the reference
 implementation of viability kernels (Heim & Spröwitz), on vibly's SLIP hopper.
 
 Both compute the same grid side by side: vibly its own way (``compute_Q_map`` over a process pool,
 as ``demos/computeQ_slip.py`` does, then ``compute_QV`` and ``project_Q2S(..., np.mean)``), and
-ParkourLab's engine with sim_core.slip_hopper's compiled copy of vibly's model (compiled once
+ParkourLab's engine with sim_core.viability.slip_hopper's compiled copy of vibly's model (compiled once
 first, its compile time reported apart). The engine runs with ``edges_extend=True``, vibly's
 convention at the grid's edges: a state reached past the last node is judged by the edge node,
 one below the first node counts as failed.
@@ -32,8 +32,8 @@ from pathlib import Path
 
 import numpy as np
 
-from sim_core.slip_hopper import SlipHopper, slip_step, slip_step_map
-from sim_core.viability import ViabilityGrid, compute_viability, viability_of_map
+from sim_core.viability.engine import ViabilityGrid, compute_viability, viability_of_map
+from sim_core.viability.slip_hopper import SlipHopper, slip_step, slip_step_map
 
 DEMO_STATES = 180  # computeQ_slip.py: s_grid = np.linspace(0.1, 1, 181)[:-1]
 DEMO_ACTIONS = 161  # computeQ_slip.py: a_grid = np.linspace(-10 / 180 * np.pi, 70 / 180 * np.pi, 161)

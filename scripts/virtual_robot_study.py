@@ -3,7 +3,7 @@ calibration, hold a height, beside the paper-model laws (issue 27's virtual-robo
 
 For each hidden truth (``scripts.calibration_truths.TRUTHS``: stiffness, damping and servo offsets
 unlike the paper's), four open-loop tracked climbs (the gaits of ``tests.tracked_climbs.VARIED_LEGS``,
-40 jumps, default noise) are calibrated (``sim_core.calibration.calibrate``), and each controller
+40 jumps, default noise) are calibrated (``sim_core.calibration.calibrate.calibrate``), and each controller
 climbs ``--runs`` times to ``--target`` for ``--jumps`` touchdowns, closed as a live run closes it
 (``tests.closed_climbs``: the PC's touchdown detector and the live law, without sockets or real
 time), the default noise on every run, seeds 100, 101, ... The calibrated laws are designed on
@@ -26,10 +26,10 @@ import numpy as np
 from backend.robot.live_law import LiveLaw
 from scripts.calibration_truths import TRUTHS, runs
 from sim_core import LegControl, PhysicalParams
-from sim_core.calibration import calibrate
-from sim_core.control_design import law_holding
-from sim_core.controls import NO_OFFSETS
-from sim_core.noise import NoiseModel
+from sim_core.calibration.calibrate import calibrate
+from sim_core.control.design import law_holding
+from sim_core.model.controls import NO_OFFSETS
+from sim_core.model.noise import NoiseModel
 from tests.closed_climbs import closed_climb, held
 from tests.tracked_climbs import PAPER
 

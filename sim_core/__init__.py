@@ -1,22 +1,23 @@
 """ParkourLab's numerical core: the ParkourBot bipedal SLIP model (see docs/model.md).
 
-Data flows parameters -> simulate -> analyse:
+Data flows parameters -> simulate -> analyse, one package per concept, each importing only those
+above it in this list (import-linter holds it: pyproject.toml):
 
-- :mod:`sim_core.params`, :mod:`sim_core.presets`, :mod:`sim_core.controls` — what to simulate;
-- :mod:`sim_core.integrate`, :mod:`sim_core.stride` — compiled kernels (stance, one jump, orbits);
-- :mod:`sim_core.poincare`, :mod:`sim_core.trajectory` — the validated map and full paths;
-- :mod:`sim_core.fixed_points`, :mod:`sim_core.gait_search` — periodic gaits and their stability,
-  a gait search, and :func:`~sim_core.gait_search.gait_of`, the gait of a control schedule;
-- :mod:`sim_core.walls`, :mod:`sim_core.climb` — left and right, and the climb jump after jump
-  (the sequencer the 3D view and the virtual robot drive, with the noise and the chute's floor),
-  its records in :mod:`sim_core.climb_records`;
-- :mod:`sim_core.basin`, :mod:`sim_core.sweep`, :mod:`sim_core.atlas`, :mod:`sim_core.mjtf`,
-  :mod:`sim_core.closed_loop` (with :mod:`sim_core.noise`) — the lab's studies (docs/analyses.md),
-  split into chunks by :mod:`sim_core.chunks`;
-- :mod:`sim_core.reference`, :mod:`sim_core.bench` — the scipy baseline and ``parkour bench``.
+- :mod:`sim_core.model` — what to simulate (parameters, presets, controls, walls, the noise model)
+  and the compiled kernels that simulate it: stance, one jump, the Poincaré map, full paths;
+- :mod:`sim_core.section` — the map's gaits: fixed points and their stability, the gait search
+  (:func:`~sim_core.section.gait_search.gait_of`: the gait of a control schedule), the atlas;
+- :mod:`sim_core.basins` — basins of attraction, and energy sweeps of a gait with its basin;
+- :mod:`sim_core.viability` — viability kernels (vibly's semantics) and the guard built on them;
+- :mod:`sim_core.control` — control laws, controllers and their designs, the closed loop, the study;
+- :mod:`sim_core.robustness` — MJTF, the MFPT chain and splitting, under the noise model;
+- :mod:`sim_core.calibration`, :mod:`sim_core.climb` — the model fitted to tracked runs, and the
+  climb in real time that the 3D view and the virtual robot drive;
+- :mod:`sim_core.chunks` (big studies as chunks), :mod:`sim_core._jit` (how kernels compile),
+  :mod:`sim_core.bench` (``parkour bench``: the kernel against scipy).
 
 No web, database or plotting imports here. The names below load on first use (PEP 562): importing
-``sim_core`` or a light module such as :mod:`sim_core.controls` does not load numba or scipy, so a
+``sim_core`` or a light module such as :mod:`sim_core.model.controls` does not load numba or scipy, so a
 command that only needs its options starts at once.
 """
 
@@ -26,36 +27,36 @@ import importlib
 
 # Public name -> the module that defines it.
 _EXPORTS = {
-    "ClimbEnd": "climb_records",
-    "ClimbSetup": "climb_records",
-    "ControlSchedule": "controls",
-    "LegControl": "controls",
-    "Failure": "failures",
-    "ParameterError": "errors",
-    "FixedPointNotFound": "errors",
-    "FixedPoint": "fixed_points",
-    "characterize": "fixed_points",
-    "find_fixed_point": "fixed_points",
-    "map_jacobian": "fixed_points",
-    "minimal_period": "fixed_points",
-    "search_gaits": "gait_search",
-    "gait_of": "gait_search",
-    "NoGaitFound": "errors",
-    "ModelParams": "params",
-    "PhysicalParams": "params",
-    "Scales": "params",
-    "Orbit": "poincare",
-    "OrbitBatch": "poincare",
-    "iterate_map": "poincare",
-    "iterate_map_batch": "poincare",
-    "PRESETS": "presets",
-    "PAPER_GAITS": "presets",
-    "START_GUESS": "presets",
-    "get_preset": "presets",
-    "Trajectory": "trajectory",
-    "simulate_trajectory": "trajectory",
-    "Wall": "walls",
-    "wall_of": "walls",
+    "ClimbEnd": "climb.records",
+    "ClimbSetup": "climb.records",
+    "ControlSchedule": "model.controls",
+    "LegControl": "model.controls",
+    "Failure": "model.failures",
+    "ParameterError": "model.errors",
+    "FixedPointNotFound": "model.errors",
+    "FixedPoint": "section.fixed_points",
+    "characterize": "section.fixed_points",
+    "find_fixed_point": "section.fixed_points",
+    "map_jacobian": "section.fixed_points",
+    "minimal_period": "section.fixed_points",
+    "search_gaits": "section.gait_search",
+    "gait_of": "section.gait_search",
+    "NoGaitFound": "model.errors",
+    "ModelParams": "model.params",
+    "PhysicalParams": "model.params",
+    "Scales": "model.params",
+    "Orbit": "model.poincare",
+    "OrbitBatch": "model.poincare",
+    "iterate_map": "model.poincare",
+    "iterate_map_batch": "model.poincare",
+    "PRESETS": "model.presets",
+    "PAPER_GAITS": "model.presets",
+    "START_GUESS": "model.presets",
+    "get_preset": "model.presets",
+    "Trajectory": "model.trajectory",
+    "simulate_trajectory": "model.trajectory",
+    "Wall": "model.walls",
+    "wall_of": "model.walls",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -5,7 +5,7 @@ zero-division checks of the default Python error model (about 30% of the stance 
 time). The kernels never raise anyway: they report non-finite results as ``invalid_state``.
 No ``fastmath``: it would break agreement with the reference.
 
-The cache lives in a directory keyed by a hash of sim_core's source.
+The cache lives in a directory keyed by a hash of sim_core's source, every package's modules.
 
 numba invalidates a cached function when *its own* file changes, not when a kernel it
 inlines from another file does (``stride.orbit`` inlines ``integrate.stance``), so a plain
@@ -26,8 +26,9 @@ import numba
 
 def _source_hash() -> str:
     digest = hashlib.sha256()
-    for path in sorted(Path(__file__).parent.glob("*.py")):
-        digest.update(path.name.encode())
+    root = Path(__file__).parent
+    for path in sorted(root.rglob("*.py")):  # every package's modules: a kernel in any may change
+        digest.update(path.relative_to(root).as_posix().encode())
         digest.update(path.read_bytes())
     digest.update(numba.__version__.encode())
     return digest.hexdigest()[:16]

@@ -2,7 +2,7 @@
 
 Both run side by side in one process over the same section states (perturbations of the
 paper preset's period-1 gait, seeded), so the ratio is meaningful on a shared, noisy machine:
-the kernel's strides per second on one core, the baseline's (:mod:`sim_core.reference`,
+the kernel's strides per second on one core, the baseline's (:mod:`sim_core.model.reference`,
 DOP853 at rtol = atol = 1e-10), their ratio, the largest difference between their next
 section states and rises, and the batch throughput on all cores. It also times the basin of
 that gait over a 200 x 200 grid x 60 jumps (issue 4's target: under 10 s on 2 cores) and
@@ -18,14 +18,14 @@ from dataclasses import asdict, dataclass
 import numba
 import numpy as np
 
-from sim_core.basin import BasinGrid, compute_basin
-from sim_core.controls import ControlSchedule
-from sim_core.failures import OK
-from sim_core.gait_search import gait_of
-from sim_core.poincare import iterate_map_batch
-from sim_core.presets import PAPER_GAITS, START_GUESS, get_preset
-from sim_core.reference import reference_jumps
-from sim_core.validation import check_range
+from sim_core.basins.basin import BasinGrid, compute_basin
+from sim_core.model.controls import ControlSchedule
+from sim_core.model.failures import OK
+from sim_core.model.poincare import iterate_map_batch
+from sim_core.model.presets import PAPER_GAITS, START_GUESS, get_preset
+from sim_core.model.reference import reference_jumps
+from sim_core.model.validation import check_range
+from sim_core.section.gait_search import gait_of
 
 BASELINE_TOLERANCE = 1e-10
 

@@ -16,13 +16,14 @@ import numpy as np
 
 from backend.robot.live_law import LiveLaw, pitch_at
 from backend.robot.touchdown import Touchdown, scan_touchdowns
-from sim_core import ControlSchedule, LegControl, PhysicalParams, climb, gait_of
-from sim_core.climb_records import ClimbSetup
-from sim_core.errors import FixedPointNotFound
-from sim_core.noise import NoiseModel
-from sim_core.noise_rules import NoiseSampler
-from sim_core.presets import START_GUESS
-from sim_core.walls import Wall, wall_of
+from sim_core import ControlSchedule, LegControl, PhysicalParams, gait_of
+from sim_core.climb import sequencer as climb
+from sim_core.climb.records import ClimbSetup
+from sim_core.model.errors import FixedPointNotFound
+from sim_core.model.noise import NoiseModel
+from sim_core.model.noise_rules import NoiseSampler
+from sim_core.model.presets import START_GUESS
+from sim_core.model.walls import Wall, wall_of
 from tests.tracked_climbs import FRAME_RATE, Truth
 
 

@@ -7,7 +7,7 @@ import socket
 import pytest
 
 from sim_core import ControlSchedule, ModelParams, get_preset
-from sim_core.noise import NO_NOISE
+from sim_core.model.noise import NO_NOISE
 from tests.helpers import free_port
 
 # Starlette's TestClient calls the service "testserver" (its Host header): allowed here as a

@@ -11,14 +11,14 @@ import numpy as np
 
 from backend.robot.touchdown import Touchdown, detect_touchdowns
 from sim_core import ControlSchedule, LegControl, PhysicalParams, gait_of, get_preset
-from sim_core.climb import simulate_climb
-from sim_core.climb_records import ClimbSetup
-from sim_core.controls import LegOffsets
-from sim_core.errors import FixedPointNotFound
-from sim_core.noise import NoiseModel
-from sim_core.noise_rules import NoiseSampler
-from sim_core.presets import START_GUESS
-from sim_core.walls import Wall
+from sim_core.climb.records import ClimbSetup
+from sim_core.climb.sequencer import simulate_climb
+from sim_core.model.controls import LegOffsets
+from sim_core.model.errors import FixedPointNotFound
+from sim_core.model.noise import NoiseModel
+from sim_core.model.noise_rules import NoiseSampler
+from sim_core.model.presets import START_GUESS
+from sim_core.model.walls import Wall
 
 PAPER = get_preset("paper")
 FRAME_RATE = 100.0  # [Hz]

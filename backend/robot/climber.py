@@ -1,16 +1,16 @@
 """The virtual robot's body: the SLIP model climbing in real time, seen by a 100 Hz tracker.
 
-A thin, threaded driver of :mod:`sim_core.climb` (the climb sequencer the 3D view runs too).
+A thin, threaded driver of :mod:`sim_core.climb.sequencer` (the climb sequencer the 3D view runs too).
 While the firmware says ``running``, jump after jump is simulated with the legs' current
 controls plus the imperfections the paper reports: each leg's servo offsets (``leg_offsets``, the
-truth a calibration should recover) and :mod:`sim_core.noise` (control noise, pitch drift
+truth a calibration should recover) and :mod:`sim_core.model.noise` (control noise, pitch drift
 offsetting the leg angles, noisy section states), and the body's path is
 streamed as tracker datagrams in real time (or ``speed`` times faster), with position noise and
 dropped frames, as PKT1 datagrams or, with ``tracker_protocol="natnet"``, as the camera software's
 NatNet frames (:mod:`backend.robot.natnet_frame`: one rigid body, the table plane its x–y plane, the
 pitch its rotation about z). Each stance is streamed before the next leg is read, as the real robot positions
 that leg during the stance. The climb ends when a jump fails (slip, no flight, ...) or the body
-reaches the chute's floor (:data:`sim_core.climb_records.FLOOR`, where the first foot touches): the
+reaches the chute's floor (:data:`sim_core.climb.records.FLOOR`, where the first foot touches): the
 robot falls and reports it, and :attr:`Climber.end` says why.
 """
 
@@ -27,15 +27,16 @@ from backend.robot.messages import Leg
 from backend.robot.natnet import parse_version
 from backend.robot.natnet_frame import RigidBody, encode_frame, quaternion_about_z
 from backend.robot.tracker import Pose, encode_datagram
-from sim_core import ControlSchedule, LegControl, PhysicalParams, climb, gait_of, get_preset
-from sim_core.climb_records import ClimbSetup, End, Samples
-from sim_core.controls import NO_OFFSETS, LegOffsets
-from sim_core.errors import FixedPointNotFound, ParameterError
-from sim_core.noise import NoiseModel
-from sim_core.noise_rules import NoiseSampler
-from sim_core.presets import START_GUESS
-from sim_core.validation import check_range
-from sim_core.walls import Wall
+from sim_core import ControlSchedule, LegControl, PhysicalParams, gait_of, get_preset
+from sim_core.climb import sequencer as climb
+from sim_core.climb.records import ClimbSetup, End, Samples
+from sim_core.model.controls import NO_OFFSETS, LegOffsets
+from sim_core.model.errors import FixedPointNotFound, ParameterError
+from sim_core.model.noise import NoiseModel
+from sim_core.model.noise_rules import NoiseSampler
+from sim_core.model.presets import START_GUESS
+from sim_core.model.validation import check_range
+from sim_core.model.walls import Wall
 
 FRAME_RATE = 100.0  # [Hz] the FLEX V100's
 

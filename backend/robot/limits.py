@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from backend.robot.messages import on_the_wire
-from sim_core.validation import ParameterError, check_range
+from sim_core.model.validation import ParameterError, check_range
 
 
 @dataclass(frozen=True)

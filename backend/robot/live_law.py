@@ -1,4 +1,4 @@
-"""A controller closed on the robot: the compiled law of :mod:`sim_core.controllers`, stepped once
+"""A controller closed on the robot: the compiled law of :mod:`sim_core.control.controllers`, stepped once
 per detected touchdown by a live run's loop (its one owner, the loop's thread).
 
 At detected touchdown ``i`` (the climb's touchdown ``i + 1``) the law sees what the robot
@@ -7,7 +7,7 @@ markers gave none) and the section state fitted from the flight before it — an
 controls of the climb's next touchdown, ``i + 2``: the leg the robot positions during the coming
 stance. Heights are the tracker's [m] over the leg length, the frame ``target_m`` is given in,
 so the law's target and heights share an origin. The ``pid`` law is today's loop
-(:func:`sim_core.closed_loop.pid_step`, each leg keeping its own angle; the error now taken as
+(:func:`sim_core.control.closed_loop.pid_step`, each leg keeping its own angle; the error now taken as
 ``target / l0 - height / l0``, the same to rounding); the others command the angle too. Every
 command says which law, whether it was clipped to the leg's range, and the law's state after it
 (the PID's integral and last error; the LQR's and deadbeat's last command).
@@ -22,19 +22,19 @@ import numpy as np
 
 from backend.robot.limits import ServoLimits
 from backend.robot.touchdown import Touchdown, pitch_before
-from sim_core.control_design import SteppedLaw, law_holding
-from sim_core.control_laws import PID, Controller
-from sim_core.controls import NO_OFFSETS, LegControl, LegOffsets
-from sim_core.params import PhysicalParams
-from sim_core.validation import check_range
-from sim_core.walls import Wall, wall_of
+from sim_core.control.design import SteppedLaw, law_holding
+from sim_core.control.laws import PID, Controller
+from sim_core.model.controls import NO_OFFSETS, LegControl, LegOffsets
+from sim_core.model.params import PhysicalParams
+from sim_core.model.validation import check_range
+from sim_core.model.walls import Wall, wall_of
 
 
 @dataclass
 class LiveLaw:
     """``law`` holding ``target_m`` [m] on a robot of ``leg_length`` [m], whose first detected
     touchdown is made with ``first`` (the right leg's start controls: the climb's touchdown 1).
-    ``offsets``: the legs' servo offsets a calibration found (:class:`sim_core.controls.LegOffsets`);
+    ``offsets``: the legs' servo offsets a calibration found (:class:`sim_core.model.controls.LegOffsets`);
     each command is the law's less its leg's offset, so the leg realises what the law chose, held
     to the servos' ``limits`` (clipped, and said so, where the offset would take it past them)."""
 

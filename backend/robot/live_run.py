@@ -31,9 +31,9 @@ from backend.robot.run_endings import CLEAN_ENDINGS, LINK_LOST, end_safely, faul
 from backend.robot.touchdown import PITCH_LOOKBACK, Touchdown, scan_touchdowns
 from backend.robot.tracker import PoseHistory, pose_arrays
 from backend.robot.tracker_watch import TRACKER_TIMEOUT_MS, TrackerWatch, frames_heard
-from sim_core.controls import LegControl
-from sim_core.errors import ParameterError
-from sim_core.walls import wall_of
+from sim_core.model.controls import LegControl
+from sim_core.model.errors import ParameterError
+from sim_core.model.walls import wall_of
 
 POLL = 0.005  # [s] how often the loop looks at new poses
 

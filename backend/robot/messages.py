@@ -20,7 +20,7 @@ import struct
 from dataclasses import dataclass
 from enum import IntEnum
 
-from sim_core.walls import Wall
+from sim_core.model.walls import Wall
 
 VERSION = 1
 HEADER = struct.Struct(">BBH")
@@ -44,7 +44,7 @@ class Kind(IntEnum):
 
 class Leg(IntEnum):
     """A leg as the wire encodes it (one byte: 0 left, 1 right). Outside the codec, speak
-    :class:`sim_core.walls.Wall`: ``Leg.of(wall)`` and ``leg.wall`` convert."""
+    :class:`sim_core.model.walls.Wall`: ``Leg.of(wall)`` and ``leg.wall`` convert."""
 
     LEFT = 0
     RIGHT = 1

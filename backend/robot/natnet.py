@@ -28,7 +28,7 @@ from __future__ import annotations
 import struct
 from dataclasses import dataclass
 
-from sim_core.errors import ParameterError
+from sim_core.model.errors import ParameterError
 
 NAT_CONNECT = 0
 NAT_SERVERINFO = 1

@@ -19,9 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim_core.controls import LegControl
-from sim_core.params import PhysicalParams
-from sim_core.walls import Wall
+from sim_core.model.controls import LegControl
+from sim_core.model.params import PhysicalParams
+from sim_core.model.walls import Wall
 
 MIN_FIT_POSES = 4
 PITCH_LOOKBACK = 10  # poses looked back through for the newest pitch the markers gave

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from backend.robot.tracker_stats import FRAME_JUMP, LATE_FRAMES, TrackerCounts, TrackerStats  # noqa: F401 (re-exported)
-from sim_core.validation import check_range
+from sim_core.model.validation import check_range
 
 DATAGRAM = struct.Struct(">4sIdddd")
 MAGIC = b"PKT1"

@@ -9,8 +9,8 @@ from typing import Annotated, Generic, Literal, TypeVar
 
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field
 
-from sim_core.climb_records import CHUTE_TOP, FLOOR
-from sim_core.control_laws import PSI0_RANGE_DEG
+from sim_core.climb.records import CHUTE_TOP, FLOOR
+from sim_core.control.laws import PSI0_RANGE_DEG
 
 
 def _inside_in_radians(psi0_deg: float) -> float:

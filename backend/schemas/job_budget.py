@@ -4,7 +4,7 @@ may take, and the job worker's rate for estimates. For request bodies and stored
 
 from __future__ import annotations
 
-from sim_core.mfpt_grid import ChainGrid
+from sim_core.robustness.mfpt_grid import ChainGrid
 
 # A job's work, in jumps at its worst (every trial to its cap, every basin point to its jump limit):
 # about an hour of the job worker on the lab's machine (1.35e5-1.6e5 jumps/s measured by
@@ -30,7 +30,7 @@ JUMP_LIMIT_DESCRIPTION = "cells undecided at the first cap go on up to this many
 # the job worker) at most, and its result (kernel, measure, viable pairs as bits) stays a few MB.
 VIABILITY_MAX_STATES = 120
 VIABILITY_MAX_ACTIONS = 40
-# A controller's MFPT by splitting (sim_core.splitting): its work is AMS runs of replicas, each
+# A controller's MFPT by splitting (sim_core.robustness.splitting): its work is AMS runs of replicas, each
 # replica's excursions ended home, at a failure or at SplittingOptions' excursion_limit (20,000
 # jumps). One replica's share of a run is counted at that limit, the long run and climbs that
 # measure the holding state before them at theirs (pilot_jumps + climbs x excursion_limit, the

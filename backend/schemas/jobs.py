@@ -34,8 +34,8 @@ from backend.schemas.job_budget import (
 )
 from backend.schemas.mfpt_jobs import LoopMfptJobCreate, MfptJobCreate
 from backend.schemas.noise import NoiseIn
-from sim_core.control_laws import KINDS
-from sim_core.viability_grid import DEFAULT_PSI0_DEG, DEFAULT_ZETA0
+from sim_core.control.laws import KINDS
+from sim_core.viability.grid import DEFAULT_PSI0_DEG, DEFAULT_ZETA0
 
 CLIENT_PATTERN = r"^[\w.:@/-]{1,64}$"  # the X-Parkour-Client header: who submits, for the queue's fairness
 

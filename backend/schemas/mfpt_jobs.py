@@ -17,13 +17,13 @@ from pydantic import Field, field_validator, model_validator
 from backend.schemas.common import ModelIn, NominalPsi0Deg, Psi0Deg, RecordRef, StateIn, Strict, TargetHeightM, Zeta0
 from backend.schemas.job_budget import LOOP_MFPT_MAX_REPLICA_RUNS, MFPT_MAX_GRID, within_budget
 from backend.schemas.noise import NoiseIn
-from sim_core.control_laws import KINDS
-from sim_core.errors import ParameterError
-from sim_core.mfpt_grid import ChainGrid
-from sim_core.noise import ASYMMETRY_LIMITS, SIGMA_LIMITS, NoiseModel
+from sim_core.control.laws import KINDS
+from sim_core.model.errors import ParameterError
+from sim_core.model.noise import ASYMMETRY_LIMITS, SIGMA_LIMITS, NoiseModel
+from sim_core.robustness.mfpt_grid import ChainGrid
 
 ControllerKind = enum.StrEnum("ControllerKind", {name.replace("-", "_").upper(): name for name in KINDS})
-ControllerKind.__doc__ = "A closed-loop law (sim_core.control_laws.KINDS)."
+ControllerKind.__doc__ = "A closed-loop law (sim_core.control.laws.KINDS)."
 
 
 class MfptJobCreate(Strict):
@@ -59,10 +59,10 @@ class MfptJobCreate(Strict):
 
 
 def _metastable(noise: NoiseModel) -> None:
-    """sim_core's refusal of noise splitting cannot take (:func:`sim_core.splitting.check_metastable`),
+    """sim_core's refusal of noise splitting cannot take (:func:`sim_core.robustness.splitting.check_metastable`),
     as a ValueError in its words. Imported only to refuse: the kernels' module loads in seconds."""
     if noise.pitch_drift_deg != 0.0 or noise.velocity == noise.psi0_deg == noise.zeta0 == 0.0:
-        from sim_core.splitting import check_metastable
+        from sim_core.robustness.splitting import check_metastable
 
         try:
             check_metastable(noise)

@@ -1,4 +1,4 @@
-"""The noise a job climbs under, as a request gives it: :class:`~sim_core.noise.NoiseModel`'s
+"""The noise a job climbs under, as a request gives it: :class:`~sim_core.model.noise.NoiseModel`'s
 fields with its defaults and ranges (SIGMA_LIMITS, ASYMMETRY_LIMITS), one home for every job kind."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ from typing import Annotated
 from pydantic import Field
 
 from backend.schemas.common import Strict
-from sim_core.noise import ASYMMETRY_LIMITS, SIGMA_LIMITS, NoiseModel
+from sim_core.model.noise import ASYMMETRY_LIMITS, SIGMA_LIMITS, NoiseModel
 
 _NOISE = NoiseModel()  # the noise's defaults
 

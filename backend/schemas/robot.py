@@ -12,9 +12,9 @@ from backend.robot.ports import check_port
 from backend.robot.tracker_watch import TRACKER_TIMEOUT_MS, TRACKER_TIMEOUT_RANGE_MS
 from backend.robot.xbee import ROBOT_ADDRESS
 from backend.schemas.common import LegIn, Psi0Deg, RecordRef, Strict, Tags, Zeta0
-from sim_core.climb_records import CHUTE_TOP, FLOOR
-from sim_core.control_design import DEADBEAT_CLIMB_PER_JUMP
-from sim_core.control_laws import KINDS
+from sim_core.climb.records import CHUTE_TOP, FLOOR
+from sim_core.control.design import DEADBEAT_CLIMB_PER_JUMP
+from sim_core.control.laws import KINDS
 
 
 class RobotConnect(Strict):

@@ -2,7 +2,7 @@
 
 :func:`calibrate_runs` reads the touchdowns of robot and replay runs (each touchdown's measured
 section state and foot height, the controls commanded for it, the body's pitch from the tracker
-frames just after it), fits the model (:func:`sim_core.calibration.calibrate`) and stores the
+frames just after it), fits the model (:func:`sim_core.calibration.calibrate.calibrate`) and stores the
 result as a :class:`~backend.store.models.ModelPreset` with its provenance: the runs, the date and
 the code version. A stored preset is used by name wherever a built-in one is
 (:func:`backend.services.models.resolve_model`): the CLI's ``--preset``, the API's ``model.preset``.
@@ -32,13 +32,13 @@ from backend.services.models import resolve_model
 from backend.services.simulation import current_code_version, unpack_trajectory
 from backend.store.models import ModelPreset, Run
 from experiments.manifest import json_safe
-from sim_core.calibration_fit import CalibrationFit
-from sim_core.controls import NO_OFFSETS, LegControl, LegOffsets
-from sim_core.errors import ParameterError
-from sim_core.params import ModelParams, PhysicalParams
-from sim_core.presets import PRESETS, get_preset
-from sim_core.touchdown_series import TouchdownSeries, finite_rms, pitch_at
-from sim_core.walls import Wall
+from sim_core.calibration.fit import CalibrationFit
+from sim_core.calibration.touchdown_series import TouchdownSeries, finite_rms, pitch_at
+from sim_core.model.controls import NO_OFFSETS, LegControl, LegOffsets
+from sim_core.model.errors import ParameterError
+from sim_core.model.params import ModelParams, PhysicalParams
+from sim_core.model.presets import PRESETS, get_preset
+from sim_core.model.walls import Wall
 
 CALIBRATED_KINDS = ("robot", "replay")
 PRESET_NAME = re.compile(PRESET_PATTERN)
@@ -87,15 +87,15 @@ def run_fell(run: Run) -> bool:
 
 
 def fit_touchdowns(series: list[TouchdownSeries], base: ModelParams) -> CalibrationFit:
-    """:func:`sim_core.calibration.calibrate`, loaded where it runs (a compute worker, a command)."""
-    from sim_core.calibration import calibrate
+    """:func:`sim_core.calibration.calibrate.calibrate`, loaded where it runs (a compute worker, a command)."""
+    from sim_core.calibration.calibrate import calibrate
 
     return calibrate(series, base)
 
 
 def predict_touchdowns(series: TouchdownSeries, models: dict) -> dict:
-    """:func:`sim_core.calibration.one_jump_predictions`, loaded where it runs."""
-    from sim_core.calibration import one_jump_predictions
+    """:func:`sim_core.calibration.calibrate.one_jump_predictions`, loaded where it runs."""
+    from sim_core.calibration.calibrate import one_jump_predictions
 
     return one_jump_predictions(series, models)
 
@@ -225,7 +225,8 @@ def _touchdown_controls(session: Session, run: Run) -> list:
 
 
 def _pitch_at(run: Run | None, times: list[float]) -> np.ndarray:
-    """The tracked pitch [rad] at each touchdown (:func:`sim_core.touchdown_model.pitch_at`); 0 without frames."""
+    """The tracked pitch [rad] at each touchdown (:func:`sim_core.calibration.touchdown_model.pitch_at`);
+    0 without frames."""
     frames = None if run is None or run.trajectory is None else unpack_trajectory(run.trajectory)
     if frames is None or "pitch" not in frames:
         return np.zeros(len(times))
@@ -235,7 +236,7 @@ def _pitch_at(run: Run | None, times: list[float]) -> np.ndarray:
 def touchdown_predictions(session: Session, run_id: int, *, preset: str | None, predict=None) -> TouchdownComparison:
     """A robot or replay run's touchdowns as measured, as the base model predicts each from the one
     before, and (``preset``, a stored calibration) as the calibrated model does, with the residuals
-    and their RMS. ``predict`` is :func:`sim_core.calibration.one_jump_predictions` or a call of it
+    and their RMS. ``predict`` is :func:`sim_core.calibration.calibrate.one_jump_predictions` or a call of it
     in a compute worker."""
     run = _calibration_run(session, run_id)
     stored = None if preset is None else get_stored_preset(session, preset)

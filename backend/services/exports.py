@@ -29,7 +29,7 @@ from backend.repositories.runs import (
     widest_schedule,
 )
 from experiments.manifest import json_safe
-from sim_core.params import ModelParams
+from sim_core.model.params import ModelParams
 
 RECORD_FIELDS = ("id", "experiment_id", "kind", "status", "created_at", "duration_s", "code_version", "tags", "notes",
                  "jumps", "jumps_completed", "failure_code", "climb", "start_xdot", "start_ydot", "end_reason",

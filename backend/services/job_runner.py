@@ -1,8 +1,8 @@
 """The job runner: one background thread that takes the stored jobs to their end, one at a time.
 
 An MJTF job survives crashes trial by trial. The runner takes the study's one plan from sim_core
-— the levels' starts (:func:`sim_core.mjtf.level_starts`, in the job worker), then the trials in
-chunks (:func:`sim_core.mjtf_plan.plan_trials`) leaving out the trials already stored — runs the
+— the levels' starts (:func:`sim_core.robustness.mjtf.level_starts`, in the job worker), then the trials in
+chunks (:func:`sim_core.robustness.mjtf_plan.plan_trials`) leaving out the trials already stored — runs the
 chunks in the service's job worker process (:mod:`backend.workers.pools`; never in the service's
 own, where they would hold up the API) or on the Dask cluster named by ``PARKOUR_DASK_ADDRESS``,
 and commits each chunk's trials and the progress in one transaction as it finishes. Killed
@@ -43,8 +43,8 @@ from backend.workers.pools import ComputePool
 from experiments.cluster import as_completed_results, chunk_map_for, dask_client
 from experiments.manifest import json_safe
 from sim_core.chunks import Cancelled
-from sim_core.failures import OK, Failure
-from sim_core.mjtf_plan import TrialChunk, plan_trials
+from sim_core.model.failures import OK, Failure
+from sim_core.robustness.mjtf_plan import TrialChunk, plan_trials
 
 log = logging.getLogger("parkourlab.jobs")
 T = TypeVar("T")
@@ -141,8 +141,8 @@ class JobRunner:
 
     def _run_mjtf(self, job_id: int, spec: MJTFSpec) -> None:
         """The study's trials not stored yet, chunk by chunk as sim_core plans them."""
-        from sim_core.mjtf import level_starts  # the kernels load with the first job (simulation.py)
-        from sim_core.mjtf_trials import run_trials
+        from sim_core.robustness.mjtf import level_starts  # the kernels load with the first job (simulation.py)
+        from sim_core.robustness.mjtf_trials import run_trials
 
         model, noise = model_params(spec.model), spec.noise.model()
         guess = None if spec.guess is None else (spec.guess.xdot, spec.guess.ydot)

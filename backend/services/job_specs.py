@@ -14,10 +14,10 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field, fields
 
 from experiments.manifest import json_safe
-from sim_core.noise import NoiseModel
+from sim_core.model.noise import NoiseModel
 
 SPEC_VERSION = 1
-_NOISE = NoiseModel()  # the noise's defaults: one home, sim_core.noise
+_NOISE = NoiseModel()  # the noise's defaults: one home, sim_core.model.noise
 
 
 @dataclass(frozen=True)
@@ -46,7 +46,7 @@ class StateSpec:
 
 @dataclass(frozen=True)
 class NoiseSpec:
-    """:class:`~sim_core.noise.NoiseModel`'s fields as stored, not validated here (the runner's
+    """:class:`~sim_core.model.noise.NoiseModel`'s fields as stored, not validated here (the runner's
     ``NoiseModel`` is): a spec stays readable whatever the ranges become."""
 
     psi0_deg: float = _NOISE.psi0_deg

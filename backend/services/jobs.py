@@ -22,7 +22,7 @@ from backend.services.models import with_preset_resolved
 from backend.services.simulation import current_code_version
 from backend.store.database import lock_for_write
 from backend.store.models import Experiment, Job, utcnow
-from sim_core.mjtf_plan import CAPPED, jump_statistics, no_outcomes
+from sim_core.robustness.mjtf_plan import CAPPED, jump_statistics, no_outcomes
 
 if TYPE_CHECKING:
     from backend.services.job_runner import JobRunner

@@ -1,4 +1,4 @@
-"""Which model a request means: a preset's name — built in (:data:`sim_core.presets.PRESETS`) or a
+"""Which model a request means: a preset's name — built in (:data:`sim_core.model.presets.PRESETS`) or a
 calibration stored by ``parkour calibrate`` — resolved to the robot it describes, in one place for
 the API (:func:`preset_resolved` for runs and quick calls), the jobs (:func:`with_preset_resolved`:
 a job keeps the numbers), the 3D view and the CLI (``cli.options.build_setup``).
@@ -13,10 +13,10 @@ from collections.abc import Awaitable, Callable
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
-from sim_core.controls import NO_OFFSETS, LegOffsets
-from sim_core.errors import ParameterError
-from sim_core.params import ModelParams, PhysicalParams
-from sim_core.presets import PRESETS
+from sim_core.model.controls import NO_OFFSETS, LegOffsets
+from sim_core.model.errors import ParameterError
+from sim_core.model.params import ModelParams, PhysicalParams
+from sim_core.model.presets import PRESETS
 
 if TYPE_CHECKING:
     from sqlalchemy.orm import Session

@@ -32,8 +32,8 @@ from backend.services.robot_journal import JournalWriter
 from backend.services.robot_records import open_robot_run, recover_interrupted
 from backend.services.robot_tracker import PoseSource, TrackerSlot
 from experiments.manifest import json_safe
-from sim_core.controls import LegControl
-from sim_core.presets import get_preset
+from sim_core.model.controls import LegControl
+from sim_core.model.presets import get_preset
 
 ESTOP_ANSWER = 0.17  # [s] the longest an e-stop waits for the robot (the link gives up at 0.15 s)
 ANSWER_WAIT = ESTOP_ANSWER + LATCH_SAVE_WAIT  # [s] the longest a press waits: the robot, then the latch file

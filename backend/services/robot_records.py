@@ -32,8 +32,8 @@ from backend.services.simulation import current_code_version, pack_trajectory, u
 from backend.store.models import Run
 from backend.store.run_record import RunRecord
 from experiments.manifest import json_safe
-from sim_core.controls import ControlSchedule, LegControl
-from sim_core.presets import get_preset
+from sim_core.model.controls import ControlSchedule, LegControl
+from sim_core.model.presets import get_preset
 
 FRAME_COLUMNS = ("time", "x", "y", "pitch")
 INTERRUPTED = "interrupted: the service stopped during the run; kept to its last journal entry"
@@ -152,7 +152,7 @@ def touchdown_columns(touchdowns: list[Touchdown], analysis: dict) -> dict:
 def touchdown_results(touchdowns: list[Touchdown], controls: list[LegControl], robot) -> dict:
     """What a robot or replay run stores about its touchdowns: each touchdown, its section state,
     the height gains, and the model's prediction from the first touchdown with the same controls."""
-    from sim_core.poincare import iterate_map
+    from sim_core.model.poincare import iterate_map
 
     gains = height_gains(touchdowns, robot) if len(touchdowns) > 1 else np.empty(0)
     prediction = None

@@ -18,7 +18,7 @@ from backend.robot.natnet import parse_version
 from backend.robot.natnet_source import NatNetPoseSource
 from backend.robot.tracker import Calibration, UdpPoseSource
 from backend.schemas import RobotConnect
-from sim_core.errors import ParameterError
+from sim_core.model.errors import ParameterError
 
 log = logging.getLogger("parkourlab.robot")
 

@@ -17,8 +17,8 @@ from backend.errors import Conflict
 from backend.repositories import runs as stored_runs
 from backend.services.calibrations import get_stored_preset, preset_params, run_fell, touchdown_series
 from backend.store.models import Run
-from sim_core.errors import ParameterError
-from sim_core.presets import get_preset
+from sim_core.model.errors import ParameterError
+from sim_core.model.presets import get_preset
 
 MAX_TRIALS = 5000
 MAX_CAP = 100_000
@@ -29,7 +29,7 @@ def robustness(
 ) -> dict:
     """The study's JSON: the preset, the noise it simulates with, and per gait the robot's MJTF and the model's."""
     from experiments.robustness import JumpsToFailure, compare, noise_of
-    from sim_core.touchdown_series import pitch_drift_deg
+    from sim_core.calibration.touchdown_series import pitch_drift_deg
 
     if not 1 <= trials <= MAX_TRIALS:
         raise ParameterError("trials", f"must be in [1, {MAX_TRIALS}], got {trials}")

@@ -31,7 +31,7 @@ from backend.services.simulation import simulate_run, unpack_trajectory
 from backend.store.database import freeing_space
 from backend.store.models import Run
 from backend.store.run_record import RunRecord
-from sim_core.errors import ParameterError
+from sim_core.model.errors import ParameterError
 
 SORTS = stored_runs.SORTS  # the API's sort parameter is checked against them
 MAX_COMPARE = 50

@@ -21,8 +21,8 @@ import numpy as np
 
 from backend.services.models import resolve_model
 from backend.services.simulation import gait_not_found_as_parameter_error
-from sim_core.controls import ControlSchedule
-from sim_core.params import ModelParams
+from sim_core.model.controls import ControlSchedule
+from sim_core.model.params import ModelParams
 
 
 def section_study(spec, model: ModelParams, progress) -> dict:
@@ -38,9 +38,9 @@ def _mfpt(spec, model: ModelParams, progress) -> dict:
     """``parkour mfpt --json`` of the job's controls, noise and grid (both grids in-process: the
     chain's two solves are one computation, its progress by chunks of pairs)."""
     from backend.schemas.job_budget import mfpt_grid_of
-    from sim_core.controls import LegControl
-    from sim_core.gait_search import gait_of
-    from sim_core.mfpt import check_chain_inputs, mfpt
+    from sim_core.model.controls import LegControl
+    from sim_core.robustness.mfpt import check_chain_inputs, mfpt
+    from sim_core.section.gait_search import gait_of
 
     noise = spec.noise.model()
     check_chain_inputs(model, noise)
@@ -57,7 +57,7 @@ def _mfpt(spec, model: ModelParams, progress) -> dict:
 def _loop_mfpt(spec, model: ModelParams, progress) -> dict:
     """``parkour mfpt --controller --json`` of the job's law, target, climb, noise and splitting."""
     from experiments.loop_mfpt import Config, run
-    from sim_core.splitting import SplittingOptions
+    from sim_core.robustness.splitting import SplittingOptions
 
     leg_length = resolve_model(None, spec.model.preset).robot.leg_length  # a stored preset is resolved already
     options = SplittingOptions(replicas=spec.replicas, runs=spec.runs, seed=spec.seed)
@@ -68,9 +68,9 @@ def _loop_mfpt(spec, model: ModelParams, progress) -> dict:
 
 def _viability(spec, model: ModelParams, progress) -> dict:
     """The kernel and measure over the job's grid, and every viable pair as bits."""
-    from sim_core.viability import compute_viability
-    from sim_core.viability_grid import section_grid
-    from sim_core.viability_section import section_step_map
+    from sim_core.viability.engine import compute_viability
+    from sim_core.viability.grid import section_grid
+    from sim_core.viability.step_map import section_step_map
 
     grid = section_grid(
         states=spec.states,

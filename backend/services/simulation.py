@@ -27,15 +27,15 @@ from backend.store.run_record import RunRecord
 from backend.workers.pools import as_json
 from backend.workers.progress import report
 from experiments.manifest import code_version, json_safe
-from sim_core.basin_grid import DEFAULT_BASIN_WINDOW, BasinGrid
-from sim_core.controls import ControlSchedule
-from sim_core.errors import FixedPointNotFound, ParameterError
-from sim_core.params import ModelParams
-from sim_core.presets import START_GUESS, get_preset
+from sim_core.basins.grid import DEFAULT_BASIN_WINDOW, BasinGrid
+from sim_core.model.controls import ControlSchedule
+from sim_core.model.errors import FixedPointNotFound, ParameterError
+from sim_core.model.params import ModelParams
+from sim_core.model.presets import START_GUESS, get_preset
 
 if TYPE_CHECKING:
     from backend.workers.pools import ComputePool
-    from sim_core.fixed_points import FixedPoint
+    from sim_core.section.fixed_points import FixedPoint
 
 _CODE_VERSION = None
 
@@ -69,8 +69,8 @@ def warm_up() -> None:
     """Load the kernels a first request needs (from numba's cache, or compiled once) and scipy's
     solver: one short map, path and gait, off the request path."""
     with KERNEL_LOCK:
-        from sim_core.gait_search import gait_of
-        from sim_core.trajectory import simulate_trajectory
+        from sim_core.model.trajectory import simulate_trajectory
+        from sim_core.section.gait_search import gait_of
 
         model, schedule = get_preset("paper").to_model(), ControlSchedule.from_degrees([(30.0, 0.9)])
         gait = gait_of(model, schedule, guess=START_GUESS)
@@ -86,7 +86,7 @@ async def computed(in_session: InSession, compute: ComputePool, work: Callable[[
 
 
 def map_orbit(body: MapIn) -> dict:
-    from sim_core.poincare import iterate_map
+    from sim_core.model.poincare import iterate_map
 
     start = (body.start.xdot, body.start.ydot)
     with KERNEL_LOCK:
@@ -94,7 +94,7 @@ def map_orbit(body: MapIn) -> dict:
 
 
 def trajectory_columns(body: TrajectoryIn) -> dict:
-    from sim_core.trajectory import simulate_trajectory
+    from sim_core.model.trajectory import simulate_trajectory
 
     start = (body.start.xdot, body.start.ydot)
     model = model_params(body.model)
@@ -124,9 +124,9 @@ def fixed_point(body: FixedPointIn) -> dict:
 
 
 def _gait_of(model: ModelParams, schedule: ControlSchedule, period: int | None, guess) -> FixedPoint:
-    """:func:`sim_core.gait_search.gait_of` for a request. ``guess`` is the request's state
+    """:func:`sim_core.section.gait_search.gait_of` for a request. ``guess`` is the request's state
     (``xdot``, ``ydot``) or None."""
-    from sim_core.gait_search import gait_of
+    from sim_core.section.gait_search import gait_of
 
     with gait_not_found_as_parameter_error():
         return gait_of(model, schedule, period, None if guess is None else (guess.xdot, guess.ydot))
@@ -135,7 +135,7 @@ def _gait_of(model: ModelParams, schedule: ControlSchedule, period: int | None, 
 @contextmanager
 def gait_not_found_as_parameter_error() -> Iterator[None]:
     """A gait search that finds nothing is a 422 naming the controls (a guess may find one)."""
-    from sim_core.errors import NoGaitFound
+    from sim_core.model.errors import NoGaitFound
 
     try:
         yield
@@ -154,8 +154,8 @@ def run_study_here(spec) -> dict:
 
 def run_study(spec, chunk_map, progress) -> dict:
     """A sweep, basin, gait-search, control-study, MFPT (chain or loop) or viability job's computation; its JSON."""
-    from sim_core.gait_search import search_gaits
-    from sim_core.sweep import energy_sweep, zeta0_values
+    from sim_core.basins.sweep import energy_sweep, zeta0_values
+    from sim_core.section.gait_search import search_gaits
 
     model = model_params(spec.model)
     if spec.kind == "control-study":
@@ -219,8 +219,8 @@ def _control_study(spec, model: ModelParams, chunk_map, progress) -> dict:
 
 def simulate_run(body: RunCreate) -> RunRecord:
     """Run the map (and the sampled path if asked): the run to store (its tags are the caller's)."""
-    from sim_core.poincare import iterate_map
-    from sim_core.trajectory import simulate_trajectory
+    from sim_core.model.poincare import iterate_map
+    from sim_core.model.trajectory import simulate_trajectory
 
     model, schedule = model_params(body.model), schedule_of(body.controls)
     start = (body.start.xdot, body.start.ydot)
@@ -253,7 +253,7 @@ def simulate_run(body: RunCreate) -> RunRecord:
 
 def _gait_near(model, schedule, start) -> dict:
     """The period-m gait nearest the start state (m: the schedule length), or why there is none."""
-    from sim_core.gait_search import gait_of
+    from sim_core.section.gait_search import gait_of
 
     try:
         with KERNEL_LOCK:

@@ -28,8 +28,8 @@ from backend.repositories import runs as run_rows
 from backend.robot.messages import Leg
 from backend.services.robot import RobotService
 from backend.services.simulation import unpack_trajectory
-from sim_core.controls import LegControl
-from sim_core.walls import Wall
+from sim_core.model.controls import LegControl
+from sim_core.model.walls import Wall
 
 if TYPE_CHECKING:
     from backend.robot.live_run import RunSnapshot

@@ -206,7 +206,7 @@ class ModelPreset(Base):
     """A named model fitted to robot runs (``parkour calibrate``): a preset beside the built-in ones.
 
     ``base`` is the built-in preset it refines; ``physical`` its fitted parameters in SI
-    (:class:`sim_core.params.PhysicalParams` fields), ``offsets`` the legs' servo offsets, ``fit``
+    (:class:`sim_core.model.params.PhysicalParams` fields), ``offsets`` the legs' servo offsets, ``fit``
     the calibration's report (standard errors, correlation, residuals, noise) and ``runs`` the ids
     it was fitted to — its provenance with ``created_at`` and ``code_version``.
     """

@@ -17,7 +17,7 @@ const PARAMETER_ROWS = [
 const PARAMETER_WORDS = { "psi0_offset_deg.left": "psi0 offset (left)", "psi0_offset_deg.right": "psi0 offset (right)",
   "zeta0_offset.left": "zeta0 offset (left)", "zeta0_offset.right": "zeta0 offset (right)" };
 const UNIT_WORDS = { "sqrt(g l0)": "√(g l0)" };
-// The fit's noise sigmas (sim_core.calibration_noise): where each enters, and its unit.
+// The fit's noise sigmas (sim_core.calibration.noise): where each enters, and its unit.
 const NOISE_WORDS = { state_input: ["touchdown state as measured", "√(g l0)"], psi0_deg: ["psi0 as realised", "deg"],
   zeta0: ["zeta0 as realised", "l0"], state_output: ["next touchdown's state as measured", "√(g l0)"], rise: ["rise as measured", "l0"] };
 

@@ -7,8 +7,8 @@ from collections.abc import Callable
 
 from backend.services import calibrations
 from sim_core import LegControl, PhysicalParams
-from sim_core.controls import NO_OFFSETS, LegOffsets
-from sim_core.walls import Wall
+from sim_core.model.controls import NO_OFFSETS, LegOffsets
+from sim_core.model.walls import Wall
 
 BASE = "paper"
 

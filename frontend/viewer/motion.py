@@ -3,7 +3,7 @@
 No viser here: these are plain objects over numpy arrays, tested on their own. Everything is in SI
 wall coordinates, the ones the tracker reports (docs/model.md §2): ``x`` [m] across the chute, 0 on
 its centre line, positive toward the right wall; ``y`` [m] up from the chute's floor
-(:data:`sim_core.climb_records.FLOOR`); ``time`` [s].
+(:data:`sim_core.climb.records.FLOOR`); ``time`` [s].
 
 - :class:`Pose` — the robot at one instant: its body and the leg to draw;
 - :class:`PathClip` — a sampled stretch of motion (one jump, or a whole stored run: tracker
@@ -20,8 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim_core.climb_records import Samples
-from sim_core.walls import Wall
+from sim_core.climb.records import Samples
+from sim_core.model.walls import Wall
 
 UNKNOWN_PHASE = -1  # tracker data: the body is seen, its legs are not
 TRAIL_STRIDE = 3  # every third sample of a path is enough for a smooth trail
@@ -49,7 +49,7 @@ class Pose:
 
 @dataclass(frozen=True)
 class PathClip(Samples):
-    """Sampled motion (the sequencer's :class:`~sim_core.climb_records.Samples`: SI, see the module doc)
+    """Sampled motion (the sequencer's :class:`~sim_core.climb.records.Samples`: SI, see the module doc)
     with what the view needs beside it: per sample, the wall the drawn leg reaches for
     (``leg_wall``) and the jump (``jump``)."""
 

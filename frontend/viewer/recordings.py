@@ -7,7 +7,7 @@
 - ``replay`` runs: their source robot run's frames with the touchdowns found again.
 
 Simulated runs are nondimensional; they are shown at the paper robot's size (its ``l0``, mass
-and ``g``), heights from the chute's floor as every climb has them (:mod:`sim_core.climb`): the
+and ``g``), heights from the chute's floor as every climb has them (:mod:`sim_core.climb.sequencer`): the
 first foot touches at the floor.
 """
 
@@ -23,9 +23,9 @@ from backend.errors import Conflict
 from backend.services.view import StoredPath, stored_path
 from frontend.viewer.motion import TRAIL_STRIDE, PathClip
 from sim_core import ControlSchedule, LegControl, ModelParams, PhysicalParams, get_preset, simulate_trajectory
-from sim_core.climb import start_height
-from sim_core.trajectory import STANCE
-from sim_core.walls import Wall, walls_of
+from sim_core.climb.sequencer import start_height
+from sim_core.model.trajectory import STANCE
+from sim_core.model.walls import Wall, walls_of
 
 # Per sqrt(l0/g), when a stored sim run has no path of its own: the panel's "Save run" rate (about
 # 160 samples/s at the paper robot's size). The simulation costs the same at any rate; trails and

@@ -26,7 +26,7 @@ from frontend.viewer.geometry import (
 from frontend.viewer.motion import Pose
 from frontend.viewer.node_rings import NodeRing, StreamedTrail, hidden_lines
 from sim_core import LegControl, PhysicalParams
-from sim_core.trajectory import STANCE
+from sim_core.model.trajectory import STANCE
 
 WALL_THICKNESS = 0.03  # [m]
 DEPTH = 0.35  # [m] how deep the walls are drawn (the model is planar)

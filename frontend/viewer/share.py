@@ -39,8 +39,8 @@ from frontend.viewer.node_rings import NodeRing
 from frontend.viewer.recordings import Recording
 from frontend.viewer.scene import FOLLOW_MARGIN, ChuteScene, place_camera
 from frontend.viewer.viser_adapter import NODE_UPDATE, RecordingWriter, embed, serialize
-from sim_core.trajectory import STANCE
-from sim_core.walls import Wall
+from sim_core.model.trajectory import STANCE
+from sim_core.model.walls import Wall
 
 EXPORT_RATE = 30.0  # frames per second of a shared replay (the browser paints at its own rate)
 MAX_EXPORT_SECONDS = 600.0

@@ -1,6 +1,6 @@
 """The model as the 3D view's source of motion: one jump from a touchdown, and the climb in real time.
 
-No viser here. Each jump is simulated by the climb sequencer (:mod:`sim_core.climb`, which the
+No viser here. Each jump is simulated by the climb sequencer (:mod:`sim_core.climb.sequencer`, which the
 virtual robot runs too) and drawn as a :class:`~frontend.viewer.motion.PathClip` (SI wall
 coordinates, docs/model.md §2).
 
@@ -21,17 +21,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from frontend.viewer.motion import PathClip, Pose
-from sim_core import LegControl, PhysicalParams, climb
-from sim_core.climb_records import ClimbSetup, End, Jump, JumpStart, NextLeg, Samples
-from sim_core.control_design import SteppedLaw
-from sim_core.control_laws import Controller
-from sim_core.trajectory import STANCE
-from sim_core.walls import Wall
+from sim_core import LegControl, PhysicalParams
+from sim_core.climb import sequencer as climb
+from sim_core.climb.records import ClimbSetup, End, Jump, JumpStart, NextLeg, Samples
+from sim_core.control.design import SteppedLaw
+from sim_core.control.laws import Controller
+from sim_core.model.trajectory import STANCE
+from sim_core.model.walls import Wall
 
 
 @dataclass(frozen=True)
 class JumpPlan:
-    """One simulated jump (:class:`sim_core.climb_records.Jump`) and its clip, for drawing.
+    """One simulated jump (:class:`sim_core.climb.records.Jump`) and its clip, for drawing.
 
     Attributes:
         jump: the sequencer's jump: its touchdown, the leg in flight, how it ended.
@@ -136,7 +137,7 @@ class LawCommand:
 
 
 class SimulatedClimb:
-    """The model climbing between the walls in real time: a driver of :mod:`sim_core.climb`.
+    """The model climbing between the walls in real time: a driver of :mod:`sim_core.climb.sequencer`.
 
     Jump ``k`` is simulated when the playback reaches its touchdown, with the controls and robot
     of that moment; the leg reaching for the next wall is read again at lift-off, as the robot's

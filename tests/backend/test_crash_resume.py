@@ -12,8 +12,8 @@ import pytest
 from sqlalchemy import create_engine, text
 
 from sim_core import get_preset
-from sim_core.mjtf import mjtf_study
-from sim_core.noise import NoiseModel
+from sim_core.model.noise import NoiseModel
+from sim_core.robustness.mjtf import mjtf_study
 from tests.helpers import free_port, start_service
 
 pytestmark = pytest.mark.slow  # two service starts: ~15 s

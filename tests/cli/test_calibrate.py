@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from backend.store.database import make_engine, migrate, session_factory, sqlite_url
-from sim_core.noise import NoiseModel
+from sim_core.model.noise import NoiseModel
 from tests.cli.helpers import invoke, json_of
 from tests.tracked_climbs import Truth, store_varied_runs
 

@@ -1,7 +1,7 @@
 """``parkour fixed-point`` and ``parkour gaits`` (cli/gaits.py): the gait JSON contract."""
 
 from tests.cli.helpers import invoke, json_of
-from tests.sim_core.test_fixed_points import GAIT_KEYS  # one gait in fixed-point and gaits --json
+from tests.sim_core.section.test_fixed_points import GAIT_KEYS  # one gait in fixed-point and gaits --json
 
 
 def test_fixed_point_json_contract():

@@ -10,7 +10,7 @@ CHEAP = ("--controls", "30:0.96", "--grid", "8", "--pitch-spacing", "2", "--gues
 @pytest.fixture(autouse=True)
 def chain_cache(tmp_path, monkeypatch):
     """Each test's own chain cache: the contract is checked on chains built, not loaded from a home."""
-    from sim_core import mfpt_cache
+    from sim_core.robustness import mfpt_cache
 
     root = tmp_path / "mfpt"
     monkeypatch.setattr(mfpt_cache, "cache_root", lambda: root)

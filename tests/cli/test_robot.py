@@ -13,8 +13,8 @@ from types import SimpleNamespace
 import pytest
 
 import cli.robot
-from sim_core.controls import LegOffsets
-from sim_core.noise import NO_NOISE
+from sim_core.model.controls import LegOffsets
+from sim_core.model.noise import NO_NOISE
 from tests.cli.helpers import invoke
 from tests.helpers import free_port
 

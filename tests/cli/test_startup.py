@@ -46,5 +46,5 @@ def test_a_commands_options_load_nothing_heavy(command):
 
 def test_the_map_loads_the_kernels_but_not_the_optimiser_store_or_service():
     modules = _imported_by("map", "--jumps", "2", "--state", "-0.93", "-0.17", "--json")
-    assert "numba" in modules and "sim_core.stride" in modules, "the probe really ran the map"
+    assert "numba" in modules and "sim_core.model.stride" in modules, "the probe really ran the map"
     assert [name for name in ("scipy.optimize", *HEAVY[2:]) if name in modules] == []

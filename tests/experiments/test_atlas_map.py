@@ -2,7 +2,7 @@
 zero, with the in-place contour where the climb changes sign; the period of each cell's most
 stable gait, blank where none was found, dots where a cell holds several; the files it writes.
 
-The atlas here is made of hand-built gaits (a real one is computed in tests/sim_core/test_atlas.py
+The atlas here is made of hand-built gaits (a real one is computed in tests/sim_core/section/test_atlas.py
 and drawn by ``parkour atlas --plot`` in tests/cli/test_atlas.py), so each cell's value is known.
 """
 
@@ -15,8 +15,8 @@ from matplotlib.image import AxesImage
 
 from experiments.atlas_map import plot_atlas, save_atlas
 from experiments.report import pyplot
-from sim_core.atlas import GaitAtlas
-from sim_core.fixed_points import FixedPoint
+from sim_core.section.atlas import GaitAtlas
+from sim_core.section.fixed_points import FixedPoint
 
 
 def gait(period: int, climb_per_jump: float, eigenvalue: float = 0.5) -> FixedPoint:

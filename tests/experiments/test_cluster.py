@@ -7,10 +7,10 @@ import pytest
 
 from experiments.cluster import SCHEDULER_ENV, chunk_map_for, scheduler_address
 from sim_core import ParameterError, find_fixed_point
-from sim_core.basin import BasinGrid, compute_basin
-from sim_core.mjtf import mjtf_study
-from sim_core.noise import NoiseModel
-from sim_core.sweep import energy_sweep
+from sim_core.basins.basin import BasinGrid, compute_basin
+from sim_core.basins.sweep import energy_sweep
+from sim_core.model.noise import NoiseModel
+from sim_core.robustness.mjtf import mjtf_study
 
 pytestmark = pytest.mark.slow  # starts worker processes (a few seconds)
 
@@ -92,7 +92,7 @@ def test_a_control_study_on_the_cluster_equals_in_process(scheduler):
     """The benchmark's chunks (a controller's trials, 50 seeds each) on two worker processes: the
     same outcome as in-process, to the last digit, but for the law's own timing."""
     from experiments.control_study import Config, run
-    from sim_core.presets import get_preset
+    from sim_core.model.presets import get_preset
 
     robot = get_preset("paper")
     config = Config(controllers=("pid", "deadbeat"), jumps=80, seeds=60, seed0=5)

@@ -6,10 +6,10 @@ import pytest
 
 from experiments.control_study import Config, check_controllers, laws_for, run
 from sim_core.chunks import in_process
-from sim_core.control_study import control_study
-from sim_core.noise import NoiseModel
-from sim_core.presets import get_preset
-from sim_core.validation import ParameterError
+from sim_core.control.study import control_study
+from sim_core.model.noise import NoiseModel
+from sim_core.model.presets import get_preset
+from sim_core.model.validation import ParameterError
 
 ROBOT = get_preset("paper")
 CONFIG = Config(controllers=("pid", "lqr"), jumps=150, seeds=14, seed0=7, noise=NoiseModel(pitch_drift_deg=2.0))

@@ -15,7 +15,7 @@ import pytest
 from experiments import fig11
 from experiments.manifest import json_safe
 from sim_core import get_preset
-from sim_core.mjtf import CAPPED
+from sim_core.robustness.mjtf import CAPPED
 
 ROBOT = get_preset("paper")
 CONFIG = fig11.Config(levels=3, trials=3, converged_trials=8, cap=60)

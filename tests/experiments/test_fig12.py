@@ -14,7 +14,7 @@ import pytest
 
 from experiments import fig12
 from sim_core import ControlSchedule, LegControl, ParameterError, find_fixed_point, get_preset
-from sim_core.presets import START_GUESS
+from sim_core.model.presets import START_GUESS
 
 ROBOT = get_preset("paper")
 CONFIG = fig12.Config(jumps=30, noisy_seeds=(1,))

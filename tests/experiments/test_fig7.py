@@ -16,7 +16,7 @@ import pytest
 from experiments import fig7
 from experiments.manifest import json_safe
 from sim_core import get_preset
-from sim_core.errors import FixedPointNotFound
+from sim_core.model.errors import FixedPointNotFound
 
 ROBOT = get_preset("paper")
 CONFIG = fig7.Config(zeta0_right_range=(0.93, 0.965), scan_steps=8, transient_jumps=200, kept_jumps=32)

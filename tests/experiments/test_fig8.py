@@ -16,7 +16,7 @@ import pytest
 from experiments import fig8
 from experiments.manifest import json_safe
 from sim_core import get_preset
-from sim_core.basin_grid import DEFAULT_BASIN_WINDOW
+from sim_core.basins.grid import DEFAULT_BASIN_WINDOW
 
 ROBOT = get_preset("paper")
 CONFIG = fig8.Config(

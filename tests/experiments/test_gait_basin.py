@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 
 from experiments.gait_basin import gait_basin
-from sim_core.basin import compute_basin
-from sim_core.basin_grid import BasinGrid
-from sim_core.controls import ControlSchedule
-from sim_core.errors import NoGaitFound, ParameterError
-from sim_core.gait_search import gait_of
-from sim_core.presets import START_GUESS, get_preset
+from sim_core.basins.basin import compute_basin
+from sim_core.basins.grid import BasinGrid
+from sim_core.model.controls import ControlSchedule
+from sim_core.model.errors import NoGaitFound, ParameterError
+from sim_core.model.presets import START_GUESS, get_preset
+from sim_core.section.gait_search import gait_of
 
 MODEL = get_preset("paper").to_model()
 SYMMETRIC = ControlSchedule.from_degrees([(30.0, 0.9)])

@@ -3,10 +3,10 @@
 import pytest
 
 from experiments.loop_mfpt import Config, run
-from sim_core.noise import NoiseModel
-from sim_core.presets import get_preset
-from sim_core.splitting import SplittingOptions
-from sim_core.validation import ParameterError
+from sim_core.model.noise import NoiseModel
+from sim_core.model.presets import get_preset
+from sim_core.model.validation import ParameterError
+from sim_core.robustness.splitting import SplittingOptions
 
 ROBOT = get_preset("paper")
 QUICK = SplittingOptions(replicas=20, runs=2, pilot_jumps=2_000, climbs=20)

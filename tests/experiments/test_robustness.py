@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from experiments.robustness import JumpsToFailure, noise_of
-from sim_core.controls import LegOffsets
+from sim_core.model.controls import LegOffsets
 
 
 def test_the_interval_covers_the_true_mjtf_as_often_as_it_says():

@@ -16,8 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from sim_core.failures import COLLAPSE, NO_FLIGHT, NO_LIFTOFF, OK, SLIP
-from sim_core.integrate import COLLAPSE_ZETA, STANCE_TIME_CAP
+from sim_core.model.failures import COLLAPSE, NO_FLIGHT, NO_LIFTOFF, OK, SLIP
+from sim_core.model.integrate import COLLAPSE_ZETA, STANCE_TIME_CAP
 
 TOLERANCE = 1e-13  # tighter than the kernel (1e-12) so differences measure the kernel
 

@@ -3,7 +3,7 @@
 import pytest
 
 from sim_core.bench import run_benchmark
-from sim_core.validation import ParameterError
+from sim_core.model.validation import ParameterError
 
 CONTRACT = {  # issue 3's: what `parkour bench --json` promised first
     "kernel_strides_per_s",

@@ -1,4 +1,4 @@
-"""How sim_core compiles (sim_core._jit): a cache directory keyed on all of sim_core's source and
+"""How sim_core compiles (sim_core._jit): a cache directory keyed on all of sim_core's source (its packages too) and
 numba's version, placed where the environment says, and kernels on numpy's error model."""
 
 import shutil
@@ -17,9 +17,7 @@ SIM_CORE = Path(_jit.__file__).parent
 def source_copy(tmp_path, monkeypatch) -> Path:
     """A copy of sim_core's modules that ``_jit`` hashes instead of the real ones."""
     copy = tmp_path / "sim_core"
-    copy.mkdir()
-    for path in SIM_CORE.glob("*.py"):
-        shutil.copy(path, copy / path.name)
+    shutil.copytree(SIM_CORE, copy, ignore=shutil.ignore_patterns("__pycache__"))
     monkeypatch.setattr(_jit, "__file__", str(copy / "_jit.py"))
     return copy
 
@@ -39,16 +37,16 @@ def test_the_hash_is_of_the_source_as_it_is(source_copy):
 
 def test_any_module_edited_changes_the_hash(source_copy):
     """numba notices an edit of a kernel's own file only; an inlined kernel's file (here: the stance
-    equations) must start a clean cache too."""
+    equations, in the model package) must start a clean cache too."""
     before = _jit._source_hash()
-    equations = source_copy / "stance_equations.py"
+    equations = source_copy / "model" / "stance_equations.py"
     equations.write_text(equations.read_text() + "\n# edited\n")
     assert _jit._source_hash() != before
 
 
 def test_a_new_module_or_another_numba_changes_the_hash(source_copy, monkeypatch):
     before = _jit._source_hash()
-    (source_copy / "new_kernels.py").write_text("")
+    (source_copy / "control" / "new_kernels.py").write_text("")
     with_new = _jit._source_hash()
     assert with_new != before
     monkeypatch.setattr(numba, "__version__", "0.0.0")

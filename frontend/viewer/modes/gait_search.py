@@ -6,9 +6,9 @@ from __future__ import annotations
 
 from frontend.viewer.simulated_climb import Controls
 from sim_core import ControlSchedule, FixedPoint
-from sim_core.errors import NoGaitFound
-from sim_core.gait_search import gait_of
-from sim_core.presets import PAPER_GAITS, START_GUESS
+from sim_core.model.errors import NoGaitFound
+from sim_core.model.presets import PAPER_GAITS, START_GUESS
+from sim_core.section.gait_search import gait_of
 
 
 def _preset_label(name: str, pairs: tuple[tuple[float, float], ...]) -> str:
@@ -18,7 +18,7 @@ def _preset_label(name: str, pairs: tuple[tuple[float, float], ...]) -> str:
     return f"{name} · {angles} · {lengths}"
 
 
-# The paper's gaits (Fig. 7, sim_core.presets.PAPER_GAITS): psi0 [deg] and zeta0 [l0] of the
+# The paper's gaits (Fig. 7, sim_core.model.presets.PAPER_GAITS): psi0 [deg] and zeta0 [l0] of the
 # left and right legs; a one-pair gait is both legs'.
 GAIT_PRESETS = {_preset_label(name, pairs): (pairs[0], pairs[-1]) for name, pairs in PAPER_GAITS.items()}
 CUSTOM = "custom"

@@ -22,11 +22,11 @@ from frontend.viewer.motion import TRAIL_STRIDE
 from frontend.viewer.scene import ChuteScene
 from frontend.viewer.simulated_climb import Controls, SimulatedClimb
 from sim_core import FixedPoint, LegControl, PhysicalParams
-from sim_core.climb_records import CHUTE_TOP
-from sim_core.control_design import law_holding
-from sim_core.control_laws import KINDS
-from sim_core.errors import FixedPointNotFound, ParameterError
-from sim_core.trajectory import STANCE
+from sim_core.climb.records import CHUTE_TOP
+from sim_core.control.design import law_holding
+from sim_core.control.laws import KINDS
+from sim_core.model.errors import FixedPointNotFound, ParameterError
+from sim_core.model.trajectory import STANCE
 
 OPEN_LOOP = "off"  # the controller dropdown's "the sliders set the legs"
 

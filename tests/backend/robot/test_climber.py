@@ -18,11 +18,11 @@ from backend.robot.touchdown import detect_touchdowns, height_gains
 from backend.robot.tracker import UdpPoseSource, decode_datagram
 from backend.robot.virtual import VirtualRobot
 from sim_core import ClimbEnd, ControlSchedule, LegControl, PhysicalParams, get_preset, iterate_map
-from sim_core.climb_records import FLOOR
-from sim_core.controls import LegOffsets
-from sim_core.errors import ParameterError
-from sim_core.noise import NO_NOISE, NoiseModel
-from sim_core.walls import Wall, wall_of
+from sim_core.climb.records import FLOOR
+from sim_core.model.controls import LegOffsets
+from sim_core.model.errors import ParameterError
+from sim_core.model.noise import NO_NOISE, NoiseModel
+from sim_core.model.walls import Wall, wall_of
 from tests.robot_rig import climb_open_loop
 
 LEGS = {Leg.LEFT: (30.0, 0.87), Leg.RIGHT: (30.0, 0.9)}

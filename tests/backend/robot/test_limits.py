@@ -6,7 +6,7 @@ import math
 import pytest
 
 from backend.robot.limits import ServoLimits
-from sim_core.errors import ParameterError
+from sim_core.model.errors import ParameterError
 
 LIMITS = ServoLimits()  # psi0 10°–60°, zeta0 0.75–0.98
 

@@ -11,14 +11,14 @@ import pytest
 from backend.robot.limits import ServoLimits
 from backend.robot.live_law import LiveLaw, live_law_for, pitch_at
 from backend.robot.touchdown import PITCH_LOOKBACK, Touchdown
-from sim_core.closed_loop import pid_step
-from sim_core.control_design import design_law
-from sim_core.controllers import control_step, new_memory
-from sim_core.controls import LegControl
-from sim_core.height_controller import HeightController
-from sim_core.presets import get_preset
-from sim_core.validation import ParameterError
-from sim_core.walls import Wall, wall_of
+from sim_core.control.closed_loop import pid_step
+from sim_core.control.controllers import control_step, new_memory
+from sim_core.control.design import design_law
+from sim_core.control.height_controller import HeightController
+from sim_core.model.controls import LegControl
+from sim_core.model.presets import get_preset
+from sim_core.model.validation import ParameterError
+from sim_core.model.walls import Wall, wall_of
 
 ROBOT = get_preset("paper")
 LEGS = [LegControl.from_degrees(35.0, 0.9), LegControl.from_degrees(33.0, 0.91)]
@@ -111,7 +111,7 @@ def test_it_is_compiled_before_the_run_starts():
 def test_a_calibrations_offsets_are_taken_off_each_command_within_the_servos_range():
     """The leg realises command + offset, so the law's choice is sent less its leg's offset; where
     that passes a servo's end the command is held there and counted as clipped."""
-    from sim_core.controls import LegOffsets
+    from sim_core.model.controls import LegOffsets
 
     law = design_law("lqr", ROBOT.to_model(), HeightController(1.8, 0.96), 35.0)
     offsets = LegOffsets(psi0_offset_deg=(0.6, -0.8), zeta0_offset=(0.004, -0.005))

@@ -7,8 +7,8 @@ import pytest
 from backend.robot.live_run import LiveRun, Record, RunSnapshot
 from backend.robot.messages import Leg
 from backend.robot.touchdown import Touchdown
-from sim_core.controls import LegControl
-from sim_core.walls import Wall
+from sim_core.model.controls import LegControl
+from sim_core.model.walls import Wall
 
 TOUCHDOWN = Touchdown(0, 1.5, Wall.RIGHT, (-0.9, 0.1), 0.4, 0.35, 8)
 CONTROL = LegControl.from_degrees(30.0, 0.87)

@@ -18,7 +18,7 @@ from backend.robot.messages import (
     decode,
     encode,
 )
-from sim_core.walls import Wall
+from sim_core.model.walls import Wall
 
 
 def test_set_leg_bytes():

@@ -19,7 +19,7 @@ from backend.robot.natnet import (
     parse_version,
     payload,
 )
-from sim_core.errors import ParameterError
+from sim_core.model.errors import ParameterError
 from tests.backend.robot.natnet_frames import server_info_packet
 
 

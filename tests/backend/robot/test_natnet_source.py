@@ -23,8 +23,8 @@ from backend.robot.virtual import VirtualRobot
 from backend.schemas import RobotConnect
 from backend.services.robot_tracker import open_tracker
 from sim_core import LegControl, get_preset
-from sim_core.noise import NO_NOISE
-from sim_core.walls import wall_of
+from sim_core.model.noise import NO_NOISE
+from sim_core.model.walls import wall_of
 from tests.backend.robot.natnet_frames import BODIES, PITCH, Scene, frame_packet, server_info_packet
 from tests.helpers import free_port
 from tests.robot_rig import climb_open_loop

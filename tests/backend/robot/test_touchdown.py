@@ -9,7 +9,7 @@ import pytest
 
 from backend.robot.touchdown import MIN_FIT_POSES, Touchdown, detect_touchdowns, height_gains, scan_touchdowns
 from sim_core import LegControl, get_preset
-from sim_core.walls import Wall
+from sim_core.model.walls import Wall
 
 PAPER = get_preset("paper")
 LEG = LegControl.from_degrees(30.0, 0.9)

@@ -22,7 +22,7 @@ from backend.schemas.jobs import (
     SweepJobCreate,
     ViabilityJobCreate,
 )
-from sim_core.noise import ASYMMETRY_LIMITS, SIGMA_LIMITS, NoiseModel
+from sim_core.model.noise import ASYMMETRY_LIMITS, SIGMA_LIMITS, NoiseModel
 from tests.backend.schemas.refusals import LEG, START, accepted, refusal_messages, refused
 
 MJTF = {"zeta0s": [0.9]}
@@ -258,7 +258,7 @@ def test_a_bad_mfpt_job_is_refused_naming_the_field(change, where, says):
 
 
 def test_a_viability_job_at_its_largest_grid_is_within_the_budget_and_its_defaults_are_sim_cores():
-    from sim_core.viability_grid import DEFAULT_PSI0_DEG, DEFAULT_ZETA0
+    from sim_core.viability.grid import DEFAULT_PSI0_DEG, DEFAULT_ZETA0
 
     job = accepted(ViabilityJobCreate, VIABILITY | {"states": 120, "actions": 40})
     assert worst_case_jumps(job) == (120**2 * 40**2, "states² x actions²")

@@ -7,10 +7,10 @@ import pytest
 from backend.schemas import JobCreate
 from backend.schemas.job_budget import LOOP_MFPT_MAX_REPLICA_RUNS, WORK_BUDGET_JUMPS, worst_case_jumps
 from backend.schemas.mfpt_jobs import ControllerKind, LoopMfptJobCreate
-from sim_core.control_laws import KINDS
-from sim_core.noise import NoiseModel
-from sim_core.splitting import SplittingOptions, check_metastable
-from sim_core.validation import ParameterError
+from sim_core.control.laws import KINDS
+from sim_core.model.noise import NoiseModel
+from sim_core.model.validation import ParameterError
+from sim_core.robustness.splitting import SplittingOptions, check_metastable
 from tests.backend.schemas.refusals import accepted, refusal_messages, refused
 
 LOOP = {"kind": "loop-mfpt"}

@@ -11,8 +11,8 @@ from backend.repositories import calibrations as stored_presets
 from backend.repositories import runs as run_store
 from backend.services import calibrations
 from backend.services.robot_records import replay_run
-from sim_core.errors import ParameterError
-from sim_core.noise import NO_NOISE, NoiseModel
+from sim_core.model.errors import ParameterError
+from sim_core.model.noise import NO_NOISE, NoiseModel
 from tests.tracked_climbs import PAPER, Truth, store_varied_runs
 
 TRUTH = Truth.of(alpha=72.0, c_zeta=1.25, c_psi=0.8, psi0_offset_deg=(0.6, -0.8), zeta0_offset=(0.004, -0.005))

@@ -13,7 +13,7 @@ from backend.repositories.runs import RunFilter
 from backend.schemas import LegIn
 from backend.services import exports, runs
 from experiments.manifest import json_safe
-from sim_core.presets import get_preset
+from sim_core.model.presets import get_preset
 
 
 def _flat(run) -> dict:

@@ -13,8 +13,8 @@ from backend.schemas import BasinJobCreate, ControlStudyJobCreate, GaitSearchJob
 from backend.services import job_runner, jobs, room
 from backend.store.models import Job, Trial
 from sim_core import get_preset
-from sim_core.mjtf import mjtf_study
-from sim_core.noise import NoiseModel
+from sim_core.model.noise import NoiseModel
+from sim_core.robustness.mjtf import mjtf_study
 from tests.backend.services.jobs_helpers import CHUNK, GUESS, SMALL, WAIT_S, job_now, stored_trials, wait_until
 
 

@@ -12,9 +12,9 @@ import pytest
 from backend.schemas import MJTFJobCreate, ModelIn
 from backend.services.models import FITTED, ResolvedModel, preset_resolved, resolve_model, with_preset_resolved
 from backend.store.models import ModelPreset
-from sim_core.controls import NO_OFFSETS, LegOffsets
-from sim_core.errors import ParameterError
-from sim_core.presets import PRESETS
+from sim_core.model.controls import NO_OFFSETS, LegOffsets
+from sim_core.model.errors import ParameterError
+from sim_core.model.presets import PRESETS
 
 PAPER = PRESETS["paper"]
 FITTED_ROBOT = dataclasses.replace(PAPER, stiffness=600.0, c_zeta=1.3, c_psi=0.7)  # what a fit might find

@@ -16,7 +16,7 @@ from backend.robot.messages import RobotState
 from backend.robot.virtual import VirtualRobot
 from backend.schemas import ClosedLoopIn, LegIn, RobotConnect, RobotRunCreate
 from backend.services.calibrations import run_fell
-from sim_core.noise import NO_NOISE
+from sim_core.model.noise import NO_NOISE
 from tests.helpers import free_port
 from tests.robot_rig import wait_for
 from tests.tracker_relay import TrackerRelay

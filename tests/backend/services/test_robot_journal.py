@@ -15,8 +15,8 @@ from backend.services.robot_journal import JournalWriter
 from backend.services.robot_records import open_robot_run
 from backend.store.models import RunJournal
 from sim_core import get_preset
-from sim_core.controls import LegControl
-from sim_core.walls import Wall
+from sim_core.model.controls import LegControl
+from sim_core.model.walls import Wall
 
 LEGS = [LegIn(psi0_deg=30.0, zeta0=0.87), LegIn(psi0_deg=30.0, zeta0=0.9)]
 WAIT_S = 30.0  # [s] an upper bound, not a timing assertion

@@ -14,7 +14,7 @@ from backend.services.robot_records import INTERRUPTED, fold_journal, open_robot
 from backend.services.simulation import unpack_trajectory
 from backend.store.models import RunJournal
 from sim_core import get_preset
-from sim_core.walls import Wall
+from sim_core.model.walls import Wall
 
 REQUEST = RobotRunCreate(controls=[LegIn(psi0_deg=30.0, zeta0=0.87), LegIn(psi0_deg=30.0, zeta0=0.9)], tags=["t"])
 

@@ -7,7 +7,7 @@ import pytest
 
 from backend.schemas import RobotConnect
 from backend.services.robot_tracker import TrackerPortInUse, TrackerSlot
-from sim_core.errors import ParameterError
+from sim_core.model.errors import ParameterError
 from tests.helpers import free_port
 
 

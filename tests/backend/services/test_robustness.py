@@ -8,8 +8,8 @@ from backend import errors
 from backend.services import calibrations
 from backend.services.robot_records import replay_run
 from backend.services.robustness import robustness
-from sim_core.errors import ParameterError
-from sim_core.noise import NoiseModel
+from sim_core.model.errors import ParameterError
+from sim_core.model.noise import NoiseModel
 from tests.tracked_climbs import Truth, store_tracked_run, store_varied_runs, tracked_climb
 
 TRUTH = Truth.of(alpha=72.0, c_zeta=1.25, c_psi=0.8, psi0_offset_deg=(0.6, -0.8), zeta0_offset=(0.004, -0.005))

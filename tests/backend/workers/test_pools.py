@@ -16,7 +16,7 @@ from backend.workers.pools import (
     ComputePool,
     ComputeTimeout,
 )
-from sim_core.errors import ParameterError
+from sim_core.model.errors import ParameterError
 
 WAIT_S = 60.0  # [s] a worker's start and a call, generously
 

@@ -11,8 +11,8 @@ from backend.store.database import make_engine, migrate, session_factory, sqlite
 from backend.store.models import ModelPreset
 from frontend.viewer.ghost_models import BASE, ghost_model, model_choices, realised
 from sim_core import LegControl, get_preset
-from sim_core.controls import NO_OFFSETS, LegOffsets
-from sim_core.walls import Wall
+from sim_core.model.controls import NO_OFFSETS, LegOffsets
+from sim_core.model.walls import Wall
 
 PAPER = get_preset("paper")
 OFFSETS = LegOffsets(psi0_offset_deg=(0.6, -0.8), zeta0_offset=(0.004, -0.005))

@@ -9,7 +9,7 @@ import pytest
 from frontend.viewer.motion import UNKNOWN_PHASE, PathClip
 from frontend.viewer.simulated_climb import Controls, SimulatedClimb
 from sim_core import LegControl, get_preset
-from sim_core.walls import Wall
+from sim_core.model.walls import Wall
 
 ROBOT = get_preset("paper")
 PERIOD_1 = LegControl.from_degrees(30, 0.90)

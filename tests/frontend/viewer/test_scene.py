@@ -27,8 +27,8 @@ from frontend.viewer.scene import (
     place_camera,
 )
 from sim_core import LegControl, get_preset
-from sim_core.trajectory import FLIGHT, STANCE
-from sim_core.walls import Wall
+from sim_core.model.trajectory import FLIGHT, STANCE
+from sim_core.model.walls import Wall
 
 ROBOT = get_preset("paper")
 HALF = 0.5 * ROBOT.wall_distance  # [m] the centre line to a wall's face

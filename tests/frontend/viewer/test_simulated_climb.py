@@ -8,9 +8,9 @@ from numpy.testing import assert_allclose
 
 from frontend.viewer.simulated_climb import Controls, SimulatedClimb, model_jump
 from sim_core import ControlSchedule, LegControl, get_preset, iterate_map
-from sim_core.climb import start_height
-from sim_core.climb_records import FLOOR, ClimbEnd
-from sim_core.walls import Wall, wall_of
+from sim_core.climb.records import FLOOR, ClimbEnd
+from sim_core.climb.sequencer import start_height
+from sim_core.model.walls import Wall, wall_of
 
 ROBOT = get_preset("paper")
 PERIOD_1 = LegControl.from_degrees(30, 0.90)
@@ -124,11 +124,11 @@ def test_each_jump_starts_where_and_when_the_one_before_ends_and_the_last_where_
 @pytest.mark.parametrize("name", ["pid", "lqr", "deadbeat"])
 def test_a_closed_loop_climbs_as_the_benchmarks_compiled_loop_does(name):
     """With a law set, each touchdown's command is the next touchdown's leg, as in the benchmark's
-    compiled trial (sim_core.control_study.controlled_loop) without noise: the same touchdown
+    compiled trial (sim_core.control.study.controlled_loop) without noise: the same touchdown
     heights, jump for jump, and the target held."""
     from experiments.control_study import Config, laws_for
-    from sim_core.control_study import controlled_loop
-    from sim_core.noise import NoiseModel
+    from sim_core.control.study import controlled_loop
+    from sim_core.model.noise import NoiseModel
 
     config = Config(controllers=(name,), target_m=0.5, jumps=30)
     loop, (law,) = laws_for(ROBOT.to_model(), config, ROBOT.leg_length)

@@ -3,7 +3,7 @@ deleted; only with the token; bad requests name their field (backend/api/routes/
 
 import pytest
 
-from sim_core.noise import NoiseModel
+from sim_core.model.noise import NoiseModel
 from tests.tracked_climbs import Truth, store_varied_runs
 
 TRUTH = Truth.of(alpha=72.0, c_zeta=1.25, c_psi=0.8, psi0_offset_deg=(0.6, -0.8), zeta0_offset=(0.004, -0.005))

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from sim_core import get_preset
-from sim_core.mjtf import mjtf_study
-from sim_core.noise import NoiseModel
+from sim_core.model.noise import NoiseModel
+from sim_core.robustness.mjtf import mjtf_study
 
 
 def _wait(client, job_id, states=("done", "failed", "cancelled"), timeout=60.0):
@@ -190,10 +190,10 @@ def test_a_control_study_job_gives_the_studys_numbers_and_its_plots(client, auth
 
 
 def test_an_mfpt_job_gives_the_chains_numbers(client, auth):
-    """The job is parkour mfpt's computation (sim_core.mfpt) on the same grid, to the last digit."""
-    from sim_core.controls import LegControl
-    from sim_core.mfpt import mfpt
-    from sim_core.mfpt_grid import ChainGrid
+    """The job is parkour mfpt's computation (sim_core.robustness.mfpt) on the same grid, to the last digit."""
+    from sim_core.model.controls import LegControl
+    from sim_core.robustness.mfpt import mfpt
+    from sim_core.robustness.mfpt_grid import ChainGrid
 
     start = {"xdot": -0.9339, "ydot": -0.1661}
     spec = {"kind": "mfpt", "zeta0": 0.9, "start": start, "grid": 8, "pitch_spacing": 2.0,
@@ -215,9 +215,9 @@ def test_a_viability_job_gives_the_engines_kernel_and_every_viable_pair(client, 
     engine's own."""
     import base64
 
-    from sim_core.viability import compute_viability
-    from sim_core.viability_grid import section_grid
-    from sim_core.viability_section import section_step_map
+    from sim_core.viability.engine import compute_viability
+    from sim_core.viability.grid import section_grid
+    from sim_core.viability.step_map import section_step_map
 
     spec = {"kind": "viability", "states": 8, "actions": 3, "zeta0_low": 0.8}
     job = client.post("/api/v1/jobs", json=spec, headers=auth)
@@ -260,7 +260,7 @@ def test_a_controllers_mfpt_job_gives_the_splittings_numbers_for_its_seed(client
     """The job is parkour mfpt --controller's computation (experiments.loop_mfpt.run) with the same
     options and seed, to the last digit; its progress counts splitting runs."""
     from experiments.loop_mfpt import Config, run
-    from sim_core.splitting import SplittingOptions
+    from sim_core.robustness.splitting import SplittingOptions
 
     spec = {"kind": "loop-mfpt", "controller": "lqr", "target_m": 0.55, "replicas": 20, "runs": 2, "seed": 3,
             "noise": {"velocity": 0.05, "pitch_drift_deg": 0.0}}  # fmt: skip

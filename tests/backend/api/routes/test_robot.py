@@ -364,8 +364,8 @@ def test_a_closed_loop_designed_on_a_stored_calibration_takes_its_leg_offsets_of
     from backend.robot.live_law import live_law_for
     from backend.schemas import ClosedLoopIn
     from backend.services.models import resolve_model
-    from sim_core.controls import LegControl
-    from sim_core.noise import NoiseModel
+    from sim_core.model.controls import LegControl
+    from sim_core.model.noise import NoiseModel
     from tests.tracked_climbs import Truth, store_varied_runs
 
     truth = Truth.of(alpha=72.0, c_zeta=1.25, c_psi=0.8, psi0_offset_deg=(0.6, -0.8), zeta0_offset=(0.004, -0.005))

@@ -2,7 +2,7 @@
 
 import pytest
 
-from sim_core.presets import get_preset
+from sim_core.model.presets import get_preset
 from tests.backend.api.bodies import RUN
 
 

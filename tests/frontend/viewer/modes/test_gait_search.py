@@ -11,7 +11,7 @@ import pytest
 from frontend.viewer.modes.gait_search import DEFAULT_START, GAIT_PRESETS, find_gait
 from frontend.viewer.simulated_climb import Controls
 from sim_core import LegControl, get_preset
-from sim_core.presets import PAPER_GAITS
+from sim_core.model.presets import PAPER_GAITS
 
 ROBOT = get_preset("paper")
 NUMBER = r"[-+]?\d+\.\d+"

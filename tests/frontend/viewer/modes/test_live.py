@@ -29,7 +29,7 @@ from frontend.viewer.modes.live import LiveMode
 from frontend.viewer.node_rings import PIECE_POINTS
 from frontend.viewer.scene import LIVE_TRAIL_PIECES, ChuteScene
 from sim_core import get_preset
-from sim_core.walls import Wall
+from sim_core.model.walls import Wall
 from tests.frontend.viewer.test_share import SceneTree, decode_recording
 from tests.frontend.viewer.view_service import wait_for
 
@@ -172,7 +172,7 @@ def test_the_live_ghost_can_predict_with_a_calibrated_model(service, browsers):
 
     from backend.robot.virtual import VirtualRobot
     from backend.store.models import ModelPreset
-    from sim_core.noise import NO_NOISE
+    from sim_core.model.noise import NO_NOISE
     from tests.helpers import free_port
     from tests.tracked_climbs import Truth
 

@@ -6,7 +6,7 @@ import pytest
 
 from frontend.viewer.modes.gait_search import GAIT_PRESETS
 from frontend.viewer.viser_adapter import slider_marks
-from sim_core.climb_records import ClimbEnd
+from sim_core.climb.records import ClimbEnd
 from tests.frontend.viewer.view_service import wait_for
 
 
