@@ -13,7 +13,7 @@ from scipy.integrate._ivp.rk import rk_step
 from sim_core.model._dop853 import dop853_step
 from sim_core.model.stance_equations import PSI, STATE_SIZE, TIME, ZETA, rates
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]  # tests/sim_core/model/ -> the checkout
 PARAMS = (77.6, 0.3, 0.2)  # alpha, c_zeta, c_psi
 
 
