@@ -36,9 +36,9 @@ import numpy as np
 from fastapi.testclient import TestClient
 
 from backend.api.app import create_app
-from backend.services.simulation import pack_trajectory
 from backend.settings import Settings
 from backend.store.models import Run
+from backend.store.trajectory_blob import pack_trajectory
 from frontend.viewer.app import ClimbView
 from frontend.viewer.recordings import load_recording
 from frontend.viewer.share import share_html

@@ -36,7 +36,7 @@ def alternating() -> ControlSchedule:
 def compute():
     """The service's compute worker pools, shared by every test's app (a worker's start, about a
     second, is paid once per session); stopped at the end."""
-    from backend.services.simulation import warm_up
+    from backend.services.quick_calls import warm_up
     from backend.workers.pools import Compute  # only the tests that use the service load it
 
     pools = Compute()

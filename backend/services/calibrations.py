@@ -29,8 +29,9 @@ from backend.schemas.calibrations import (
     TouchdownComparison,
 )
 from backend.services.models import resolve_model
-from backend.services.simulation import current_code_version, unpack_trajectory
+from backend.services.provenance import current_code_version
 from backend.store.models import ModelPreset, Run
+from backend.store.trajectory_blob import unpack_trajectory
 from experiments.manifest import json_safe
 from sim_core.calibration.fit import CalibrationFit
 from sim_core.calibration.touchdown_series import TouchdownSeries, finite_rms, pitch_at

@@ -35,8 +35,9 @@ from sqlalchemy.orm import Session, sessionmaker
 from backend.repositories import jobs as stored_jobs
 from backend.schemas.jobs import JobState
 from backend.services.job_specs import MJTFSpec, decode
+from backend.services.model_requests import model_params
 from backend.services.room import Stopped, Waiting, when_room
-from backend.services.simulation import model_params, run_study, run_study_here
+from backend.services.studies import run_study, run_study_here
 from backend.store.database import StorageFull
 from backend.store.models import Trial, utcnow
 from backend.workers.pools import ComputePool

@@ -19,7 +19,7 @@ from backend.schemas.jobs import JobOut, JobPage, JobResults, JobState, MJTFLeve
 from backend.services.job_queue import Standing, check_room, standings
 from backend.services.job_specs import decode, encode, spec_of
 from backend.services.models import with_preset_resolved
-from backend.services.simulation import current_code_version
+from backend.services.provenance import current_code_version
 from backend.store.database import lock_for_write
 from backend.store.models import Experiment, Job, utcnow
 from sim_core.robustness.mjtf_plan import CAPPED, jump_statistics, no_outcomes

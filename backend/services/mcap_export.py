@@ -44,8 +44,8 @@ from backend.errors import Conflict
 from backend.repositories import runs as stored_runs
 from backend.services.mcap_schemas import CHANNELS
 from backend.services.robot_records import recorded_leg_for
-from backend.services.simulation import unpack_trajectory
 from backend.store.models import Run
+from backend.store.trajectory_blob import unpack_trajectory
 from experiments.manifest import json_safe
 
 EXPORTED_KINDS = ("robot", "replay")

@@ -27,10 +27,11 @@ from backend.repositories import runs as stored_runs
 from backend.robot.run_endings import robot_ending_record
 from backend.robot.touchdown import Touchdown, detect_touchdowns, height_gains
 from backend.schemas import RunDetail
+from backend.services.provenance import current_code_version
 from backend.services.runs import run_detail
-from backend.services.simulation import current_code_version, pack_trajectory, unpack_trajectory
 from backend.store.models import Run
 from backend.store.run_record import RunRecord
+from backend.store.trajectory_blob import pack_trajectory, unpack_trajectory
 from experiments.manifest import json_safe
 from sim_core.model.controls import ControlSchedule, LegControl
 from sim_core.model.presets import get_preset

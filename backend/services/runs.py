@@ -26,11 +26,12 @@ from backend.repositories.runs import RunFilter
 from backend.schemas import RunAggregate, RunComparison, RunCreate, RunDetail, RunOut, RunTrajectory
 from backend.services.exports import flat_record
 from backend.services.models import InSession, preset_resolved
+from backend.services.quick_calls import simulate_run
 from backend.services.run_stats import stats
-from backend.services.simulation import simulate_run, unpack_trajectory
 from backend.store.database import freeing_space
 from backend.store.models import Run
 from backend.store.run_record import RunRecord
+from backend.store.trajectory_blob import unpack_trajectory
 from sim_core.model.errors import ParameterError
 
 SORTS = stored_runs.SORTS  # the API's sort parameter is checked against them

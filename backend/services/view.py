@@ -27,7 +27,7 @@ from backend.errors import Conflict
 from backend.repositories import runs as run_rows
 from backend.robot.messages import Leg
 from backend.services.robot import RobotService
-from backend.services.simulation import unpack_trajectory
+from backend.store.trajectory_blob import unpack_trajectory
 from sim_core.model.controls import LegControl
 from sim_core.model.walls import Wall
 

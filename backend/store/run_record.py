@@ -25,5 +25,5 @@ class RunRecord:
     code_version: str
     failure_code: str | None = None
     duration_s: float = 0.0  # [s] wall-clock time it took
-    trajectory: bytes | None = None  # the sampled path (backend.services.simulation.pack_trajectory)
+    trajectory: bytes | None = None  # the sampled path (backend.store.trajectory_blob.pack_trajectory)
     tags: tuple[str, ...] = field(default=())

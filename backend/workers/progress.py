@@ -2,7 +2,7 @@
 :meth:`backend.workers.pools.ComputePool.progress`.
 
 Each pool's workers share one queue, handed to them as they start (:func:`attach`); a job's study
-passes :func:`report` as its progress callback (``backend.services.simulation.run_study_here``).
+passes :func:`report` as its progress callback (``backend.services.studies.run_study_here``).
 """
 
 from __future__ import annotations

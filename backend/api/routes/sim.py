@@ -12,25 +12,25 @@ from fastapi.responses import Response
 
 from backend import schemas
 from backend.api.deps import Db, QuickCompute
-from backend.services import simulation
+from backend.services import quick_calls
 
 router = APIRouter(prefix="/api/v1/sim", tags=["simulate"])
 
 
 @router.post("/map", response_model=schemas.MapOut)
 async def sim_map(body: schemas.MapIn, database: Db, compute: QuickCompute) -> Response:
-    return _json(await simulation.computed(database, compute, simulation.map_orbit, body))
+    return _json(await quick_calls.computed(database, compute, quick_calls.map_orbit, body))
 
 
 @router.post("/trajectory", response_model=schemas.TrajectoryOut)
 async def sim_trajectory(body: schemas.TrajectoryIn, database: Db, compute: QuickCompute) -> Response:
     """The sampled path in wall coordinates (nondimensional), for drawing; not stored."""
-    return _json(await simulation.computed(database, compute, simulation.trajectory_columns, body))
+    return _json(await quick_calls.computed(database, compute, quick_calls.trajectory_columns, body))
 
 
 @router.post("/fixed-point", response_model=schemas.FixedPointOut)
 async def sim_fixed_point(body: schemas.FixedPointIn, database: Db, compute: QuickCompute) -> Response:
-    return _json(await simulation.computed(database, compute, simulation.fixed_point, body))
+    return _json(await quick_calls.computed(database, compute, quick_calls.fixed_point, body))
 
 
 def _json(encoded: bytes) -> Response:

@@ -26,7 +26,7 @@ from starlette.types import ASGIApp
 
 from backend import schemas
 from backend.api.deps import AUTHORIZED, Db
-from backend.services import simulation
+from backend.services.provenance import current_code_version
 from backend.store.database import ping
 
 SWAGGER_ASSETS = Path(fastapi_offline.__file__).parent / "static"  # Swagger UI 5: reads OpenAPI 3.1
@@ -127,7 +127,7 @@ async def health(db: Db, request: Request) -> schemas.Health:
     return schemas.Health(
         status="ok",
         database=await db(ping),
-        code_version=simulation.current_code_version(),
+        code_version=current_code_version(),
         notices=list(request.app.state.waiting.notices()),
     )
 

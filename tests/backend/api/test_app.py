@@ -37,7 +37,7 @@ def test_the_api_loads_no_kernels_plotting_cluster_or_view(tmp_path):
     )
     result = subprocess.run([sys.executable, "-c", probe, str(tmp_path)], capture_output=True, text=True, check=True)
     modules = set(json.loads(result.stdout.splitlines()[-1]))
-    assert "fastapi" in modules and "backend.services.simulation" in modules, "the probe built the app"
+    assert "fastapi" in modules and "backend.services.quick_calls" in modules, "the probe built the app"
     assert [name for name in HEAVY if name in modules] == []
 
 

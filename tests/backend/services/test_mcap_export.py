@@ -17,7 +17,7 @@ from backend.services.mcap_export import METADATA_NAME, export_run
 from backend.services.mcap_schemas import CHANNELS
 from backend.services.mcap_visuals import PROTOBUF_CHANNELS, SERIES, SERIES_SCHEMA
 from backend.services.robot_records import open_robot_run, replay_run
-from backend.services.simulation import unpack_trajectory
+from backend.store.trajectory_blob import unpack_trajectory
 from sim_core import get_preset
 from tests.robot_runs import REQUEST, TRACKER_EPOCH, store_robot_run
 

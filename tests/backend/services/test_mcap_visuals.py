@@ -29,7 +29,7 @@ from backend.services.mcap_export import export_run
 from backend.services.mcap_schemas import CHANNELS
 from backend.services.mcap_visuals import PROTOBUF_CHANNELS, SERIES, series_cdr
 from backend.services.robot_records import replay_run
-from backend.services.simulation import unpack_trajectory
+from backend.store.trajectory_blob import unpack_trajectory
 from tests.robot_runs import store_robot_run
 
 RTOL_F32 = 1e-6  # Rerun keeps positions and quaternions as float32

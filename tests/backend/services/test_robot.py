@@ -20,7 +20,7 @@ from backend.robot.virtual import VirtualRobot
 from backend.schemas import LegIn, RobotConnect, RobotRunCreate
 from backend.services.robot import ANSWER_WAIT, RobotUnavailable
 from backend.services.robot_records import replay_run, touchdown_results
-from backend.services.simulation import unpack_trajectory
+from backend.store.trajectory_blob import unpack_trajectory
 from sim_core import ParameterError, get_preset
 from tests.helpers import answer_within, free_port
 from tests.robot_rig import FOREIGN, LinkCalls, PtyRobot, Radio, received_frame, telemetry

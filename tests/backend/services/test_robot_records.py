@@ -11,8 +11,8 @@ from backend.robot.touchdown import Touchdown
 from backend.robot.tracker import Calibration
 from backend.schemas import LegIn, RobotRunCreate
 from backend.services.robot_records import INTERRUPTED, fold_journal, open_robot_run, recover_interrupted, replay_run
-from backend.services.simulation import unpack_trajectory
 from backend.store.models import RunJournal
+from backend.store.trajectory_blob import unpack_trajectory
 from sim_core import get_preset
 from sim_core.model.walls import Wall
 

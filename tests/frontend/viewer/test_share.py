@@ -21,9 +21,9 @@ import zstandard
 
 from backend.schemas import LegIn, RunCreate, StateIn
 from backend.services import runs as run_service
-from backend.services.simulation import pack_trajectory
 from backend.store.database import make_engine, migrate, session_factory, sqlite_url
 from backend.store.models import Run
+from backend.store.trajectory_blob import pack_trajectory
 from frontend.viewer import share
 from frontend.viewer.geometry import to_scene
 from frontend.viewer.modes.painter import show_frame

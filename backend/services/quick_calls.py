@@ -1,6 +1,6 @@
-"""Simulations the service runs: translating request bodies into sim_core calls and back.
+"""The quick calls: the map, a sampled path, a gait and a run to store, answered from a compute worker.
 
-The functions here are what the service's compute workers run (:mod:`backend.workers.pools`):
+The functions here are what the service's quick compute workers run (:mod:`backend.workers.pools`):
 module-level, with picklable arguments and results. The compiled kernels (numba, and scipy for
 the fixed points) load with a worker's first call, not with the service, so ``parkour serve``
 answers before they have loaded; :func:`warm_up` (handed to the pools by ``create_app``) loads
@@ -9,11 +9,8 @@ them in each worker at start-up. Hence the imports inside the functions below.
 
 from __future__ import annotations
 
-import io
-import math
 import threading
 import time
-import zlib
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import asdict
@@ -21,13 +18,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from backend.schemas import FixedPointIn, LegIn, MapIn, ModelIn, RunCreate, TrajectoryIn
+from backend.schemas import FixedPointIn, MapIn, RunCreate, TrajectoryIn
+from backend.services.model_requests import model_params, schedule_of
 from backend.services.models import InSession, preset_resolved, resolve_model
+from backend.services.provenance import current_code_version
 from backend.store.run_record import RunRecord
+from backend.store.trajectory_blob import pack_trajectory
 from backend.workers.pools import as_json
-from backend.workers.progress import report
-from experiments.manifest import code_version, json_safe
-from sim_core.basins.grid import DEFAULT_BASIN_WINDOW, BasinGrid
+from experiments.manifest import json_safe
 from sim_core.model.controls import ControlSchedule
 from sim_core.model.errors import FixedPointNotFound, ParameterError
 from sim_core.model.params import ModelParams
@@ -37,32 +35,10 @@ if TYPE_CHECKING:
     from backend.workers.pools import ComputePool
     from sim_core.section.fixed_points import FixedPoint
 
-_CODE_VERSION = None
-
 # numba's default threading layer (workqueue) aborts the process if two threads launch
 # parallel kernels at once; threads of one process that run kernels take turns through this lock
 # (in the service's own process, only the 3D view and the robot's controller still do).
 KERNEL_LOCK = threading.Lock()
-
-
-def current_code_version() -> str:
-    global _CODE_VERSION
-    if _CODE_VERSION is None:
-        _CODE_VERSION = code_version()[:64]
-    return _CODE_VERSION
-
-
-def model_params(body) -> ModelParams:
-    """A request's :class:`~backend.schemas.ModelIn` or a stored job's ModelSpec as the model: its
-    preset (:func:`~backend.services.models.resolve_model`; a stored one is resolved to its base
-    before it gets here) with the request's overrides."""
-    fields = body.model_dump() if isinstance(body, ModelIn) else asdict(body)
-    overrides = {name: value for name, value in fields.items() if name != "preset"}
-    return resolve_model(None, fields["preset"], field="model.preset").model(**overrides)
-
-
-def schedule_of(controls: list[LegIn]) -> ControlSchedule:
-    return ControlSchedule.from_degrees([(leg.psi0_deg, leg.zeta0) for leg in controls])
 
 
 def warm_up() -> None:
@@ -144,79 +120,6 @@ def gait_not_found_as_parameter_error() -> Iterator[None]:
         raise ParameterError("controls", message) from None
 
 
-def run_study_here(spec) -> dict:
-    """:func:`run_study` in the job worker: its chunks one after the other there (each uses every
-    core), progress reported to the service (:func:`backend.workers.progress.report`)."""
-    from sim_core.chunks import in_process
-
-    return run_study(spec, in_process, report)
-
-
-def run_study(spec, chunk_map, progress) -> dict:
-    """A sweep, basin, gait-search, control-study, MFPT (chain or loop) or viability job's computation; its JSON."""
-    from sim_core.basins.sweep import energy_sweep, zeta0_values
-    from sim_core.section.gait_search import search_gaits
-
-    model = model_params(spec.model)
-    if spec.kind == "control-study":
-        return _control_study(spec, model, chunk_map, progress)
-    if spec.kind in ("mfpt", "loop-mfpt", "viability"):
-        from backend.services.section_jobs import section_study
-
-        return section_study(spec, model, progress)
-    if spec.kind == "sweep":
-        psi0 = math.radians(spec.psi0_deg)
-        grid = None if spec.basin_grid == 0 else BasinGrid(*DEFAULT_BASIN_WINDOW, spec.basin_grid)
-        guess = None if spec.guess is None else (spec.guess.xdot, spec.guess.ydot)
-        sweep = energy_sweep(
-            model,
-            psi0,
-            zeta0_values(spec.zeta0_low, spec.zeta0_high, spec.steps),
-            guess=guess,
-            basin_grid=grid,
-            basin_jumps=spec.basin_jumps,
-            basin_jump_limit=spec.basin_jump_limit,
-            chunk_map=chunk_map,
-            progress=progress,
-        )
-        return sweep.to_dict()
-    schedule = schedule_of(spec.controls)
-    if spec.kind == "gaits":
-        gaits = search_gaits(model, schedule, spec.period or len(schedule), grid=(spec.grid, spec.grid))
-        progress(1, 1)
-        return {"gaits": [gait.to_dict() for gait in gaits]}
-    # basin
-    from experiments.gait_basin import gait_basin
-
-    guess = None if spec.guess is None else (spec.guess.xdot, spec.guess.ydot)
-    with gait_not_found_as_parameter_error():
-        basin = gait_basin(
-            model,
-            schedule,
-            period=spec.period,
-            guess=guess,
-            grid=spec.grid,
-            max_jumps=spec.jumps,
-            tolerance=spec.tolerance,
-            jump_limit=spec.jump_limit,
-            chunk_map=chunk_map,
-            progress=progress,
-        )
-    return basin.to_dict()
-
-
-def _control_study(spec, model: ModelParams, chunk_map, progress) -> dict:
-    """The benchmark's JSON (``parkour control-study --json``) and what the panel plots of it."""
-    from experiments.control_study import Config, run
-
-    leg_length = resolve_model(None, spec.model.preset).robot.leg_length  # a stored preset is resolved already
-    config = Config(controllers=tuple(spec.controllers), target_m=spec.target_m, psi0_deg=spec.psi0_deg,
-                    start_zeta0=spec.start_zeta0, jumps=spec.jumps, seeds=spec.seeds, seed0=spec.seed0,
-                    noise=spec.noise.model())  # fmt: skip
-    result = run(model, leg_length, config, chunk_map=chunk_map, progress=progress)
-    return {**result.to_dict(), "plots": result.plots()}
-
-
 def simulate_run(body: RunCreate) -> RunRecord:
     """Run the map (and the sampled path if asked): the run to store (its tags are the caller's)."""
     from sim_core.model.poincare import iterate_map
@@ -261,15 +164,3 @@ def _gait_near(model, schedule, start) -> dict:
     except FixedPointNotFound as error:
         return {"found": False, "reason": str(error)}
     return {"found": True, **gait.to_dict()}
-
-
-def pack_trajectory(columns: dict[str, np.ndarray]) -> bytes:
-    """Columns as one compressed .npz blob: a run stays one row however many samples it has."""
-    buffer = io.BytesIO()
-    np.savez(buffer, **columns)
-    return zlib.compress(buffer.getvalue(), level=6)
-
-
-def unpack_trajectory(blob: bytes) -> dict[str, np.ndarray]:
-    with np.load(io.BytesIO(zlib.decompress(blob))) as data:
-        return {name: data[name] for name in data.files}
