@@ -80,8 +80,8 @@ class ModelSetup:
 
 def build_setup(preset: str, **overrides: float | None) -> ModelSetup:
     """The preset's model with any non-None nondimensional override applied; the preset resolved
-    as every caller resolves one (:func:`backend.services.models.resolve_model`)."""
-    from backend.services.models import resolve_model  # light: it loads the store only for a stored preset
+    as every caller resolves one (:func:`backend.services.presets.resolve_model`)."""
+    from backend.services.presets import resolve_model  # light: it loads the store only for a stored preset
 
     robot = resolve_model(None, preset).robot if preset in PRESETS else stored_preset(preset)
     chosen = {name: value for name, value in overrides.items() if value is not None}
@@ -94,7 +94,7 @@ def build_setup(preset: str, **overrides: float | None) -> ModelSetup:
 def stored_preset(name: str) -> PhysicalParams:
     """A preset ``parkour calibrate`` stored, from the database of ``$PARKOUR_DATA_DIR`` (default
     ./data) or ``$DATABASE_URL``; the unknown-preset error if there is none (no store is created)."""
-    from backend.services.models import resolve_model
+    from backend.services.presets import resolve_model
 
     try:
         with store_sessions(None) as sessions, sessions() as session:

@@ -28,7 +28,7 @@ from backend.services import exports, quick_calls
 from backend.services import runs as run_service
 from backend.services.job_runner import JobRunner
 from backend.services.robot import RobotService
-from backend.services.room import Waiting, now_or_when_room
+from backend.services.storage_waits import Waiting, now_or_when_room
 from backend.services.view import ViewContext, ViewFactory, ViewStarter
 from backend.settings import Settings
 from backend.store.database import ensure_reserve, make_engine, migrate, session_factory

@@ -5,7 +5,7 @@ section state and foot height, the controls commanded for it, the body's pitch f
 frames just after it), fits the model (:func:`sim_core.calibration.calibrate.calibrate`) and stores the
 result as a :class:`~backend.store.models.ModelPreset` with its provenance: the runs, the date and
 the code version. A stored preset is used by name wherever a built-in one is
-(:func:`backend.services.models.resolve_model`): the CLI's ``--preset``, the API's ``model.preset``.
+(:func:`backend.services.presets.resolve_model`): the CLI's ``--preset``, the API's ``model.preset``.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ from backend.schemas.calibrations import (
     CalibrationOut,
     TouchdownComparison,
 )
-from backend.services.models import resolve_model
+from backend.services.presets import resolve_model
 from backend.services.provenance import current_code_version
 from backend.store.models import ModelPreset, Run
 from backend.store.trajectory_blob import unpack_trajectory

@@ -13,7 +13,7 @@ are deterministic: they run whole through the chunk map, report progress per chu
 their result on the job when done; a restart recomputes them. Cancelling marks the job; the runner
 sees it within ``CANCEL_POLL`` and stops the worker at once (a chunk under way is dropped: its
 trials are not committed, and nothing else depends on it). On a full disk a job pauses: what it
-computed waits in memory and is committed when there is room again (:mod:`backend.services.room`);
+computed waits in memory and is committed when there is room again (:mod:`backend.services.storage_waits`);
 stopped meanwhile, it stays running and the next start resumes it. The jobs a crash left unfinished
 are settled on the runner's thread too, so a full disk never holds up the service's start.
 """
@@ -36,7 +36,7 @@ from backend.repositories import jobs as stored_jobs
 from backend.schemas.jobs import JobState
 from backend.services.job_specs import MJTFSpec, decode
 from backend.services.model_requests import model_params
-from backend.services.room import Stopped, Waiting, when_room
+from backend.services.storage_waits import Stopped, Waiting, when_room
 from backend.services.studies import run_study, run_study_here
 from backend.store.database import StorageFull
 from backend.store.models import Trial, utcnow

@@ -18,7 +18,7 @@ from backend.repositories.common import locked
 from backend.schemas.jobs import JobOut, JobPage, JobResults, JobState, MJTFLevelOut
 from backend.services.job_queue import Standing, check_room, standings
 from backend.services.job_specs import decode, encode, spec_of
-from backend.services.models import with_preset_resolved
+from backend.services.presets import with_preset_resolved
 from backend.services.provenance import current_code_version
 from backend.store.database import lock_for_write
 from backend.store.models import Experiment, Job, utcnow

@@ -1,7 +1,7 @@
 """A request's model and controls as sim_core's: what every simulation, quick call and job starts from.
 
 A request's :class:`~backend.schemas.ModelIn`, or a stored job's ModelSpec, is its preset
-(:func:`~backend.services.models.resolve_model`) with the request's overrides; its legs are a
+(:func:`~backend.services.presets.resolve_model`) with the request's overrides; its legs are a
 :class:`~sim_core.model.controls.ControlSchedule`.
 """
 
@@ -10,14 +10,14 @@ from __future__ import annotations
 from dataclasses import asdict
 
 from backend.schemas import LegIn, ModelIn
-from backend.services.models import resolve_model
+from backend.services.presets import resolve_model
 from sim_core.model.controls import ControlSchedule
 from sim_core.model.params import ModelParams
 
 
 def model_params(body) -> ModelParams:
     """A request's :class:`~backend.schemas.ModelIn` or a stored job's ModelSpec as the model: its
-    preset (:func:`~backend.services.models.resolve_model`; a stored one is resolved to its base
+    preset (:func:`~backend.services.presets.resolve_model`; a stored one is resolved to its base
     before it gets here) with the request's overrides."""
     fields = body.model_dump() if isinstance(body, ModelIn) else asdict(body)
     overrides = {name: value for name, value in fields.items() if name != "preset"}

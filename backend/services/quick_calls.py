@@ -20,7 +20,7 @@ import numpy as np
 
 from backend.schemas import FixedPointIn, MapIn, RunCreate, TrajectoryIn
 from backend.services.model_requests import model_params, schedule_of
-from backend.services.models import InSession, preset_resolved, resolve_model
+from backend.services.presets import InSession, preset_resolved, resolve_model
 from backend.services.provenance import current_code_version
 from backend.store.run_record import RunRecord
 from backend.store.trajectory_blob import pack_trajectory

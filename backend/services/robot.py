@@ -26,7 +26,7 @@ from backend.robot.live_law import LiveLaw, live_law_for
 from backend.robot.live_run import LiveRun, RunSnapshot, execute, telemetry_dict
 from backend.robot.supervisor import LinkSupervisor
 from backend.schemas import RobotConnect, RobotRunCreate
-from backend.services.models import resolve_model
+from backend.services.presets import resolve_model
 from backend.services.robot_estop import LATCH_SAVE_WAIT, latch_status, press
 from backend.services.robot_journal import JournalWriter
 from backend.services.robot_records import open_robot_run, recover_interrupted

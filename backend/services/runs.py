@@ -25,7 +25,7 @@ from backend.repositories import runs as stored_runs
 from backend.repositories.runs import RunFilter
 from backend.schemas import RunAggregate, RunComparison, RunCreate, RunDetail, RunOut, RunTrajectory
 from backend.services.exports import flat_record
-from backend.services.models import InSession, preset_resolved
+from backend.services.presets import InSession, preset_resolved
 from backend.services.quick_calls import simulate_run
 from backend.services.run_stats import stats
 from backend.store.database import freeing_space

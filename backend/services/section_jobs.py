@@ -19,7 +19,7 @@ import base64
 
 import numpy as np
 
-from backend.services.models import resolve_model
+from backend.services.presets import resolve_model
 from backend.services.quick_calls import gait_not_found_as_parameter_error
 from sim_core.model.controls import ControlSchedule
 from sim_core.model.params import ModelParams

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 
 from backend.services.model_requests import model_params, schedule_of
-from backend.services.models import resolve_model
+from backend.services.presets import resolve_model
 from backend.services.quick_calls import gait_not_found_as_parameter_error
 from backend.services.section_jobs import section_study
 from backend.workers.progress import report

@@ -7,6 +7,7 @@ A test module importing this is skipped, saying why, where there is no Chromium 
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import time
@@ -30,6 +31,15 @@ CSP_LISTENER = """window.__csp_violations = [];
 document.addEventListener("securitypolicyviolation", (e) => window.__csp_violations.push(
   `${e.violatedDirective} refused ${e.blockedURI} (${e.sourceFile}:${e.lineNumber})`));"""
 TOKEN_ACCEPTED = "document.querySelector('#token-status').dataset.state === 'accepted'"
+# Every message the panel shows, kept in the page as it is added (an init script: from each load
+# on, reloads too): an "ok" message goes after 4 s, which a loaded machine's test can spend
+# between its click and its first look (:func:`said`).
+KEEP_MESSAGES = """window.__said = [];
+document.addEventListener("DOMContentLoaded", () => {
+  const box = document.querySelector("#messages");
+  if (box) new MutationObserver((changes) => changes.forEach((change) => change.addedNodes.forEach(
+    (node) => window.__said.push(node.textContent)))).observe(box, {childList: true});
+});"""
 
 
 @contextmanager
@@ -50,6 +60,7 @@ def panel(browser, base: str, token: str, *, failed_requests: bool = False) -> I
     than by being aborted on purpose (a finished job's event stream) fails the test."""
     context = browser.new_context(viewport=VIEWPORT)
     context.add_init_script(CSP_LISTENER)
+    context.add_init_script(KEEP_MESSAGES)
     page = context.new_page()
     errors = []
     page.on("pageerror", lambda error: errors.append(str(error)))
@@ -61,7 +72,6 @@ def panel(browser, base: str, token: str, *, failed_requests: bool = False) -> I
         )
     try:
         page.goto(f"{base}/")
-        page.evaluate(KEEP_MESSAGES)
         page.fill("#token", token)
         page.dispatch_event("#token", "change")
         until(page, TOKEN_ACCEPTED)
@@ -84,18 +94,11 @@ def until(page, expression: str, timeout: float = 30_000) -> None:
         time.sleep(0.05)
 
 
-# Every message the panel shows, kept in the page as it is added: an "ok" message goes after 4 s,
-# which a loaded machine's test can spend between its click and its first look.
-KEEP_MESSAGES = """(() => {
-  window.__said = [];
-  new MutationObserver((changes) => changes.forEach((change) => change.addedNodes.forEach(
-    (node) => window.__said.push(node.textContent)))).observe(document.querySelector('#messages'), {childList: true});
-})()"""
-
-
-def said(page, words: str, timeout: float = 30_000) -> str:
-    """Wait until the panel has shown a message with ``words`` in it since it opened (gone or not); the latest such."""
-    found = f"window.__said.filter((text) => text.includes({words!r})).at(-1)"
+def said(page, *words: str, timeout: float = 30_000) -> str:
+    """Wait until the panel has shown a message with all of ``words`` in it since it loaded (gone
+    or not); the latest such. The page's context has :data:`KEEP_MESSAGES`."""
+    test = " && ".join(f"text.includes({json.dumps(word)})" for word in words)
+    found = f"window.__said.filter((text) => {test}).at(-1)"
     until(page, f"{found} !== undefined", timeout)
     return page.evaluate(found)
 

@@ -20,7 +20,7 @@ from backend.robot.virtual import VirtualRobot
 from backend.store.database import make_engine, session_factory, sqlite_url
 from sim_core.model.noise import NO_NOISE
 from tests.backend.api.bodies import RUN
-from tests.frontend.browser import CSP_LISTENER, chromium, panel, said, screenshot, until
+from tests.frontend.browser import CSP_LISTENER, KEEP_MESSAGES, chromium, panel, said, screenshot, until
 from tests.helpers import free_port, served
 from tests.robot_runs import store_robot_run
 
@@ -54,6 +54,7 @@ def test_the_sign_in_link_keeps_the_token_out_of_the_address_bar_and_says_it_is_
     base, token = service
     context = page.context.browser.new_context()
     context.add_init_script(CSP_LISTENER)
+    context.add_init_script(KEEP_MESSAGES)
     fresh = context.new_page()
     try:
         fresh.goto(f"{base}/panel/#token={token}")
@@ -88,8 +89,7 @@ def test_simulate_shows_plots_and_the_gait(page):
     assert "Period 2" in page.inner_text("#gait-readout")
     screenshot(page, "simulate")
     page.click("#save-run")
-    until(page, "document.querySelector('.message.ok')?.textContent.includes('stored')")
-    run_id = page.inner_text(".message.ok").split()[1]
+    run_id = said(page, "stored").split()[1]
     page.click("nav [data-tab=history]")
     page.wait_for_selector(f"#run-{run_id}")
     assert "panel" in page.inner_text(f"#run-{run_id} .tags")
@@ -185,7 +185,7 @@ def test_a_bad_value_is_marked_at_its_field_and_nothing_is_sent(page, value, mes
     assert page.get_attribute("input[name=zetaL]", "aria-invalid") == "false", "the fixed field is unmarked"
     page.fill("input[name=jumps]", "8")
     page.click("#run-sim")
-    until(page, "document.querySelector('.message.ok')?.textContent.includes('jumps simulated')")
+    said(page, "jumps simulated")
     assert page.query_selector("#sim-form .field-error") is None and page.query_selector(".message.error") is None
 
 
@@ -330,8 +330,7 @@ def test_runs_and_jobs_filed_under_an_experiment_appear_on_its_page(page, servic
     until(page, f"!!document.querySelector('#sim-form select.experiment-choice option[value=\"{experiment}\"]')")
     page.select_option("#sim-form select.experiment-choice", str(experiment))
     page.click("#save-run")
-    until(page, "document.querySelector('.message.ok')?.textContent.includes('stored')")
-    run_id = int(page.inner_text(".message.ok").split()[1])
+    run_id = int(said(page, "stored").split()[1])
     page.click("#run-basin")  # the Simulate tab's analyses are filed with its saved runs
     until(page, "document.querySelector('#analysis-status').textContent.startsWith('basin job')")
     basin_job = int(page.inner_text("#analysis-status").split()[2].rstrip(":"))
@@ -913,6 +912,7 @@ def _other_browser(page):
     """A colleague's browser: no token, its own connections to the service."""
     context = page.context.browser.new_context(viewport={"width": 1360, "height": 900})
     context.add_init_script(CSP_LISTENER)
+    context.add_init_script(KEEP_MESSAGES)
     context.add_init_script(BANNER_CLOCK)
     return context
 
@@ -1100,8 +1100,7 @@ def test_stored_script_is_shown_as_text_in_every_view(page, service):
     page.fill("#experiment-form input[name=name]", XSS[2])
     page.fill("#experiment-form input[name=description]", XSS[0])
     page.click("#create-experiment")
-    until(page, "document.querySelector('.message.ok')?.textContent.includes('created')")
-    assert XSS[2] in page.inner_text(".message.ok")
+    said(page, XSS[2], "created")  # the new experiment's name, said as text
     row = f"#experiment-table tr:has(button[data-experiment='{experiment['id']}'])"
     page.wait_for_selector(row)
     assert page.inner_text(f"{row} button.show-experiment") == name

@@ -169,10 +169,10 @@ def test_start_up_goes_on_while_what_a_crash_left_waits_for_space(settings, comp
     every such write fails until space "returns": the service starts, answers, says what waits,
     and settles them once it fits."""
     from backend.repositories import jobs as stored_jobs
-    from backend.services import robot, room
+    from backend.services import robot, storage_waits
     from backend.store.database import StorageFull
 
-    monkeypatch.setattr(room, "STORAGE_RETRY", 0.05)
+    monkeypatch.setattr(storage_waits, "STORAGE_RETRY", 0.05)
     disk_full = [True]
 
     def failing_while_full(write):

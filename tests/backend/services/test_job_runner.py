@@ -10,7 +10,7 @@ from sqlalchemy import delete, select, update
 
 from backend.errors import NotFound
 from backend.schemas import BasinJobCreate, ControlStudyJobCreate, GaitSearchJobCreate, LegIn, MJTFJobCreate, StateIn
-from backend.services import job_runner, jobs, room
+from backend.services import job_runner, jobs, storage_waits
 from backend.store.models import Job, Trial
 from sim_core import get_preset
 from sim_core.model.noise import NoiseModel
@@ -212,7 +212,7 @@ def test_a_job_pauses_on_a_full_disk_and_goes_on_when_there_is_room(sessions, se
     fail as SQLite fails on a full disk), and are committed once there is room: no trial lost."""
     from backend.store.database import StorageFull
 
-    monkeypatch.setattr(room, "STORAGE_RETRY", 0.05)
+    monkeypatch.setattr(storage_waits, "STORAGE_RETRY", 0.05)
     commit, failures = job_runner.JobRunner._commit_chunk, []
 
     def full_twice(runner, *args):

@@ -363,7 +363,7 @@ def test_a_closed_loop_designed_on_a_stored_calibration_takes_its_leg_offsets_of
     from backend.robot.limits import ServoLimits
     from backend.robot.live_law import live_law_for
     from backend.schemas import ClosedLoopIn
-    from backend.services.models import resolve_model
+    from backend.services.presets import resolve_model
     from sim_core.model.controls import LegControl
     from sim_core.model.noise import NoiseModel
     from tests.tracked_climbs import Truth, store_varied_runs

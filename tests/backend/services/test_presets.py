@@ -1,4 +1,4 @@
-"""Which model a request means (backend/services/models.py): a built-in preset, a calibration stored
+"""Which model a request means (backend/services/presets.py): a built-in preset, a calibration stored
 by name (its fitted robot, offsets and nondimensional numbers), or an error naming the field and the
 presets there are."""
 
@@ -10,7 +10,7 @@ import sys
 import pytest
 
 from backend.schemas import MJTFJobCreate, ModelIn
-from backend.services.models import FITTED, ResolvedModel, preset_resolved, resolve_model, with_preset_resolved
+from backend.services.presets import FITTED, ResolvedModel, preset_resolved, resolve_model, with_preset_resolved
 from backend.store.models import ModelPreset
 from sim_core.model.controls import NO_OFFSETS, LegOffsets
 from sim_core.model.errors import ParameterError
@@ -73,7 +73,7 @@ def test_an_unknown_name_lists_the_stored_presets_too_under_the_field_asked_for(
 def test_a_built_in_preset_needs_neither_the_store_nor_sqlalchemy():
     code = (
         "import sys\n"
-        "from backend.services.models import resolve_model\n"
+        "from backend.services.presets import resolve_model\n"
         "resolve_model(None, 'paper')\n"
         "print(sorted(name for name in ('sqlalchemy', 'backend.repositories.calibrations') if name in sys.modules))"
     )

@@ -1,4 +1,4 @@
-"""Writes that wait for disk space (backend/services/room.py): retried until they fit, listed while
+"""Writes that wait for disk space (backend/services/storage_waits.py): retried until they fit, listed while
 they wait, given up when the service stops."""
 
 from __future__ import annotations
@@ -7,8 +7,8 @@ import threading
 
 import pytest
 
-from backend.services import room
-from backend.services.room import Stopped, Waiting, now_or_when_room, when_room
+from backend.services import storage_waits
+from backend.services.storage_waits import Stopped, Waiting, now_or_when_room, when_room
 from backend.store.database import StorageFull
 
 
@@ -28,8 +28,8 @@ class Disk:
 
 @pytest.fixture(autouse=True)
 def quick_retries(monkeypatch):
-    monkeypatch.setattr(room, "STORAGE_RETRY", 0.01)
-    monkeypatch.setattr(room, "after_storage_full", lambda _engine: None)  # no engine here: nothing to fold
+    monkeypatch.setattr(storage_waits, "STORAGE_RETRY", 0.01)
+    monkeypatch.setattr(storage_waits, "after_storage_full", lambda _engine: None)  # no engine here: nothing to fold
 
 
 def test_a_write_is_tried_again_until_it_fits_and_its_answer_returned(caplog):
