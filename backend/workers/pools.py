@@ -26,6 +26,7 @@ import logging
 import multiprocessing
 import os
 import queue as queue_module
+import signal
 import threading
 from collections.abc import Callable
 from concurrent.futures.process import BrokenProcessPool
@@ -59,6 +60,9 @@ class ComputeFailed(RuntimeError):
 
 
 def _init_worker(progress, niceness: int) -> None:
+    # A Ctrl-C reaches the service's whole process group; the service stops its pools itself
+    # (:func:`_stop`), and a worker that took it printed a KeyboardInterrupt traceback each.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     progress_module.attach(progress)
     # Below the service in the OS's eyes: with every core busy, the service's own process — HTTP,
     # the live view, the e-stop — still gets the CPU first.

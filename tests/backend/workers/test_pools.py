@@ -3,6 +3,7 @@ dead or stopped worker is replaced."""
 
 import asyncio
 import os
+import signal
 import time
 
 import pytest
@@ -93,6 +94,20 @@ def test_a_pool_sets_its_workers_niceness():
     finally:
         compute.close()
         reads.close()
+
+
+def _ignores_ctrl_c() -> bool:
+    return signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+
+
+def test_a_worker_leaves_a_ctrl_c_to_the_service():
+    """Ctrl-C reaches the service's process group: the workers printed a KeyboardInterrupt traceback
+    each; the service ends them itself."""
+    pool = ComputePool("ctrl-c")
+    try:
+        assert pool.run(_ignores_ctrl_c, timeout=WAIT_S)
+    finally:
+        pool.close()
 
 
 _warmed = False  # in a worker: whether its warm-up ran
