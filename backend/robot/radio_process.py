@@ -13,8 +13,8 @@ then, and the service queues one each period, topping the queue up to :data:`LEA
 service that stops (hung, or GIL-bound for longer than the lease) stops the heartbeats half a
 second later, and the robot's own watchdog disarms it; a service that dies closes the control
 socket, and this process closes the port and ends. It ignores SIGINT and SIGTERM: a Ctrl-C to the
-service's process group must leave the port to the service's shutdown, which disarms the robot
-through it.
+service's process group must leave the port to the service's shutdown, which ends a live run
+through it (every ending disarms the robot) before it closes the link.
 
 Started by :class:`backend.robot.process_port.ProcessPort` as ``python -m backend.robot.radio_process
 URL BAUD ADDRESS CONTROL_FD DATA_FD``. Wire (control: ``socket.SOCK_SEQPACKET``, one message each):
