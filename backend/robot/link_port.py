@@ -24,6 +24,16 @@ WRITE_TIMEOUT = 0.1  # [s] the longest any write may block its caller (pyserial'
 READ_TIMEOUT = 0.02  # [s]
 
 
+def open_serial(url: str, baud: int):
+    """The pyserial port ``url`` names, if a link may open it (``ports.check_port``), with the link's
+    read and write timeouts, set up for small frames. Raises serial.SerialException, ValueError or
+    OSError saying why not. The in-process port and the radio process both open theirs here."""
+    check_port(url)
+    port = serial.serial_for_url(url, baudrate=baud, timeout=READ_TIMEOUT, write_timeout=WRITE_TIMEOUT)
+    no_delay(port)
+    return port
+
+
 class LinkPort:
     """One serial port to the PC's radio, frames to ``robot_address``; :meth:`open` before use."""
 
@@ -48,14 +58,9 @@ class LinkPort:
     def open(self) -> None:
         """Open the port (a LinkError naming it if it cannot be)."""
         try:
-            check_port(self.url)
-            port = serial.serial_for_url(
-                self.url, baudrate=self.baud, timeout=READ_TIMEOUT, write_timeout=WRITE_TIMEOUT
-            )
+            self._serial = open_serial(self.url, self.baud)
         except (serial.SerialException, ValueError, OSError) as error:
             raise LinkError(f"cannot open {self.url}: {error}") from None
-        no_delay(port)
-        self._serial = port
 
     def close(self) -> None:
         with self.write_lock:  # no write is under way on the port being closed (each is bounded)

@@ -21,6 +21,7 @@ import time
 from pathlib import Path
 
 from backend.robot import radio_process as radio
+from backend.robot.link_port import READ_TIMEOUT, WRITE_TIMEOUT
 from backend.robot.link_types import LinkError
 from backend.robot.messages import encode
 from backend.robot.ports import check_port
@@ -96,7 +97,7 @@ class ProcessPort:
             reason = first[1:].decode(errors="replace") if failed else "the radio process did not start"
             _end(process, control, data)
             raise LinkError(f"cannot open {self.url}: {reason}")
-        data.settimeout(radio.READ_TIMEOUT)
+        data.settimeout(READ_TIMEOUT)
         self._process, self._control, self._data = process, control, data
 
     def close(self) -> None:
@@ -126,9 +127,9 @@ class ProcessPort:
         it; waits for the port until ``deadline`` (monotonic) as LinkPort.write does. ``clear_queue``:
         the frames queued for the cadence are dropped first, in the same request (an e-stop's)."""
         kind = radio.WRITE_ALONE if clear_queue else radio.WRITE
-        status, reason = self._request(kind, encode(message), deadline, radio.WRITE_TIMEOUT)
+        status, reason = self._request(kind, encode(message), deadline, WRITE_TIMEOUT)
         if status == radio.TIMED_OUT:
-            raise LinkError(f"write blocked for {radio.WRITE_TIMEOUT * 1000:.0f} ms: the line is jammed")
+            raise LinkError(f"write blocked for {WRITE_TIMEOUT * 1000:.0f} ms: the line is jammed")
         if status != radio.OK:
             raise LinkError(f"write failed: {reason}")
 
@@ -152,7 +153,7 @@ class ProcessPort:
             if control is None:
                 raise LinkError("the link is down")
             now = time.monotonic()
-            answer_by = now + radio.WRITE_TIMEOUT + (ANSWER_MARGIN if deadline is None else max(0.0, deadline - now))
+            answer_by = now + WRITE_TIMEOUT + (ANSWER_MARGIN if deadline is None else max(0.0, deadline - now))
             self._number = (self._number + 1) & 0xFFFF
             try:
                 control.sendall(kind + radio.HEAD.pack(self._number, now + life) + payload)

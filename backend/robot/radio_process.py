@@ -42,13 +42,12 @@ import time
 
 import serial
 
-from backend.robot.ports import no_delay, write_within
+from backend.robot.link_port import READ_TIMEOUT, WRITE_TIMEOUT, open_serial
+from backend.robot.ports import write_within
 from backend.robot.xbee import TransmitLog, encode_frame, tx_request
 
 LEASE = 0.5  # [s] how long each queued frame renews the lease: a service silent for longer stops the heartbeats
 LEASE_FRAMES = 5  # the frames the service keeps queued: one per heartbeat period of the lease
-WRITE_TIMEOUT = 0.1  # [s] the longest a frame's write may block (as the in-process LinkPort)
-READ_TIMEOUT = 0.02  # [s]
 # [s] between the PC's heartbeats: half the protocol's 0.2 s, so a late one (a loaded machine) still
 # keeps the rule; the robot's watchdog allows 1 s. Here, the one small module both processes import.
 HEARTBEAT_PERIOD = 0.1
@@ -170,17 +169,16 @@ def handle(radio: Radio, request: bytes) -> bytes:
 
 def main(argv: list[str]) -> int:
     url, baud, robot_address, control_fd, data_fd = argv
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the service ends this process, after its shutdown's disarm
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the service ends this process, after its shutdown
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
     parent = os.getppid()
     control = socket.socket(fileno=int(control_fd))
     data = socket.socket(fileno=int(data_fd))
     try:
-        port = serial.serial_for_url(url, baudrate=int(baud), timeout=READ_TIMEOUT, write_timeout=WRITE_TIMEOUT)
+        port = open_serial(url, int(baud))
     except (serial.SerialException, ValueError, OSError) as error:
         control.sendall(FAILED + str(error).encode())
         return 1
-    no_delay(port)
     control.sendall(OPENED)
     stop = threading.Event()
     reader = threading.Thread(target=forward, args=(port, data, stop), name="radio-reader", daemon=True)
