@@ -11,10 +11,11 @@ interpreter (``RobotLink(radio_process=False)``, as before) and in a radio proce
 
 The robot (the virtual robot's firmware, radio only, its real 1 s watchdog) runs in a process of its
 own (tests/robot_elsewhere.py) and notes when each of the PC's frames arrives, on the machine's
-monotonic clock. Per mode: gaps between consecutive frames from the PC (the phase's start and end
-count as frames, so a PC that stops is a gap to the end) (any frame feeds the
-watchdog; the PC sends one every 0.1 s), their median, p99 (nearest rank), max, how many exceed
-150 and 350 ms, and whether the robot disarmed itself (watchdog) during the phase. Then the lease:
+monotonic clock. Per mode: gaps between consecutive frames from the PC (any frame feeds the
+watchdog; the PC sends one every 0.1 s; the phase's start and end count as frames, so a PC that
+stops is a gap to the end) as bench_heartbeat.gaps_ms gives them — median, p99 (nearest rank),
+max, how many exceed 150, 300 and 350 ms — and whether the robot disarmed itself (watchdog) during
+the phase. Then the lease:
 the radio process' service held for ``--lease-hold`` seconds (longer than the 0.5 s lease and the
 robot's 1 s watchdog): the robot must disarm itself (``lease.robot_disarmed``).
 
@@ -27,18 +28,15 @@ Usage, from the checkout's root:
 from __future__ import annotations
 
 import argparse
-import ctypes
-import ctypes.util
-import itertools
 import json
-import math
 import random
 import threading
 import time
 
 from backend.robot.link import RobotLink
 from backend.robot.messages import Fault, RobotState
-from tests.robot_elsewhere import RobotElsewhere
+from scripts.bench_heartbeat import gaps_ms
+from tests.robot_elsewhere import RobotElsewhere, hold_the_gil
 
 WATCHDOG = 1.0  # [s] the robot's (firmware.HEARTBEAT_TIMEOUT)
 SETTLE = 0.5  # [s] after arming, before the phase: the cadence (and a radio process' lease) running
@@ -56,28 +54,9 @@ def hold_schedule(seconds: float, low: float, high: float, every: float, seed: i
         at += length
 
 
-def hold(seconds: float) -> None:
-    """Keep this interpreter's GIL for ``seconds`` (a C call that sleeps and never lets go of it)."""
-    ctypes.PyDLL(ctypes.util.find_library("c")).usleep(int(seconds * 1e6))
-
-
 def busy(stop: threading.Event) -> None:
     while not stop.is_set():
         sum(i * i for i in range(2_000))
-
-
-def gap_figures(times: list[float]) -> dict:
-    gaps = sorted((b - a) * 1000 for a, b in itertools.pairwise(times))
-    if not gaps:
-        return {"count": 0}
-    return {
-        "count": len(gaps),
-        "median_ms": round(gaps[len(gaps) // 2], 1),
-        "p99_ms": round(gaps[max(0, math.ceil(0.99 * len(gaps)) - 1)], 1),
-        "max_ms": round(gaps[-1], 1),
-        "over_150": sum(g > 150 for g in gaps),
-        "over_350": sum(g > 350 for g in gaps),
-    }
 
 
 def phase(radio_process: bool, holds: list[tuple[float, float]], seconds: float, python_threads: int) -> dict:
@@ -96,9 +75,7 @@ def phase(radio_process: bool, holds: list[tuple[float, float]], seconds: float,
             held = 0.0
             for at, length in holds:
                 time.sleep(max(0.0, start + at - time.monotonic()))
-                began = time.perf_counter()
-                hold(length)
-                held += time.perf_counter() - began
+                held += hold_the_gil(length)
             time.sleep(max(0.0, start + seconds - time.monotonic()))
             end = time.monotonic()
             stop.set()
@@ -109,7 +86,7 @@ def phase(radio_process: bool, holds: list[tuple[float, float]], seconds: float,
             link.close()
     return {
         "port": "radio process" if radio_process else "thread (in the service's interpreter)",
-        "frames": gap_figures(arrivals),
+        "frames": gaps_ms(arrivals),
         "holds": {
             "count": len(holds),
             "held_s": round(held, 2),
@@ -131,7 +108,7 @@ def lease(seconds: float) -> dict:
             link.arm()
             time.sleep(SETTLE)
             start = time.monotonic()
-            hold(seconds)
+            hold_the_gil(seconds)
             time.sleep(0.05)
             firmware = robot.firmware()
             after = [t for t, _kind in robot.arrivals() if t >= start]

@@ -4,11 +4,14 @@ A test that holds this process' GIL (to stand for a busy service) would stall a 
 running on its threads too, and the robot would read the PC's frames late instead of missing them.
 :class:`RobotElsewhere` runs the radio-only :class:`~backend.robot.virtual.VirtualRobot` in a
 spawned process, with the watchdog the test chooses, and answers what its firmware reports now and
-when each of the PC's messages arrived (``scripts/bench_link_hold.py`` measures the gaps with it).
+when each of the PC's messages arrived (``scripts/bench_link_hold.py`` measures the gaps with it);
+:func:`hold_the_gil` stalls this interpreter as a compiled kernel does.
 """
 
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
 import multiprocessing
 import time
 from dataclasses import dataclass
@@ -85,3 +88,12 @@ class RobotElsewhere:
         self._process.join(10)
         if self._process.is_alive():
             self._process.kill()
+
+
+def hold_the_gil(seconds: float) -> float:
+    """Hold this interpreter's GIL for ``seconds`` (at least): libc's ``usleep`` called through
+    ``ctypes.PyDLL``, which keeps the GIL for the call, as a compiled kernel does. The seconds held."""
+    libc = ctypes.PyDLL(ctypes.util.find_library("c"))
+    started = time.perf_counter()
+    libc.usleep(int(seconds * 1e6))
+    return time.perf_counter() - started

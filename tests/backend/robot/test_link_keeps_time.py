@@ -11,8 +11,6 @@ its whole length (here a C call that sleeps without letting go of it).
   lease runs out, and the robot disarms itself: a service that stops stops the robot.
 """
 
-import ctypes
-import ctypes.util
 import time
 
 import pytest
@@ -20,22 +18,13 @@ import pytest
 from backend.robot.link import RobotLink
 from backend.robot.messages import Fault, RobotState
 from backend.robot.radio_process import LEASE
-from tests.robot_elsewhere import RobotElsewhere
+from tests.robot_elsewhere import RobotElsewhere, hold_the_gil
 
 pytestmark = pytest.mark.realtime
 
 WATCHDOG = 0.35  # [s] the robot's: the heartbeat gaps the issue measured against
 SHORT_HOLD = 0.5  # [s] longer than the watchdog, shorter than the lease
 LONG_HOLD = LEASE + WATCHDOG + 0.65  # [s] the lease and the watchdog, and a margin for the radio process' wake-up
-
-
-def hold_the_gil(seconds: float) -> float:
-    """Hold this interpreter's GIL for ``seconds`` (at least): libc's ``usleep`` called through
-    ``ctypes.PyDLL``, which keeps the GIL for the call, as a compiled kernel does. The seconds held."""
-    libc = ctypes.PyDLL(ctypes.util.find_library("c"))
-    started = time.perf_counter()
-    libc.usleep(int(seconds * 1e6))
-    return time.perf_counter() - started
 
 
 def armed_after_hold(radio_process: bool, hold: float):
