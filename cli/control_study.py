@@ -8,7 +8,7 @@ import typer
 
 from cli.options import JsonOption, ModelSetup, SchedulerOption, handles_errors, print_json, with_model, with_noise
 from cli.studies import run_study
-from sim_core.control.laws import KINDS
+from sim_core.control.registry import NAMES
 from sim_core.model.noise import NoiseModel
 
 app = typer.Typer(rich_markup_mode=None)
@@ -29,7 +29,7 @@ def control_study_command(
     setup: ModelSetup,
     noise: NoiseModel,
     controllers: Annotated[
-        str, typer.Option("--controllers", help=f"Comma-separated, of: {', '.join(KINDS)}.")
+        str, typer.Option("--controllers", help=f"Comma-separated, of: {', '.join(NAMES)}.")
     ] = "pid,pid-pitch,lqr,deadbeat",
     target: Annotated[float, typer.Option("--target", help="Height to hold [m].")] = 0.55,
     seeds: Annotated[int, typer.Option("--seeds", help="Trials per controller (seeds seed0, seed0 + 1, ...).")] = 200,

@@ -20,7 +20,7 @@ from cli.options import (
     with_model,
     with_noise,
 )
-from sim_core.control.laws import KINDS
+from sim_core.control.registry import NAMES
 from sim_core.model.noise import NoiseModel
 from sim_core.model.validation import ParameterError
 from sim_core.robustness.mfpt_grid import ChainGrid
@@ -65,7 +65,7 @@ def mfpt_command(
         str | None,
         typer.Option(
             "--controller",
-            help=f"A closed-loop law ({', '.join(KINDS)}): its MFPT by splitting on the compiled loop, no pitch "
+            help=f"A closed-loop law ({', '.join(NAMES)}): its MFPT by splitting on the compiled loop, no pitch "
             f"drift; --controls then gives the climb's nominal psi0 and first zeta0 (default {CLIMB_CONTROLS}).",
         ),
     ] = None,

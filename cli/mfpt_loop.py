@@ -13,11 +13,11 @@ def controller_mfpt(
 ) -> None:  # fmt: skip
     """Run and print; ``splitting``: the options given (None: the default)."""
     from experiments.loop_mfpt import Config, run
-    from sim_core.control.laws import KINDS
+    from sim_core.control.registry import NAMES
     from sim_core.robustness.splitting import SplittingOptions
 
-    if controller not in KINDS:
-        raise ParameterError("--controller", f"must be one of {', '.join(KINDS)}, got {controller!r}")
+    if controller not in NAMES:
+        raise ParameterError("--controller", f"must be one of {', '.join(NAMES)}, got {controller!r}")
     schedule = parse_controls(controls)
     if len(schedule) != 1:
         raise ParameterError(

@@ -18,11 +18,12 @@ from experiments.fig12 import PidClimb
 from sim_core.chunks import ChunkMap, Progress, in_process
 from sim_core.climb.records import CHUTE_TOP, FLOOR
 from sim_core.control.design import design_law
-from sim_core.control.laws import KINDS, Controller
+from sim_core.control.laws import Controller
+from sim_core.control.registry import NAMES, check_names
 from sim_core.control.study import ControllerOutcome, control_study
 from sim_core.model.noise import NoiseModel
 from sim_core.model.params import ModelParams
-from sim_core.model.validation import ParameterError, check_range
+from sim_core.model.validation import check_range
 
 FAILURE_CURVE_POINTS = 41  # failures counted at this many jumps, 0 .. jumps
 ERROR_BINS = 40  # the height error's histogram, over ±ERROR_SPAN_M
@@ -30,16 +31,8 @@ ERROR_SPAN_M = 0.05
 
 
 def check_controllers(names) -> tuple[str, ...]:
-    """``names`` in order, each a known controller once; a ParameterError naming ``controllers``."""
-    names = tuple(names)
-    if not names:
-        raise ParameterError("controllers", f"must name at least one of {', '.join(KINDS)}")
-    for name in names:
-        if name not in KINDS:
-            raise ParameterError("controllers", f"must be among {', '.join(KINDS)}, got {name!r}")
-    if len(set(names)) != len(names):
-        raise ParameterError("controllers", f"names a controller twice: {', '.join(names)}")
-    return names
+    """``names`` in order, each a registered controller once; a ParameterError naming ``controllers``."""
+    return check_names(names, "controllers")
 
 
 @dataclass(frozen=True)
@@ -47,7 +40,7 @@ class Config:
     """The study: ``controllers`` by name, the height to hold [m], the climb's nominal leg angle
     [deg] and starting zeta0, and the trials (seeds ``seed0 .. seed0 + seeds - 1``)."""
 
-    controllers: tuple[str, ...] = ("pid", "pid-pitch", "lqr", "deadbeat")
+    controllers: tuple[str, ...] = NAMES
     target_m: float = 0.55
     psi0_deg: float = 35.0
     start_zeta0: float = 0.9

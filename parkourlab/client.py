@@ -83,6 +83,11 @@ class Client(JobCalls):
         """``{"status": "ok", "database": "sqlite"|"postgresql", "code_version": …}``."""
         return self._http.call("GET", "/api/v1/health")
 
+    def controllers(self) -> list[dict[str, Any]]:
+        """The closed-loop laws this service knows, in order: ``{"name", "summary", "sets_leg_angle"}``
+        each, from its catalog (a control study's ``controllers``, a loop's ``controller``)."""
+        return self._http.call("GET", "/api/v1/catalog")["controllers"]
+
     def token_accepted(self) -> bool:
         """Whether the service accepts this client's token (False without one)."""
         return bool(self._http.token) and self._http.succeeds("GET", "/api/v1/auth")

@@ -24,11 +24,16 @@ class JobCalls:
 
     _http: Http
 
+    def job_kinds(self) -> list[dict[str, Any]]:
+        """The job kinds this service takes, in order: ``{"name", "title", "request"}`` each
+        (``request``: its body's schema in the service's OpenAPI document), from its catalog."""
+        return self._http.call("GET", "/api/v1/catalog")["job_kinds"]
+
     def submit_job(self, kind: str, **spec: Any) -> Job:
-        """Queue a job of ``kind`` (``mjtf``, ``sweep``, ``basin``, ``gaits``, ``control-study``,
-        ``mfpt``, ``loop-mfpt``, ``viability``) with ``spec`` as its body (the API's field names;
-        docs/service.md). Returns it queued (202). The typed ``submit_*`` methods below are the
-        same with each field named."""
+        """Queue a job of ``kind`` (one of :meth:`job_kinds`: ``mjtf``, ``sweep``, ``basin``,
+        ``gaits``, ``control-study``, ``mfpt``, ``loop-mfpt``, ``viability`` today) with ``spec`` as
+        its body (the API's field names; docs/service.md). Returns it queued (202). The typed
+        ``submit_*`` methods below are the same with each field named."""
         body = {"kind": kind} | present(spec)
         return self._http.call("POST", "/api/v1/jobs", body=body)
 

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from backend.schemas import MJTFJobCreate
+from backend.jobs.mjtf import MJTFJobCreate
 from backend.services import jobs
 from backend.store.database import make_engine, migrate, session_factory, sqlite_url
 from backend.store.models import Trial

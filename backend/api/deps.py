@@ -24,6 +24,7 @@ from backend.services.robot import RobotService
 from backend.store.database import StorageFull, after_storage_full
 from backend.workers.pools import ComputePool
 from backend.workers.store_reads import StoreReads
+from sim_core.control.registry import NAMES
 
 T = TypeVar("T")
 VIEW_NOT_STARTED = "the 3D view is not running (it starts with `parkour serve`)"
@@ -75,7 +76,7 @@ async def run_filter(
     ] = None,
     loop: schemas.RunLoop | None = None,
     controller: Annotated[
-        str | None, Query(min_length=1, max_length=16, description="a closed loop's law: pid, pid-pitch, lqr, deadbeat")
+        str | None, Query(min_length=1, max_length=16, description=f"a closed loop's law: {', '.join(NAMES)}")
     ] = None,
     q: Annotated[
         str | None, Query(min_length=1, max_length=200, description="text in the notes or a tag (any case)")

@@ -23,7 +23,8 @@ import numpy as np
 from backend.robot.limits import ServoLimits
 from backend.robot.touchdown import Touchdown, pitch_before
 from sim_core.control.design import SteppedLaw, law_holding
-from sim_core.control.laws import PID, Controller
+from sim_core.control.laws import Controller
+from sim_core.control.registry import LAWS
 from sim_core.model.controls import NO_OFFSETS, LegControl, LegOffsets
 from sim_core.model.params import PhysicalParams
 from sim_core.model.validation import check_range
@@ -66,8 +67,8 @@ class LiveLaw:
         height = touchdown.body_height / self.leg_length
         psi0, zeta0, clipped = self.stepped.step(height, pitch, *touchdown.state, wall == Wall.LEFT)
         side = 1 if wall == Wall.RIGHT else 0
-        commanded = (leg_psi0 if self.stepped.kind == PID else psi0 - self._psi0_offset[side],
-                     zeta0 - self.offsets.zeta0_offset[side])  # fmt: skip
+        angle = psi0 - self._psi0_offset[side] if LAWS[self.name].sets_leg_angle else leg_psi0
+        commanded = (angle, zeta0 - self.offsets.zeta0_offset[side])
         held = (min(max(commanded[0], self._psi0_range[0]), self._psi0_range[1]),
                 min(max(commanded[1], self.limits.zeta0[0]), self.limits.zeta0[1]))  # fmt: skip
         clipped = clipped or held != commanded

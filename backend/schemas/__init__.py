@@ -13,6 +13,7 @@ from backend.schemas.calibrations import (
     CalibrationOut,
     TouchdownComparison,
 )
+from backend.schemas.catalog import Catalog, ControllerOut, JobKindOut
 from backend.schemas.common import (
     MAX_ID,
     MAX_JUMPS,
@@ -20,6 +21,7 @@ from backend.schemas.common import (
     MAX_PAGE,
     MAX_PATH_SAMPLES,
     MAX_TRIALS,
+    ControllerKind,
     Health,
     IsoDateTime,
     Label,
@@ -43,23 +45,7 @@ from backend.schemas.experiments import (
     ExperimentUpdate,
 )
 from backend.schemas.job_budget import QUEUE_BUDGET_JUMPS, WORK_BUDGET_JUMPS
-from backend.schemas.jobs import (
-    CLIENT_PATTERN,
-    JOB_KINDS,
-    BasinJobCreate,
-    ControlStudyJobCreate,
-    GaitSearchJobCreate,
-    JobCreate,
-    JobOut,
-    JobPage,
-    JobResults,
-    JobState,
-    MJTFJobCreate,
-    MJTFLevelOut,
-    SweepJobCreate,
-    ViabilityJobCreate,
-)
-from backend.schemas.mfpt_jobs import ControllerKind, LoopMfptJobCreate, LoopNoiseIn, MfptJobCreate
+from backend.schemas.jobs import CLIENT_PATTERN, JobOut, JobPage, JobResults, JobState, MJTFLevelOut
 from backend.schemas.noise import NoiseIn
 from backend.schemas.robot import ClosedLoopIn, EstopLatchOut, RobotConnect, RobotEstopOut, RobotRunCreate, RobotStatus
 from backend.schemas.runs import (
@@ -83,7 +69,6 @@ from backend.schemas.view import VIEWER_ID_PATTERN, ViewerId, ViewOut, ViewRepla
 
 __all__ = [
     "CLIENT_PATTERN",
-    "JOB_KINDS",
     "MAX_ID",
     "MAX_JUMPS",
     "MAX_LEVELS",
@@ -94,13 +79,13 @@ __all__ = [
     "QUEUE_BUDGET_JUMPS",
     "VIEWER_ID_PATTERN",
     "WORK_BUDGET_JUMPS",
-    "BasinJobCreate",
     "CalibrationCreate",
     "CalibrationList",
     "CalibrationOut",
+    "Catalog",
     "ClosedLoopIn",
-    "ControlStudyJobCreate",
     "ControllerKind",
+    "ControllerOut",
     "EstopLatchOut",
     "ExperimentBase",
     "ExperimentCreate",
@@ -110,23 +95,18 @@ __all__ = [
     "ExperimentUpdate",
     "FixedPointIn",
     "FixedPointOut",
-    "GaitSearchJobCreate",
     "Health",
     "IsoDateTime",
-    "JobCreate",
+    "JobKindOut",
     "JobOut",
     "JobPage",
     "JobResults",
     "JobState",
     "Label",
     "LegIn",
-    "LoopMfptJobCreate",
-    "LoopNoiseIn",
-    "MJTFJobCreate",
     "MJTFLevelOut",
     "MapIn",
     "MapOut",
-    "MfptJobCreate",
     "ModelIn",
     "NoiseIn",
     "Page",
@@ -152,12 +132,10 @@ __all__ = [
     "StateIn",
     "Stats",
     "Strict",
-    "SweepJobCreate",
     "TokenAccepted",
     "TouchdownComparison",
     "TrajectoryIn",
     "TrajectoryOut",
-    "ViabilityJobCreate",
     "ViewOut",
     "ViewReplay",
     "ViewerId",

@@ -4,6 +4,7 @@ inputs, the limits, record references and the page of a list."""
 from __future__ import annotations
 
 import datetime
+import enum
 import math
 from typing import Annotated, Generic, Literal, TypeVar
 
@@ -11,6 +12,10 @@ from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Fie
 
 from sim_core.climb.records import CHUTE_TOP, FLOOR
 from sim_core.control.laws import PSI0_RANGE_DEG
+from sim_core.control.registry import NAMES
+
+ControllerKind = enum.StrEnum("ControllerKind", {name.replace("-", "_").upper(): name for name in NAMES})
+ControllerKind.__doc__ = "A closed-loop law (the registry, sim_core.control.laws.LAWS)."
 
 
 def _inside_in_radians(psi0_deg: float) -> float:

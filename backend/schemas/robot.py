@@ -14,7 +14,7 @@ from backend.robot.xbee import ROBOT_ADDRESS
 from backend.schemas.common import LegIn, Psi0Deg, RecordRef, Strict, Tags, Zeta0
 from sim_core.climb.records import CHUTE_TOP, FLOOR
 from sim_core.control.design import DEADBEAT_CLIMB_PER_JUMP
-from sim_core.control.laws import KINDS
+from sim_core.control.registry import NAMES
 
 
 class RobotConnect(Strict):
@@ -101,7 +101,7 @@ class ClosedLoopIn(Strict):
     target_m: Annotated[
         float, Field(gt=FLOOR, le=CHUTE_TOP, description="height to hold [m], above the floor, within the chute")
     ]
-    controller: Annotated[str, Field(description=f"the law, one of: {', '.join(KINDS)}")] = "pid"
+    controller: Annotated[str, Field(description=f"the law, one of: {', '.join(NAMES)}")] = "pid"
     kp: Annotated[float, Field(ge=0.0, le=10.0)] = 0.04
     ki: Annotated[float, Field(ge=0.0, le=10.0)] = 0.0
     kd: Annotated[float, Field(ge=0.0, le=10.0)] = 0.02
@@ -123,8 +123,8 @@ class ClosedLoopIn(Strict):
     @field_validator("controller")
     @classmethod
     def _known(cls, name: str) -> str:
-        if name not in KINDS:
-            raise ValueError(f"must be one of {', '.join(KINDS)}, got {name!r}")
+        if name not in NAMES:
+            raise ValueError(f"must be one of {', '.join(NAMES)}, got {name!r}")
         return name
 
     @field_validator("zeta0_max")

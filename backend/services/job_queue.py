@@ -2,7 +2,7 @@
 
 Jobs run one at a time (:mod:`backend.services.job_runner`). What is queued and running is bounded
 by :data:`~backend.schemas.job_budget.QUEUE_BUDGET_JUMPS` of work, each job counted at its worst
-(:func:`~backend.schemas.job_budget.worst_case_jumps`; a running one by the share it has still to do), and
+(:func:`~backend.jobs.worst_case_jumps`, each kind's own count; a running one by the share it has still to do), and
 one client — a script, the panel: the ``X-Parkour-Client`` header, else its address — may hold at
 most :data:`~backend.schemas.job_budget.CLIENT_SHARE` of it, so one script cannot starve the panel. A job
 past either is refused with a 429 (:class:`~backend.errors.QueueFull`) saying what is queued.
@@ -18,16 +18,10 @@ from dataclasses import dataclass
 from sqlalchemy.orm import Session
 
 from backend.errors import QueueFull
+from backend.jobs import UnreadableSpec, decode, worst_case_jumps
 from backend.repositories import jobs as stored_jobs
-from backend.schemas.job_budget import (
-    CLIENT_SHARE,
-    JOB_RATE_JUMPS_PER_S,
-    MAX_QUEUED_JOBS,
-    QUEUE_BUDGET_JUMPS,
-    worst_case_jumps,
-)
+from backend.schemas.job_budget import CLIENT_SHARE, JOB_RATE_JUMPS_PER_S, MAX_QUEUED_JOBS, QUEUE_BUDGET_JUMPS
 from backend.schemas.jobs import JobState
-from backend.services.job_specs import UnreadableSpec, decode
 from backend.store.models import Job
 
 

@@ -32,9 +32,10 @@ from typing import TypeVar
 import numpy as np
 from sqlalchemy.orm import Session, sessionmaker
 
+from backend.jobs import decode, job_kind
+from backend.jobs.mjtf import MJTFSpec
 from backend.repositories import jobs as stored_jobs
 from backend.schemas.jobs import JobState
-from backend.services.job_specs import MJTFSpec, decode
 from backend.services.model_requests import model_params
 from backend.services.storage_waits import Stopped, Waiting, when_room
 from backend.services.studies import run_study, run_study_here
@@ -135,7 +136,7 @@ class JobRunner:
                 return
             job = stored_jobs.get(session, job_id)
             kind, spec = job.kind, decode(job.spec)
-        if kind == "mjtf":
+        if job_kind(kind).run is None:  # MJTF: trials stored chunk by chunk, a restart resumes them
             self._run_mjtf(job_id, spec)
         else:
             self._run_study(job_id, spec)

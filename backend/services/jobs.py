@@ -13,11 +13,11 @@ from typing import TYPE_CHECKING
 
 from sqlalchemy.orm import Session
 
+from backend.jobs import decode, encode, job_kind, spec_of
 from backend.repositories import jobs as stored_jobs
 from backend.repositories.common import locked
 from backend.schemas.jobs import JobOut, JobPage, JobResults, JobState, MJTFLevelOut
 from backend.services.job_queue import Standing, check_room, standings
-from backend.services.job_specs import decode, encode, spec_of
 from backend.services.presets import with_preset_resolved
 from backend.services.provenance import current_code_version
 from backend.store.database import lock_for_write
@@ -31,7 +31,7 @@ FINAL = frozenset({JobState.DONE, JobState.CANCELLED, JobState.FAILED})  # a job
 
 
 def create_job(session: Session, body, runner: JobRunner | None = None, *, client: str | None = None) -> JobOut:
-    """Store a job (any of ``schemas.JOB_KINDS``, a stored preset resolved) submitted by ``client``
+    """Store a job (any of :data:`backend.jobs.JOB_KINDS`, a stored preset resolved) submitted by ``client``
     and hand it to ``runner``; MJTF totals count trials, other kinds chunks. The queue's room is
     checked under the write lock (:mod:`backend.services.job_queue`: a 429 past its budget or the
     client's share), and its experiment read under it (``locked``), so a concurrent delete of it
@@ -41,7 +41,7 @@ def create_job(session: Session, body, runner: JobRunner | None = None, *, clien
     check_room(session, body, client or "unknown")
     if body.experiment_id is not None:
         locked(session, Experiment, body.experiment_id, "experiment")
-    spec = spec_of(body)  # stored as its own versioned record: job_specs.py says why
+    spec = spec_of(body)  # stored as its own versioned record: backend/jobs/specs.py says why
     job = stored_jobs.add(
         session,
         Job(
@@ -49,7 +49,7 @@ def create_job(session: Session, body, runner: JobRunner | None = None, *, clien
             kind=spec.kind,
             spec=encode(spec),
             state=JobState.QUEUED,
-            total=len(spec.zeta0s) * spec.trials if spec.kind == "mjtf" else 1,
+            total=job_kind(spec.kind).total(spec),
             code_version=current_code_version(),
             submitted_by=client,
         ),

@@ -9,10 +9,12 @@ from __future__ import annotations
 
 from dataclasses import asdict
 
-from backend.schemas import LegIn, ModelIn
+from backend.jobs.base import schedule_of
+from backend.schemas import ModelIn
 from backend.services.presets import resolve_model
-from sim_core.model.controls import ControlSchedule
 from sim_core.model.params import ModelParams
+
+__all__ = ["model_params", "schedule_of"]  # the legs' conversion lives with the jobs, which share it
 
 
 def model_params(body) -> ModelParams:
@@ -22,8 +24,3 @@ def model_params(body) -> ModelParams:
     fields = body.model_dump() if isinstance(body, ModelIn) else asdict(body)
     overrides = {name: value for name, value in fields.items() if name != "preset"}
     return resolve_model(None, fields["preset"], field="model.preset").model(**overrides)
-
-
-def schedule_of(controls: list[LegIn]) -> ControlSchedule:
-    """The legs of a request, in order, as a control schedule."""
-    return ControlSchedule.from_degrees([(leg.psi0_deg, leg.zeta0) for leg in controls])

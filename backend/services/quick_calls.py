@@ -11,13 +11,13 @@ from __future__ import annotations
 
 import threading
 import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from backend.jobs.base import gait_not_found_as_parameter_error
 from backend.schemas import FixedPointIn, MapIn, RunCreate, TrajectoryIn
 from backend.services.model_requests import model_params, schedule_of
 from backend.services.presets import InSession, preset_resolved, resolve_model
@@ -27,7 +27,7 @@ from backend.store.trajectory_blob import pack_trajectory
 from backend.workers.pools import as_json
 from experiments.manifest import json_safe
 from sim_core.model.controls import ControlSchedule
-from sim_core.model.errors import FixedPointNotFound, ParameterError
+from sim_core.model.errors import FixedPointNotFound
 from sim_core.model.params import ModelParams
 from sim_core.model.presets import START_GUESS, get_preset
 
@@ -106,18 +106,6 @@ def _gait_of(model: ModelParams, schedule: ControlSchedule, period: int | None, 
 
     with gait_not_found_as_parameter_error():
         return gait_of(model, schedule, period, None if guess is None else (guess.xdot, guess.ydot))
-
-
-@contextmanager
-def gait_not_found_as_parameter_error() -> Iterator[None]:
-    """A gait search that finds nothing is a 422 naming the controls (a guess may find one)."""
-    from sim_core.model.errors import NoGaitFound
-
-    try:
-        yield
-    except NoGaitFound as error:
-        message = f"no period-{error.period} gait found from a grid of guesses; give a guess"
-        raise ParameterError("controls", message) from None
 
 
 def simulate_run(body: RunCreate) -> RunRecord:

@@ -4,8 +4,8 @@
 import { $ } from "./api.js";
 import { draw, layout } from "./plots.js";
 import { element, fillTable } from "./dom.js";
+import { controllerColor } from "./catalog.js";
 
-const COLORS = { pid: "#d61f1f", "pid-pitch": "#e08a00", lqr: "#2c6fb7", deadbeat: "#2a9d4b" };
 const cm = (metres) => (metres === null || metres === undefined ? "—" : `${(metres * 100).toFixed(2)} cm`);
 const EXTRA_PLOTS = ["job-plot-errors", "job-plot-climbs"];
 
@@ -30,7 +30,7 @@ export function hideControlStudy() {
   }
 }
 
-export function showControlStudy(id, result) {
+export async function showControlStudy(id, result) {
   const [seed0, seeds] = result.seeds;
   const table = $("#job-study");
   table.querySelector("caption").textContent =
@@ -41,7 +41,8 @@ export function showControlStudy(id, result) {
   // Both boxes shown before either is drawn: each takes half the row only once both are shown,
   // and Plotly sizes a plot to its box as it draws.
   for (const id of EXTRA_PLOTS) document.getElementById(id).hidden = false;
-  const color = (name) => ({ color: COLORS[name] ?? "#555" });
+  const colors = Object.fromEntries(await Promise.all(plots.map(async (plot) => [plot.name, await controllerColor(plot.name)])));
+  const color = (name) => ({ color: colors[name] });
   draw("job-plot", plots.map((plot) => ({
     x: plot.failure_curve.jumps, y: plot.failure_curve.failures, mode: "lines", line: { shape: "hv", ...color(plot.name) }, name: plot.name,
   })), layout(`Job ${id}: trials failed by jump`, "jumps", `trials failed (of ${seeds})`, { yaxis: { title: { text: `trials failed (of ${seeds})` }, rangemode: "tozero" } }));

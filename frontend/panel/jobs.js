@@ -269,7 +269,7 @@ export async function showJob(id) {
   } else if (job.kind === "sweep") {
     plotSweep("job-plot", results.result, `Job ${id}: symmetric gait at psi0 = ${job.spec.psi0_deg}° over zeta0`);
   } else if (job.kind === "control-study") {
-    showControlStudy(id, results.result);
+    await showControlStudy(id, results.result);
   } else if (job.kind === "basin") {
     plotBasin("job-plot", results.result, `Job ${id}: basin of attraction`);
   } else if (job.kind === "mfpt") {

@@ -13,6 +13,7 @@ import { drawLive, refreshRobot, syncLive } from "./robot.js";
 import "./connect.js";
 import "./simulate.js";
 import { showView } from "./view.js";
+import { fillChoosers } from "./catalog.js";
 
 initTabs((name) => {
   if (name === "history") loadExperiments().then(loadRuns).then(loadCalibrations).catch(() => {});
@@ -21,4 +22,5 @@ initTabs((name) => {
   syncLive();  // the live websocket is open while the Robot tab is shown
   if (name === "view3d") showView();
 });
-restoreView().catch(() => {});  // a link to a History view (?tab=history&…) opens it
+// The choosers are filled first: a link to a History view may choose a controller.
+fillChoosers().catch(() => {}).then(() => restoreView()).catch(() => {});  // a link to a History view (?tab=history&…) opens it

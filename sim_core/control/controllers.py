@@ -4,8 +4,9 @@ One interface for every law (docs/model.md §5.2): at touchdown ``k`` the robot 
 height and its pitch (the tracker's, §6); the law returns the leg angle and leg length of
 touchdown ``k + 1`` (one jump of delay, as on the robot), within the leg's range relative to the
 body, and says whether it had to clip them (saturation is counted, not hidden). A controller is
-a frozen dataclass (:mod:`sim_core.control.laws`: its parameters, checked) that gives the
-compiled loop a kind and a flat parameter array; :func:`control_step` is the one compiled dispatch.
+a frozen dataclass (a module of :mod:`sim_core.control.laws`, the registry: its parameters,
+checked) that gives the compiled loop a kind (its ``NUMBER``) and a flat parameter array;
+:func:`control_step` is the one compiled dispatch, a branch per law.
 
 Kinds so far:
 

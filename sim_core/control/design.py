@@ -1,5 +1,5 @@
-"""A named controller built for one model — the one place that turns a name (``pid``, ``pid-pitch``,
-``lqr``, ``deadbeat``) and the height loop's settings into the law the compiled loop runs — and
+"""A named controller built for one model — a registered law's name (:data:`sim_core.control.registry.LAWS`)
+and the height loop's settings turned into the law the compiled loop runs — and
 :class:`SteppedLaw`, a law stepped one touchdown at a time by one owner (a live run's loop, the
 3D view's climb).
 
@@ -13,17 +13,16 @@ in-place zeta0.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from sim_core.control.height_controller import HeightController
-from sim_core.control.laws import KINDS, PSI0_RANGE_DEG, Controller, Pid
+from sim_core.control.laws import DEADBEAT_CLIMB_PER_JUMP, PSI0_RANGE_DEG, Controller, DesignRequest
+from sim_core.control.registry import design
 from sim_core.model.controls import LegControl
 from sim_core.model.params import ModelParams
-from sim_core.model.validation import ParameterError
 
-DEADBEAT_CLIMB_PER_JUMP = 0.5  # [l0], sim_core.control.laws.Deadbeat's default
 Command = tuple[float, float, bool]  # the next touchdown's psi0 [rad] and zeta0, and whether it was clipped
 
 
@@ -36,24 +35,12 @@ def design_law(
     psi0_range_deg: tuple[float, float] = PSI0_RANGE_DEG,
     climb_per_jump: float = DEADBEAT_CLIMB_PER_JUMP,
 ) -> Controller:
-    """The law ``name`` holding ``height.target`` [l0] about the gait of jumping in place at
-    ``psi0_deg`` with ``height.zeta0_hover``, its leg length within the height loop's range and
-    its leg angle within ``psi0_range_deg`` (the servos'); the PIDs take ``height``'s gains. A
-    ParameterError naming ``controller`` for an unknown name, or the field a law refuses."""
-    if name not in KINDS:
-        raise ParameterError("controller", f"must be among {', '.join(KINDS)}, got {name!r}")
-    zeta0_range = (height.zeta0_min, height.zeta0_max)
-    if name == "lqr":
-        from sim_core.control.return_map_lqr import design_lqr  # scipy's Riccati solver, only when asked
-
-        return replace(design_lqr(model, height.target, psi0_deg, height.zeta0_hover, zeta0_range=zeta0_range),
-                       psi0_range_deg=psi0_range_deg)  # fmt: skip
-    if name == "deadbeat":
-        from sim_core.control.deadbeat import design_deadbeat
-
-        return design_deadbeat(model, height.target, psi0_deg, height.zeta0_hover, zeta0_range=zeta0_range,
-                               climb_per_jump=climb_per_jump, psi0_range_deg=psi0_range_deg)  # fmt: skip
-    return Pid(height, psi0_deg, pitch_feedback=name == "pid-pitch", psi0_range_deg=psi0_range_deg)
+    """The law ``name`` (one of :data:`sim_core.control.registry.LAWS`) holding ``height.target`` [l0]
+    about the gait of jumping in place at ``psi0_deg`` with ``height.zeta0_hover``, its leg length
+    within the height loop's range and its leg angle within ``psi0_range_deg`` (the servos'); the
+    PIDs take ``height``'s gains. A ParameterError naming ``controller`` for an unknown name, or
+    the field a law refuses."""
+    return design(name, DesignRequest(model, height, psi0_deg, psi0_range_deg, climb_per_jump))
 
 
 def law_holding(

@@ -163,3 +163,9 @@ def test_importing_the_client_loads_none_of_the_project():
     code = f"import sys, parkourlab; print([m for m in sys.modules if m.split('.')[0] in {heavy!r}])"
     loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert loaded.strip() == "[]"
+
+
+def test_the_controllers_are_the_services_registry(client):
+    from sim_core.control.registry import LAWS
+
+    assert [law["name"] for law in client.controllers()] == list(LAWS)

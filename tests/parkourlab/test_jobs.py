@@ -119,7 +119,7 @@ EVERY_FIELD = {
 
 @pytest.mark.parametrize("kind", sorted(EVERY_FIELD))
 def test_each_submit_sends_a_body_the_api_takes(kind):
-    from backend.schemas import JOB_KINDS
+    from backend.jobs import JOB_KINDS
 
     body = submitted(EVERY_FIELD[kind])
     request_model = JOB_KINDS[kind]
@@ -130,7 +130,7 @@ def test_each_submit_sends_a_body_the_api_takes(kind):
 
 def test_typed_submits_name_every_field_of_their_kind():
     """A field added to a job's request model is a parameter of its ``submit_*`` (or this fails)."""
-    from backend.schemas import JOB_KINDS
+    from backend.jobs import JOB_KINDS
 
     for kind, request_model in JOB_KINDS.items():
         parameters = set(inspect.signature(getattr(Client, f"submit_{kind.replace('-', '_')}")).parameters) - {"self"}
@@ -205,3 +205,11 @@ def test_wait_raises_for_a_failed_job_unless_told_not_to():
 def test_a_controllers_mfpt_names_the_law_and_leaves_the_rest_to_the_service():
     body = submitted(lambda c: c.submit_loop_mfpt("lqr", noise={"velocity": 0.05}, replicas=20, runs=2))
     assert body == {"kind": "loop-mfpt", "controller": "lqr", "noise": {"velocity": 0.05}, "replicas": 20, "runs": 2}
+
+
+def test_the_job_kinds_are_the_services_registry(client):
+    from backend.jobs import KINDS
+
+    kinds = client.job_kinds()
+    assert [kind["name"] for kind in kinds] == [kind.name for kind in KINDS]
+    assert all(hasattr(Client, f"submit_{kind['name'].replace('-', '_')}") for kind in kinds), "a typed submit each"

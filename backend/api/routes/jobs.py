@@ -1,4 +1,4 @@
-"""Batch jobs: MJTF trials, sweeps, basins and gait searches, queued and resumed across restarts."""
+"""Batch jobs of every registered kind (:mod:`backend.jobs`), queued and resumed across restarts."""
 
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ from fastapi.responses import StreamingResponse
 
 from backend import schemas
 from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, RecordId, Runner, SubmittedBy
+from backend.jobs import JobCreate
 from backend.services import jobs
 
 EVENT_POLL_S = 0.25  # progress comes from committed chunks; a quarter second is live enough
@@ -21,7 +22,7 @@ router = APIRouter(prefix="/api/v1/jobs", tags=["jobs"])
 
 
 @router.post("", status_code=202, dependencies=AUTHORIZED, response_model=schemas.JobOut)
-async def create_job(body: schemas.JobCreate, db: Db, runner: Runner, client: SubmittedBy) -> schemas.JobOut:
+async def create_job(body: JobCreate, db: Db, runner: Runner, client: SubmittedBy) -> schemas.JobOut:
     """Queue a job. Past the queue's budget of work, or this client's share of it, a 429 says what
     is queued (docs/service.md); ``queue_position`` and ``eta_s`` say where it stands."""
     return await db(jobs.create_job, body, runner, client=client)

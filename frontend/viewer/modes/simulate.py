@@ -24,7 +24,7 @@ from frontend.viewer.simulated_climb import Controls, SimulatedClimb
 from sim_core import FixedPoint, LegControl, PhysicalParams
 from sim_core.climb.records import CHUTE_TOP
 from sim_core.control.design import law_holding
-from sim_core.control.laws import KINDS
+from sim_core.control.registry import NAMES
 from sim_core.model.errors import FixedPointNotFound, ParameterError
 from sim_core.model.trajectory import STANCE
 
@@ -59,7 +59,7 @@ class SimulateMode(Mode):
                 "damping [N·s/m]", 0.0, 3.0, 0.05, robot.c_zeta, hint="leg and pivot"
             )
             self.gui_controller = gui.add_dropdown(
-                "Controller", (OPEN_LOOP, *KINDS), initial_value=OPEN_LOOP,
+                "Controller", (OPEN_LOOP, *NAMES), initial_value=OPEN_LOOP,
                 hint="close the loop: from each touchdown the law sets the next leg (the sliders set the first)",
             )  # fmt: skip
             self.gui_target = self._ranged_slider("target [m]", 0.1, CHUTE_TOP, 0.01, 0.55, hint="the height held")

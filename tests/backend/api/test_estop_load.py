@@ -19,6 +19,7 @@ import httpx
 import pytest
 
 from backend import schemas
+from backend.jobs.mjtf import MJTFJobCreate
 from backend.robot.firmware import Firmware
 from backend.robot.messages import Command, Kind
 from backend.robot.virtual import VirtualRobot
@@ -36,7 +37,7 @@ JOB_START_S = 60.0  # [s] the job's first chunk is done (its kernels are loaded)
 
 def test_the_heavy_job_and_the_load_are_valid_requests():
     """The job and the /sim/map body above are what the API accepts."""
-    assert len(schemas.MJTFJobCreate(**HEAVY_JOB).zeta0s) == 11
+    assert len(MJTFJobCreate(**HEAVY_JOB).zeta0s) == 11
     assert schemas.MapIn(**MAP_BODY).jumps == 1000
 
 

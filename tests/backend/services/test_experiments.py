@@ -3,8 +3,9 @@
 import pytest
 
 from backend.errors import Conflict, NotFound
+from backend.jobs.mjtf import MJTFJobCreate
 from backend.repositories import experiments as stored_experiments
-from backend.schemas import ExperimentCreate, ExperimentUpdate, MJTFJobCreate
+from backend.schemas import ExperimentCreate, ExperimentUpdate
 from backend.services import experiments, runs
 from backend.services.jobs import create_job
 

@@ -7,8 +7,9 @@ import pytest
 from sqlalchemy import update
 
 from backend.errors import QueueFull
-from backend.schemas import MJTFJobCreate
-from backend.schemas.job_budget import JOB_RATE_JUMPS_PER_S, worst_case_jumps
+from backend.jobs import worst_case_jumps
+from backend.jobs.mjtf import MJTFJobCreate
+from backend.schemas.job_budget import JOB_RATE_JUMPS_PER_S
 from backend.services import job_queue, jobs
 from backend.store.models import Job
 from tests.backend.services.jobs_helpers import SMALL

@@ -9,7 +9,11 @@ import pytest
 from sqlalchemy import delete, select, update
 
 from backend.errors import NotFound
-from backend.schemas import BasinJobCreate, ControlStudyJobCreate, GaitSearchJobCreate, LegIn, MJTFJobCreate, StateIn
+from backend.jobs.basin import BasinJobCreate
+from backend.jobs.control_study import ControlStudyJobCreate
+from backend.jobs.gaits import GaitSearchJobCreate
+from backend.jobs.mjtf import MJTFJobCreate
+from backend.schemas import LegIn, StateIn
 from backend.services import job_runner, jobs, storage_waits
 from backend.store.models import Job, Trial
 from sim_core import get_preset
@@ -170,7 +174,8 @@ def test_the_runner_leaves_a_job_cancelled_before_it_starts_alone(sessions, sess
 
 def test_a_stored_job_the_request_schema_now_refuses_still_resumes(sessions, session, compute):
     """Its spec is read as stored (job_specs.py), not re-validated by today's request ranges."""
-    from backend.services.job_specs import MJTFSpec, StateSpec, encode
+    from backend.jobs.mjtf import MJTFSpec
+    from backend.jobs.specs import StateSpec, encode
 
     # Two levels at one zeta0: the request schema refuses that today (they must be distinct).
     spec = MJTFSpec(zeta0s=(0.9, 0.9), trials=3, cap=50, guess=StateSpec(-0.93, -0.2))

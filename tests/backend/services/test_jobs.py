@@ -6,7 +6,9 @@ import pytest
 from sqlalchemy import update
 
 from backend.errors import NotFound
-from backend.schemas import GaitSearchJobCreate, JobState, LegIn, MJTFJobCreate
+from backend.jobs.gaits import GaitSearchJobCreate
+from backend.jobs.mjtf import MJTFJobCreate
+from backend.schemas import JobState, LegIn
 from backend.services import jobs
 from backend.store.models import Experiment, Job, Trial
 from tests.backend.services.jobs_helpers import SMALL

@@ -9,7 +9,8 @@ import sys
 
 import pytest
 
-from backend.schemas import MJTFJobCreate, ModelIn
+from backend.jobs.mjtf import MJTFJobCreate
+from backend.schemas import ModelIn
 from backend.services.presets import FITTED, ResolvedModel, preset_resolved, resolve_model, with_preset_resolved
 from backend.store.models import ModelPreset
 from sim_core.model.controls import NO_OFFSETS, LegOffsets

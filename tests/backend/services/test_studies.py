@@ -2,7 +2,10 @@
 
 import pytest
 
-from backend.schemas import BasinJobCreate, GaitSearchJobCreate, LegIn, StateIn, SweepJobCreate
+from backend.jobs.basin import BasinJobCreate
+from backend.jobs.gaits import GaitSearchJobCreate
+from backend.jobs.sweep import SweepJobCreate
+from backend.schemas import LegIn, StateIn
 from backend.services.studies import run_study
 from sim_core.chunks import in_process
 from tests.backend.services.test_quick_calls import EIGENVALUE_ATOL, PERIOD_1, PERIOD_1_EIGENVALUE, _strict_json

@@ -11,7 +11,8 @@ from sim_core.basins.sweep import find_in_place_zeta0
 from sim_core.control.controllers import control_step, new_memory
 from sim_core.control.design import SteppedLaw, design_law, law_holding
 from sim_core.control.height_controller import HeightController
-from sim_core.control.laws import KINDS, Deadbeat, Lqr, Pid
+from sim_core.control.laws import Deadbeat, Lqr, Pid
+from sim_core.control.registry import KINDS
 from sim_core.model.controls import LegControl
 from sim_core.model.presets import get_preset
 from sim_core.model.validation import ParameterError

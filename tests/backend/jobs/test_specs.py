@@ -3,29 +3,16 @@
 import pytest
 from pydantic import ValidationError
 
-from backend.schemas import (
-    JOB_KINDS,
-    BasinJobCreate,
-    ControlStudyJobCreate,
-    GaitSearchJobCreate,
-    LoopMfptJobCreate,
-    MfptJobCreate,
-    MJTFJobCreate,
-    SweepJobCreate,
-    ViabilityJobCreate,
-)
-from backend.services.job_specs import (
-    SPEC_VERSION,
-    LegSpec,
-    LoopMfptSpec,
-    MJTFSpec,
-    NoiseSpec,
-    StateSpec,
-    UnreadableSpec,
-    decode,
-    encode,
-    spec_of,
-)
+from backend.jobs import JOB_KINDS, decode, spec_of
+from backend.jobs.basin import BasinJobCreate
+from backend.jobs.control_study import ControlStudyJobCreate
+from backend.jobs.gaits import GaitSearchJobCreate
+from backend.jobs.loop_mfpt import LoopMfptJobCreate, LoopMfptSpec
+from backend.jobs.mfpt import MfptJobCreate
+from backend.jobs.mjtf import MJTFJobCreate, MJTFSpec
+from backend.jobs.specs import SPEC_VERSION, LegSpec, NoiseSpec, StateSpec, UnreadableSpec, encode
+from backend.jobs.sweep import SweepJobCreate
+from backend.jobs.viability import ViabilityJobCreate
 
 LEGS = [{"psi0_deg": 30.0, "zeta0": 0.9}]
 REQUESTS = [

@@ -1,27 +1,24 @@
-"""Batch jobs' bodies (backend/schemas/jobs.py): the kinds told apart by ``kind`` (MJTF when it is
-left out), each bounded field by field and by one work budget in jumps, and a job read back."""
+"""Batch jobs' bodies (each kind's module in backend/jobs/, their union in backend/jobs/__init__.py):
+the kinds told apart by ``kind`` (MJTF when it is left out), each bounded field by field and by
+one work budget in jumps, and a job read back."""
 
 import dataclasses
 import datetime
+from typing import Literal
 
 import pytest
 
-from backend.schemas.job_budget import WORK_BUDGET_JUMPS, worst_case_jumps
-from backend.schemas.jobs import (
-    JOB_KINDS,
-    BasinJobCreate,
-    ControlStudyJobCreate,
-    GaitSearchJobCreate,
-    JobCreate,
-    JobOut,
-    JobResults,
-    JobState,
-    MfptJobCreate,
-    MJTFJobCreate,
-    NoiseIn,
-    SweepJobCreate,
-    ViabilityJobCreate,
-)
+from backend.jobs import JOB_KINDS, KINDS, JobCreate, UnreadableSpec, job_kind, worst_case_jumps
+from backend.jobs.basin import BasinJobCreate
+from backend.jobs.control_study import ControlStudyJobCreate
+from backend.jobs.gaits import GaitSearchJobCreate
+from backend.jobs.mfpt import MfptJobCreate
+from backend.jobs.mjtf import MJTFJobCreate
+from backend.jobs.sweep import SweepJobCreate
+from backend.jobs.viability import ViabilityJobCreate
+from backend.schemas import NoiseIn
+from backend.schemas.job_budget import WORK_BUDGET_JUMPS
+from backend.schemas.jobs import JobOut, JobResults, JobState
 from sim_core.model.noise import ASYMMETRY_LIMITS, SIGMA_LIMITS, NoiseModel
 from tests.backend.schemas.refusals import LEG, START, accepted, refusal_messages, refused
 
@@ -282,3 +279,12 @@ def test_a_viability_job_at_its_largest_grid_is_within_the_budget_and_its_defaul
 def test_a_bad_viability_job_is_refused_naming_the_field(change, where, says):
     assert refused(ViabilityJobCreate, VIABILITY | change) == [where]
     assert says in refusal_messages(ViabilityJobCreate, VIABILITY | change)
+
+
+@pytest.mark.parametrize("kind", KINDS, ids=lambda kind: kind.name)
+def test_each_registered_kind_names_itself_in_its_request_and_its_spec(kind):
+    assert kind.request.model_fields["kind"].annotation == Literal[kind.name]
+    assert next(field.default for field in dataclasses.fields(kind.spec) if field.name == "kind") == kind.name
+    assert JOB_KINDS[kind.name] is kind.request and job_kind(kind.name) is kind
+    with pytest.raises(UnreadableSpec, match="unknown job kind"):
+        job_kind("no-such-kind")

@@ -1,13 +1,14 @@
-"""The MFPT jobs' bodies (backend/schemas/mfpt_jobs.py): a controller's MFPT by splitting — its law
-one of the four, no pitch drift (sim_core's own words, at the field), replicas x runs bounded
-within the work budget. The gait's chain (``mfpt``) is tested with the other kinds (test_jobs.py)."""
+"""The MFPT jobs' bodies (backend/jobs/mfpt.py, loop_mfpt.py): a controller's MFPT by splitting —
+its law one of the four, no pitch drift (sim_core's own words, at the field), replicas x runs bounded
+within the work budget. The gait's chain (``mfpt``) is tested with the other kinds (test_kinds.py)."""
 
 import pytest
 
-from backend.schemas import JobCreate
-from backend.schemas.job_budget import LOOP_MFPT_MAX_REPLICA_RUNS, WORK_BUDGET_JUMPS, worst_case_jumps
-from backend.schemas.mfpt_jobs import ControllerKind, LoopMfptJobCreate
-from sim_core.control.laws import KINDS
+from backend.jobs import JobCreate, worst_case_jumps
+from backend.jobs.loop_mfpt import LOOP_MFPT_MAX_REPLICA_RUNS, LoopMfptJobCreate
+from backend.schemas import ControllerKind
+from backend.schemas.job_budget import WORK_BUDGET_JUMPS
+from sim_core.control.registry import KINDS
 from sim_core.model.noise import NoiseModel
 from sim_core.model.validation import ParameterError
 from sim_core.robustness.splitting import SplittingOptions, check_metastable
