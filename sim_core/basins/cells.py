@@ -75,7 +75,7 @@ def converge_states(
     states = np.array(starts, dtype=np.float64)  # a copy: each round moves the states on
     count = states.shape[0]
     jumps_to_converge, failure, jumps_done = (np.empty(count, dtype=np.int64) for _ in range(3))
-    arguments = (schedule.as_array(), np.ascontiguousarray(orbit, dtype=np.float64), tolerance, *model.kernel_args())
+    arguments = (schedule.as_array(), np.ascontiguousarray(orbit, dtype=np.float64), tolerance, model.record())
     cells, first_jump = np.arange(count), 0
     for round_, cap in enumerate(caps(max_jumps, jump_limit)):
         if round_:
@@ -107,7 +107,7 @@ def _near_orbit(xdot, ydot, phase, period, orbit, tolerance):
 
 
 @kernel
-def converge(xdot, ydot, first_jump, cap, schedule, orbit, tolerance, alpha, d_hat, c_zeta, c_psi, mu):
+def converge(xdot, ydot, first_jump, cap, schedule, orbit, tolerance, model):
     """Run jumps ``first_jump`` … ``cap - 1`` from ``(xdot, ydot)``, the state after ``first_jump``
     jumps (already tested when ``first_jump > 0``), until it reaches ``orbit`` or fails.
 
@@ -119,9 +119,7 @@ def converge(xdot, ydot, first_jump, cap, schedule, orbit, tolerance, alpha, d_h
     if first_jump == 0 and _near_orbit(xdot, ydot, 0, period, orbit, tolerance):
         return 0, OK, 0, xdot, ydot
     for k in range(first_jump, cap):
-        status, next_xdot, next_ydot, _ = scheduled_jump(
-            xdot, ydot, schedule, k, alpha, d_hat, c_zeta, c_psi, mu, no_record
-        )
+        status, next_xdot, next_ydot, _ = scheduled_jump(xdot, ydot, schedule, k, model, no_record)
         if status != OK:
             return NOT_CONVERGED, status, k + 1, xdot, ydot
         xdot, ydot = next_xdot, next_ydot
@@ -140,11 +138,7 @@ def converge_batch(
     schedule,
     orbit,
     tolerance,
-    alpha,
-    d_hat,
-    c_zeta,
-    c_psi,
-    mu,
+    model,
     jumps_to_converge,
     failure,
     jumps,
@@ -153,5 +147,5 @@ def converge_batch(
     its run stopped; outputs are (N,) int arrays."""
     for i in prange(states.shape[0]):
         jumps_to_converge[i], failure[i], jumps[i], states[i, 0], states[i, 1] = converge(
-            states[i, 0], states[i, 1], first_jump, cap, schedule, orbit, tolerance, alpha, d_hat, c_zeta, c_psi, mu
+            states[i, 0], states[i, 1], first_jump, cap, schedule, orbit, tolerance, model
         )

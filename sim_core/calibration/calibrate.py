@@ -77,7 +77,7 @@ def predict(pairs: Pairs, model: ModelParams, offsets: LegOffsets) -> tuple[np.n
     out = np.empty((len(pairs), 3))
     psi0 = np.radians(np.asarray(offsets.psi0_offset_deg, dtype=float))
     zeta0 = np.asarray(offsets.zeta0_offset, dtype=float)
-    failed = predict_pairs(pairs.before, pairs.after, *model.kernel_args(), psi0, zeta0, out)
+    failed = predict_pairs(pairs.before, pairs.after, model.record(), psi0, zeta0, out)
     return out, int(failed)
 
 
@@ -203,7 +203,7 @@ def _confounded(correlation: np.ndarray) -> tuple[tuple[str, str, float], ...]:
 
 def _sensitivities(pairs: Pairs, model: ModelParams, offsets: LegOffsets) -> np.ndarray:
     psi0 = np.radians(np.asarray(offsets.psi0_offset_deg, dtype=float))
-    return sensitivities(pairs, model.kernel_args(), psi0, np.asarray(offsets.zeta0_offset, dtype=float))
+    return sensitivities(pairs, model.record(), psi0, np.asarray(offsets.zeta0_offset, dtype=float))
 
 
 def _whitening(sensitivity: np.ndarray, noise: TouchdownNoise) -> np.ndarray:

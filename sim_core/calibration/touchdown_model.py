@@ -27,6 +27,7 @@ from sim_core._jit import kernel
 from sim_core.calibration.touchdown_series import PSI0_ERROR, ZETA0_ERROR, Pairs
 from sim_core.model.failures import OK
 from sim_core.model.integrate import STATE_SIZE
+from sim_core.model.params import ModelRecord
 from sim_core.model.stride import jump
 
 # Inputs :func:`sensitivities` differentiates by: (table, column) and the finite-difference step.
@@ -60,11 +61,12 @@ def _foot_shift(ydot, shift, psi0, zeta0, psi0_commanded, zeta0_commanded):
 
 
 @kernel
-def predict_pairs(before, after, alpha, d_hat, c_zeta, c_psi, mu, psi0_offsets, zeta0_offsets, out):
+def predict_pairs(before, after, model, psi0_offsets, zeta0_offsets, out):
     """The detected touchdown ``k + 1`` the model predicts from each measured touchdown ``k``.
 
     Args:
         before, after: :class:`Pairs` columns; only ``after``'s controls, leg and pitch are read.
+        model: the model's record (:meth:`sim_core.model.params.ModelParams.record`).
         psi0_offsets [rad], zeta0_offsets [l0]: shape (2,), left and right leg.
         out: output (pairs, 3): predicted ``xdot, ydot`` and rise [l0]; NaN where the jump failed.
 
@@ -87,7 +89,7 @@ def predict_pairs(before, after, alpha, d_hat, c_zeta, c_psi, mu, psi0_offsets, 
         shift = _detection_shift(xdot, psi0, zeta0, psi_c, zeta_c)
         ydot = before[i, 1] + shift  # back to the real touchdown
         status, next_xdot, next_ydot, rise, _, _, _ = jump(
-            xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c_psi, mu, no_record
+            xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, model, no_record
         )
         if status != OK or not (next_xdot < 0.0):
             out[i, :] = math.nan
@@ -104,16 +106,17 @@ def predict_pairs(before, after, alpha, d_hat, c_zeta, c_psi, mu, psi0_offsets, 
     return failed
 
 
-def sensitivities(pairs: Pairs, model_args: tuple, psi0_offsets: np.ndarray, zeta0_offsets: np.ndarray) -> np.ndarray:
+def sensitivities(pairs: Pairs, model: ModelRecord, psi0_offsets: np.ndarray, zeta0_offsets: np.ndarray) -> np.ndarray:
     """Shape (pairs, 3, 6): how each predicted ``(xdot, ydot, rise)`` moves with the inputs of
     :data:`INPUTS` — the measured state ``(xdot, ydot)`` of touchdown ``k`` and the two legs'
-    ``(psi0 [rad], zeta0 [l0])`` errors — by central differences; NaN where a jump fails."""
+    ``(psi0 [rad], zeta0 [l0])`` errors — by central differences, on ``model``
+    (:meth:`sim_core.model.params.ModelParams.record`); NaN where a jump fails."""
     result = np.empty((len(pairs), 3, len(INPUTS)))
     plus, minus = np.empty((len(pairs), 3)), np.empty((len(pairs), 3))
     for j, (table, column, step) in enumerate(INPUTS):
         for sign, out in ((1.0, plus), (-1.0, minus)):
             tables = {"before": pairs.before.copy(), "after": pairs.after.copy()}
             tables[table][:, column] += sign * step
-            predict_pairs(tables["before"], tables["after"], *model_args, psi0_offsets, zeta0_offsets, out)
+            predict_pairs(tables["before"], tables["after"], model, psi0_offsets, zeta0_offsets, out)
         result[:, :, j] = (plus - minus) / (2.0 * step)
     return result

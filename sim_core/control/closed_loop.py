@@ -155,8 +155,8 @@ def closed_loop_climb(
         controller.zeta0_min,
         controller.zeta0_max,
         int(seed),
-        *noise.kernel_args(),
-        *model.kernel_args(),
+        noise.record(),
+        model.record(),
         time,
         height,
         zeta0,
@@ -188,7 +188,6 @@ def pid_step(error, previous_error, integral, zeta0_hover, kp, ki, kd, zeta0_min
     return command, integral if pushing_out else integral + error
 
 
-# Flat scalar arguments, in mjtf_trials.trial's order: repeated on purpose (see there).
 @kernel
 def pid_loop(
     xdot,
@@ -203,30 +202,20 @@ def pid_loop(
     zeta0_min,
     zeta0_max,
     seed,
-    sigma_psi0,
-    sigma_zeta0,
-    sigma_velocity,
-    sigma_pitch,
-    asymmetry_psi0,
-    asymmetry_zeta0,
-    alpha,
-    d_hat,
-    c_zeta,
-    c_psi,
-    mu,
+    noise,
+    model,
     time,
     height,
     zeta0_used,
     states,
 ):
-    """The closed loop, compiled; fills the output arrays per touchdown. Returns ``(status, jumps)``."""
+    """The closed loop, compiled; fills the output arrays per touchdown. Returns ``(status, jumps)``.
+    ``noise`` and ``model`` are the records of :class:`NoiseModel` and :class:`ModelParams`."""
     seed_trial(seed)
     no_record = np.empty((0, STATE_SIZE))
     jumps = time.shape[0] - 1
     pitch = 0.0
-    psi0, zeta0 = perturbed_controls(
-        schedule, 0, pitch, first_zeta0, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
-    )
+    psi0, zeta0 = perturbed_controls(schedule, 0, pitch, first_zeta0, noise)
     foot = 0.0
     now = 0.0
     integral = 0.0
@@ -244,16 +233,14 @@ def pid_loop(
         error = target - body
         command, integral = pid_step(error, previous_error, integral, zeta0_hover, kp, ki, kd, zeta0_min, zeta0_max)
         previous_error = error
-        next_pitch = pitch_step(pitch, sigma_pitch)
-        next_psi0, next_zeta0 = perturbed_controls(
-            schedule, k + 1, next_pitch, command, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
-        )
+        next_pitch = pitch_step(pitch, noise)
+        next_psi0, next_zeta0 = perturbed_controls(schedule, k + 1, next_pitch, command, noise)
         status, xdot, ydot, rise, stance_time, flight_time, _ = jump(
-            xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c_psi, mu, no_record
+            xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, model, no_record
         )
         if status != OK:
             return status, k
-        xdot, ydot = disturbed_state(xdot, ydot, sigma_velocity)
+        xdot, ydot = disturbed_state(xdot, ydot, noise)
         foot += rise
         now += stance_time + flight_time
         pitch, psi0, zeta0 = next_pitch, next_psi0, next_zeta0

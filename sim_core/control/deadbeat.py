@@ -40,12 +40,13 @@ import numpy as np
 from sim_core._jit import kernel
 from sim_core.model.failures import OK
 from sim_core.model.integrate import STATE_SIZE
+from sim_core.model.params import ModelRecord
 from sim_core.model.stride import flight, jump, lift_off
 from sim_core.viability.guard import lands_in_kernel
 
 # Parameter layout of the compiled law (sim_core.control.laws.Deadbeat.kernel_args).
 TARGET, PSI0_STAR, ZETA0_STAR, ZETA0_LOW, ZETA0_HIGH, PSI0_LOW, PSI0_HIGH, CLIMB_PER_JUMP, PITCH_GAIN = range(9)
-MODEL = 9  # the design model's (alpha, d_hat, c_zeta, c_psi, mu)
+MODEL = 9  # the design model's ModelRecord fields, in their order (alpha, d_hat, c_zeta, c_psi, mu)
 XDOT_STAR, YDOT_STAR, Q_STATE = 14, 15, 16
 PARAMETER_COUNT = 17  # then, optionally, the viability guard (sim_core.viability.guard's layout)
 GRID = 13  # candidates over the leg's range
@@ -55,8 +56,11 @@ INVPHI = (math.sqrt(5.0) - 1.0) / 2.0
 
 @kernel
 def design_model(parameters):
-    """The design model's ``(alpha, d_hat, c_zeta, c_psi, mu)`` from the law's parameters."""
-    return parameters[MODEL], parameters[MODEL + 1], parameters[MODEL + 2], parameters[MODEL + 3], parameters[MODEL + 4]
+    """The design model's record (:class:`sim_core.model.params.ModelRecord`) from the law's
+    parameters, where :meth:`sim_core.control.laws.Deadbeat.kernel_args` lays it out."""
+    return ModelRecord(
+        parameters[MODEL], parameters[MODEL + 1], parameters[MODEL + 2], parameters[MODEL + 3], parameters[MODEL + 4]
+    )
 
 
 @kernel
@@ -64,24 +68,24 @@ def horizon_cost(parameters, psi, vx, vy, foot_to_body, next_zeta0, aim_1, aim_2
     """The cost of ``next_zeta0`` from lift-off (``psi`` [rad], velocity ``vx, vy``);
     ``foot_to_body``: how far the two aims lie above this foot. Inf where the model predicts a
     failure within the two jumps."""
-    alpha, d_hat, c_zeta, c_psi, mu = design_model(parameters)
+    model = design_model(parameters)
     psi0_star, zeta0_star = parameters[PSI0_STAR], parameters[ZETA0_STAR]
-    status, xdot, ydot, landed, _ = flight(psi, vx, vy, d_hat, psi0_star, next_zeta0)  # landed: above this foot
+    status, xdot, ydot, landed, _ = flight(psi, vx, vy, model.d_hat, psi0_star, next_zeta0)  # landed: above this foot
     if status != OK:
         return math.inf
     # Jump k + 1 (stride.jump, cut at its lift-off for the guard).
-    status, psi_1, vx_1, vy_1, _, _ = lift_off(xdot, ydot, psi0_star, next_zeta0, alpha, c_zeta, c_psi, mu, record)
+    status, psi_1, vx_1, vy_1, _, _ = lift_off(xdot, ydot, psi0_star, next_zeta0, model, record)
     if status != OK:
         return math.inf
-    if parameters.size > PARAMETER_COUNT and not lands_in_kernel(parameters, PARAMETER_COUNT, psi_1, vx_1, vy_1, d_hat):
+    guarded = parameters.size > PARAMETER_COUNT
+    if guarded and not lands_in_kernel(parameters, PARAMETER_COUNT, psi_1, vx_1, vy_1, model.d_hat):
         return math.inf
-    status, xdot, ydot, touchdown_height, _ = flight(psi_1, vx_1, vy_1, d_hat, psi0_star, zeta0_star)
+    status, xdot, ydot, touchdown_height, _ = flight(psi_1, vx_1, vy_1, model.d_hat, psi0_star, zeta0_star)
     if status != OK:
         return math.inf
     rise = touchdown_height - zeta0_star * math.sin(psi0_star)
     second = landed - next_zeta0 * math.sin(psi0_star) + rise + zeta0_star * math.sin(psi0_star)
-    status, _, _, _, _, _, _ = jump(xdot, ydot, psi0_star, zeta0_star, psi0_star, zeta0_star, alpha, d_hat, c_zeta,
-                                    c_psi, mu, record)  # fmt: skip
+    status, _, _, _, _, _, _ = jump(xdot, ydot, psi0_star, zeta0_star, psi0_star, zeta0_star, model, record)
     if status != OK:  # the gait's controls would not carry on from there
         return math.inf
     miss_1, miss_2 = landed - (aim_1 + foot_to_body), second - (aim_2 + foot_to_body)
@@ -94,9 +98,8 @@ def deadbeat_zeta0(parameters, psi0, zeta0, height, xdot, ydot):
     """The next touchdown's zeta0 and whether it was guarded or held at the range's end, from
     touchdown ``k``'s body ``height`` [l0], section state and controls ``(psi0, zeta0)``."""
     record = np.empty((0, STATE_SIZE))
-    alpha, _, c_zeta, c_psi, mu = design_model(parameters)
     zeta0_star, low, high = parameters[ZETA0_STAR], parameters[ZETA0_LOW], parameters[ZETA0_HIGH]
-    status, psi, vx, vy, _, _ = lift_off(xdot, ydot, psi0, zeta0, alpha, c_zeta, c_psi, mu, record)
+    status, psi, vx, vy, _, _ = lift_off(xdot, ydot, psi0, zeta0, design_model(parameters), record)
     if status != OK:  # the stance under way is predicted to fail: nothing later changes that
         return zeta0_star, True
     step = parameters[CLIMB_PER_JUMP]
@@ -146,7 +149,7 @@ def design_deadbeat(
 
     gait = gait_of(model, ControlSchedule.of(LegControl(math.radians(psi0_deg), zeta0_hover)), guess=START_GUESS)
     state = (float(gait.state[0]), float(gait.state[1]))
-    law = Deadbeat(target, psi0_deg, zeta0_hover, state, model.kernel_args(), **options)
+    law = Deadbeat(target, psi0_deg, zeta0_hover, state, tuple(model.record()), **options)
     if not viability_guard:
         return law
     return replace(law, guard=design_guard(model, psi0_deg, law.zeta0_range))

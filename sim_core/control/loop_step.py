@@ -31,14 +31,11 @@ LOOP_STATE_SIZE = MEMORY + MEMORY_SIZE
 
 
 @kernel
-def start_loop(
-    state, kind, xdot, ydot, first_psi0, first_zeta0, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
-):
+def start_loop(state, kind, xdot, ydot, first_psi0, first_zeta0, noise):
     """Fill ``state`` with the loop at its first touchdown: the foot at height 0, zero pitch, the
-    first leg commanded ``(first_psi0, first_zeta0)`` and realised with fresh noise."""
-    psi0, zeta0 = commanded_controls(
-        0, 0.0, first_psi0, first_zeta0, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
-    )
+    first leg commanded ``(first_psi0, first_zeta0)`` and realised with fresh noise (``noise``: a
+    :class:`sim_core.model.noise.NoiseRecord`)."""
+    psi0, zeta0 = commanded_controls(0, 0.0, first_psi0, first_zeta0, noise)
     state[XDOT], state[YDOT], state[PSI0], state[ZETA0] = xdot, ydot, psi0, zeta0
     state[FOOT], state[PITCH] = 0.0, 0.0
     state[MEMORY:] = start_memory(kind, first_psi0, first_zeta0)
@@ -51,42 +48,24 @@ def body_height(state):
 
 
 @kernel
-def loop_jump(
-    state,
-    k,
-    kind,
-    parameters,
-    sigma_psi0,
-    sigma_zeta0,
-    sigma_velocity,
-    sigma_pitch,
-    asymmetry_psi0,
-    asymmetry_zeta0,
-    alpha,
-    d_hat,
-    c_zeta,
-    c_psi,
-    mu,
-    no_record,
-):
+def loop_jump(state, k, kind, parameters, noise, model, no_record):
     """From touchdown ``k`` to ``k + 1``: the law reads what touchdown ``k`` shows (its height, the
     pitch tracked in its stance, its section state) and sets touchdown ``k + 1``; ``state`` is
-    advanced in place. Returns ``(status, clipped)``: on a jump's failure only the law's memory has
-    moved; a touchdown with the body below the floor is reached, and ends the run as ``FLOOR``."""
+    advanced in place; ``noise`` and ``model`` are the records of :class:`sim_core.model.noise.NoiseModel`
+    and :class:`sim_core.model.params.ModelParams`. Returns ``(status, clipped)``: on a jump's failure
+    only the law's memory has moved; a touchdown with the body below the floor is reached, and ends
+    the run as ``FLOOR``."""
     command_psi0, command_zeta0, clipped = control_step(
         kind, parameters, state[MEMORY:], body_height(state), state[PITCH], state[XDOT], state[YDOT], (k + 1) % 2 == 0
     )
-    next_pitch = pitch_step(state[PITCH], sigma_pitch)
-    next_psi0, next_zeta0 = commanded_controls(
-        k + 1, next_pitch, command_psi0, command_zeta0, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
-    )
+    next_pitch = pitch_step(state[PITCH], noise)
+    next_psi0, next_zeta0 = commanded_controls(k + 1, next_pitch, command_psi0, command_zeta0, noise)
     status, xdot, ydot, rise, _stance_time, _flight_time, _ = jump(
-        state[XDOT], state[YDOT], state[PSI0], state[ZETA0], next_psi0, next_zeta0, alpha, d_hat, c_zeta, c_psi, mu,
-        no_record,
-    )  # fmt: skip
+        state[XDOT], state[YDOT], state[PSI0], state[ZETA0], next_psi0, next_zeta0, model, no_record
+    )
     if status != OK:
         return status, clipped
-    xdot, ydot = disturbed_state(xdot, ydot, sigma_velocity)
+    xdot, ydot = disturbed_state(xdot, ydot, noise)
     state[XDOT], state[YDOT], state[PSI0], state[ZETA0] = xdot, ydot, next_psi0, next_zeta0
     state[FOOT] += rise
     state[PITCH] = next_pitch

@@ -43,11 +43,13 @@ def linearised_map(model: ModelParams, state, psi0: float, zeta0: float) -> np.n
     ``state`` with controls ``(psi0 [rad], zeta0)`` on every jump."""
     point = np.array([state[0], state[1], psi0, zeta0, psi0, zeta0])
     record = np.empty((0, STATE_SIZE))
-    args = model.kernel_args()
+    parameters = model.record()
 
     def outcome(values: np.ndarray) -> np.ndarray:
         xdot, ydot, psi0_k, zeta0_k, psi0_next, zeta0_next = values
-        status, next_xdot, next_ydot, rise, *_ = jump(xdot, ydot, psi0_k, zeta0_k, psi0_next, zeta0_next, *args, record)
+        status, next_xdot, next_ydot, rise, *_ = jump(
+            xdot, ydot, psi0_k, zeta0_k, psi0_next, zeta0_next, parameters, record
+        )
         if status != OK:
             raise ParameterError("psi0_deg", "the gait fails within a linearisation step: no LQR about it")
         body_rise = rise + zeta0_next * math.sin(psi0_next) - zeta0_k * math.sin(psi0_k)

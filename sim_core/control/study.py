@@ -174,7 +174,7 @@ def study_chunk(
         clipped = np.zeros(jumps, dtype=np.bool_)
         status, completed = controlled_loop(
             state[0], state[1], math.radians(controller.psi0_deg), start_zeta0, kind, parameters, seed,
-            *noise.kernel_args(), *model.kernel_args(), height, clipped,
+            noise.record(), model.record(), height, clipped,
         )  # fmt: skip
         if status != OK:
             codes[Failure(status).code] += 1
@@ -233,47 +233,21 @@ def _time_steps(kind, parameters, steps):
     return total
 
 
-# Flat scalar arguments, in closed_loop.pid_loop's order from the seed on: repeated on purpose.
 @kernel
-def controlled_loop(
-    xdot,
-    ydot,
-    first_psi0,
-    first_zeta0,
-    kind,
-    parameters,
-    seed,
-    sigma_psi0,
-    sigma_zeta0,
-    sigma_velocity,
-    sigma_pitch,
-    asymmetry_psi0,
-    asymmetry_zeta0,
-    alpha,
-    d_hat,
-    c_zeta,
-    c_psi,
-    mu,
-    height,
-    saturated,
-):
-    """One trial under controller ``(kind, parameters)``; fills ``height`` per touchdown reached [l0]
-    and ``saturated`` per command. Returns ``(status, jumps completed)``."""
+def controlled_loop(xdot, ydot, first_psi0, first_zeta0, kind, parameters, seed, noise, model, height, saturated):
+    """One trial under controller ``(kind, parameters)`` with the ``noise`` and ``model`` records
+    (:meth:`NoiseModel.record`, :meth:`ModelParams.record`); fills ``height`` per touchdown reached
+    [l0] and ``saturated`` per command. Returns ``(status, jumps completed)``."""
     seed_trial(seed)
     no_record = np.empty((0, STATE_SIZE))
     state = np.empty(LOOP_STATE_SIZE)
-    start_loop(
-        state, kind, xdot, ydot, first_psi0, first_zeta0, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
-    )
+    start_loop(state, kind, xdot, ydot, first_psi0, first_zeta0, noise)
     jumps = height.shape[0] - 1
     for k in range(jumps + 1):
         height[k] = body_height(state)
         if k == jumps:
             break
-        status, saturated[k] = loop_jump(
-            state, k, kind, parameters, sigma_psi0, sigma_zeta0, sigma_velocity, sigma_pitch, asymmetry_psi0,
-            asymmetry_zeta0, alpha, d_hat, c_zeta, c_psi, mu, no_record,
-        )  # fmt: skip
+        status, saturated[k] = loop_jump(state, k, kind, parameters, noise, model, no_record)
         if status != OK:
             return status, k
     return OK, jumps

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -43,6 +44,19 @@ ZETA0_MIN, ZETA0_MAX = ZETA0_LIMITS
 # offset in (-limit, limit). The API's request schema states the same ranges from these.
 SIGMA_LIMITS = {"psi0_deg": 30.0, "zeta0": 0.2, "velocity": 1.0, "pitch_drift_deg": 30.0}
 ASYMMETRY_LIMITS = {"asymmetry_psi0_deg": 30.0, "asymmetry_zeta0": 0.5}
+
+
+class NoiseRecord(NamedTuple):
+    """:class:`NoiseModel` as the compiled kernels take it (:meth:`NoiseModel.record`): one typed
+    argument, read by field (``noise.sigma_pitch``), angles in radians. numba types it as a named
+    tuple of six float64."""
+
+    sigma_psi0: float  # standard deviation of the leg angle at touchdown [rad]
+    sigma_zeta0: float  # standard deviation of the leg length at touchdown [l0]
+    sigma_velocity: float  # standard deviation of each section-state component [sqrt(g l0)]
+    sigma_pitch: float  # standard deviation of the pitch random walk's step [rad]
+    asymmetry_psi0: float  # the right leg's leg-angle offset [rad]
+    asymmetry_zeta0: float  # the right leg's leg-length offset [l0]
 
 
 @dataclass(frozen=True)
@@ -70,15 +84,15 @@ class NoiseModel:
         for field, limit in ASYMMETRY_LIMITS.items():
             check_range(f"noise.{field}", getattr(self, field), -limit, limit)
 
-    def kernel_args(self) -> tuple[float, ...]:
-        """``(sigma_psi0, sigma_zeta0, sigma_velocity, sigma_pitch, asymmetry_psi0, asymmetry_zeta0)``, radians."""
-        return (
-            math.radians(self.psi0_deg),
-            self.zeta0,
-            self.velocity,
-            math.radians(self.pitch_drift_deg),
-            math.radians(self.asymmetry_psi0_deg),
-            self.asymmetry_zeta0,
+    def record(self) -> NoiseRecord:
+        """The noise as the compiled kernels take it, angles in radians, every value a float."""
+        return NoiseRecord(
+            sigma_psi0=math.radians(self.psi0_deg),
+            sigma_zeta0=float(self.zeta0),
+            sigma_velocity=float(self.velocity),
+            sigma_pitch=math.radians(self.pitch_drift_deg),
+            asymmetry_psi0=math.radians(self.asymmetry_psi0_deg),
+            asymmetry_zeta0=float(self.asymmetry_zeta0),
         )
 
     def to_dict(self) -> dict:

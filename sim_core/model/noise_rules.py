@@ -4,8 +4,9 @@ Each rule is written once, as a compiled function of the draws (:func:`noisy_con
 :func:`drifted_pitch`, :func:`disturbed`; docs/model.md §5.1). Two samplers feed them: the kernels
 here (:func:`perturbed_controls`, :func:`pitch_step`, :func:`disturbed_state`; numba's generator,
 seeded once per trial, so MJTF and the PID study depend only on their seed, never on the number
-of threads or workers), and :class:`NoiseSampler` (a numpy ``Generator``), which the climb
-sequencer (:mod:`sim_core.climb.sequencer`) uses for the virtual robot. Both draw in the same order: a
+of threads or workers; each takes the noise as one record, :meth:`sim_core.model.noise.NoiseModel.record`),
+and :class:`NoiseSampler` (a numpy ``Generator``), which the climb sequencer
+(:mod:`sim_core.climb.sequencer`) uses for the virtual robot. Both draw in the same order: a
 pitch step, then ``psi0``, then ``zeta0`` of the next leg; after the jump, ``xdot`` then ``ydot``;
 a zero standard deviation draws nothing.
 """
@@ -65,39 +66,41 @@ def _draw(sigma):
 
 
 @kernel
-def perturbed_controls(schedule, k, pitch, base_zeta0, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0):
-    """Controls ``(psi0, zeta0)`` of jump ``k`` with pitch ``pitch`` and fresh noise.
+def perturbed_controls(schedule, k, pitch, base_zeta0, noise):
+    """Controls ``(psi0, zeta0)`` of jump ``k`` with pitch ``pitch`` and fresh noise (``noise``: a
+    :class:`sim_core.model.noise.NoiseRecord`).
 
     ``base_zeta0`` replaces the schedule's zeta0 when finite (the closed loop's command).
     """
     row = k % schedule.shape[0]
     zeta0 = schedule[row, ZETA0_COLUMN] if math.isnan(base_zeta0) else base_zeta0
-    return commanded_controls(
-        k, pitch, schedule[row, PSI0_COLUMN], zeta0, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
+    return commanded_controls(k, pitch, schedule[row, PSI0_COLUMN], zeta0, noise)
+
+
+@kernel
+def commanded_controls(k, pitch, psi0, zeta0, noise):
+    """Controls ``(psi0, zeta0)`` of jump ``k`` commanded ``(psi0, zeta0)``, with pitch ``pitch``
+    and fresh noise (the draws in the order :func:`perturbed_controls` takes them)."""
+    right_leg = k % 2 == 1  # sim_core.model.walls.wall_of(k) is Wall.RIGHT, spelled for numba
+    psi0_draw = _draw(noise.sigma_psi0)
+    zeta0_draw = _draw(noise.sigma_zeta0)
+    return noisy_controls(
+        psi0, zeta0, right_leg, pitch, noise.asymmetry_psi0, noise.asymmetry_zeta0, psi0_draw, zeta0_draw
     )
 
 
 @kernel
-def commanded_controls(k, pitch, psi0, zeta0, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0):
-    """Controls ``(psi0, zeta0)`` of jump ``k`` commanded ``(psi0, zeta0)``, with pitch ``pitch``
-    and fresh noise (the draws in the order :func:`perturbed_controls` takes them)."""
-    right_leg = k % 2 == 1  # sim_core.model.walls.wall_of(k) is Wall.RIGHT, spelled for numba
-    psi0_draw = _draw(sigma_psi0)
-    zeta0_draw = _draw(sigma_zeta0)
-    return noisy_controls(psi0, zeta0, right_leg, pitch, asymmetry_psi0, asymmetry_zeta0, psi0_draw, zeta0_draw)
-
-
-@kernel
-def disturbed_state(xdot, ydot, sigma_velocity):
+def disturbed_state(xdot, ydot, noise):
     """The section state with measurement-free process noise added to each component."""
-    xdot_draw = _draw(sigma_velocity)
-    ydot_draw = _draw(sigma_velocity)
+    xdot_draw = _draw(noise.sigma_velocity)
+    ydot_draw = _draw(noise.sigma_velocity)
     return disturbed(xdot, ydot, xdot_draw, ydot_draw)
 
 
 @kernel
-def pitch_step(pitch, sigma_pitch):
-    return drifted_pitch(pitch, _draw(sigma_pitch))
+def pitch_step(pitch, noise):
+    """The next jump's pitch [rad], drawn."""
+    return drifted_pitch(pitch, _draw(noise.sigma_pitch))
 
 
 # The Python sampler (a numpy Generator) ----------------------------------------------------------
@@ -110,28 +113,27 @@ class NoiseSampler:
 
     def __init__(self, noise: NoiseModel, rng: np.random.Generator):
         self.noise, self.rng = noise, rng
-        (self._psi0, self._zeta0, self._velocity, self._pitch, self._asymmetry_psi0, self._asymmetry_zeta0) = (
-            noise.kernel_args()
-        )
+        self._record = noise.record()
 
     def _draw(self, sigma: float) -> float:
         return float(self.rng.normal(0.0, sigma)) if sigma > 0.0 else 0.0
 
     def pitch_step(self, pitch: float) -> float:
         """The next jump's pitch [rad]."""
-        return float(drifted_pitch(pitch, self._draw(self._pitch)))
+        return float(drifted_pitch(pitch, self._draw(self._record.sigma_pitch)))
 
     def controls(self, commanded: LegControl, wall: Wall, pitch: float) -> LegControl:
         """The controls the leg on ``wall`` touches down with, commanded ``commanded``, at ``pitch`` [rad]."""
-        psi0_draw = self._draw(self._psi0)
-        zeta0_draw = self._draw(self._zeta0)
+        noise = self._record
+        psi0_draw = self._draw(noise.sigma_psi0)
+        zeta0_draw = self._draw(noise.sigma_zeta0)
         psi0, zeta0 = noisy_controls(
             commanded.psi0,
             commanded.zeta0,
             wall == Wall.RIGHT,
             pitch,
-            self._asymmetry_psi0,
-            self._asymmetry_zeta0,
+            noise.asymmetry_psi0,
+            noise.asymmetry_zeta0,
             psi0_draw,
             zeta0_draw,
         )
@@ -139,7 +141,7 @@ class NoiseSampler:
 
     def state(self, state) -> tuple[float, float]:
         """A section state ``(xdot, ydot)`` after a jump, with process noise."""
-        xdot_draw = self._draw(self._velocity)
-        ydot_draw = self._draw(self._velocity)
+        xdot_draw = self._draw(self._record.sigma_velocity)
+        ydot_draw = self._draw(self._record.sigma_velocity)
         xdot, ydot = disturbed(float(state[0]), float(state[1]), xdot_draw, ydot_draw)
         return float(xdot), float(ydot)

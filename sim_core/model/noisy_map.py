@@ -55,11 +55,7 @@ def middle_step(
     zeta0_draw,
     xdot_draw,
     ydot_draw,
-    alpha,
-    d_hat,
-    c_zeta,
-    c_psi,
-    mu,
+    model,
     no_record,
 ):
     """One noisy jump from the middle of a flight to the middle of the next.
@@ -70,20 +66,21 @@ def middle_step(
             pitch, negated, plus the step's pitch draw).
         psi0, zeta0: the commanded controls of the coming leg [rad, l0].
         psi0_draw ... ydot_draw: the step's other noise, already scaled.
+        model: the model's record (:meth:`sim_core.model.params.ModelParams.record`).
 
     Returns:
         ``(status, xdot, ydot)`` at the next middle; NaNs after a failed stance or flight.
     """
     nan = math.nan
     psi, zeta = noisy_controls(psi0, zeta0, False, next_pitch, 0.0, 0.0, psi0_draw, zeta0_draw)
-    time = (0.5 * d_hat - zeta * math.cos(psi)) / xdot
+    time = (0.5 * model.d_hat - zeta * math.cos(psi)) / xdot
     touchdown_xdot, touchdown_ydot = disturbed(-xdot, ydot - time, xdot_draw, ydot_draw)
     status, psi_end, liftoff_xdot, liftoff_ydot, _, _ = lift_off(
-        touchdown_xdot, touchdown_ydot, psi, zeta, alpha, c_zeta, c_psi, mu, no_record
+        touchdown_xdot, touchdown_ydot, psi, zeta, model, no_record
     )
     if status != OK:
         return status, nan, nan
-    return to_middle(psi_end, liftoff_xdot, liftoff_ydot, d_hat)
+    return to_middle(psi_end, liftoff_xdot, liftoff_ydot, model.d_hat)
 
 
 @kernel
@@ -145,8 +142,8 @@ def matched_spread(values, weights, ok, axis):
 
 @parallel_kernel
 def pair_transitions(
-    pair_nodes, pair_layers, xdots, ydots, pitches, state_of, psi0, zeta0, draws, draw_weights,
-    alpha, d_hat, c_zeta, c_psi, mu, cols, probabilities, counts, failed, escaped,
+    pair_nodes, pair_layers, xdots, ydots, pitches, state_of, psi0, zeta0, draws, draw_weights, model,
+    cols, probabilities, counts, failed, escaped,
 ):  # fmt: skip
     """The noisy jump from each *pair*: a velocity node of the grid (``pair_nodes``: ``ix + iy *
     nx`` on the axes ``xdots``, ``ydots``) with the coming leg at the pitch of layer
@@ -175,9 +172,8 @@ def pair_transitions(
         lost = 0.0
         for s in range(samples):
             status, landed_x[s], landed_y[s] = middle_step(
-                x, y, pitches[layer], psi0, zeta0, draws[s, 0], draws[s, 1], draws[s, 2], draws[s, 3],
-                alpha, d_hat, c_zeta, c_psi, mu, no_record,
-            )  # fmt: skip
+                x, y, pitches[layer], psi0, zeta0, draws[s, 0], draws[s, 1], draws[s, 2], draws[s, 3], model, no_record
+            )
             ok[s] = status == OK
             if not ok[s]:
                 lost += draw_weights[s]
@@ -224,7 +220,7 @@ def pair_transitions(
 
 
 @parallel_kernel
-def first_jumps(xdot, ydot, psi0, zeta0, draws, alpha, d_hat, c_zeta, c_psi, mu, states, status):
+def first_jumps(xdot, ydot, psi0, zeta0, draws, model, states, status):
     """The first jump of a trial, as MJTF starts one (docs/model.md §5): from the touchdown
     ``(xdot, ydot)`` at zero pitch, the leg's controls noisy, no velocity noise, to the middle of
     its flight. ``draws`` (n, 2) are the leg's draws (psi0, zeta0, scaled); ``states`` (n, 3)
@@ -232,17 +228,15 @@ def first_jumps(xdot, ydot, psi0, zeta0, draws, alpha, d_hat, c_zeta, c_psi, mu,
     for s in prange(draws.shape[0]):
         no_record = np.empty((0, STATE_SIZE))
         psi, zeta = noisy_controls(psi0, zeta0, False, 0.0, 0.0, 0.0, draws[s, 0], draws[s, 1])
-        result, psi_end, liftoff_xdot, liftoff_ydot, _, _ = lift_off(
-            xdot, ydot, psi, zeta, alpha, c_zeta, c_psi, mu, no_record
-        )
+        result, psi_end, liftoff_xdot, liftoff_ydot, _, _ = lift_off(xdot, ydot, psi, zeta, model, no_record)
         if result == OK:
-            result, states[s, 0], states[s, 1] = to_middle(psi_end, liftoff_xdot, liftoff_ydot, d_hat)
+            result, states[s, 0], states[s, 1] = to_middle(psi_end, liftoff_xdot, liftoff_ydot, model.d_hat)
         states[s, 2] = 0.0
         status[s] = result
 
 
 @parallel_kernel
-def sampled_paths(starts, psi0, zeta0, draws, alpha, d_hat, c_zeta, c_psi, mu, visited, steps):
+def sampled_paths(starts, psi0, zeta0, draws, model, visited, steps):
     """Noisy paths from each start (n, 3: xdot, ydot, pitch) for at most ``draws.shape[1]`` steps
     (``draws`` (n, steps, 5): pitch step, psi0, zeta0, xdot, ydot, scaled): ``visited`` (n,
     steps, 3) gets the states reached (NaN after a failure), ``steps`` (n,) how many steps each
@@ -255,9 +249,8 @@ def sampled_paths(starts, psi0, zeta0, draws, alpha, d_hat, c_zeta, c_psi, mu, v
         for k in range(draws.shape[1]):
             p = -p + draws[i, k, 0]
             status, x, y = middle_step(
-                x, y, p, psi0, zeta0, draws[i, k, 1], draws[i, k, 2], draws[i, k, 3], draws[i, k, 4],
-                alpha, d_hat, c_zeta, c_psi, mu, no_record,
-            )  # fmt: skip
+                x, y, p, psi0, zeta0, draws[i, k, 1], draws[i, k, 2], draws[i, k, 3], draws[i, k, 4], model, no_record
+            )
             if status != OK:
                 steps[i] = k
                 break

@@ -15,8 +15,27 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 from sim_core.model.validation import check_range
+
+
+class ModelRecord(NamedTuple):
+    """:class:`ModelParams` as the compiled kernels take it (:meth:`ModelParams.record`): one typed
+    argument, read by field (``model.alpha``), so a new parameter is added here and in the dataclass
+    alone, not to every kernel's argument list. numba types it as a named tuple of five float64.
+    Fields, units and order as :class:`ModelParams`'s (tests/sim_core/model/test_params.py checks it).
+
+    A ``parallel`` kernel takes a record as an argument; one it built itself and used in a
+    ``prange`` loop fails to compile (numba 0.68 cannot name the type in the loop's generated
+    function), so records are built outside such kernels or in the kernels they call.
+    """
+
+    alpha: float
+    d_hat: float
+    c_zeta: float
+    c_psi: float
+    mu: float
 
 
 @dataclass(frozen=True, slots=True)
@@ -42,9 +61,10 @@ class ModelParams:
         check_range("d_hat", self.d_hat, 0.0)
         _check_damping_and_friction(self)
 
-    def kernel_args(self) -> tuple[float, float, float, float, float]:
-        """``(alpha, d_hat, c_zeta, c_psi, mu)``, the order the compiled kernels take them in."""
-        return (self.alpha, self.d_hat, self.c_zeta, self.c_psi, self.mu)
+    def record(self) -> ModelRecord:
+        """The parameters as the compiled kernels take them. Each is a Python float, so an ``int``
+        given here does not compile a second specialisation of every kernel."""
+        return ModelRecord._make(float(getattr(self, name)) for name in ModelRecord._fields)
 
 
 @dataclass(frozen=True, slots=True)

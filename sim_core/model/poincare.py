@@ -107,7 +107,7 @@ def iterate_map(model: ModelParams, schedule: ControlSchedule, state, jumps: int
     states = np.empty((jumps + 1, 2))
     rises = np.empty(jumps)
     status, completed = stride.orbit(
-        initial[0], initial[1], schedule.as_array(), first_jump, *model.kernel_args(), states, rises
+        initial[0], initial[1], schedule.as_array(), first_jump, model.record(), states, rises
     )
     if status == OK:
         return Orbit(states=states, rises=rises, failure=None, failed_jump=None)
@@ -158,9 +158,7 @@ def iterate_map_batch(
     out_rises = np.empty((count, jumps))
     status = np.empty(count, dtype=np.int64)
     completed = np.empty(count, dtype=np.int64)
-    stride.orbit_batch(
-        initial, schedule_array, first_jump, *model.kernel_args(), out_states, out_rises, status, completed
-    )
+    stride.orbit_batch(initial, schedule_array, first_jump, model.record(), out_states, out_rises, status, completed)
     return OrbitBatch(states=out_states, rises=out_rises, status=status, completed=completed)
 
 

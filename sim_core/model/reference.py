@@ -30,7 +30,7 @@ def reference_jump(
 ) -> tuple[int, float, float, float]:
     """One jump with scipy: ``(status, next_xdot, next_ydot, rise)`` (NaNs on failure)."""
     xdot, ydot = state
-    alpha, d_hat, c_zeta, c_psi, mu = model.kernel_args()
+    alpha, c_zeta, c_psi = model.alpha, model.c_zeta, model.c_psi  # locals: the equations read them every call
     cos0, sin0 = math.cos(leg.psi0), math.sin(leg.psi0)
     start = [leg.zeta0, leg.psi0, xdot * cos0 + ydot * sin0, (-xdot * sin0 + ydot * cos0) / leg.zeta0]
 
@@ -43,7 +43,7 @@ def reference_jump(
             -(math.cos(psi) + 2.0 * zeta_dot * psi_dot) / zeta - c_psi * psi_dot,
         ]
 
-    psi_limit = math.atan(mu)
+    psi_limit = math.atan(model.mu)
     events = [
         _terminal(lambda _t, y: y[0] - 1.0, direction=1.0),
         _terminal(lambda _t, y: y[0] - COLLAPSE_ZETA, direction=-1.0),
@@ -59,7 +59,7 @@ def reference_jump(
     _zeta, psi, zeta_dot, psi_dot = solution.y_events[0][0]
     vx = zeta_dot * math.cos(psi) - psi_dot * math.sin(psi)
     vy = zeta_dot * math.sin(psi) + psi_dot * math.cos(psi)
-    distance = d_hat - math.cos(psi) - next_leg.zeta0 * math.cos(next_leg.psi0)
+    distance = model.d_hat - math.cos(psi) - next_leg.zeta0 * math.cos(next_leg.psi0)
     if vx <= 0.0 or distance <= 0.0:
         return (NO_FLIGHT, *nan)
     flight_time = distance / vx

@@ -5,9 +5,11 @@ section state ``(xdot, ydot)`` (``xdot < 0``: the body flies toward the left wal
 the stance (:func:`sim_core.model.integrate.stance`), the closed-form flight to the right wall, and
 flips coordinates so the next touchdown is again on the left wall.
 
-These are kernels: floats and arrays in, a status out, no validation beyond what keeps them
-from producing garbage. The validated entry point is :mod:`sim_core.model.poincare`; trajectories and
-the studies' own compiled loops (basins, MJTF, the closed loop) call :func:`jump` directly.
+These are kernels: floats, arrays and the model's record (``model``,
+:meth:`sim_core.model.params.ModelParams.record`, read by field) in, a status out, no validation
+beyond what keeps them from producing garbage. The validated entry point is
+:mod:`sim_core.model.poincare`; trajectories and the studies' own compiled loops (basins, MJTF,
+the closed loop) call :func:`jump` directly.
 """
 
 from __future__ import annotations
@@ -42,7 +44,7 @@ def liftoff_velocity(psi, zeta_dot, psi_dot):
 
 
 @kernel
-def lift_off(xdot, ydot, psi0, zeta0, alpha, c_zeta, c_psi, mu, record):
+def lift_off(xdot, ydot, psi0, zeta0, model, record):
     """A jump's stance alone: from its touchdown (section state ``xdot, ydot``, controls ``psi0
     [rad], zeta0``) to lift-off. Returns ``(status, psi, liftoff_xdot, liftoff_ydot, stance_time,
     rows_recorded)``: the leg angle [rad] and body velocity at lift-off, NaN where the stance
@@ -52,7 +54,11 @@ def lift_off(xdot, ydot, psi0, zeta0, alpha, c_zeta, c_psi, mu, record):
         return INVALID_STATE, nan, nan, nan, nan, 0
     zeta_dot, psi_dot = touchdown_polar_state(xdot, ydot, psi0, zeta0)
     final = np.empty(STATE_SIZE)
-    status, rows = stance(zeta0, psi0, zeta_dot, psi_dot, alpha, c_zeta, c_psi, mu, final, record)
+    # The integrator keeps scalar parameters, the four it uses: its DOP853 steps are generated
+    # (scripts/generate_dop853.py) and tested on their own (tests/sim_core/model/test_dop853.py).
+    status, rows = stance(
+        zeta0, psi0, zeta_dot, psi_dot, model.alpha, model.c_zeta, model.c_psi, model.mu, final, record
+    )
     if status != OK:
         return status, nan, nan, nan, final[TIME], rows
     psi = final[PSI]
@@ -61,14 +67,14 @@ def lift_off(xdot, ydot, psi0, zeta0, alpha, c_zeta, c_psi, mu, record):
 
 
 @kernel
-def jump(xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c_psi, mu, record):
+def jump(xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, model, record):
     """One application of the Poincaré map.
 
     Args:
         xdot, ydot: section state at this jump's touchdown (after the flip) [sqrt(g l0)].
         psi0, zeta0: this jump's leg controls [rad, l0]; they set the touchdown just made.
         next_psi0, next_zeta0: the next jump's controls; they set where this flight ends.
-        alpha, d_hat, c_zeta, c_psi, mu: nondimensional model parameters.
+        model: the nondimensional model parameters (:class:`sim_core.model.params.ModelRecord`).
         record: stance nodes, see :func:`sim_core.model.integrate.stance` (shape (0, STATE_SIZE) for none).
 
     Returns:
@@ -79,13 +85,11 @@ def jump(xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c
     nan = math.nan
     if not math.isfinite(next_psi0 + next_zeta0) or not (0.0 < next_zeta0 < 1.0):
         return INVALID_STATE, nan, nan, nan, nan, nan, 0
-    status, psi, liftoff_xdot, liftoff_ydot, stance_time, rows = lift_off(
-        xdot, ydot, psi0, zeta0, alpha, c_zeta, c_psi, mu, record
-    )
+    status, psi, liftoff_xdot, liftoff_ydot, stance_time, rows = lift_off(xdot, ydot, psi0, zeta0, model, record)
     if status != OK:
         return status, nan, nan, nan, stance_time, nan, rows
     status, next_xdot, next_ydot, touchdown_height, flight_time = flight(
-        psi, liftoff_xdot, liftoff_ydot, d_hat, next_psi0, next_zeta0
+        psi, liftoff_xdot, liftoff_ydot, model.d_hat, next_psi0, next_zeta0
     )
     if status != OK:
         return status, nan, nan, nan, stance_time, nan, rows
@@ -111,7 +115,7 @@ def flight(psi, liftoff_xdot, liftoff_ydot, d_hat, next_psi0, next_zeta0):
 
 
 @kernel
-def scheduled_jump(xdot, ydot, schedule, k, alpha, d_hat, c_zeta, c_psi, mu, no_record):
+def scheduled_jump(xdot, ydot, schedule, k, model, no_record):
     """Jump ``k`` of a cyclic schedule (rows ``k`` and ``k + 1`` mod its length); ``no_record`` is
     an empty (0, STATE_SIZE) array, allocated once by the caller's loop.
 
@@ -126,18 +130,14 @@ def scheduled_jump(xdot, ydot, schedule, k, alpha, d_hat, c_zeta, c_psi, mu, no_
         schedule[this, ZETA0_COLUMN],
         schedule[following, PSI0_COLUMN],
         schedule[following, ZETA0_COLUMN],
-        alpha,
-        d_hat,
-        c_zeta,
-        c_psi,
-        mu,
+        model,
         no_record,
     )
     return status, xdot, ydot, rise
 
 
 @kernel
-def orbit(xdot, ydot, schedule, first_jump, alpha, d_hat, c_zeta, c_psi, mu, states, rises):
+def orbit(xdot, ydot, schedule, first_jump, model, states, rises):
     """Iterate the map ``rises.shape[0]`` times with a cyclic control schedule.
 
     Args:
@@ -157,9 +157,7 @@ def orbit(xdot, ydot, schedule, first_jump, alpha, d_hat, c_zeta, c_psi, mu, sta
     states[0, 0] = xdot
     states[0, 1] = ydot
     for k in range(jumps):
-        status, xdot, ydot, rise = scheduled_jump(
-            xdot, ydot, schedule, first_jump + k, alpha, d_hat, c_zeta, c_psi, mu, no_record
-        )
+        status, xdot, ydot, rise = scheduled_jump(xdot, ydot, schedule, first_jump + k, model, no_record)
         if status != OK:
             return status, k
         states[k + 1, 0] = xdot
@@ -169,7 +167,7 @@ def orbit(xdot, ydot, schedule, first_jump, alpha, d_hat, c_zeta, c_psi, mu, sta
 
 
 @parallel_kernel
-def orbit_batch(initial, schedules, first_jump, alpha, d_hat, c_zeta, c_psi, mu, states, rises, status, completed):
+def orbit_batch(initial, schedules, first_jump, model, states, rises, status, completed):
     """:func:`orbit` for many starts on all cores.
 
     Args:
@@ -180,6 +178,4 @@ def orbit_batch(initial, schedules, first_jump, alpha, d_hat, c_zeta, c_psi, mu,
     shared = schedules.shape[0] == 1
     for i in prange(initial.shape[0]):
         schedule = schedules[0] if shared else schedules[i]
-        status[i], completed[i] = orbit(
-            initial[i, 0], initial[i, 1], schedule, first_jump, alpha, d_hat, c_zeta, c_psi, mu, states[i], rises[i]
-        )
+        status[i], completed[i] = orbit(initial[i, 0], initial[i, 1], schedule, first_jump, model, states[i], rises[i])

@@ -106,7 +106,7 @@ def simulate_trajectory(
     jumps = check_jumps(jumps)
     check_range("sample_rate", sample_rate, 0.0, 1e6, high_open=False)
     check_range("start_height", start_height)
-    args = model.kernel_args()
+    parameters = model.record()
     half_width = 0.5 * model.d_hat
     record = np.empty((MAX_STANCE_NODES, STATE_SIZE))
     pieces: list[dict[str, np.ndarray]] = []
@@ -121,7 +121,7 @@ def simulate_trajectory(
         leg, next_leg = schedule[k], schedule[k + 1]
         side = -float(wall_of(k))  # the flipped frame's sign: +1 for a stance on the left wall (x = -d/2)
         status, next_xdot, next_ydot, rise, stance_time, flight_time, rows = stride.jump(
-            xdot, ydot, leg.psi0, leg.zeta0, next_leg.psi0, next_leg.zeta0, *args, record
+            xdot, ydot, leg.psi0, leg.zeta0, next_leg.psi0, next_leg.zeta0, parameters, record
         )
         if rows >= 2:
             pieces.append(_stance_piece(record[:rows], clock, sample_rate, side, half_width, foot_height, k))

@@ -55,9 +55,9 @@ def chain_key(model, controls, noise, start, grid) -> str:
         "format": FORMAT,
         "source": CACHE_DIR.name,  # sim_core's source and numba's version, as numba's cache
         "numpy": np.__version__,
-        "model": [float(value) for value in model.kernel_args()],
+        "model": [float(value) for value in model.record()],
         "controls": [float(controls.psi0), float(controls.zeta0)],
-        "noise": [float(value) for value in noise.kernel_args()],
+        "noise": [float(value) for value in noise.record()],
         "start": [float(value) for value in np.asarray(start, dtype=float).ravel()],
         "grid": asdict(grid),
     }

@@ -70,8 +70,10 @@ class Chain:
 
 
 def noise_sigmas(noise: NoiseModel) -> tuple[float, float, float, float]:
-    sigma_psi0, sigma_zeta0, sigma_velocity, sigma_pitch, _, _ = noise.kernel_args()
-    return sigma_psi0, sigma_zeta0, sigma_velocity, sigma_pitch
+    """The chain's standard deviations ``(psi0 [rad], zeta0 [l0], velocity [sqrt(g l0)], pitch step
+    [rad])`` (the asymmetry offsets are refused by :mod:`sim_core.robustness.mfpt`)."""
+    record = noise.record()
+    return record.sigma_psi0, record.sigma_zeta0, record.sigma_velocity, record.sigma_pitch
 
 
 def first_landings(model, controls, noise, start, points):
@@ -83,9 +85,7 @@ def first_landings(model, controls, noise, start, points):
     draws, weights = quadrature((sigma_psi0, sigma_zeta0), points)
     states = np.empty((draws.shape[0], 3))
     status = np.empty(draws.shape[0], dtype=np.int64)
-    first_jumps(
-        float(start[0]), float(start[1]), controls.psi0, controls.zeta0, draws, *model.kernel_args(), states, status
-    )
+    first_jumps(float(start[0]), float(start[1]), controls.psi0, controls.zeta0, draws, model.record(), states, status)
     return states, status, weights
 
 
@@ -98,9 +98,7 @@ def explore(model, controls, noise, start, grid: ChainGrid) -> np.ndarray:
     leg = rng.standard_normal((grid.paths, 2)) * [sigma_psi0, sigma_zeta0]
     starts = np.empty((grid.paths, 3))
     status = np.empty(grid.paths, dtype=np.int64)
-    first_jumps(
-        float(start[0]), float(start[1]), controls.psi0, controls.zeta0, leg, *model.kernel_args(), starts, status
-    )
+    first_jumps(float(start[0]), float(start[1]), controls.psi0, controls.zeta0, leg, model.record(), starts, status)
     starts = starts[status == 0]
     if starts.shape[0] == 0:
         raise ParameterError("controls", "every first jump from the start fails: nothing to build a chain on")
@@ -108,7 +106,7 @@ def explore(model, controls, noise, start, grid: ChainGrid) -> np.ndarray:
     draws = rng.standard_normal((starts.shape[0], grid.path_jumps, 5)) * scales
     visited = np.empty((starts.shape[0], grid.path_jumps, 3))
     steps = np.empty(starts.shape[0], dtype=np.int64)
-    sampled_paths(starts, controls.psi0, controls.zeta0, draws, *model.kernel_args(), visited, steps)
+    sampled_paths(starts, controls.psi0, controls.zeta0, draws, model.record(), visited, steps)
     visited = visited.reshape(-1, 3)
     return np.concatenate([starts, visited[np.isfinite(visited[:, 0])]])
 
@@ -161,7 +159,7 @@ def build_chain(model, controls, noise, start, grid: ChainGrid, progress: Progre
         counts = np.empty(count, dtype=np.int64)
         pair_transitions(
             pair_nodes[part], pair_layers[part], xdots, ydots, pitches, state_of, controls.psi0, controls.zeta0,
-            draws, draw_weights, *model.kernel_args(), cols, probabilities, counts, failed[part], escaped[part],
+            draws, draw_weights, model.record(), cols, probabilities, counts, failed[part], escaped[part],
         )  # fmt: skip
         used = np.arange(width) < counts[:, None]
         rows = np.repeat(np.arange(count), counts)

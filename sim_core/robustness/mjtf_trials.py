@@ -29,103 +29,33 @@ def run_trials(
     """One trial per seed from ``start``, on all cores: ``(jumps completed, status)`` arrays."""
     jumps = np.empty(seeds.size, dtype=np.int64)
     status = np.empty(seeds.size, dtype=np.int64)
-    trials_batch(
-        float(start[0]),
-        float(start[1]),
-        schedule,
-        seeds,
-        cap,
-        *noise.kernel_args(),
-        *model.kernel_args(),
-        jumps,
-        status,
-    )
+    trials_batch(float(start[0]), float(start[1]), schedule, seeds, cap, noise.record(), model.record(), jumps, status)
     return jumps, status
 
 
-# The kernels' flat argument lists (noise as NoiseModel.kernel_args(), the model as
-# ModelParams.kernel_args(), the same order in trial, trials_batch and closed_loop.pid_loop) are
-# repeated on purpose: numba kernels take scalars, not dataclasses, and each list is checked by the
-# kernel's own tests against the Python wrappers that unpack the dataclasses.
+# The noise and the model reach the kernels as one record each (NoiseModel.record(),
+# ModelParams.record()), read by field: a new parameter is a new field, not a longer argument
+# list to copy into every kernel that passes it on.
 @kernel
-def trial(
-    xdot,
-    ydot,
-    schedule,
-    seed,
-    cap,
-    sigma_psi0,
-    sigma_zeta0,
-    sigma_velocity,
-    sigma_pitch,
-    asymmetry_psi0,
-    asymmetry_zeta0,
-    alpha,
-    d_hat,
-    c_zeta,
-    c_psi,
-    mu,
-):
+def trial(xdot, ydot, schedule, seed, cap, noise, model):
     """One noisy run: ``(jumps completed, status of the failing jump or OK at the cap)``."""
     seed_trial(seed)
     no_record = np.empty((0, STATE_SIZE))
     pitch = 0.0
-    psi0, zeta0 = perturbed_controls(
-        schedule, 0, pitch, math.nan, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
-    )
+    psi0, zeta0 = perturbed_controls(schedule, 0, pitch, math.nan, noise)
     for k in range(cap):
-        next_pitch = pitch_step(pitch, sigma_pitch)
-        next_psi0, next_zeta0 = perturbed_controls(
-            schedule, k + 1, next_pitch, math.nan, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
-        )
-        status, xdot, ydot, _, _, _, _ = jump(
-            xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, alpha, d_hat, c_zeta, c_psi, mu, no_record
-        )
+        next_pitch = pitch_step(pitch, noise)
+        next_psi0, next_zeta0 = perturbed_controls(schedule, k + 1, next_pitch, math.nan, noise)
+        status, xdot, ydot, _, _, _, _ = jump(xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, model, no_record)
         if status != OK:
             return k, status
-        xdot, ydot = disturbed_state(xdot, ydot, sigma_velocity)
+        xdot, ydot = disturbed_state(xdot, ydot, noise)
         pitch, psi0, zeta0 = next_pitch, next_psi0, next_zeta0
     return cap, OK
 
 
 @parallel_kernel
-def trials_batch(
-    xdot,
-    ydot,
-    schedule,
-    seeds,
-    cap,
-    sigma_psi0,
-    sigma_zeta0,
-    sigma_velocity,
-    sigma_pitch,
-    asymmetry_psi0,
-    asymmetry_zeta0,
-    alpha,
-    d_hat,
-    c_zeta,
-    c_psi,
-    mu,
-    jumps,
-    status,
-):
+def trials_batch(xdot, ydot, schedule, seeds, cap, noise, model, jumps, status):
     """:func:`trial` for each seed on all cores."""
     for i in prange(seeds.size):
-        jumps[i], status[i] = trial(
-            xdot,
-            ydot,
-            schedule,
-            seeds[i],
-            cap,
-            sigma_psi0,
-            sigma_zeta0,
-            sigma_velocity,
-            sigma_pitch,
-            asymmetry_psi0,
-            asymmetry_zeta0,
-            alpha,
-            d_hat,
-            c_zeta,
-            c_psi,
-            mu,
-        )
+        jumps[i], status[i] = trial(xdot, ydot, schedule, seeds[i], cap, noise, model)

@@ -56,28 +56,29 @@ class Loop:
         self.kind, self.parameters = controller.kernel_args()
         self.psi0 = math.radians(controller.psi0_deg)
         self.target = controller.target
-        self.sigmas = np.array(noise.kernel_args())
-        self.model = np.array(model.kernel_args())
+        self.noise = noise.record()
+        self.model = model.record()
         self.limit = limit
         self.path = np.empty((limit, LOOP_STATE_SIZE))  # reused: each excursion is copied out
         self.scores = np.empty(limit)
 
     def start(self, start, start_zeta0: float, rng: np.random.Generator) -> np.ndarray:
         """The loop at its first touchdown, as the control study starts it."""
-        return started(self.kind, start[0], start[1], self.psi0, start_zeta0, _seed(rng), self.sigmas)
+        return started(self.kind, start[0], start[1], self.psi0, start_zeta0, _seed(rng), self.noise)
 
     def run(self, state: np.ndarray, touchdown: int, jumps: int, rng: np.random.Generator) -> tuple[int, np.ndarray]:
         """``jumps`` more touchdowns from ``state`` (advanced in place): ``(status, states reached)``."""
         states = np.empty((jumps, LOOP_STATE_SIZE))
-        status, done = long_run(state, touchdown, self.kind, self.parameters, _seed(rng), self.sigmas, self.model,
-                                states)  # fmt: skip
+        status, done = long_run(
+            state, touchdown, self.kind, self.parameters, _seed(rng), self.noise, self.model, states
+        )
         return status, states[:done]
 
     def excursion(self, state: np.ndarray, touchdown: int, holding: Holding, rng: np.random.Generator):
         """From touchdown ``touchdown`` until home or a failure: ``(states, touchdown indices,
         scores, level)``, the start included; ``level`` is the highest score, infinite on a failure."""
         home = (holding.mean, holding.whitening, holding.home)
-        status, done = excursion(state.copy(), touchdown, self.kind, self.parameters, _seed(rng), self.sigmas,
+        status, done = excursion(state.copy(), touchdown, self.kind, self.parameters, _seed(rng), self.noise,
                                  self.model, self.target, *home, self.path, self.scores)  # fmt: skip
         if status == TOO_LONG:
             raise ParameterError("excursion_limit", f"an excursion neither failed nor came home in {self.limit} jumps")

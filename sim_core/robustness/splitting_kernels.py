@@ -49,23 +49,24 @@ def score_of(state, k, target, mean, whitening, work):
 
 
 @kernel
-def started(kind, xdot, ydot, first_psi0, first_zeta0, seed, sigmas):
+def started(kind, xdot, ydot, first_psi0, first_zeta0, seed, noise):
     """The loop's state at its first touchdown (:func:`sim_core.control.loop_step.start_loop`), its
-    first leg's noise drawn from ``seed``."""
+    first leg's noise (``noise``: a :class:`sim_core.model.noise.NoiseRecord`) drawn from ``seed``."""
     seed_trial(seed)
     state = np.empty(LOOP_STATE_SIZE)
-    start_loop(state, kind, xdot, ydot, first_psi0, first_zeta0, sigmas[0], sigmas[1], sigmas[4], sigmas[5])
+    start_loop(state, kind, xdot, ydot, first_psi0, first_zeta0, noise)
     return state
 
 
 @kernel
-def long_run(state, k, kind, parameters, seed, sigmas, model, states):
+def long_run(state, k, kind, parameters, seed, noise, model, states):
     """Continue the loop from touchdown ``k`` (``state``, advanced in place) for up to
-    ``states.shape[0]`` jumps, recording each touchdown reached. Returns ``(status, jumps done)``."""
+    ``states.shape[0]`` jumps, recording each touchdown reached; ``noise`` and ``model`` are the
+    records of the noise and the model. Returns ``(status, jumps done)``."""
     seed_trial(seed)
     no_record = np.empty((0, STATE_SIZE))
     for j in range(states.shape[0]):
-        status, _ = _jump(state, k + j, kind, parameters, sigmas, model, no_record)
+        status, _ = loop_jump(state, k + j, kind, parameters, noise, model, no_record)
         if status != OK:
             return status, j
         states[j] = state
@@ -73,7 +74,7 @@ def long_run(state, k, kind, parameters, seed, sigmas, model, states):
 
 
 @kernel
-def excursion(state, k, kind, parameters, seed, sigmas, model, target, mean, whitening, level, path, scores):
+def excursion(state, k, kind, parameters, seed, noise, model, target, mean, whitening, level, path, scores):
     """Continue the loop from touchdown ``k`` until its score falls below ``level`` (back home),
     it fails, or ``path`` is full; ``path`` and ``scores`` get each touchdown reached. Returns
     ``(OK, jumps)`` when back, ``(failure status, jumps before it)``, or ``(TOO_LONG, jumps)``."""
@@ -81,7 +82,7 @@ def excursion(state, k, kind, parameters, seed, sigmas, model, target, mean, whi
     no_record = np.empty((0, STATE_SIZE))
     work = np.empty(FEATURES)
     for j in range(path.shape[0]):
-        status, _ = _jump(state, k + j, kind, parameters, sigmas, model, no_record)
+        status, _ = loop_jump(state, k + j, kind, parameters, noise, model, no_record)
         if status != OK:
             return status, j
         path[j] = state
@@ -108,11 +109,3 @@ def features_table(states, target):
     for j in range(states.shape[0]):
         features_of(states[j], target, out[j])
     return out
-
-
-@kernel
-def _jump(state, k, kind, parameters, sigmas, model, no_record):
-    return loop_jump(
-        state, k, kind, parameters, sigmas[0], sigmas[1], sigmas[2], sigmas[3], sigmas[4], sigmas[5],
-        model[0], model[1], model[2], model[3], model[4], no_record,
-    )  # fmt: skip

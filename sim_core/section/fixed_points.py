@@ -107,14 +107,14 @@ class _MapPower:
     """``q -> P^n(q)`` through the compiled orbit kernel, reusing its buffers."""
 
     def __init__(self, model: ModelParams, schedule: ControlSchedule, jumps: int):
-        self.args = model.kernel_args()
+        self.model = model.record()
         self.schedule = schedule.as_array()
         self.states = np.empty((jumps + 1, 2))
         self.rises = np.empty(jumps)
 
     def __call__(self, state: np.ndarray) -> np.ndarray | None:
         """The state after n jumps, or None if a jump fails."""
-        status, _ = stride.orbit(state[0], state[1], self.schedule, 0, *self.args, self.states, self.rises)
+        status, _ = stride.orbit(state[0], state[1], self.schedule, 0, self.model, self.states, self.rises)
         return self.states[-1].copy() if status == OK else None
 
 

@@ -33,7 +33,7 @@ def section_step_map(model: ModelParams, *, with_pitch: bool = False) -> StepMap
     ``(psi0, zeta0)``."""
     if model.d_hat <= 2.0:
         raise ParameterError("d_hat", f"must exceed 2 for the mid-chute section, got {model.d_hat:g}")
-    parameters = model.kernel_args()
+    parameters = model.record()
     dimensions = 3 if with_pitch else 2
 
     def step(states: np.ndarray, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -42,23 +42,22 @@ def section_step_map(model: ModelParams, *, with_pitch: bool = False) -> StepMap
             raise ValueError(f"states must be (N, {dimensions}), got {states.shape}")
         reached = np.empty_like(states)
         failed = np.empty(states.shape[0], dtype=bool)
-        middle_steps(states, np.ascontiguousarray(actions, dtype=np.float64), *parameters, reached, failed)
+        middle_steps(states, np.ascontiguousarray(actions, dtype=np.float64), parameters, reached, failed)
         return reached, failed
 
     return step
 
 
 @parallel_kernel
-def middle_steps(states, actions, alpha, d_hat, c_zeta, c_psi, mu, reached, failed):
+def middle_steps(states, actions, model, reached, failed):
     """One noiseless mid-chute step for each row (pitch in column 2 when there is one)."""
     no_record = np.empty((0, STATE_SIZE))
     with_pitch = states.shape[1] == 3
     for i in prange(states.shape[0]):
         pitch = states[i, 2] if with_pitch else 0.0
         status, xdot, ydot = middle_step(
-            states[i, 0], states[i, 1], pitch, actions[i, 0], actions[i, 1],
-            0.0, 0.0, 0.0, 0.0, alpha, d_hat, c_zeta, c_psi, mu, no_record,
-        )  # fmt: skip
+            states[i, 0], states[i, 1], pitch, actions[i, 0], actions[i, 1], 0.0, 0.0, 0.0, 0.0, model, no_record
+        )
         failed[i] = status != OK
         reached[i, 0] = xdot
         reached[i, 1] = ydot

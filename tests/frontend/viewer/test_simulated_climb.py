@@ -139,9 +139,9 @@ def test_a_closed_loop_climbs_as_the_benchmarks_compiled_loop_does(name):
     view.pose_at(60.0)
     heights = np.full(31, np.nan)
     kind, parameters = law.kernel_args()
-    no_noise = [0.0] * len(NoiseModel().kernel_args())
-    status, _ = controlled_loop(*loop.start, first.psi0, first.zeta0, kind, parameters, 0, *no_noise,
-                                *ROBOT.to_model().kernel_args(), heights, np.zeros(30, dtype=np.bool_))  # fmt: skip
+    no_noise = NoiseModel(0.0, 0.0, 0.0, 0.0).record()
+    status, _ = controlled_loop(*loop.start, first.psi0, first.zeta0, kind, parameters, 0, no_noise,
+                                ROBOT.to_model().record(), heights, np.zeros(30, dtype=np.bool_))  # fmt: skip
     shown = np.array([plan.jump.start.body_height for plan in view.plans[:31]]) / ROBOT.leg_length
     assert status == 0 and len(view.commands) >= 30
     assert_allclose(shown, heights, rtol=1e-9, atol=1e-12)

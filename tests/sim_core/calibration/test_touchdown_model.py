@@ -34,7 +34,7 @@ def _pairs(states, commanded, *, pitch=None, right_first=False) -> Pairs:
 
 def _predict(model, pairs, psi0_offsets=NO_OFFSETS, zeta0_offsets=NO_OFFSETS):
     out = np.empty((len(pairs), 3))
-    failed = predict_pairs(pairs.before, pairs.after, *model.kernel_args(), psi0_offsets, zeta0_offsets, out)
+    failed = predict_pairs(pairs.before, pairs.after, model.record(), psi0_offsets, zeta0_offsets, out)
     return out, failed
 
 
@@ -42,7 +42,7 @@ def test_without_offsets_or_pitch_the_prediction_is_one_map_jump(paper):
     states = [(-0.93, -0.17), (-0.9, -0.2)]
     out, failed = _predict(paper, _pairs(states, [COMMANDED, COMMANDED]))
     leg = (COMMANDED.psi0, COMMANDED.zeta0)
-    status, xdot, ydot, rise, *_ = jump(*states[0], *leg, *leg, *paper.kernel_args(), np.empty((0, STATE_SIZE)))
+    status, xdot, ydot, rise, *_ = jump(*states[0], *leg, *leg, paper.record(), np.empty((0, STATE_SIZE)))
     assert failed == 0 and status == 0
     assert_allclose(out[0], [xdot, ydot, rise], rtol=0, atol=SAME_JUMP_TOL)
 
@@ -92,7 +92,7 @@ def test_a_failing_jump_is_nan_and_counted(paper):
 def test_sensitivities_are_the_predictions_derivatives(paper, column):
     """Each column against central differences of its own, at a step ten times or more the module's."""
     pairs = _pairs([(-0.93, -0.17), (-0.9, -0.2), (-0.95, -0.15)], [COMMANDED] * 3)
-    slope = sensitivities(pairs, paper.kernel_args(), NO_OFFSETS, NO_OFFSETS)
+    slope = sensitivities(pairs, paper.record(), NO_OFFSETS, NO_OFFSETS)
     assert slope.shape == (2, 3, len(INPUTS))
     table, index, _ = INPUTS[column]
     moved = []

@@ -25,7 +25,7 @@ from sim_core.viability.guard import lands_in_kernel
 MODEL = get_preset("paper").to_model()
 PSI0 = math.radians(35.0)
 NO_RECORD = np.empty((0, STATE_SIZE))
-NO_NOISE = tuple(0.0 for _ in NoiseModel().kernel_args())
+NO_NOISE = NoiseModel(0.0, 0.0, 0.0, 0.0).record()
 
 
 @pytest.fixture(scope="module")
@@ -55,13 +55,13 @@ def test_no_command_leaves_the_viability_kernel_and_a_kernel_that_holds_nothing_
     for _ in range(200):
         xdot, ydot = rng.uniform(-1.6, -0.3), rng.uniform(-1.0, 1.0)
         zeta0, height = rng.uniform(0.8, 0.98), rng.uniform(0.0, 4.0)
-        _, psi, vx, vy, _, _ = lift_off(xdot, ydot, PSI0, zeta0, *_stance_args(), NO_RECORD)
+        _, psi, vx, vy, _, _ = lift_off(xdot, ydot, PSI0, zeta0, MODEL.record(), NO_RECORD)
         command, guarded = deadbeat_zeta0(parameters, PSI0, zeta0, height, xdot, ydot)
         if command == law.zeta0 and guarded:
             continue  # nothing was safe: the gait's own controls
         # The command's jump, cut at its lift-off, reaches the middle inside the kernel.
         status, x1, y1, *_ = flight(psi, vx, vy, MODEL.d_hat, PSI0, command)
-        _, psi_1, vx_1, vy_1, _, _ = lift_off(x1, y1, PSI0, command, *_stance_args(), NO_RECORD)
+        _, psi_1, vx_1, vy_1, _, _ = lift_off(x1, y1, PSI0, command, MODEL.record(), NO_RECORD)
         assert status == OK and lands_in_kernel(parameters, PARAMETER_COUNT, psi_1, vx_1, vy_1, MODEL.d_hat)
         refused += deadbeat_zeta0(free, PSI0, zeta0, height, xdot, ydot)[0] != command
     assert refused > 0, "somewhere the unguarded law's choice leaves the kernel"
@@ -78,10 +78,10 @@ def test_the_horizon_is_the_maps_own_two_jumps(law, hover):
     _, parameters = law.kernel_args()
     parameters[16] = 0.0  # q_state off
     (xdot, ydot), zeta0 = law.state, hover - 0.02
-    _, psi, vx, vy, _, _ = lift_off(xdot, ydot, PSI0, zeta0, *_stance_args(), NO_RECORD)
+    _, psi, vx, vy, _, _ = lift_off(xdot, ydot, PSI0, zeta0, MODEL.record(), NO_RECORD)
     for next_zeta0 in (0.86, 0.9, 0.94):
-        status, x1, y1, rise_1, *_ = jump(xdot, ydot, PSI0, zeta0, PSI0, next_zeta0, *MODEL.kernel_args(), NO_RECORD)
-        status_2, _, _, rise_2, *_ = jump(x1, y1, PSI0, next_zeta0, PSI0, hover, *MODEL.kernel_args(), NO_RECORD)
+        status, x1, y1, rise_1, *_ = jump(xdot, ydot, PSI0, zeta0, PSI0, next_zeta0, MODEL.record(), NO_RECORD)
+        status_2, _, _, rise_2, *_ = jump(x1, y1, PSI0, next_zeta0, PSI0, hover, MODEL.record(), NO_RECORD)
         assert status == status_2 == OK
         body = zeta0 * math.sin(PSI0)
         first = rise_1 + next_zeta0 * math.sin(PSI0) - body
@@ -99,16 +99,16 @@ def test_the_guard_never_sends_a_command_the_model_predicts_fails(law, hover):
     for _ in range(300):
         xdot, ydot = rng.uniform(-1.6, -0.3), rng.uniform(-1.0, 1.0)
         zeta0, height = rng.uniform(0.8, 0.98), rng.uniform(0.0, 4.0)
-        if lift_off(xdot, ydot, PSI0, zeta0, *_stance_args(), NO_RECORD)[0] != OK:
+        if lift_off(xdot, ydot, PSI0, zeta0, MODEL.record(), NO_RECORD)[0] != OK:
             continue
         command, guarded = deadbeat_zeta0(parameters, PSI0, zeta0, height, xdot, ydot)
         assert 0.8 <= command <= 0.98
-        status, x1, y1, *_ = jump(xdot, ydot, PSI0, zeta0, PSI0, command, *MODEL.kernel_args(), NO_RECORD)
+        status, x1, y1, *_ = jump(xdot, ydot, PSI0, zeta0, PSI0, command, MODEL.record(), NO_RECORD)
         if guarded and command == law.zeta0:
             continue  # nothing went, or nothing stayed in the viability kernel: the gait's own zeta0
         assert status == OK, (xdot, ydot, zeta0, command)
         sent += 1
-        follow = jump(x1, y1, PSI0, command, PSI0, hover, *MODEL.kernel_args(), NO_RECORD)[0]
+        follow = jump(x1, y1, PSI0, command, PSI0, hover, MODEL.record(), NO_RECORD)[0]
         assert follow == OK, (xdot, ydot, zeta0, command)
     assert sent > 100
 
@@ -131,8 +131,8 @@ def _climb(law, start, psi0, zeta0, jumps=60):
     kind, parameters = law.kernel_args()
     heights = np.full(jumps + 1, math.nan)
     clipped = np.zeros(jumps, dtype=np.bool_)
-    status, done = controlled_loop(start[0], start[1], psi0, zeta0, kind, parameters, 0, *NO_NOISE,
-                                   *MODEL.kernel_args(), heights, clipped)  # fmt: skip
+    status, done = controlled_loop(start[0], start[1], psi0, zeta0, kind, parameters, 0, NO_NOISE,
+                                   MODEL.record(), heights, clipped)  # fmt: skip
     assert (status, done) == (OK, jumps)
     return heights
 
@@ -157,8 +157,3 @@ def test_its_parameters_are_checked_naming_the_field(law, change, field):
     with pytest.raises(ParameterError) as caught:
         Deadbeat(**values)
     assert caught.value.field == field
-
-
-def _stance_args():
-    alpha, _, c_zeta, c_psi, mu = MODEL.kernel_args()
-    return alpha, c_zeta, c_psi, mu

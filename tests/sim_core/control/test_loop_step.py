@@ -30,7 +30,7 @@ def _run(state, k0, law, noise, seed, jumps):
     seed_trial(seed)
     states, no_record = [], np.empty((0, STATE_SIZE))
     for k in range(k0, k0 + jumps):
-        status, _ = loop_jump(state, k, kind, parameters, *noise.kernel_args(), *ROBOT.to_model().kernel_args(),
+        status, _ = loop_jump(state, k, kind, parameters, noise.record(), ROBOT.to_model().record(),
                               no_record)  # fmt: skip
         assert status == OK
         states.append(state.copy())
@@ -44,7 +44,7 @@ def test_a_copied_state_continues_as_the_original_whatever_ran_between(climb_and
     kind = law.kernel_args()[0]
     state = np.empty(LOOP_STATE_SIZE)
     seed_trial(5)
-    start_loop(state, kind, *loop.start, math.radians(law.psi0_deg), 0.9, *NOISE.kernel_args()[:2], 0.0, 0.0)
+    start_loop(state, kind, *loop.start, math.radians(law.psi0_deg), 0.9, NOISE.record())
     _run(state, 0, law, NOISE, 6, 30)
     copy = state.copy()
     first = _run(state, 30, law, NOISE, 7, 40)
@@ -57,8 +57,8 @@ def test_a_run_that_comes_down_below_the_floor_ends_there(climb_and_law):
     loop, law = climb_and_law
     kind, parameters = law.kernel_args()
     state = np.empty(LOOP_STATE_SIZE)
-    start_loop(state, kind, *loop.start, math.radians(law.psi0_deg), 0.9, 0.0, 0.0, 0.0, 0.0)
-    arguments = (*NO_NOISE.kernel_args(), *ROBOT.to_model().kernel_args(), np.empty((0, STATE_SIZE)))
+    start_loop(state, kind, *loop.start, math.radians(law.psi0_deg), 0.9, NO_NOISE.record())
+    arguments = (NO_NOISE.record(), ROBOT.to_model().record(), np.empty((0, STATE_SIZE)))
     high, low = state.copy(), state.copy()
     high[FOOT] = 0.0
     assert loop_jump(high, 0, kind, parameters, *arguments)[0] == OK and body_height(high) > 0

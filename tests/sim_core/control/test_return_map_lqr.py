@@ -21,7 +21,7 @@ def _climb(law, model, first_zeta0, jumps=60):
     """The noise-free climb under ``law`` from its gait's section state: (status, heights)."""
     kind, parameters = law.kernel_args()
     height, clipped = np.full(jumps + 1, math.nan), np.zeros(jumps, dtype=bool)
-    arguments = (*NO_NOISE.kernel_args(), *model.kernel_args(), height, clipped)
+    arguments = (NO_NOISE.record(), model.record(), height, clipped)
     status, _ = controlled_loop(*law.state, math.radians(law.psi0_deg), first_zeta0, kind, parameters, 0, *arguments)
     return status, height
 

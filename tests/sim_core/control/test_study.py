@@ -33,7 +33,7 @@ def test_the_pid_trial_is_the_closed_loop_climb(loop, seed):
                             noise=noise, seed=seed)  # fmt: skip
     kind, parameters = Pid(loop.controller, 35.0).kernel_args()
     height, clipped = np.full(121, math.nan), np.zeros(120, dtype=bool)
-    arguments = (*noise.kernel_args(), *loop.model.kernel_args(), height, clipped)
+    arguments = (noise.record(), loop.model.record(), height, clipped)
     status, completed = controlled_loop(*loop.start, math.radians(35.0), 0.9, kind, parameters, seed, *arguments)
     assert completed + 1 == run.height.size
     np.testing.assert_array_equal(height[: completed + 1], run.height)

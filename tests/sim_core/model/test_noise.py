@@ -1,14 +1,15 @@
-"""The noise model's parameters (sim_core.model.noise): validation naming the field, kernel units, seeds."""
+"""The noise model (sim_core.model.noise): validation naming the field, the kernels' record and its units, seeds."""
 
 import math
 import subprocess
 import sys
+from dataclasses import fields
 
 import numpy as np
 import pytest
 
 from sim_core import ParameterError
-from sim_core.model.noise import ASYMMETRY_LIMITS, NO_NOISE, SIGMA_LIMITS, NoiseModel, trial_seeds
+from sim_core.model.noise import ASYMMETRY_LIMITS, NO_NOISE, SIGMA_LIMITS, NoiseModel, NoiseRecord, trial_seeds
 
 
 @pytest.mark.parametrize(
@@ -41,13 +42,21 @@ def test_every_field_has_one_range_and_its_default_lies_in_it():
             NoiseModel(**{field: -limit})
 
 
-def test_kernel_arguments_are_in_radians_and_l0():
+def test_the_kernels_record_is_in_radians_and_l0():
     noise = NoiseModel(1.0, 0.01, 0.02, 2.0, asymmetry_psi0_deg=-3.0, asymmetry_zeta0=0.005)
-    assert noise.kernel_args() == pytest.approx(
-        (math.radians(1.0), 0.01, 0.02, math.radians(2.0), math.radians(-3.0), 0.005)
-    )
+    record = noise.record()
+    assert record == pytest.approx((math.radians(1.0), 0.01, 0.02, math.radians(2.0), math.radians(-3.0), 0.005))
+    assert (record.sigma_pitch, record.asymmetry_zeta0) == (math.radians(2.0), 0.005)
     assert NoiseModel(**noise.to_dict()) == noise
-    assert NO_NOISE.kernel_args() == (0.0,) * 6
+    assert NO_NOISE.record() == (0.0,) * 6
+
+
+def test_the_record_carries_every_field_of_the_noise_once():
+    """One record field per NoiseModel field, in its order (a new disturbance needs both), each a
+    float, so numba compiles one specialisation of every kernel whatever numbers are given."""
+    assert len(NoiseRecord._fields) == len(fields(NoiseModel))
+    record = NoiseModel(psi0_deg=1, zeta0=0, velocity=0, pitch_drift_deg=0).record()
+    assert all(type(value) is float for value in record)
 
 
 def test_trial_seeds_depend_on_seed_and_stream_only():

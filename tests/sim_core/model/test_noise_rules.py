@@ -49,7 +49,7 @@ def test_zero_sigmas_give_the_exact_controls_and_draw_nothing():
     assert sampler.state((-0.9, -0.2)) == (-0.9, -0.2)
     assert rng.bit_generator.state == before
     schedule = ControlSchedule.of(LEG).as_array()
-    assert perturbed_controls(schedule, 1, 0.0, math.nan, 0.0, 0.0, 0.0, 0.0) == (LEG.psi0, LEG.zeta0)
+    assert perturbed_controls(schedule, 1, 0.0, math.nan, NO_NOISE.record()) == (LEG.psi0, LEG.zeta0)
 
 
 def test_controls_are_clamped_inside_the_leg_domain():
@@ -72,10 +72,10 @@ def _numba_draws(seed, sigma_a, sigma_b):
 
 def test_both_samplers_are_the_one_rule_applied_to_their_draws():
     noise = NoiseModel(psi0_deg=1.0, zeta0=0.01, velocity=0.0, pitch_drift_deg=1.0, asymmetry_psi0_deg=0.5)
-    sigma_psi0, sigma_zeta0, _, _, asymmetry_psi0, asymmetry_zeta0 = noise.kernel_args()
+    sigma_psi0, sigma_zeta0, _, _, asymmetry_psi0, asymmetry_zeta0 = noise.record()
     schedule = ControlSchedule.of(LEG).as_array()
     seed_trial(11)
-    kernel = perturbed_controls(schedule, 1, PITCH, math.nan, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0)
+    kernel = perturbed_controls(schedule, 1, PITCH, math.nan, noise.record())
     draws = _numba_draws(11, sigma_psi0, sigma_zeta0)  # numba's generator, same seed, same order
     assert kernel == noisy_controls(LEG.psi0, LEG.zeta0, True, PITCH, asymmetry_psi0, asymmetry_zeta0, *draws)
     rng = np.random.default_rng(11)
@@ -98,4 +98,4 @@ def test_the_python_sampler_is_reproducible_and_walks_the_pitch():
     assert walk(3) == walk(3)
     assert walk(3) != walk(4)
     assert len({pitch for pitch, _ in walk(3)}) == 20, "the pitch drifts every jump"
-    assert pitch_step(0.0, 0.0) == 0.0
+    assert pitch_step(0.0, NO_NOISE.record()) == 0.0

@@ -34,9 +34,7 @@ def gait(paper, symmetric):
 def to_middle_of(paper, state, psi0, zeta0, psi0_draw=0.0, zeta0_draw=0.0):
     starts = np.empty((1, 3))
     status = np.empty(1, dtype=np.int64)
-    first_jumps(
-        state[0], state[1], psi0, zeta0, np.array([[psi0_draw, zeta0_draw]]), *paper.kernel_args(), starts, status
-    )
+    first_jumps(state[0], state[1], psi0, zeta0, np.array([[psi0_draw, zeta0_draw]]), paper.record(), starts, status)
     assert status[0] == OK
     return starts[0]
 
@@ -49,11 +47,11 @@ def test_two_halves_of_a_jump_are_the_map_s_jump(paper, gait, pitch_deg, psi0_de
     state = gait.state
     middle = to_middle_of(paper, state, psi0, zeta0)
     status, x1, y1 = middle_step(
-        middle[0], middle[1], pitch, psi0, zeta0, 0.0, 0.0, 0.0, 0.0, *paper.kernel_args(), NO_RECORD
+        middle[0], middle[1], pitch, psi0, zeta0, 0.0, 0.0, 0.0, 0.0, paper.record(), NO_RECORD
     )
     assert status == OK
     status, touchdown_x, touchdown_y, *_ = jump(
-        state[0], state[1], psi0, zeta0, psi0 + pitch, zeta0, *paper.kernel_args(), NO_RECORD
+        state[0], state[1], psi0, zeta0, psi0 + pitch, zeta0, paper.record(), NO_RECORD
     )
     assert status == OK
     expected = to_middle_of(paper, (touchdown_x, touchdown_y), psi0 + pitch, zeta0)
@@ -64,13 +62,13 @@ def test_noisy_paths_on_the_middle_section_last_as_long_as_mjtf_trials(paper):
     # The same noise, drawn independently: the mean jumps to failure agree within their intervals.
     noise, psi0, zeta0 = NoiseModel(), math.radians(30.0), 0.96
     level = mjtf_study(paper, psi0, [zeta0], noise=noise, trials=600, cap=5000, seed=7, guess=(-0.93, 0.2)).levels[0]
-    sigma_psi0, sigma_zeta0, sigma_velocity, sigma_pitch, _, _ = noise.kernel_args()
+    sigma_psi0, sigma_zeta0, sigma_velocity, sigma_pitch, _, _ = noise.record()
     rng = np.random.default_rng(11)
     count, steps = 600, 2000
     starts = np.empty((count, 3))
     status = np.empty(count, dtype=np.int64)
     leg = rng.standard_normal((count, 2)) * [sigma_psi0, sigma_zeta0]
-    first_jumps(*level.start, psi0, zeta0, leg, *paper.kernel_args(), starts, status)
+    first_jumps(*level.start, psi0, zeta0, leg, paper.record(), starts, status)
     draws = rng.standard_normal((count, steps, 5)) * [
         sigma_pitch,
         sigma_psi0,
@@ -80,7 +78,7 @@ def test_noisy_paths_on_the_middle_section_last_as_long_as_mjtf_trials(paper):
     ]
     visited = np.empty((count, steps, 3))
     done = np.empty(count, dtype=np.int64)
-    sampled_paths(starts, psi0, zeta0, draws, *paper.kernel_args(), visited, done)
+    sampled_paths(starts, psi0, zeta0, draws, paper.record(), visited, done)
     jumps = np.where(status == OK, 1 + done, 0)
     assert np.all(done < steps), "every path fails"
     spread = math.hypot(level.std / math.sqrt(level.jumps.size), jumps.std() / math.sqrt(count))
@@ -129,7 +127,7 @@ def test_a_pair_s_transitions_and_losses_add_up_to_one(paper, gait):
     counts = np.empty(4, dtype=np.int64)
     failed, escaped = np.empty(4), np.empty(4)
     pair_transitions(nodes, layers, xdots, ydots, pitches, state_of, psi0, zeta0, draws, weights,
-                     *paper.kernel_args(), cols, probabilities, counts, failed, escaped)  # fmt: skip
+                     paper.record(), cols, probabilities, counts, failed, escaped)  # fmt: skip
     for pair in range(4):
         kept = probabilities[pair, : counts[pair]]
         assert np.all(kept > 0) and np.all(np.diff(cols[pair, : counts[pair]]) > 0)

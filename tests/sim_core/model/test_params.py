@@ -1,11 +1,12 @@
 """Parameters and presets: conversions and clear errors (controls: test_controls.py)."""
 
 import math
-from dataclasses import replace
+from dataclasses import astuple, fields, replace
 
 import pytest
 
 from sim_core import ModelParams, ParameterError, PhysicalParams, get_preset
+from sim_core.model.params import ModelRecord
 
 
 def test_paper_preset_matches_model_md():
@@ -15,6 +16,16 @@ def test_paper_preset_matches_model_md():
     assert model.c_zeta == pytest.approx(0.310, abs=5e-4)
     assert model.c_psi == pytest.approx(0.310, abs=5e-4)
     assert model.mu == 2.0
+
+
+def test_the_kernels_record_is_the_parameters_field_for_field():
+    """ModelRecord names ModelParams' fields in their order, so a parameter added to one and not the
+    other fails here; its values are the parameters', as floats (one compiled specialisation)."""
+    assert ModelRecord._fields == tuple(field.name for field in fields(ModelParams))
+    model = get_preset("paper").to_model()
+    assert model.record() == astuple(model) and model.record().mu == model.mu
+    whole = ModelParams(alpha=80, d_hat=3).record()
+    assert whole == (80.0, 3.0, 0.0, 0.0, math.inf) and all(type(value) is float for value in whole)
 
 
 def test_physical_model_round_trip():

@@ -37,7 +37,7 @@ NO_RECORD = np.empty((0, STATE_SIZE))
 
 def _jump(model, state, leg=LEG, next_leg=LEG, record=NO_RECORD):
     """``jump`` as poincare calls it: ``(status, next_xdot, next_ydot, rise, stance, flight, rows)``."""
-    return jump(state[0], state[1], leg.psi0, leg.zeta0, next_leg.psi0, next_leg.zeta0, *model.kernel_args(), record)
+    return jump(state[0], state[1], leg.psi0, leg.zeta0, next_leg.psi0, next_leg.zeta0, model.record(), record)
 
 
 def test_successful_jump_fills_every_slot(paper):
@@ -73,15 +73,14 @@ def test_lift_off_is_the_jumps_own_stance(paper):
     """lift_off ends where jump's stance ends: the recorded lift-off row, the same stance time, and
     the same failure with the stance time kept; an invalid state fails before any stance."""
     record = np.empty((500, STATE_SIZE))
-    alpha, _, c_zeta, c_psi, mu = paper.kernel_args()
-    status, psi, vx, vy, stance_time, rows = lift_off(*START, LEG.psi0, LEG.zeta0, alpha, c_zeta, c_psi, mu, record)
+    status, psi, vx, vy, stance_time, rows = lift_off(*START, LEG.psi0, LEG.zeta0, paper.record(), record)
     assert status == OK and record[rows - 1, PSI] == psi
     assert (vx, vy) == liftoff_velocity(psi, record[rows - 1, ZETA_DOT], record[rows - 1, PSI_DOT])
     assert stance_time == _jump(paper, START)[4]
     slipping = LegControl.from_degrees(70.0, 0.9)
-    failed = lift_off(*START, slipping.psi0, slipping.zeta0, alpha, c_zeta, c_psi, mu, NO_RECORD)
+    failed = lift_off(*START, slipping.psi0, slipping.zeta0, paper.record(), NO_RECORD)
     assert failed[0] == SLIP == _jump(paper, START, slipping)[0] and math.isnan(failed[1])
-    assert lift_off(0.1, -0.2, LEG.psi0, LEG.zeta0, alpha, c_zeta, c_psi, mu, NO_RECORD)[0] == INVALID_STATE
+    assert lift_off(0.1, -0.2, LEG.psi0, LEG.zeta0, paper.record(), NO_RECORD)[0] == INVALID_STATE
 
 
 @pytest.mark.parametrize(
@@ -139,7 +138,7 @@ def test_failures_keep_only_the_stance_time(paper, expected, overrides, leg_deg,
 )
 def test_invalid_inputs_fail_before_any_stance(paper, state, next_zeta0):
     record = np.full((10, STATE_SIZE), 7.0)
-    result = jump(state[0], state[1], LEG.psi0, LEG.zeta0, LEG.psi0, next_zeta0, *paper.kernel_args(), record)
+    result = jump(state[0], state[1], LEG.psi0, LEG.zeta0, LEG.psi0, next_zeta0, paper.record(), record)
     status, *numbers, rows = result
     assert status == INVALID_STATE and rows == 0
     assert all(math.isnan(v) for v in numbers), "no stance was integrated: every number is NaN"
@@ -156,12 +155,12 @@ def test_polar_and_cartesian_rates_invert_at_full_length(xdot, ydot, psi0_deg):
 
 def test_scheduled_jumps_use_rows_k_and_k_plus_one_cyclically(paper):
     schedule = ControlSchedule.from_degrees([(30.0, 0.87), (34.0, 0.9), (28.0, 0.88)])
-    array, args = schedule.as_array(), paper.kernel_args()
+    array, model = schedule.as_array(), paper.record()
     state = START
     for k in range(5):
         this, following = schedule[k], schedule[k + 1]
         direct = _jump(paper, state, this, following)
-        scheduled = scheduled_jump(state[0], state[1], array, k, *args, NO_RECORD)
+        scheduled = scheduled_jump(state[0], state[1], array, k, model, NO_RECORD)
         assert scheduled == direct[:4], f"jump {k}"
         state = scheduled[1:3]
 
@@ -171,7 +170,7 @@ def test_chained_jumps_are_iterate_map(paper, alternating):
     expected = iterate_map(paper, alternating, START, 6, first_jump=1)
     array, state = alternating.as_array(), START
     for k in range(6):
-        status, xdot, ydot, rise = scheduled_jump(state[0], state[1], array, 1 + k, *paper.kernel_args(), NO_RECORD)
+        status, xdot, ydot, rise = scheduled_jump(state[0], state[1], array, 1 + k, paper.record(), NO_RECORD)
         assert status == OK
         state = (xdot, ydot)
         assert state == tuple(expected.states[k + 1]) and rise == expected.rises[k], f"jump {k + 1}"
@@ -184,7 +183,7 @@ def _orbit_buffers(jumps: int):
 
 def test_orbit_fills_its_buffers(paper, symmetric):
     states, rises = _orbit_buffers(5)
-    status, completed = orbit(*START, symmetric.as_array(), 0, *paper.kernel_args(), states, rises)
+    status, completed = orbit(*START, symmetric.as_array(), 0, paper.record(), states, rises)
     assert (status, completed) == (OK, 5)
     assert tuple(states[0]) == START and np.isfinite(states).all() and np.isfinite(rises).all()
     assert (states[1:, 0] < 0).all()
@@ -194,7 +193,7 @@ def test_orbit_marks_what_follows_a_failure(paper):
     """psi0 = 45°, zeta0 = 0.8/0.9 climbs three jumps and then has no flight."""
     schedule = ControlSchedule.from_degrees([(45.0, 0.8), (45.0, 0.9)])
     states, rises = _orbit_buffers(8)
-    status, completed = orbit(*START, schedule.as_array(), 0, *paper.kernel_args(), states, rises)
+    status, completed = orbit(*START, schedule.as_array(), 0, paper.record(), states, rises)
     assert (status, completed) == (NO_FLIGHT, 3), "on failure, jump `completed` (0-based) failed"
     assert np.isfinite(states[: completed + 1]).all() and np.isfinite(rises[:completed]).all()
     assert np.isnan(states[completed + 1 :]).all() and np.isnan(rises[completed:]).all()
@@ -205,7 +204,7 @@ def test_orbit_marks_what_follows_a_failure(paper):
 
 def test_orbit_of_zero_jumps_keeps_the_start(paper, symmetric):
     states, rises = _orbit_buffers(0)
-    assert orbit(*START, symmetric.as_array(), 0, *paper.kernel_args(), states, rises) == (OK, 0)
+    assert orbit(*START, symmetric.as_array(), 0, paper.record(), states, rises) == (OK, 0)
     assert tuple(states[0]) == START
 
 
@@ -215,12 +214,12 @@ def test_orbit_batch_shares_or_splits_schedules(paper, symmetric):
     for given in (symmetric.as_array()[np.newaxis], schedules):
         states, rises = np.empty((3, 5, 2)), np.empty((3, 4))
         status, completed = np.empty(3, dtype=np.int64), np.empty(3, dtype=np.int64)
-        orbit_batch(starts, given, 0, *paper.kernel_args(), states, rises, status, completed)
+        orbit_batch(starts, given, 0, paper.record(), states, rises, status, completed)
         assert list(status) == [OK, INVALID_STATE, OK] and list(completed) == [4, 0, 4]
         for i in (0, 2):
             single_states, single_rises = _orbit_buffers(4)
             schedule = given[0] if given.shape[0] == 1 else given[i]
-            orbit(*starts[i], schedule, 0, *paper.kernel_args(), single_states, single_rises)
+            orbit(*starts[i], schedule, 0, paper.record(), single_states, single_rises)
             assert_allclose(states[i], single_states, rtol=0, atol=0, err_msg=f"start {i}")
         assert np.isnan(states[1, 1:]).all() and tuple(states[1, 0]) == (0.5, 0.0)
     batch = iterate_map_batch(paper, schedules, starts, 4)

@@ -34,24 +34,20 @@ def gait(paper, symmetric):
 def _python_trial(model, schedule, start, noise, seed, cap):
     """A trial spelled out in Python from the same compiled rules, in the order the module documents:
     the first leg at launch; per jump a pitch step, the next leg's controls, the jump, the state noise."""
-    sigma_psi0, sigma_zeta0, sigma_velocity, sigma_pitch, asymmetry_psi0, asymmetry_zeta0 = noise.kernel_args()
+    noise = noise.record()
     seed_trial(seed)
     xdot, ydot = start
     pitch = 0.0
-    psi0, zeta0 = perturbed_controls(
-        schedule, 0, pitch, math.nan, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
-    )
+    psi0, zeta0 = perturbed_controls(schedule, 0, pitch, math.nan, noise)
     for k in range(cap):
-        next_pitch = pitch_step(pitch, sigma_pitch)
-        next_psi0, next_zeta0 = perturbed_controls(
-            schedule, k + 1, next_pitch, math.nan, sigma_psi0, sigma_zeta0, asymmetry_psi0, asymmetry_zeta0
-        )
+        next_pitch = pitch_step(pitch, noise)
+        next_psi0, next_zeta0 = perturbed_controls(schedule, k + 1, next_pitch, math.nan, noise)
         status, xdot, ydot, *_ = jump(
-            xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, *model.kernel_args(), np.empty((0, STATE_SIZE))
+            xdot, ydot, psi0, zeta0, next_psi0, next_zeta0, model.record(), np.empty((0, STATE_SIZE))
         )
         if status != OK:
             return k, status
-        xdot, ydot = disturbed_state(xdot, ydot, sigma_velocity)
+        xdot, ydot = disturbed_state(xdot, ydot, noise)
         pitch, psi0, zeta0 = next_pitch, next_psi0, next_zeta0
     return cap, OK
 
@@ -59,14 +55,14 @@ def _python_trial(model, schedule, start, noise, seed, cap):
 def test_a_trial_draws_in_the_noise_rules_order(paper, symmetric, gait):
     schedule = symmetric.as_array()
     for seed in SEEDS[:8]:
-        compiled = trial(*gait.state, schedule, seed, CAP, *EVERY_SOURCE.kernel_args(), *paper.kernel_args())
+        compiled = trial(*gait.state, schedule, seed, CAP, EVERY_SOURCE.record(), paper.record())
         assert compiled == _python_trial(paper, schedule, gait.state, EVERY_SOURCE, seed, CAP), f"seed {seed}"
 
 
 def test_the_batch_is_one_trial_per_seed_on_any_number_of_threads(paper, symmetric, gait):
     schedule = symmetric.as_array()
     jumps, status = run_trials(paper, schedule, gait.state, NOISE, SEEDS, CAP)
-    one_by_one = [trial(*gait.state, schedule, seed, CAP, *NOISE.kernel_args(), *paper.kernel_args()) for seed in SEEDS]
+    one_by_one = [trial(*gait.state, schedule, seed, CAP, NOISE.record(), paper.record()) for seed in SEEDS]
     assert_array_equal(jumps, [j for j, _ in one_by_one])
     assert_array_equal(status, [s for _, s in one_by_one])
     threads = numba.get_num_threads()

@@ -22,7 +22,7 @@ from sim_core.robustness.splitting_kernels import (
 )
 
 ROBOT = get_preset("paper")
-MODEL = np.array(ROBOT.to_model().kernel_args())
+MODEL = ROBOT.to_model().record()
 
 
 @pytest.fixture(scope="module")
@@ -33,9 +33,7 @@ def lqr():
 
 def _start(lqr, noise=NO_NOISE, seed=0):
     loop, law = lqr
-    return started(
-        law.kernel_args()[0], *loop.start, math.radians(law.psi0_deg), 0.9, seed, np.array(noise.kernel_args())
-    )
+    return started(law.kernel_args()[0], *loop.start, math.radians(law.psi0_deg), 0.9, seed, noise.record())
 
 
 @pytest.mark.parametrize("seed", [1, 2])
@@ -56,7 +54,7 @@ def test_the_score_is_the_whitened_distance_per_wall(lqr, seed):
 def test_an_excursion_stops_home_or_runs_full(lqr):
     law = lqr[1]
     kind, parameters = law.kernel_args()
-    sigmas = np.array(NoiseModel(pitch_drift_deg=0.0).kernel_args())
+    sigmas = NoiseModel(pitch_drift_deg=0.0).record()
     state = _start(lqr, seed=3)
     settle = np.empty((40, state.size))
     assert long_run(state, 0, kind, parameters, 4, sigmas, MODEL, settle) == (OK, 40)
@@ -84,7 +82,7 @@ def _first_jump(state, kind, parameters, sigmas):
 def test_a_failure_ends_an_excursion_with_its_status(lqr):
     law = lqr[1]
     kind, parameters = law.kernel_args()
-    sigmas = np.array(NoiseModel(velocity=0.3, pitch_drift_deg=0.0).kernel_args())  # fails within jumps
+    sigmas = NoiseModel(velocity=0.3, pitch_drift_deg=0.0).record()  # fails within jumps
     mean, whitening = np.zeros((2, FEATURES)), np.zeros((2, FEATURES, FEATURES))
     path, scores = np.empty((1000, LOOP_STATE_SIZE)), np.empty(1000)
     status, done = excursion(_start(lqr), 0, kind, parameters, 9, sigmas, MODEL, law.target, mean, whitening, -1.0,

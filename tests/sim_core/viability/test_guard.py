@@ -30,7 +30,7 @@ def test_the_guard_allows_exactly_the_viable_pairs_of_the_grid(paper, guard):
         (np.array([math.radians(PSI0_DEG)]), np.linspace(*ZETA0_RANGE, 7)),
     )
     result = compute_viability(section_step_map(paper), grid)
-    alpha, d_hat, c_zeta, c_psi, mu = paper.kernel_args()
+    d_hat = paper.d_hat
     psi0 = math.radians(PSI0_DEG)
     checked = 0
     for (i, j, _, k), viable in np.ndenumerate(result.viable_pairs):
@@ -39,7 +39,7 @@ def test_the_guard_allows_exactly_the_viable_pairs_of_the_grid(paper, guard):
         # The pair's stance, from the node's flight to the wall.
         xdot, ydot, zeta0 = grid.state_axes[0][i], grid.state_axes[1][j], grid.action_axes[1][k]
         time = (0.5 * d_hat - zeta0 * math.cos(psi0)) / xdot
-        status, psi, vx, vy, _, _ = lift_off(-xdot, ydot - time, psi0, zeta0, alpha, c_zeta, c_psi, mu, NO_RECORD)
+        status, psi, vx, vy, _, _ = lift_off(-xdot, ydot - time, psi0, zeta0, paper.record(), NO_RECORD)
         assert status == OK
         assert lands_in_kernel(guard, 0, psi, vx, vy, d_hat) == viable, (i, j, k)
         checked += 1
