@@ -20,7 +20,7 @@ NUMBER = 3  # its branch in the compiled dispatch
 class Deadbeat:
     """The deadbeat law on a short horizon with a safety guard (:mod:`sim_core.control.deadbeat`; built by
     :func:`sim_core.control.deadbeat.design_deadbeat`): zeta0 chosen each jump by the design model
-    (``model``: ``(alpha, d_hat, c_zeta, c_psi, mu)``, :meth:`sim_core.model.params.ModelParams.kernel_args`)
+    (``model``: ``(alpha, d_hat, c_zeta, c_psi, mu)``, :meth:`sim_core.model.params.ModelParams.record`'s order)
     to climb at most ``climb_per_jump`` [l0] a jump toward ``target`` [l0] over the next two
     touchdowns, keeping the section state near the gait's ``state`` (weight ``q_state``), never a
     command the model predicts fails; the leg angle at ``psi0_deg`` (the pitch fed back as in
