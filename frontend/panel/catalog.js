@@ -1,10 +1,9 @@
 // What the service offers, from its catalog (GET /api/v1/catalog): the registered controllers
 // fill every chooser marked data-controllers — "all" (every one chosen), a name (that one
-// chosen) or "none" (nothing chosen: a filter whose first option is "any") — and the registered
-// job kinds the chooser marked data-job-kinds, each kind that has a form in the page (a
-// fieldset[data-kind]: the others are asked for through the API). Nothing is listed in the page
-// itself, so a controller or a job kind added to a registry shows up everywhere at once.
-import { $, call } from "./api.js";
+// chosen) or "none" (nothing chosen: a filter whose first option is "any"); the job kinds fill
+// the Jobs tab's chooser (jobs.js). Nothing is listed in the page itself, so a controller or a
+// job kind added to a registry shows up everywhere at once.
+import { call } from "./api.js";
 import { attributes, element } from "./dom.js";
 
 // A line colour per controller, by its place in the registry: the first four as they always were.
@@ -38,14 +37,4 @@ export async function fillChoosers(root = document) {
     select.replaceChildren(...keep, ...controllers.map((law) => option(law, chosen === "all" || chosen === law.name)));
     if (select.multiple) select.size = Math.min(Math.max(controllers.length, 2), 8);
   }
-  const forms = new Set([...document.querySelectorAll("fieldset[data-kind]")].map((fieldset) => fieldset.dataset.kind));
-  for (const select of root.querySelectorAll("select[data-job-kinds]")) {
-    const kinds = (await loadCatalog()).job_kinds.filter((kind) => forms.has(kind.name));
-    const chosen = select.value;
-    select.replaceChildren(...kinds.map((kind) => attributes(element("option", kind.title), { value: kind.name })));
-    if (kinds.some((kind) => kind.name === chosen)) select.value = chosen;
-    select.dispatchEvent(new Event("change"));  // its kind's fields shown
-  }
 }
-
-export const chooser = (name) => $(`select[data-controllers][name="${name}"]`);

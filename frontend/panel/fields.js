@@ -148,5 +148,14 @@ export const Fields = (() => {
     return { left, marked };
   }
 
-  return { ready, readFields, markApiErrors, clear, annotation };
+  // A request body's schema by its name in the OpenAPI document (the catalog's ``request``), or undefined.
+  async function schema(name) {
+    await ready;
+    return resolve(schemas[name]);
+  }
+
+  // A property's own schema, its $ref followed and an optional field's null branch left out.
+  const plain = (property) => resolve(property);
+
+  return { ready, readFields, markApiErrors, clear, annotation, schema, plain };
 })();

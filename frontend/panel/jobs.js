@@ -7,6 +7,8 @@ import { element, fillTable, attributes } from "./dom.js";
 import { hideControlStudy, showControlStudy } from "./control_study.js";
 import { hideViability, showViability } from "./viability.js";
 import { hideLoopMfpt, showLoopMfpt } from "./loop_mfpt.js";
+import { loadCatalog } from "./catalog.js";
+import { generatedBody, generatedFieldset } from "./job_forms.js";
 
 const streams = new Map();
 const FINAL = ["done", "cancelled", "failed"];
@@ -19,7 +21,11 @@ export function describeJob(job) {
   if (job.kind === "mfpt") return `MFPT of ${spec.psi0_deg}°/${spec.zeta0}, grid ${spec.grid}`;
   if (job.kind === "loop-mfpt") return `MFPT of ${spec.controller} at ${spec.target_m} m, ${spec.runs} runs × ${spec.replicas} replicas`;
   if (job.kind === "viability") return `viability, ${spec.states}² states × ${spec.actions}² actions`;
-  const legs = (spec.controls || []).map((leg) => `${leg.psi0_deg}°/${leg.zeta0}`).join(", ");
+  if (!spec.controls) {  // a kind without words of its own here: its numbers, as the API names them
+    return Object.entries(spec).filter(([name, value]) => typeof value === "number" && name !== "version")
+      .map(([name, value]) => `${name.replaceAll("_", " ")} ${value}`).join(", ");
+  }
+  const legs = spec.controls.map((leg) => `${leg.psi0_deg}°/${leg.zeta0}`).join(", ");
   const limit = spec.jump_limit ? `, up to ${spec.jump_limit} jumps` : "";
   return job.kind === "basin" ? `${legs}, ${spec.grid}² start states${limit}` : legs;
 }
@@ -140,7 +146,29 @@ on("#job-kind", "change", (event) => {
     fieldset.disabled = fieldset.hidden;  // hidden fields are neither validated nor sent
   }
 });
-$("#job-kind").dispatchEvent(new Event("change"));  // also after the browser restores a form
+
+// The kind chooser, from the service's catalog: a kind with its own fieldset in index.html, or
+// one built from its request's schema (job_forms.js), in the registry's order; a kind whose
+// body the panel cannot build (a gait search's legs) is left to the API.
+const GENERATED = new Map();  // kind -> its generated form's fields
+async function fillJobKinds() {
+  const form = $("#job-form"), select = $("#job-kind");
+  const options = [];
+  for (const kind of (await loadCatalog()).job_kinds) {
+    if (!form.querySelector(`fieldset[data-kind="${kind.name}"]`)) {
+      const made = await generatedFieldset(kind);
+      if (!made) continue;
+      GENERATED.set(kind.name, made.fields);
+      form.querySelector(":scope > .buttons").before(made.fieldset);
+    }
+    options.push(attributes(element("option", kind.title), { value: kind.name }));
+  }
+  const chosen = select.value;
+  select.replaceChildren(...options);
+  if (options.some((option) => option.value === chosen)) select.value = chosen;
+  select.dispatchEvent(new Event("change"));  // its kind's fields shown (also after the browser restores a form)
+}
+fillJobKinds().catch(() => {});
 
 // The job form's fields by kind: each checked against its job's request body (fields.js).
 const JOB_FIELDS = {
@@ -180,8 +208,9 @@ const JOB_LOCATIONS = { psi0_deg: "psi0", zeta0s: "zeta0s", trials: "trials", ca
 // field is marked).
 async function jobSpec(form) {
   const kind = form.elements.kind.value;
-  const v = await checked(form, JOB_FIELDS[kind]);
+  const v = await checked(form, JOB_FIELDS[kind] ?? GENERATED.get(kind));
   if (v === null) return null;
+  if (GENERATED.has(kind)) return generatedBody(kind, GENERATED.get(kind), v);
   if (kind === "mjtf") {
     return { body: { kind, psi0_deg: v.psi0, trials: v.trials, cap: v.cap, seed: v.seed, zeta0s: v.zeta0s }, locations: JOB_LOCATIONS };
   }
@@ -278,6 +307,9 @@ export async function showJob(id) {
     showLoopMfpt(id, results.result);
   } else if (job.kind === "viability") {
     showViability(id, results.result);
+  } else if (job.kind !== "gaits") {
+    // A kind the panel draws no plot for: its figures are in its results (GET /api/v1/jobs/{id}/results).
+    say(`Job ${id} (${job.kind}) is done: its result is at ${API}/jobs/${id}/results.`);
   } else {
     const gaits = results.result.gaits || [];
     say(`Job ${id}: ${gaits.length} gait(s): ${gaits.map((g) => `period ${g.period} at (${g.state.map((v) => v.toFixed(3)).join(", ")}), max |λ| ${g.max_abs_eigenvalue.toFixed(3)}`).join("; ")}.`);
