@@ -1,14 +1,13 @@
 // The Jobs tab: the job form by kind, the jobs table page by page with live progress (event
 // streams) and each queued job's place and estimate, results.
 import { API, $, say, call, on } from "./api.js";
-import { filedUnder, SQRT_GL0, checked, simControls } from "./forms.js";
+import { filedUnder } from "./forms.js";
 import { draw, layout, plotSweep, plotBasin } from "./plots.js";
 import { element, fillTable, attributes } from "./dom.js";
 import { hideControlStudy, showControlStudy } from "./control_study.js";
 import { hideViability, showViability } from "./viability.js";
 import { hideLoopMfpt, showLoopMfpt } from "./loop_mfpt.js";
-import { loadCatalog } from "./catalog.js";
-import { generatedBody, generatedFieldset } from "./job_forms.js";
+import { jobSpec } from "./job_forms.js";
 
 const streams = new Map();
 const FINAL = ["done", "cancelled", "failed"];
@@ -139,110 +138,6 @@ on("#jobs-newer", "click", () => {
   paging.at -= 1;
   return loadJobs();
 });
-
-on("#job-kind", "change", (event) => {
-  for (const fieldset of document.querySelectorAll("#job-form fieldset[data-kind]")) {
-    fieldset.hidden = fieldset.dataset.kind !== event.target.value;
-    fieldset.disabled = fieldset.hidden;  // hidden fields are neither validated nor sent
-  }
-});
-
-// The kind chooser, from the service's catalog: a kind with its own fieldset in index.html, or
-// one built from its request's schema (job_forms.js), in the registry's order; a kind whose
-// body the panel cannot build (a gait search's legs) is left to the API.
-const GENERATED = new Map();  // kind -> its generated form's fields
-async function fillJobKinds() {
-  const form = $("#job-form"), select = $("#job-kind");
-  const options = [];
-  for (const kind of (await loadCatalog()).job_kinds) {
-    if (!form.querySelector(`fieldset[data-kind="${kind.name}"]`)) {
-      const made = await generatedFieldset(kind);
-      if (!made) continue;
-      GENERATED.set(kind.name, made.fields);
-      form.querySelector(":scope > .buttons").before(made.fieldset);
-    }
-    options.push(attributes(element("option", kind.title), { value: kind.name }));
-  }
-  const chosen = select.value;
-  select.replaceChildren(...options);
-  if (options.some((option) => option.value === chosen)) select.value = chosen;
-  select.dispatchEvent(new Event("change"));  // its kind's fields shown (also after the browser restores a form)
-}
-fillJobKinds().catch(() => {});
-
-// The job form's fields by kind: each checked against its job's request body (fields.js).
-const JOB_FIELDS = {
-  mjtf: [{ name: "psi0", rule: "MJTFJobCreate.psi0_deg", unit: "°" }, { name: "zeta0s", rule: "MJTFJobCreate.zeta0s", unit: "l0", list: true },
-    { name: "trials", rule: "MJTFJobCreate.trials" }, { name: "cap", rule: "MJTFJobCreate.cap", unit: "jumps" }, { name: "seed", rule: "MJTFJobCreate.seed" }],
-  sweep: [{ name: "sweep_psi0", rule: "SweepJobCreate.psi0_deg", unit: "°" }, { name: "zeta0_low", rule: "SweepJobCreate.zeta0_low", unit: "l0" },
-    { name: "zeta0_high", rule: "SweepJobCreate.zeta0_high", unit: "l0" }, { name: "steps", rule: "SweepJobCreate.steps" },
-    { name: "basin_grid", rule: "SweepJobCreate.basin_grid" }],
-  basin: [{ name: "grid", rule: "BasinJobCreate.grid" }, { name: "basin_jumps", rule: "BasinJobCreate.jumps", unit: "jumps" },
-    { name: "jump_limit", rule: "BasinJobCreate.jump_limit", unit: "jumps", optional: true }, { name: "tolerance", rule: "BasinJobCreate.tolerance", unit: SQRT_GL0 }],
-  "control-study": [{ name: "study_target", rule: "ControlStudyJobCreate.target_m", unit: "m" }, { name: "study_seeds", rule: "ControlStudyJobCreate.seeds" },
-    { name: "study_jumps", rule: "ControlStudyJobCreate.jumps", unit: "jumps" }, { name: "study_seed0", rule: "ControlStudyJobCreate.seed0" }],
-  mfpt: [{ name: "mfpt_psi0", rule: "MfptJobCreate.psi0_deg", unit: "°" }, { name: "mfpt_zeta0", rule: "MfptJobCreate.zeta0", unit: "l0" },
-    { name: "mfpt_velocity", rule: "NoiseIn.velocity", unit: SQRT_GL0 }, { name: "mfpt_drift", rule: "NoiseIn.pitch_drift_deg", unit: "°" },
-    { name: "mfpt_grid", rule: "MfptJobCreate.grid" }, { name: "mfpt_pitch", rule: "MfptJobCreate.pitch_spacing", unit: "σ" }],
-  "loop-mfpt": [{ name: "loop_target", rule: "LoopMfptJobCreate.target_m", unit: "m" }, { name: "loop_velocity", rule: "LoopNoiseIn.velocity", unit: SQRT_GL0 },
-    { name: "loop_runs", rule: "LoopMfptJobCreate.runs" }, { name: "loop_replicas", rule: "LoopMfptJobCreate.replicas" }, { name: "loop_seed", rule: "LoopMfptJobCreate.seed" }],
-  viability: [{ name: "viability_states", rule: "ViabilityJobCreate.states" }, { name: "viability_actions", rule: "ViabilityJobCreate.actions" },
-    { name: "viability_psi0_low", rule: "ViabilityJobCreate.psi0_low_deg", unit: "°" }, { name: "viability_psi0_high", rule: "ViabilityJobCreate.psi0_high_deg", unit: "°" },
-    { name: "viability_zeta0_low", rule: "ViabilityJobCreate.zeta0_low", unit: "l0" }, { name: "viability_zeta0_high", rule: "ViabilityJobCreate.zeta0_high", unit: "l0" }],
-};
-const MFPT_LOCATIONS = { psi0_deg: "mfpt_psi0", zeta0: "mfpt_zeta0", grid: "mfpt_grid", pitch_spacing: "mfpt_pitch",
-  "noise.velocity": "mfpt_velocity", "noise.pitch_drift_deg": "mfpt_drift" };
-const LOOP_FIELDS = { controller: "loop_controller", target_m: "loop_target", "noise.velocity": "loop_velocity", runs: "loop_runs",
-  replicas: "loop_replicas", seed: "loop_seed" };
-// Under its kind too (the API's 422 names it first); the rule across fields (replicas × runs) is marked at replicas.
-const LOOP_LOCATIONS = { ...LOOP_FIELDS, ...Object.fromEntries(Object.entries(LOOP_FIELDS).map(([field, input]) => [`loop-mfpt.${field}`, input])),
-  "loop-mfpt": "loop_replicas" };
-const VIABILITY_LOCATIONS = { states: "viability_states", actions: "viability_actions", psi0_low_deg: "viability_psi0_low",
-  psi0_high_deg: "viability_psi0_high", zeta0_low: "viability_zeta0_low", zeta0_high: "viability_zeta0_high" };
-const STUDY_LOCATIONS = { controllers: "study_controllers", target_m: "study_target", seeds: "study_seeds", jumps: "study_jumps",
-  seed0: "study_seed0" };
-const JOB_LOCATIONS = { psi0_deg: "psi0", zeta0s: "zeta0s", trials: "trials", cap: "cap", seed: "seed", zeta0_low: "zeta0_low",
-  zeta0_high: "zeta0_high", steps: "steps", basin_grid: "basin_grid", grid: "grid", jumps: "basin_jumps", jump_limit: "jump_limit", tolerance: "tolerance" };
-
-// The job to schedule from the form — {body, locations: body field -> input} — or null (a bad
-// field is marked).
-async function jobSpec(form) {
-  const kind = form.elements.kind.value;
-  const v = await checked(form, JOB_FIELDS[kind] ?? GENERATED.get(kind));
-  if (v === null) return null;
-  if (GENERATED.has(kind)) return generatedBody(kind, GENERATED.get(kind), v);
-  if (kind === "mjtf") {
-    return { body: { kind, psi0_deg: v.psi0, trials: v.trials, cap: v.cap, seed: v.seed, zeta0s: v.zeta0s }, locations: JOB_LOCATIONS };
-  }
-  if (kind === "control-study") {
-    const controllers = [...form.elements.study_controllers.selectedOptions].map((option) => option.value);
-    const body = { kind, controllers, target_m: v.study_target, seeds: v.study_seeds, jumps: v.study_jumps, seed0: v.study_seed0 };
-    return { body, locations: { ...STUDY_LOCATIONS, ...Object.fromEntries(Object.entries(STUDY_LOCATIONS).map(([field, input]) => [`control-study.${field}`, input])) } };
-  }
-  if (kind === "mfpt") {
-    const body = { kind, psi0_deg: v.mfpt_psi0, zeta0: v.mfpt_zeta0, grid: v.mfpt_grid, pitch_spacing: v.mfpt_pitch,
-      noise: { velocity: v.mfpt_velocity, pitch_drift_deg: v.mfpt_drift } };
-    return { body, locations: MFPT_LOCATIONS };
-  }
-  if (kind === "loop-mfpt") {
-    const body = { kind, controller: form.elements.loop_controller.value, target_m: v.loop_target, noise: { velocity: v.loop_velocity, pitch_drift_deg: 0 },
-      runs: v.loop_runs, replicas: v.loop_replicas, seed: v.loop_seed };
-    return { body, locations: LOOP_LOCATIONS };
-  }
-  if (kind === "viability") {
-    const body = { kind, states: v.viability_states, actions: v.viability_actions, psi0_low_deg: v.viability_psi0_low,
-      psi0_high_deg: v.viability_psi0_high, zeta0_low: v.viability_zeta0_low, zeta0_high: v.viability_zeta0_high };
-    return { body, locations: VIABILITY_LOCATIONS };
-  }
-  if (kind === "sweep") {
-    const body = { kind, psi0_deg: v.sweep_psi0, zeta0_low: v.zeta0_low, zeta0_high: v.zeta0_high, steps: v.steps, basin_grid: v.basin_grid };
-    return { body, locations: { ...JOB_LOCATIONS, psi0_deg: "sweep_psi0" } };
-  }
-  const sim = await simControls();
-  if (!sim) return null;
-  const body = { kind, controls: sim.controls, guess: sim.start, grid: v.grid, jumps: v.basin_jumps, jump_limit: v.jump_limit, tolerance: v.tolerance };
-  return { body, locations: JOB_LOCATIONS };
-}
 
 on("#job-form", "submit", async (event) => {
   event.preventDefault();
