@@ -204,7 +204,7 @@ class JobCalls:
         ``actions`` per control axis over psi0 ``psi0_low_deg``-``psi0_high_deg`` [deg] and zeta0
         ``zeta0_low``-``zeta0_high`` [l0]. Its result: ``kernel_fraction``, ``kernel`` and
         ``measure`` over the states, the axes, and ``viable_pairs`` (base64 bits, see
-        :mod:`backend.services.section_jobs`)."""
+        :mod:`backend.jobs.viability`)."""
         spec = {"states": states, "actions": actions, "psi0_low_deg": psi0_low_deg, "psi0_high_deg": psi0_high_deg}
         spec |= {"zeta0_low": zeta0_low, "zeta0_high": zeta0_high}
         return self.submit_job("viability", **spec, model=mapping(model), experiment_id=experiment_id)
