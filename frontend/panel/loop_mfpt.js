@@ -1,5 +1,5 @@
 // A controller's MFPT job in the Jobs tab (the result of ``parkour mfpt --controller --json``:
-// backend/services/section_jobs.py): the estimate in words, and each splitting run's failure
+// backend/jobs/loop_mfpt.py): the estimate in words, and each splitting run's failure
 // probability (an exit failing before it comes home) around their mean. Every value reaches the
 // page as text or as Plotly data.
 import { $ } from "./api.js";

@@ -1,4 +1,4 @@
-// A viability job's results in the Jobs tab (backend/services/section_jobs.py): the measure of
+// A viability job's results in the Jobs tab (backend/jobs/viability.py): the measure of
 // every mid-chute state (the fraction of leg commands that keep the robot going forever; outside
 // the kernel none does), and a clicked state's viable commands over (psi0, zeta0), unpacked from
 // the result's bits. Every value reaches the page as Plotly data or text.

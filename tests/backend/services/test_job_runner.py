@@ -173,7 +173,7 @@ def test_the_runner_leaves_a_job_cancelled_before_it_starts_alone(sessions, sess
 
 
 def test_a_stored_job_the_request_schema_now_refuses_still_resumes(sessions, session, compute):
-    """Its spec is read as stored (job_specs.py), not re-validated by today's request ranges."""
+    """Its spec is read as stored (backend/jobs/specs.py), not re-validated by today's request ranges."""
     from backend.jobs.mjtf import MJTFSpec
     from backend.jobs.specs import StateSpec, encode
 
