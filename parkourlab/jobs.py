@@ -209,6 +209,27 @@ class JobCalls:
         spec |= {"zeta0_low": zeta0_low, "zeta0_high": zeta0_high}
         return self.submit_job("viability", **spec, model=mapping(model), experiment_id=experiment_id)
 
+    def submit_atlas(
+        self,
+        *,
+        psi0_low_deg: float | None = None,
+        psi0_high_deg: float | None = None,
+        zeta0_low: float | None = None,
+        zeta0_high: float | None = None,
+        rows: int | None = None,
+        columns: int | None = None,
+        transient: int | None = None,
+        model: Mapping[str, Any] | None = None,
+        experiment_id: int | None = None,
+    ) -> Job:
+        """The gait atlas (``parkour atlas``, symmetric): where stable gaits live over ``rows`` leg
+        angles from ``psi0_low_deg`` to ``psi0_high_deg`` [deg] x ``columns`` leg lengths from
+        ``zeta0_low`` to ``zeta0_high`` [l0], each orbit let settle ``transient`` jumps. Its result
+        is ``parkour atlas --json``: per cell the most stable gait's period, climb per jump and max |λ|."""
+        spec = {"psi0_low_deg": psi0_low_deg, "psi0_high_deg": psi0_high_deg, "zeta0_low": zeta0_low}
+        spec |= {"zeta0_high": zeta0_high, "rows": rows, "columns": columns, "transient": transient}
+        return self.submit_job("atlas", **spec, model=mapping(model), experiment_id=experiment_id)
+
     def job(self, job: JobRef) -> Job:
         """A job's state now: ``state``, ``completed`` of ``total``, ``progress`` in [0, 1], ``error``."""
         return self._http.call("GET", f"/api/v1/jobs/{job_id(job)}")

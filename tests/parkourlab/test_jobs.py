@@ -110,6 +110,10 @@ EVERY_FIELD = {
         "deadbeat", target_m=0.6, psi0_deg=34.0, start_zeta0=0.88, noise={"velocity": 0.05, "pitch_drift_deg": 0.0},
         replicas=50, runs=8, seed=4, model={"preset": "paper"}, experiment_id=2,
     ),
+    "atlas": lambda c: c.submit_atlas(
+        psi0_low_deg=20.0, psi0_high_deg=40.0, zeta0_low=0.85, zeta0_high=0.95, rows=4, columns=5, transient=200,
+        model={"preset": "paper"}, experiment_id=2,
+    ),
     "viability": lambda c: c.submit_viability(
         states=30, actions=10, psi0_low_deg=20.0, psi0_high_deg=45.0, zeta0_low=0.75, zeta0_high=0.97,
         model={"preset": "paper"}, experiment_id=2,

@@ -30,7 +30,7 @@ CONTROL = {"kind": "control-study"}
 MFPT = {"kind": "mfpt"}
 VIABILITY = {"kind": "viability"}
 BODIES = {"mjtf": MJTF, "sweep": SWEEP, "basin": BASIN, "gaits": GAITS, "control-study": CONTROL, "mfpt": MFPT,
-          "loop-mfpt": {"kind": "loop-mfpt"}, "viability": VIABILITY}  # fmt: skip
+          "loop-mfpt": {"kind": "loop-mfpt"}, "viability": VIABILITY, "atlas": {"kind": "atlas"}}  # fmt: skip
 
 
 @pytest.mark.parametrize("kind", JOB_KINDS)
@@ -41,8 +41,8 @@ def test_a_job_is_read_as_the_kind_it_names(kind):
 
 def test_a_job_without_a_kind_is_mjtf_and_an_unknown_kind_is_refused():
     assert type(accepted(JobCreate, MJTF)) is MJTFJobCreate
-    assert refused(JobCreate, {"kind": "atlas"}) == [()]
-    assert "'mjtf', 'sweep', 'basin', 'gaits'" in refusal_messages(JobCreate, {"kind": "atlas"})
+    assert refused(JobCreate, {"kind": "reach"}) == [()]
+    assert "'mjtf', 'sweep', 'basin', 'gaits'" in refusal_messages(JobCreate, {"kind": "reach"})
 
 
 def test_errors_name_the_kind_then_the_field():

@@ -110,7 +110,7 @@ def test_sweep_basin_and_gait_search_jobs(client, auth):
     [
         ({"kind": "sweep", "zeta0_low": 0.95, "zeta0_high": 0.9}, "sweep"),
         ({"kind": "basin", "controls": [{"psi0_deg": 30, "zeta0": 0.9}], "grid": 10**6}, "grid"),
-        ({"kind": "atlas"}, "kind"),
+        ({"kind": "reach"}, "kind"),
     ],
 )
 def test_bad_study_specs_are_a_422(client, auth, spec, field):
