@@ -43,6 +43,7 @@ from pathlib import Path
 
 import httpx
 from bench_load import RUN, Connection, cpu_seconds, machine_cpu_seconds  # scripts/ is on the path
+from bench_store import run_row
 from sqlalchemy import MetaData, insert
 
 from backend.store.database import make_engine, migrate, sqlite_url
@@ -139,23 +140,12 @@ def _run(run_id: int, rng: random.Random) -> dict:
                     else None}  # fmt: skip
     elif kind == "replay":
         results["source_run_id"] = max(1, run_id - rng.randrange(1, 50))
-    return {
-        "id": run_id,
+    return run_row(run_id, psi0, zeta0, failure, jumps_completed, rng) | {
         "kind": kind,
         "status": status,
         "duration_s": rng.uniform(0.001, 60 if kind == "robot" else 0.5),
-        "code_version": "bench",
         "created_at": EPOCH + datetime.timedelta(minutes=run_id + rng.uniform(0, 30)),
-        "model": {"alpha": 77.6, "d_hat": 2.42, "c_zeta": 0.31, "c_psi": 0.31, "mu": 2.0},
         "controls": [[psi0, zeta0], [psi0, zeta0]] if kind != "sim" else [[psi0, zeta0]],
-        "start_state": [-0.93, -0.17],
-        "jumps": 20,
-        "alpha": 77.6,
-        "psi0_deg": psi0,
-        "zeta0": zeta0,
-        "failure_code": failure,
-        "jumps_completed": jumps_completed,
-        "climb": rng.uniform(-1, 8),
         "results": results,
         "notes": rng.choice(NOTES),
     }
@@ -240,15 +230,31 @@ def check_pages(base: str) -> None:
                 assert not overlap and second["total"] == first["total"], params
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def stop_sides(processes: dict, git_worktree: list, base_tree: Path, scratch: Path) -> None:
+    """End a side-by-side bench: both services stopped, the base's worktree and the scratch folder gone."""
+    for process in processes.values():
+        process.terminate()
+        process.wait(30)
+    if base_tree.exists():
+        subprocess.run([*git_worktree, "remove", "--force", str(base_tree)], check=False)
+    shutil.rmtree(scratch, ignore_errors=True)
+
+
+def side_by_side_options(doc: str, *, runs: int, rounds: int, seconds: float, port: int) -> argparse.ArgumentParser:
+    """The options of a bench that runs a base revision and this tree side by side, with its defaults."""
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
     parser.add_argument("--base", default="HEAD", help="the revision to compare against (default: the last commit)")
-    parser.add_argument("--runs", type=int, default=100_000)
+    parser.add_argument("--runs", type=int, default=runs)
     parser.add_argument("--clients", type=int, default=20)
-    parser.add_argument("--rounds", type=int, default=3)
-    parser.add_argument("--seconds", type=float, default=8.0, help="each phase's length")
+    parser.add_argument("--rounds", type=int, default=rounds)
+    parser.add_argument("--seconds", type=float, default=seconds, help="each phase's length")
+    parser.add_argument("--port", type=int, default=port, help="the base's port; the new one's is the next")
+    return parser
+
+
+def main() -> None:
+    parser = side_by_side_options(__doc__, runs=100_000, rounds=3, seconds=8.0, port=8791)
     parser.add_argument("--writes", type=float, default=0.0, help="the fraction of requests that store a run")
-    parser.add_argument("--port", type=int, default=8791, help="the base's port; the new one's is the next")
     parser.add_argument(
         "--same-queries",
         action="store_true",
@@ -291,12 +297,7 @@ def main() -> None:
                               args.writes, round_, processes[name].pid)  # fmt: skip
                 results["rounds"][name].append(entry)
     finally:
-        for process in processes.values():
-            process.terminate()
-            process.wait(30)
-        if base_tree.exists():
-            subprocess.run([*git_worktree, "remove", "--force", str(base_tree)], check=False)
-        shutil.rmtree(scratch, ignore_errors=True)
+        stop_sides(processes, git_worktree, base_tree, scratch)
     if args.json:
         print(json.dumps(results))
         return

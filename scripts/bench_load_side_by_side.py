@@ -14,7 +14,6 @@ Usage: PYTHONPATH=. python scripts/bench_load_side_by_side.py [--base HEAD] [--c
 
 from __future__ import annotations
 
-import argparse
 import random
 import shutil
 import statistics
@@ -22,7 +21,12 @@ import subprocess
 import tempfile
 from pathlib import Path
 
-from bench_history_page import schema_of, seed  # scripts/ is on the path when this script runs
+from bench_history_page import (  # scripts/ is on the path when this script runs
+    schema_of,
+    seed,
+    side_by_side_options,
+    stop_sides,
+)
 from bench_load import phase
 
 from backend.store.database import make_engine, migrate, sqlite_url
@@ -42,13 +46,7 @@ def median_of(phases: list[dict], *keys: str) -> float:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--base", default="HEAD", help="the revision to compare against (default: the last commit)")
-    parser.add_argument("--runs", type=int, default=20_000)
-    parser.add_argument("--clients", type=int, default=20)
-    parser.add_argument("--rounds", type=int, default=5)
-    parser.add_argument("--seconds", type=float, default=4.0, help="each phase's length")
-    parser.add_argument("--port", type=int, default=8781, help="the base's port; the new one's is the next")
+    parser = side_by_side_options(__doc__, runs=20_000, rounds=5, seconds=4.0, port=8781)
     args = parser.parse_args()
     scratch = Path(tempfile.mkdtemp(prefix="parkourlab-sbs-"))
     base_tree = scratch / "base-tree"
@@ -78,12 +76,7 @@ def main() -> None:
                 url, pid = f"http://127.0.0.1:{sides[name][1]}", processes[name].pid
                 results[name].append(phase(url, tokens[name], args.clients, args.seconds, pid))
     finally:
-        for process in processes.values():
-            process.terminate()
-            process.wait(30)
-        if base_tree.exists():
-            subprocess.run([*git_worktree, "remove", "--force", str(base_tree)], check=False)
-        shutil.rmtree(scratch, ignore_errors=True)
+        stop_sides(processes, git_worktree, base_tree, scratch)
     print(f"{args.clients} clients, {args.rounds} rounds of {args.seconds:g} s per side; base = {args.base}")
     for name, phases in results.items():
         errors = [entry["errors"] for entry in phases if entry["errors"]]

@@ -34,6 +34,26 @@ QUERIES = [
 ]
 
 
+def run_row(run_id: int, psi0: float, zeta0: float, failure: str | None, jumps_completed: int, rng) -> dict:
+    """A stored run's row as the benches seed it: 20 jumps of one leg pair on the paper's model
+    (its ``kind``, ``duration_s`` and ``results`` are each bench's)."""
+    return {
+        "id": run_id,
+        "status": "done",
+        "code_version": "bench",
+        "model": {"alpha": 77.6, "d_hat": 2.42, "c_zeta": 0.31, "c_psi": 0.31, "mu": 2.0},
+        "controls": [[psi0, zeta0]],
+        "start_state": [-0.93, -0.17],
+        "jumps": 20,
+        "alpha": 77.6,
+        "psi0_deg": psi0,
+        "zeta0": zeta0,
+        "failure_code": failure,
+        "jumps_completed": jumps_completed,
+        "climb": rng.uniform(-1, 8),
+    }
+
+
 def seed(url: str, count: int, rng: random.Random) -> None:
     engine = make_engine(url)
     migrate(engine)
@@ -44,26 +64,10 @@ def seed(url: str, count: int, rng: random.Random) -> None:
             for run_id in range(start + 1, min(start + 10_000, count) + 1):
                 zeta0, psi0 = rng.uniform(0.8, 0.98), rng.uniform(15, 45)
                 failure = rng.choice(failures)
-                rows.append(
-                    {
-                        "id": run_id,
-                        "kind": rng.choice(["sim", "sim", "sim", "robot"]),
-                        "status": "done",
-                        "duration_s": rng.uniform(0.001, 0.5),
-                        "code_version": "bench",
-                        "model": {"alpha": 77.6, "d_hat": 2.42, "c_zeta": 0.31, "c_psi": 0.31, "mu": 2.0},
-                        "controls": [[psi0, zeta0]],
-                        "start_state": [-0.93, -0.17],
-                        "jumps": 20,
-                        "alpha": 77.6,
-                        "psi0_deg": psi0,
-                        "zeta0": zeta0,
-                        "failure_code": failure,
-                        "jumps_completed": 20 if failure is None else rng.randrange(20),
-                        "climb": rng.uniform(-1, 8),
-                        "results": {"states": [[-0.93, -0.17]] * 21, "rises": [0.33] * 20, "failure": None},
-                    }
-                )
+                jumps_completed = 20 if failure is None else rng.randrange(20)
+                row = run_row(run_id, psi0, zeta0, failure, jumps_completed, rng)
+                row |= {"kind": rng.choice(["sim", "sim", "sim", "robot"]), "duration_s": rng.uniform(0.001, 0.5)}
+                rows.append(row | {"results": {"states": [[-0.93, -0.17]] * 21, "rises": [0.33] * 20, "failure": None}})
                 tags += [{"run_id": run_id, "tag": tag} for tag in rng.sample(TAGS, 2)]
             connection.execute(insert(Run), rows)
             connection.execute(insert(RunTag), tags)
