@@ -16,6 +16,8 @@ from dataclasses import asdict, dataclass, fields
 
 from experiments.manifest import json_safe
 from sim_core.model.noise import NoiseModel
+from sim_core.model.params import ModelParams
+from sim_core.model.presets import preset_model
 
 SPEC_VERSION = 1
 _NOISE = NoiseModel()  # the noise's defaults: one home, sim_core.model.noise
@@ -35,6 +37,12 @@ class ModelSpec:
     c_zeta: float | None = None
     c_psi: float | None = None
     mu: float | None = None
+
+    def params(self) -> ModelParams:
+        """The model the job runs: its preset (a stored one was resolved to its base when the job
+        was accepted) with its overrides."""
+        overrides = {name: value for name, value in asdict(self).items() if name != "preset"}
+        return preset_model(self.preset, field="model.preset", **overrides)
 
 
 @dataclass(frozen=True)

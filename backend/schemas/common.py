@@ -13,6 +13,8 @@ from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Fie
 from sim_core.climb.records import CHUTE_TOP, FLOOR
 from sim_core.control.laws import PSI0_RANGE_DEG
 from sim_core.control.registry import NAMES
+from sim_core.model.params import ModelParams
+from sim_core.model.presets import preset_model
 
 ControllerKind = enum.StrEnum("ControllerKind", {name.replace("-", "_").upper(): name for name in NAMES})
 ControllerKind.__doc__ = "A closed-loop law (the registry, sim_core.control.laws.LAWS)."
@@ -95,6 +97,12 @@ class ModelIn(Strict):
     mu: Annotated[float, Field(gt=0.0, le=MAX_FRICTION)] | None = Field(
         None, description=f"friction coefficient, in (0, {MAX_FRICTION:g}]; omit for the preset (no slip)"
     )
+
+    def params(self) -> ModelParams:
+        """The model this asks for: its preset with its overrides. A stored preset is resolved to its
+        base before a request gets here (backend.services.presets.with_preset_resolved)."""
+        overrides = self.model_dump(exclude={"preset"})
+        return preset_model(self.preset, field="model.preset", **overrides)
 
 
 class StateIn(Strict):

@@ -36,7 +36,6 @@ from backend.jobs import decode, job_kind
 from backend.jobs.mjtf import MJTFSpec
 from backend.repositories import jobs as stored_jobs
 from backend.schemas.jobs import JobState
-from backend.services.model_requests import model_params
 from backend.services.storage_waits import Stopped, Waiting, when_room
 from backend.services.studies import run_study, run_study_here
 from backend.store.database import StorageFull
@@ -146,7 +145,7 @@ class JobRunner:
         from sim_core.robustness.mjtf import level_starts  # the kernels load with the first job (simulation.py)
         from sim_core.robustness.mjtf_trials import run_trials
 
-        model, noise = model_params(spec.model), spec.noise.model()
+        model, noise = spec.model.params(), spec.noise.model()
         guess = None if spec.guess is None else (spec.guess.xdot, spec.guess.ydot)
         try:
             starts = self.pool.submit(functools.partial(level_starts, guess=guess), model, np.radians(spec.psi0_deg),

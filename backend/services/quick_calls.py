@@ -17,9 +17,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from backend.jobs.base import gait_not_found_as_parameter_error
+from backend.jobs.base import gait_not_found_as_parameter_error, schedule_of
 from backend.schemas import FixedPointIn, MapIn, RunCreate, TrajectoryIn
-from backend.services.model_requests import model_params, schedule_of
 from backend.services.presets import InSession, preset_resolved, resolve_model
 from backend.services.provenance import current_code_version
 from backend.store.run_record import RunRecord
@@ -66,14 +65,14 @@ def map_orbit(body: MapIn) -> dict:
 
     start = (body.start.xdot, body.start.ydot)
     with KERNEL_LOCK:
-        return iterate_map(model_params(body.model), schedule_of(body.controls), start, body.jumps).to_dict()
+        return iterate_map(body.model.params(), schedule_of(body.controls), start, body.jumps).to_dict()
 
 
 def trajectory_columns(body: TrajectoryIn) -> dict:
     from sim_core.model.trajectory import simulate_trajectory
 
     start = (body.start.xdot, body.start.ydot)
-    model = model_params(body.model)
+    model = body.model.params()
     path = simulate_trajectory(model, schedule_of(body.controls), start, body.jumps, sample_rate=body.rate)
     scales = resolve_model(None, body.model.preset).robot.scales  # l0 and g are the preset's: they set the units
     return json_safe(
@@ -94,7 +93,7 @@ def trajectory_columns(body: TrajectoryIn) -> dict:
 
 
 def fixed_point(body: FixedPointIn) -> dict:
-    model, schedule = model_params(body.model), schedule_of(body.controls)
+    model, schedule = body.model.params(), schedule_of(body.controls)
     with KERNEL_LOCK:
         return _gait_of(model, schedule, body.period, body.guess).to_dict()
 
@@ -113,7 +112,7 @@ def simulate_run(body: RunCreate) -> RunRecord:
     from sim_core.model.poincare import iterate_map
     from sim_core.model.trajectory import simulate_trajectory
 
-    model, schedule = model_params(body.model), schedule_of(body.controls)
+    model, schedule = body.model.params(), schedule_of(body.controls)
     start = (body.start.xdot, body.start.ydot)
     began = time.perf_counter()
     trajectory = None

@@ -8,7 +8,6 @@ Module-level and picklable, like the quick calls; the kernels load inside the ru
 from __future__ import annotations
 
 from backend.jobs import JobContext, job_kind
-from backend.services.model_requests import model_params
 from backend.services.presets import resolve_model
 from backend.workers.progress import report
 
@@ -25,5 +24,5 @@ def run_study(spec, chunk_map, progress) -> dict:
     """The job's computation by its kind's run; its JSON result. ``progress(done, total)`` raises
     Cancelled on a cancel."""
     robot = resolve_model(None, spec.model.preset).robot  # a stored preset is resolved already
-    context = JobContext(model_params(spec.model), robot, chunk_map, progress)
+    context = JobContext(spec.model.params(), robot, chunk_map, progress)
     return job_kind(spec.kind).run(spec, context)

@@ -13,9 +13,10 @@ scan finds a period-4 attractor (docs/analyses.md).
 
 from __future__ import annotations
 
+from dataclasses import replace
 from types import MappingProxyType
 
-from sim_core.model.params import PhysicalParams
+from sim_core.model.params import ModelParams, PhysicalParams
 from sim_core.model.validation import ParameterError
 
 PRESETS = MappingProxyType(
@@ -55,3 +56,12 @@ def get_preset(name: str) -> PhysicalParams:
     except KeyError:
         known = ", ".join(sorted(PRESETS))
         raise ParameterError("preset", f"unknown preset {name!r}; known presets: {known}") from None
+
+
+def preset_model(name: str, *, field: str = "preset", **overrides: float | None) -> ModelParams:
+    """Built-in preset ``name``'s nondimensional model with every non-None override applied (a
+    ParameterError on each out-of-range one); an unknown name is a ParameterError on ``field``
+    naming the known presets."""
+    if name not in PRESETS:
+        raise ParameterError(field, f"unknown preset {name!r}; known presets: {', '.join(sorted(PRESETS))}")
+    return replace(PRESETS[name].to_model(), **{key: value for key, value in overrides.items() if value is not None})

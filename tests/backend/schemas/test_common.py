@@ -7,6 +7,7 @@ import math
 import pytest
 from pydantic import BaseModel, TypeAdapter, ValidationError
 
+from backend.jobs.specs import ModelSpec
 from backend.schemas.common import (
     MAX_FRICTION,
     MAX_ID,
@@ -23,6 +24,7 @@ from backend.schemas.common import (
     Zeta0,
     finite_or_none,
 )
+from sim_core.model.errors import ParameterError
 from tests.backend.schemas.refusals import LEG, START, accepted, refused
 
 NON_FINITE = [math.nan, math.inf, -math.inf]
@@ -200,3 +202,17 @@ def test_anything_but_iso_8601_is_refused_with_an_example(text):
     """Pydantic alone reads a number as seconds since 1970: "0.5" would be a date."""
     with pytest.raises(ValidationError, match=r"must be an ISO 8601 date or time, e\.g\. 2026-12-03"):
         TypeAdapter(IsoDateTime).validate_python(text)
+
+
+def test_a_requests_model_starts_from_its_preset(paper):
+    assert ModelIn().params() == paper
+    changed = ModelIn(alpha=40.0, mu=1.5).params()
+    assert (changed.alpha, changed.mu, changed.d_hat, changed.c_zeta) == (40.0, 1.5, paper.d_hat, paper.c_zeta)
+
+
+def test_a_stored_jobs_model_is_its_requests():
+    request = ModelIn(alpha=40.0, c_psi=0.2)
+    assert ModelSpec(**request.model_dump()).params() == request.params()
+    with pytest.raises(ParameterError) as unknown:
+        ModelSpec(preset="gone").params()
+    assert unknown.value.field == "model.preset" and "paper" in unknown.value.message
