@@ -15,7 +15,7 @@ from backend.jobs.budget import within_budget
 from backend.jobs.gaits import GAIT_SEARCH_JUMPS
 from backend.jobs.specs import ModelSpec
 from backend.schemas.common import ModelIn, Psi0Deg, RecordRef, Strict, Zeta0
-from sim_core.section.atlas import DEFAULT_STARTS, MAX_PERIOD, TRANSIENT_JUMPS
+from sim_core.section.atlas_plan import DEFAULT_STARTS, MAX_PERIOD, TRANSIENT_JUMPS
 
 GridSide = Annotated[int, Field(ge=2, le=200, description="cells along this axis")]
 

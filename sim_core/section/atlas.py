@@ -25,13 +25,10 @@ from sim_core.model.failures import OK
 from sim_core.model.params import ModelParams
 from sim_core.model.poincare import iterate_map_batch
 from sim_core.model.validation import ParameterError
+from sim_core.section.atlas_plan import DEFAULT_STARTS, MAX_CELLS, MAX_PERIOD, TRANSIENT_JUMPS
 from sim_core.section.fixed_points import FixedPoint, FixedPointNotFound, find_fixed_point
 
-MAX_PERIOD = 8  # [jumps]: longer cycles (or chaos) count as "no periodic gait"
-TRANSIENT_JUMPS = 300
 SETTLED = 1e-2  # [sqrt(g l0)]: a tail repeating to this is near a cycle; Levenberg–Marquardt finishes the job
-DEFAULT_STARTS = ((-0.9, -0.2), (-0.6, 0.5), (-1.4, -0.8), (-1.2, 0.8))  # [sqrt(g l0)]
-MAX_CELLS = 40_000
 CHUNK_ORBITS = 4096
 
 
