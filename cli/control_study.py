@@ -30,7 +30,7 @@ def control_study_command(
     noise: NoiseModel,
     controllers: Annotated[
         str, typer.Option("--controllers", help=f"Comma-separated, of: {', '.join(NAMES)}.")
-    ] = "pid,pid-pitch,lqr,deadbeat",
+    ] = ",".join(NAMES),
     target: Annotated[float, typer.Option("--target", help="Height to hold [m].")] = 0.55,
     seeds: Annotated[int, typer.Option("--seeds", help="Trials per controller (seeds seed0, seed0 + 1, ...).")] = 200,
     seed0: Annotated[int, typer.Option("--seed0", help="The first trial's seed (>= 0).")] = 0,

@@ -178,9 +178,10 @@ class JobCalls:
         experiment_id: int | None = None,
     ) -> Job:
         """A controller's mean first-passage time (``parkour mfpt --controller``): ``controller``
-        (``pid``, ``pid-pitch``, ``lqr``, ``deadbeat``) holding ``target_m`` [m] after the control
-        study's climb from ``psi0_deg`` [deg], ``start_zeta0`` [l0], under ``noise`` without pitch
-        drift, by ``runs`` splitting runs of ``replicas`` each (replicas × runs bounded), every draw
+        (one of :meth:`controllers`: ``pid``, ``pid-pitch``, ``lqr``, ``deadbeat`` today) holding
+        ``target_m`` [m] after the control study's climb from ``psi0_deg`` [deg], ``start_zeta0``
+        [l0], under ``noise`` without pitch drift, by ``runs`` splitting runs of ``replicas`` each
+        (replicas × runs bounded), every draw
         from ``seed``. Its result: ``mfpt_jumps``, ``ci95``, ``lambda2``, ``relative_error`` and the
         ``splitting``'s numbers (``probabilities``: each run's). None: the service's default."""
         spec = {"controller": controller, "target_m": target_m, "psi0_deg": psi0_deg, "start_zeta0": start_zeta0}
