@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated
 
+import numpy as np
 import typer
 
 from cli.options import (
@@ -19,7 +20,9 @@ from cli.options import (
     with_noise,
 )
 from cli.studies import fixed_leg_of, over_zeta0
+from sim_core.model.errors import ParameterError
 from sim_core.model.noise import NoiseModel
+from sim_core.model.validation import check_range
 
 app = typer.Typer(rich_markup_mode=None)
 
@@ -36,6 +39,10 @@ def mjtf_command(
         tuple[float, float], typer.Option("--zeta0-range", help="LOW HIGH of zeta0 over the energy levels.")
     ] = (0.84, 0.96),
     levels: Annotated[int, typer.Option("--levels", help="Number of energy levels.")] = 10,
+    zeta0: Annotated[
+        list[float] | None,
+        typer.Option("--zeta0", help="A level's zeta0, instead of the range (repeat for several; once: one level)."),
+    ] = None,
     trials: Annotated[int, typer.Option("--trials", help="Trials per level.")] = 8,
     cap: Annotated[int, typer.Option("--cap", help="Jumps after which a trial counts as survived.")] = 1000,
     seed: SeedOption = 0,
@@ -50,8 +57,14 @@ def mjtf_command(
     from sim_core.basins.sweep import zeta0_values
     from sim_core.robustness.mjtf import CAPPED, check_trials, mjtf_study
 
-    with option_named("--levels", "steps"):
-        zeta0s = zeta0_values(*zeta0_range, levels)
+    if zeta0:
+        zeta0s = np.array([check_range("--zeta0", value, 0.0, 1.0) for value in zeta0])
+        if len(set(zeta0)) != len(zeta0):
+            raise ParameterError("--zeta0", f"must name each level once, got {', '.join(f'{z:g}' for z in zeta0)}")
+        levels = len(zeta0s)
+    else:
+        with option_named("--levels", "steps"):
+            zeta0s = zeta0_values(*zeta0_range, levels)
     check_trials(trials, cap)
     study = over_zeta0(
         mjtf_study,
