@@ -5,8 +5,8 @@ Errors a client can fix come back as 4xx JSON with the field and the allowed ran
 FastAPI's ``detail[]`` shape (``loc``, ``msg``, ``type``, ``input``, ``ctx``) but quotes at most
 :data:`PREVIEW_CHARS` characters of the input, whatever it was (a megabyte string, NaN, a lone
 surrogate), and at most :data:`MAX_ERRORS` errors. Anything unforeseen is a JSON 500 that says
-nothing of the internals; the exception goes to the log. Unknown paths (404) and methods (405)
-are JSON already (FastAPI's HTTPException handler).
+nothing of the internals; the exception goes to the log. Unknown paths (404) are JSON; a method a
+path does not take is a 405 whose ``Allow`` lists every method the path takes (:mod:`backend.api.methods`).
 """
 
 from __future__ import annotations
@@ -18,8 +18,9 @@ import math
 from fastapi import FastAPI, Request, status
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
+from starlette.exceptions import HTTPException as StarletteHTTPException
 
-from backend.api import security
+from backend.api import methods, security
 from backend.errors import Conflict, NotFound, QueueFull
 from backend.robot.link import EstopLatched, LinkError
 from backend.services.robot import RobotUnavailable
@@ -64,7 +65,12 @@ def install(app: FastAPI) -> None:
         body = {"detail": [{"loc": ["body", error.field], "msg": str(error), "type": "value_error"}]}
         return JSONResponse(body, status_code=status.HTTP_422_UNPROCESSABLE_CONTENT)
 
-    async def invalid_request(_request, error: RequestValidationError):
+    async def invalid_request(request: Request, error: RequestValidationError):
+        errors = error.errors()
+        if any(entry.get("loc", ("",))[0] == "path" for entry in errors):
+            literal = methods.literal_methods(request)
+            if literal and request.method not in literal:  # PATCH /runs/aggregate: no run id, a wrong method
+                return methods.not_allowed(request, literal)
         return JSONResponse(
             {"detail": compact_errors(error.errors())}, status_code=status.HTTP_422_UNPROCESSABLE_CONTENT
         )
@@ -77,6 +83,12 @@ def install(app: FastAPI) -> None:
             {"detail": SERVER_ERROR}, status_code=status.HTTP_500_INTERNAL_SERVER_ERROR, headers=headers
         )
 
+    async def http_error(request: Request, error: StarletteHTTPException):
+        if error.status_code == status.HTTP_405_METHOD_NOT_ALLOWED:
+            return methods.not_allowed(request, methods.allowed_methods(request))
+        return JSONResponse({"detail": error.detail}, status_code=error.status_code, headers=error.headers)
+
+    app.add_exception_handler(StarletteHTTPException, http_error)
     app.add_exception_handler(ParameterError, bad_parameter)
     app.add_exception_handler(RequestValidationError, invalid_request)
     app.add_exception_handler(Exception, server_error)

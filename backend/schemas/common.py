@@ -8,7 +8,7 @@ import enum
 import math
 from typing import Annotated, Generic, Literal, TypeVar
 
-from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field
 
 from sim_core.climb.records import CHUTE_TOP, FLOOR
 from sim_core.control.laws import PSI0_RANGE_DEG
@@ -20,18 +20,17 @@ ControllerKind = enum.StrEnum("ControllerKind", {name.replace("-", "_").upper():
 ControllerKind.__doc__ = "A closed-loop law (the registry, sim_core.control.laws.LAWS)."
 
 
-def _inside_in_radians(psi0_deg: float) -> float:
-    # The kernel takes radians: an angle a hair inside (0, 90) degrees (5e-324) must not become 0 there.
-    if not 0.0 < math.radians(psi0_deg) < math.pi / 2:
-        raise ValueError(f"must be in (0, 90) degrees, got {psi0_deg!r}, which is 0 or 90 once in radians")
-    return psi0_deg
-
-
+# A leg angle in (0, 90) degrees, a hair taken off each end: the kernels take radians, and an angle
+# a hair inside (5e-324 degrees) would be 0 there. The schema says the bounds it holds to, so every
+# value the OpenAPI document allows is accepted.
+PSI0_HAIR_DEG = 1e-9
 Psi0Deg = Annotated[
     float,
-    Field(gt=0.0, lt=90.0, description="leg angle at touchdown [degrees], in (0, 90)"),
-    AfterValidator(_inside_in_radians),
-]
+    Field(
+        ge=PSI0_HAIR_DEG, le=90.0 - PSI0_HAIR_DEG,
+        description=f"leg angle at touchdown [degrees], in (0, 90): [{PSI0_HAIR_DEG:g}, 90 - {PSI0_HAIR_DEG:g}]",
+    ),
+]  # fmt: skip
 
 
 def _iso_8601(value: object) -> object:

@@ -18,7 +18,6 @@ import threading
 import time
 from pathlib import Path
 
-from backend.errors import NotFound
 from backend.robot.latch import EstopLatch
 from backend.robot.limits import ServoLimits
 from backend.robot.link import LinkError, LinkState, RobotLink
@@ -284,9 +283,11 @@ class RobotService:
         return live_law_for(loop, design.robot, legs, limits, offsets=design.offsets)
 
     def stop_run(self) -> dict:
+        """End the live run (its ending disarms) and the status after; with no live run, nothing to
+        stop: the status as it is (stopping is always possible, and a second press is no error)."""
         run = self._run
         if run is None:
-            raise NotFound("live run", 0)
+            return self.status()
         run.stop("stopped")
         run.done.wait(STOP_WAIT)
         return self.status()

@@ -184,3 +184,25 @@ def test_a_server_error_is_json_without_a_traceback_and_is_logged(settings, capl
     assert response.headers["x-content-type-options"] == "nosniff"
     logged = [record for record in caplog.records if record.name == "parkourlab.api"]
     assert logged and logged[0].exc_info and "GET /api/v1/broken" in logged[0].getMessage()
+
+
+@pytest.mark.parametrize(
+    ("method", "path", "allow"),
+    [
+        ("OPTIONS", "/api/v1/runs/1", "DELETE, GET, PATCH"),  # Starlette said GET: the first route's only
+        ("PUT", "/api/v1/runs/1", "DELETE, GET, PATCH"),
+        ("DELETE", "/api/v1/runs", "GET, POST"),
+        ("PATCH", "/api/v1/runs/aggregate", "GET"),  # was a 422 about run_id: the path names no run
+        ("DELETE", "/api/v1/runs/export", "GET"),
+        ("PUT", "/api/v1/jobs/1", "GET"),
+    ],
+)
+def test_a_method_a_path_does_not_take_is_a_405_listing_every_method_it_does(client, auth, method, path, allow):
+    response = client.request(method, path, headers=auth)
+    assert response.status_code == 405 and response.headers["allow"] == allow
+    assert response.json()["detail"] == f"method {method} not allowed on {path}; it takes {allow}"
+
+
+def test_a_run_id_that_is_no_number_is_still_a_422_naming_it(client):
+    response = client.get("/api/v1/runs/abc")
+    assert response.status_code == 422 and response.json()["detail"][0]["loc"] == ["path", "run_id"]

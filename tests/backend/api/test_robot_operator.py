@@ -93,3 +93,10 @@ def test_a_tracker_address_this_machine_cannot_bind_is_a_422(client, auth, conne
     bad = {**body, "tracker_host": "192.0.2.1", "tracker_port": free_port(socket.SOCK_DGRAM)}  # TEST-NET: not ours
     response = client.post("/api/v1/robot/connect", json=bad, headers=auth)
     assert response.status_code == 422 and response.json()["detail"][0]["loc"] == ["body", "tracker_host"]
+
+
+def test_stopping_with_no_live_run_is_no_error(client, auth):
+    """Stopping is always possible: with nothing to stop, the status as it is (it was a 404 naming "live run 0")."""
+    for _ in range(2):
+        response = client.post("/api/v1/robot/runs/stop", headers=auth)
+        assert response.status_code == 200 and response.json()["run"] is None

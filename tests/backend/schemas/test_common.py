@@ -65,7 +65,7 @@ def test_a_leg_outside_its_range_is_refused_naming_the_field(field, inside, outs
 def test_a_leg_angle_that_is_0_once_in_radians_is_refused_on_psi0_deg():
     """5e-324 degrees is inside (0, 90) but 0 radians: the kernels would get a leg along the wall."""
     assert refused(LegIn, LEG | {"psi0_deg": 5e-324}) == [("psi0_deg",)]
-    assert accepted(LegIn, LEG | {"psi0_deg": 1e-300}).psi0_deg == 1e-300
+    assert accepted(LegIn, LEG | {"psi0_deg": 1e-9}).psi0_deg == 1e-9  # the schema's minimum, said in the document
 
 
 @pytest.mark.parametrize(
@@ -216,3 +216,14 @@ def test_a_stored_jobs_model_is_its_requests():
     with pytest.raises(ParameterError) as unknown:
         ModelSpec(preset="gone").params()
     assert unknown.value.field == "model.preset" and "paper" in unknown.value.message
+
+
+def test_every_leg_angle_the_schema_allows_is_accepted_and_inside_in_radians():
+    """The OpenAPI document's bounds are the ones held to (schemathesis found 5e-324 allowed there, refused here)."""
+    schema = LegIn.model_json_schema()["properties"]["psi0_deg"]
+    low, high = schema["minimum"], schema["maximum"]
+    for value in (low, math.nextafter(low, 90.0), 45.0, math.nextafter(high, 0.0), high):
+        assert accepted(LegIn, LEG | {"psi0_deg": value}).psi0_deg == value
+        assert 0.0 < math.radians(value) < math.pi / 2, "the kernels get an angle off the wall and off the normal"
+    for value in (math.nextafter(low, 0.0), 5e-324, 0.0, math.nextafter(high, 90.0), 90.0):
+        assert refused(LegIn, LEG | {"psi0_deg": value}) == [("psi0_deg",)]

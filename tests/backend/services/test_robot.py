@@ -52,8 +52,7 @@ def test_without_a_robot_nothing_moves(service):
     assert stopped["estop"]["latched"] is True
     with pytest.raises(RobotUnavailable):
         service.start_run(RobotRunCreate(controls=LEGS))
-    with pytest.raises(errors.NotFound):
-        service.stop_run()
+    assert service.stop_run()["run"] is None, "nothing to stop is no error: stopping is always possible"
 
 
 def test_a_live_run_is_stored_with_the_models_prediction(connected, session):
