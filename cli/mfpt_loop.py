@@ -38,7 +38,10 @@ def controller_mfpt(
         print_json(payload)
         return
     if payload["mfpt_jumps"] is None:
-        print(f"{controller}: no splitting run reached a failure; MFPT beyond what they can reach")
+        bound = payload["mfpt_at_least_jumps"]
+        held = "" if bound is None else (f"; more than {bound:.3g} jumps (95%: no failure in the "
+                                         f"{payload['failure_free_jumps']} jumps the long runs held)")  # fmt: skip
+        print(f"{controller}: no splitting run reached a failure; MFPT beyond what they can reach{held}")
         return
     low, high = payload["ci95"]
     upper = "inf" if high is None else f"{high:.3g}"  # a t interval on the rate open above

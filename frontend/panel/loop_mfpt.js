@@ -22,7 +22,9 @@ export function loopMfptWords(result) {
   const split = result.splitting;
   const how = `${split.runs} runs × ${split.replicas} replicas, seed ${split.seed}, ${result.seconds.toFixed(1)} s`;
   if (result.mfpt_jumps === null) {
-    return `${result.controller} holds ${result.target_m} m past anything splitting reached: no run saw an exit fail (${how}).`;
+    const bound = typeof result.mfpt_at_least_jumps === "number"
+      ? ` — more than ${jumps(result.mfpt_at_least_jumps)} jumps (95%: no failure in the ${result.failure_free_jumps} jumps its long runs held)` : "";
+    return `${result.controller} holds ${result.target_m} m past anything splitting reached${bound}: no run saw an exit fail (${how}).`;
   }
   const interval = result.ci95 ? ` (95%: ${jumps(result.ci95[0])}–${jumps(result.ci95[1])})` : "";
   return `${result.controller} holds ${result.target_m} m for about ${jumps(result.mfpt_jumps)} jumps${interval}, by splitting; ` +

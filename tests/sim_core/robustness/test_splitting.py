@@ -107,3 +107,20 @@ def test_no_failure_reached_is_said_as_null_not_a_number():
                       (holding, holding), 1.0, SplittingOptions())  # fmt: skip
     payload = result.to_dict()
     assert payload["mfpt_jumps"] is None and payload["ci95"] is None and payload["lambda2"] == 1.0
+    # Two runs' long runs held SplittingOptions().pilot_jumps each with no failure: a 95% lower bound.
+    held = 2 * SplittingOptions().pilot_jumps
+    assert payload["failure_free_jumps"] == held and payload["mfpt_at_least_jumps"] == pytest.approx(held / 2.995732)
+
+
+def test_the_lower_bound_is_wrong_at_most_5_percent_of_the_time():
+    """A loop failing every m jumps on average, just under the bound the code gives for one run's
+    1,000 failure-free jumps: it holds those jumps with no failure (and the bound is then too high)
+    in at most 5% of the cases (geometric draws of the first failure)."""
+    exits, touchdowns = np.zeros((1, LOOP_STATE_SIZE)), np.zeros(1, dtype=int)
+    holding = Holding(np.zeros((2, 5)), np.zeros((2, 5, 5)), 1.0, 2.0, exits, touchdowns, 20.0, 0, 10.0, 0.0)
+    options = SplittingOptions(pilot_jumps=1_000)
+    bound = LoopMfpt("pid", 2.0, NoiseModel(pitch_drift_deg=0.0), math.inf, (math.inf, math.inf), (0.0,),
+                     (holding,), 1.0, options).mfpt_at_least  # fmt: skip
+    mean = 0.99 * bound  # the bound is too high for this loop whenever it is given
+    firsts = np.random.default_rng(7).geometric(1.0 / mean, size=200_000)
+    assert (firsts > options.pilot_jumps).mean() <= 0.05
