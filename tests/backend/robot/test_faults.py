@@ -80,6 +80,7 @@ def _restore(rig: PtyRobot, how: str) -> None:
     (rig.resume if how == "out of range" else rig.plug_in)()
 
 
+@pytest.mark.realtime  # waits on the supervisor's retry period and the line's drop: wall-clock timing
 @pytest.mark.parametrize("how", ["out of range", "unplugged"])
 def test_a_dropped_line_is_reconnected_once_and_the_robot_disarmed(how, monkeypatch, caplog, thread_errors):
     """Out of range: silence both ways on the same pty; unplugged: the pty and its by-id link gone,
@@ -107,7 +108,10 @@ def test_a_dropped_line_is_reconnected_once_and_the_robot_disarmed(how, monkeypa
         failed = connects - 2  # the first connect and the reconnect aside
         assert failed >= 2, f"the attempts while the line was down failed and were retried: {failed}"
         assert calls.most_connecting == 1 and calls.callers == {"robot-link-supervisor"}, calls.callers
-        assert rig.commands(since=restored) == [Kind.DISARM], "the reconnect sent DISARM, and nothing else"
+        # The safety property, not one frame sequence: a loaded machine may see the DISARM sent again
+        # before its acknowledgement (it read [DISARM, DISARM] beside another pty robot, 5 of 5).
+        sent = rig.commands(since=restored)
+        assert sent and set(sent) == {Kind.DISARM}, f"the reconnect sent DISARM, and nothing else: {sent}"
         assert link.state == LinkState.DISARMED and link.telemetry.state == RobotState.DISARMED
         reasons = [t.reason for t in link.transitions if t.after == LinkState.DISCONNECTED]
         expected = "no heartbeat" if how == "out of range" else "read failed"
