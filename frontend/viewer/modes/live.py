@@ -166,7 +166,10 @@ class LiveMode(Mode):
         status = service.status()
         tracker = status["tracker"]
         latest = tracker["latest"]
-        where = "no frames yet" if latest is None else f"body at ({latest['x']:.3f}, {latest['y']:.3f}) m"
+        if latest is not None:
+            where = f"body at ({latest['x']:.3f}, {latest['y']:.3f}) m"
+        else:  # frames may come without the robot's body in them (it is out of view, or another rigid body)
+            where = "no frames yet" if not tracker["received"] else "no pose of the robot's body in them yet"
         error = "–" if self.last_error is None else f"{100 * self.last_error:+.1f} cm"
         return (
             f"**Link:** {status['state']} · **tracker:** {tracker['received']} frames, "

@@ -266,3 +266,25 @@ def test_a_view_that_first_sees_a_run_under_way_draws_it_from_its_first_frame(se
     live.frame()
     scene, _ = live.recorded()[-1]
     assert trail_drawn(scene) == segments_of(path), "the run's own frames, from its first: none from before it"
+
+
+@dataclass
+class Status:
+    """The robot service as the readout reads it: its tracker, and its status with the tracker's counts."""
+
+    tracker: PoseHistory
+    received: int
+
+    def status(self) -> dict:
+        tracker = {"received": self.received, "loss": 0.0, "latest": None}
+        return {"state": "disarmed", "tracker": tracker}
+
+
+def test_the_readout_tells_frames_without_the_body_from_no_frames(server):
+    """It said "2488 frames … no frames yet" when frames came without the robot's body in them."""
+    lock = threading.RLock()
+    for received, words in ((0, "no frames yet"), (2488, "no pose of the robot's body in them yet")):
+        mode = LiveMode(server, ChuteScene(server.scene, ROBOT), lock, Status(PoseHistory(Calibration()), received))
+        readout = mode.readout(60.0)
+        assert f"{received} frames" in readout and words in readout
+        assert received == 0 or "no frames yet" not in readout
