@@ -8,8 +8,8 @@ coordinates, docs/model.md §2).
 - :func:`model_jump` — one jump of the model from a touchdown (live mode's ghost);
 - :class:`Controls` — what simulate mode's sliders set: both legs and the robot;
 - :class:`SimulatedClimb` — the model climbing in real time, each jump with the controls of the
-  moment it starts, the next leg read at lift-off as the robot does, ending at a failing jump or
-  at the chute's floor (docs/model.md §7); with a law set (:meth:`SimulatedClimb.set_law`), the
+  moment it starts, the next leg read at lift-off as the robot does, ending at a failing jump, at
+  the chute's floor (docs/model.md §7) or at its top; with a law set (:meth:`SimulatedClimb.set_law`), the
   loop closed as on the robot: at each touchdown the law sets the next touchdown's leg.
 """
 
@@ -23,7 +23,7 @@ import numpy as np
 from frontend.viewer.motion import PathClip, Pose
 from sim_core import LegControl, PhysicalParams
 from sim_core.climb import sequencer as climb
-from sim_core.climb.records import ClimbSetup, End, Jump, JumpStart, NextLeg, Samples
+from sim_core.climb.records import CHUTE_TOP, ClimbSetup, End, Jump, JumpStart, NextLeg, Samples
 from sim_core.control.design import SteppedLaw
 from sim_core.control.laws import Controller
 from sim_core.model.trajectory import STANCE
@@ -82,7 +82,7 @@ class JumpPlan:
 
     @property
     def failure(self) -> End | None:
-        """Why the climb ended in this jump (a ``Failure`` or ``ClimbEnd.FLOOR``), or None."""
+        """Why the climb ended in this jump (a ``Failure``, ``ClimbEnd.FLOOR`` or ``ClimbEnd.TOP``), or None."""
         return self.jump.end
 
     @property
@@ -112,6 +112,12 @@ def model_jump(
     """
     start = JumpStart(jump_index, Wall(wall), start_time, start_height, (float(state[0]), float(state[1])), leg)
     return JumpPlan.of(climb.jump(ClimbSetup(robot), start, NextLeg(next_leg)), robot)
+
+
+def _chute(robot: PhysicalParams) -> ClimbSetup:
+    """A simulated climb's setup: it ends at the lab's chute's top, as the table does (an open loop
+    climbed to 9.8 m in a 2 m chute)."""
+    return ClimbSetup(robot, top=CHUTE_TOP)
 
 
 @dataclass(frozen=True)
@@ -160,7 +166,7 @@ class SimulatedClimb:
             self._start_state = state or self._start_state
             controls = self._controls
             first = controls.leg_for(Wall.LEFT)
-            start = climb.launch(ClimbSetup(controls.robot), first, self._start_state)
+            start = climb.launch(_chute(controls.robot), first, self._start_state)
             self.stepped = None if self._law is None else SteppedLaw(self._law, first)
             self.commands: list[LawCommand] = []
             self.plans: list[JumpPlan] = []
@@ -202,7 +208,7 @@ class SimulatedClimb:
                 if plan.failure is not None or t < plan.clip.end:
                     return plan.clip.pose_at(t)
                 # The leg that touches down is the one that flew: its controls were fixed at lift-off.
-                self._plan(climb.touchdown_after(ClimbSetup(plan.robot), plan.jump))
+                self._plan(climb.touchdown_after(_chute(plan.robot), plan.jump))
 
     def next_touchdown_time(self, t: float) -> float:
         """[s] when the jump under way at ``t`` ends (for stepping one jump)."""
@@ -213,7 +219,7 @@ class SimulatedClimb:
         """Jump ``start`` planned with the next leg's controls of now (read again at lift-off); closed
         loop, the law's command from this touchdown."""
         controls = self._controls
-        setup = ClimbSetup(controls.robot)
+        setup = _chute(controls.robot)
         if self.stepped is not None:
             self._command(start, controls.robot)
         next_leg = climb.read_next_leg(start, self._next_leg_for(start))
@@ -238,6 +244,6 @@ class SimulatedClimb:
         self._next_leg_read = True
         plan = self.current
         next_leg = climb.read_next_leg(plan.jump.start, self._next_leg_for(plan.jump.start))
-        replanned = climb.replan(ClimbSetup(plan.robot), plan.jump, next_leg)
+        replanned = climb.replan(_chute(plan.robot), plan.jump, next_leg)
         if replanned is not plan.jump:
             self.plans[-1] = JumpPlan.of(replanned, plan.robot)

@@ -35,6 +35,7 @@ class ClimbEnd(Enum):
     """Why a climb ended other than a failing jump (:class:`sim_core.model.failures.Failure`)."""
 
     FLOOR = "floor"
+    TOP = "top"
 
     @property
     def code(self) -> str:
@@ -45,18 +46,23 @@ class ClimbEnd(Enum):
         return _MESSAGES[self]
 
 
-_MESSAGES = {ClimbEnd.FLOOR: "the body reached the chute's floor"}
+_MESSAGES = {
+    ClimbEnd.FLOOR: "the body reached the chute's floor",
+    ClimbEnd.TOP: f"the body reached the chute's top ({CHUTE_TOP:g} m): the lab's table ends there",
+}
 
 End = Failure | ClimbEnd
 
 
 @dataclass(frozen=True)
 class ClimbSetup:
-    """What every jump of a climb shares: the robot, the sampling and the floor."""
+    """What every jump of a climb shares: the robot, the sampling, the floor and (None: none) a top,
+    which a jump landing above ends the climb at (:attr:`ClimbEnd.TOP`)."""
 
     robot: PhysicalParams
     sample_rate: float = SAMPLE_RATE  # per sqrt(l0/g)
     floor: float = FLOOR  # [m]
+    top: float | None = None  # [m]
 
 
 @dataclass(frozen=True)

@@ -102,13 +102,15 @@ def jump(setup: ClimbSetup, start: JumpStart, next_leg: NextLeg) -> Jump:
     robot = setup.robot
     if completed and _next_body_height(start, next_leg, rise, robot) < setup.floor:
         completed, floor = False, True  # reached between the last sample and the touchdown
+    top = completed and setup.top is not None and _next_body_height(start, next_leg, rise, robot) > setup.top
+    completed = completed and not top  # landing above the top ends the climb there: no next touchdown
     flight = np.flatnonzero(samples.phase == FLIGHT)
     return Jump(
         start=start,
         next=next_leg,
         samples=samples,
         liftoff=int(flight[0]) if flight.size else len(samples),
-        end=ClimbEnd.FLOOR if floor else failure,
+        end=ClimbEnd.FLOOR if floor else (ClimbEnd.TOP if top else failure),
         rise=rise if completed else math.nan,
         duration=float(si.touchdown_times[-1]) if completed else math.nan,
         arrival=(float(path.section_states[-1, 0]), float(path.section_states[-1, 1])) if completed else None,

@@ -8,7 +8,7 @@ from numpy.testing import assert_allclose
 
 from frontend.viewer.simulated_climb import Controls, SimulatedClimb, model_jump
 from sim_core import ControlSchedule, LegControl, get_preset, iterate_map
-from sim_core.climb.records import FLOOR, ClimbEnd
+from sim_core.climb.records import CHUTE_TOP, FLOOR, ClimbEnd
 from sim_core.climb.sequencer import start_height
 from sim_core.model.walls import Wall, wall_of
 
@@ -96,6 +96,17 @@ def test_a_descending_climb_stops_at_the_floor_and_names_it():
     assert len(climb.plans) > 1 and all(plan.rise < 0 for plan in climb.plans[:-1]), "it descended"
     assert pose.y == pytest.approx(FLOOR), "it stops where the body meets the floor"
     assert min(plan.clip.y.min() for plan in climb.plans) >= FLOOR, "never below it"
+
+
+def test_a_climbing_gait_stops_at_the_chutes_top_and_names_it():
+    """An open loop climbed to 9.8 m in the lab's 2 m chute (issue 40): the climb ends at the jump
+    that would land above the top, and says so."""
+    climb = _climb()  # the paper's climbing gait
+    pose = climb.pose_at(600.0)
+    assert climb.ended and climb.current.failure is ClimbEnd.TOP and "top" in climb.current.failure.message
+    touchdowns = [float(plan.clip.y[0]) for plan in climb.plans]
+    assert max(touchdowns) <= CHUTE_TOP < climb.current.next_height, "every touchdown inside; the next one above"
+    assert climb.pose_at(601.0) == pose, "the pose holds after the end"
 
 
 def test_model_jump_mirrors_on_the_right_wall():

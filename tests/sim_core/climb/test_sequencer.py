@@ -121,6 +121,19 @@ def test_a_descending_climb_ends_at_the_floor():
         touchdown_after(SETUP, last)
 
 
+def test_a_climb_with_a_top_ends_at_the_jump_landing_above_it():
+    climbing = LegControl.from_degrees(30, 0.90)
+    free = simulate_climb(SETUP, lambda _wall: climbing, (-0.93, -0.17), 40)
+    heights = [j.start.body_height for j in free]
+    top = 0.5 * (heights[5] + heights[6])  # between touchdowns 5 and 6
+    jumps = simulate_climb(dataclasses.replace(SETUP, top=top), lambda _wall: climbing, (-0.93, -0.17), 40)
+    assert len(jumps) == 6 and jumps[-1].end is ClimbEnd.TOP and jumps[-1].arrival is None
+    assert [j.start.body_height for j in jumps] == heights[:6], "the same climb up to the top"
+    assert all(j.end is None for j in free), "no top: it climbs on"
+    with pytest.raises(ValueError, match="top"):
+        touchdown_after(SETUP, jumps[-1])
+
+
 def test_a_failing_jump_ends_the_climb_with_its_failure():
     steep = LegControl.from_degrees(70, 0.9)  # outside the friction cone (mu = 2: 63.4°)
     jumps = simulate_climb(SETUP, lambda _wall: steep, START, 5)
