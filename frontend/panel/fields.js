@@ -135,9 +135,14 @@ export const Fields = (() => {
     let marked = 0;
     for (const error of detail) {
       const location = (error.loc || []).filter((part) => part !== "body").join(".");
-      const input = locations[location] === undefined ? null : form.elements[locations[location]];
       // pydantic prefixes a validator's own message with its kind ("Value error, …"): not the user's words.
-      const message = String(error.msg).replace(/^(Value|Assertion) error, /, "");
+      const raw = String(error.msg).replace(/^(Value|Assertion) error, /, "");
+      // A rule across fields (psi0_low_deg must be below psi0_high_deg, the work too big) names its
+      // fields in the API's words: said in the form's labels, at the first field it names.
+      const named = namedFields(form, raw, locations);
+      const message = inLabels(raw, named);
+      const at = locations[location] ?? named[0]?.input;
+      const input = at === undefined ? null : form.elements[at];
       if (input && !input.matches(":disabled") && input.getAttribute("aria-invalid") !== "true") {
         mark(input, message);
         marked += 1;
@@ -156,6 +161,35 @@ export const Fields = (() => {
 
   // A property's own schema, its $ref followed and an optional field's null branch left out.
   const plain = (property) => resolve(property);
+
+  // The form's fields that ``message`` names by their API names ({field, input, label}), in the
+  // order they appear; longer names first, so "zeta0_low" is not read as "zeta0".
+  function namedFields(form, message, locations) {
+    const fields = Object.keys(locations).filter((field) => /^\w+$/.test(field));
+    if (!fields.length) return [];
+    const found = new Map();
+    for (const match of message.matchAll(namePattern(fields))) {
+      const input = form.elements[locations[match[0]]];
+      if (found.has(match[0]) || !input?.labels?.length) continue;
+      const label = input.labels[0].childNodes[0]?.textContent?.trim() || match[0];
+      found.set(match[0], { field: match[0], input: locations[match[0]], label: `"${label}"` });
+    }
+    return [...found.values()];  // in the order the message names them
+  }
+
+  // ``message`` with the API names of ``named`` said as the form's labels: a name like psi0_low_deg
+  // wherever it stands, a plain word (seeds, jumps) only inside a work formula "(a x b x c)", where
+  // it is a field and not prose ("up to 1e9 jumps").
+  function inLabels(message, named) {
+    if (!named.length) return message;
+    const labels = new Map(named.map(({ field, label }) => [field, label]));
+    const apiLike = [...labels.keys()].filter((field) => /[_\d]/.test(field));
+    const said = (text, fields) => (fields.length ? text.replace(namePattern(fields), (field) => labels.get(field)) : text);
+    return said(message, apiLike).replace(/\(([^()]*\bx\b[^()]*)\)/g, (formula) => said(formula, [...labels.keys()]));
+  }
+
+  // One pattern for whole API field names, the longest first (so "zeta0_low" is not read as "zeta0").
+  const namePattern = (fields) => new RegExp(`\\b(${[...fields].sort((a, b) => b.length - a.length).join("|")})\\b`, "g");
 
   return { ready, readFields, markApiErrors, clear, annotation, schema, plain };
 })();

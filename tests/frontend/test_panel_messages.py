@@ -241,3 +241,25 @@ def test_the_panel_submits_jobs_as_panel_for_the_queues_share(page, service):
     said(page, "scheduled")
     newest = httpx.get(f"{base}/api/v1/jobs?limit=1").json()["items"][0]
     assert newest["submitted_by"] == "panel"
+
+
+def test_a_rule_across_fields_is_said_in_the_forms_labels_at_the_field(page):
+    """Was: the banner said "viability: psi0_low_deg must be below psi0_high_deg" and "... (controllers x
+    seeds x jumps) ..." in the API's names. Now: at the first field the rule names, in the form's labels."""
+    page.click("nav [data-tab=jobs]")
+    page.select_option("#job-kind", "viability")
+    page.fill("input[name=viability_psi0_low]", "50")
+    page.fill("input[name=viability_psi0_high]", "20")
+    page.click("#submit-job")
+    until(page, "document.querySelector('input[name=viability_psi0_low]').getAttribute('aria-invalid') === 'true'")
+    assert page.inner_text("#viability_psi0_low-error") == '"psi0 from [deg]" must be below "to"'
+    page.fill("input[name=viability_psi0_low]", "20")
+    page.fill("input[name=viability_psi0_high]", "50")
+
+    page.select_option("#job-kind", "control-study")
+    page.fill("input[name=study_seeds]", "10000")
+    page.fill("input[name=study_jumps]", "100000")
+    page.click("#submit-job")
+    until(page, "document.querySelector('#job-form .field-error') !== null")
+    marked = page.evaluate("document.querySelector('#job-form .field-error').textContent")
+    assert '("controllers" x "trials" x "jumps per trial")' in marked and "seeds" not in marked, marked
