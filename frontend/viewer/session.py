@@ -57,6 +57,9 @@ class ViewerSession:
         self.closed = False
         self.scene = ChuteScene(client.scene, robot)
         gui = client.gui
+        self.gui_estop, self.gui_estop_said = None, None
+        if context.robot_service is not None:
+            self.gui_estop, self.gui_estop_said = self._estop_button(gui, context.robot_service)
         # target="_top": the panel embeds this view in a frame, and a plain link loaded a second
         # panel (and a second e-stop) inside it. viser renders a markdown's HTML as it is.
         link = f'<a href="{html.escape(panel_url, quote=True)}" target="_top">← Control panel</a>'
@@ -70,6 +73,23 @@ class ViewerSession:
         self.modes["replay"].share = share
         self.mode = self.modes["simulate"]
         self.gui_mode.on_update(lambda _event: self.set_mode(self.gui_mode.value))
+
+    @staticmethod
+    def _estop_button(gui, robot_service):
+        """The e-stop on the view's own page too (it had none: only the panel's), first in its GUI.
+        It presses the service's e-stop (connected or not, bounded, latching) and says the answer."""
+        button = gui.add_button("EMERGENCY STOP", color="red", hint="Stops the robot now and latches (needs no token)")
+        said = gui.add_markdown("")
+
+        def press(_event) -> None:
+            answer = robot_service.estop()
+            heard = (
+                "acknowledged by the robot" if answer.get("acknowledged") else answer.get("reason", "not acknowledged")
+            )
+            said.content = f"**E-stop sent:** {heard}; latched until a person resets it in the control panel."
+
+        button.on_click(press)
+        return button, said
 
     @property
     def run_id(self) -> int | None:

@@ -97,3 +97,36 @@ def test_a_closed_view_draws_and_computes_nothing(session):
     session.set_mode("live")
     session.replay(7, None, replay_of(7), None)
     assert session.mode.name == "simulate" and session.run_id is None
+
+
+class Pressed:
+    """A robot service that records e-stop presses and answers as the service does, unacknowledged."""
+
+    def __init__(self):
+        self.presses = 0
+
+    def estop(self) -> dict:
+        self.presses += 1
+        return {"acknowledged": False, "reason": "the robot is not connected: nothing to send the ESTOP to"}
+
+
+def test_the_views_own_page_has_an_estop_that_presses_the_services(server):
+    """The 3D view on its own port had no e-stop (issue 40): with a robot service, it has one; a
+    press from the browser presses the service's e-stop and says its answer."""
+    robot = Pressed()
+    with HeadlessViewer(server.get_port()) as browser:
+        wait_for(server.get_clients)
+        (client,) = server.get_clients().values()
+        session = ViewerSession(client, None, ViewContext(sessions=None, robot_service=robot), ROBOT,
+                                panel_url="/panel/", share=share)  # fmt: skip
+        try:
+            browser.set_gui("EMERGENCY STOP", True)  # the browser's click
+            wait_for(lambda: robot.presses == 1)
+            wait_for(lambda: "E-stop sent" in session.gui_estop_said.content)
+            assert "not connected" in session.gui_estop_said.content and "latched" in session.gui_estop_said.content
+        finally:
+            session.close()
+
+
+def test_without_a_robot_service_the_view_has_no_estop(session):
+    assert session.gui_estop is None
