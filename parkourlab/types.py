@@ -80,7 +80,8 @@ class Job(TypedDict):
     """A batch job. ``completed`` of ``total`` units (trials for MJTF) are done; ``progress`` is
     their ratio in [0, 1]; ``spec`` is the job's body with the service's defaults filled in.
     ``submitted_by``: who submitted it (its client's name, else its address); ``queue_position``
-    (1: next) and ``eta_s`` [s], until it ends at the latest: None once it is final."""
+    (1: next), ``eta_s`` [s] until it should end (as expected on the service's machine) and
+    ``eta_max_s`` [s] until it ends at the latest: None once it is final."""
 
     id: int
     experiment_id: int | None
@@ -97,6 +98,7 @@ class Job(TypedDict):
     submitted_by: str | None
     queue_position: int | None
     eta_s: float | None
+    eta_max_s: float | None
 
 
 class MJTFLevel(TypedDict):

@@ -78,7 +78,7 @@ def main() -> None:
         scratch = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="parkourlab-estimates-")))
         base, token = stack.enter_context(served(scratch / "data"))
         client = stack.enter_context(Client(base, token=token, name="bench-estimates"))
-        time.sleep(2.0)  # the service warms its kernels in the background: an idle service, as a person finds it
+        time.sleep(20.0)  # the service warms every kind's kernels in the background: an idle service, as found
         rows = measure(client, args.rounds)
     worst = max((max(row["ratio"], 1 / row["ratio"]) for row in rows if row["ratio"]), default=None)
     if args.json:

@@ -24,7 +24,7 @@ from backend.api import errors, security, statuses
 from backend.api.deps import Database
 from backend.api.routes import calibrations, catalog, experiments, jobs, robot, runs, sim, site, view
 from backend.api.token_file import api_token
-from backend.services import exports, quick_calls
+from backend.services import exports, quick_calls, studies
 from backend.services import runs as run_service
 from backend.services.job_runner import JobRunner
 from backend.services.robot import RobotService
@@ -78,7 +78,8 @@ def create_app(
     sessions = session_factory(engine)
     token, _ = api_token(settings.data_dir)
     owns_compute = compute is None
-    compute = compute or Compute(warm_up=quick_calls.warm_up, reads_warm_up=functools.partial(loaded, RUN_READS))
+    compute = compute or Compute(warm_up=quick_calls.warm_up, jobs_warm_up=studies.warm_job_kinds,
+                                 reads_warm_up=functools.partial(loaded, RUN_READS))  # fmt: skip
     waiting = Waiting()  # writes that wait for disk space: the health check lists them
     stopping = threading.Event()
     runner = JobRunner(sessions, compute.jobs, dask_address=settings.dask_address, waiting=waiting)

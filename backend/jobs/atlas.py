@@ -79,4 +79,13 @@ def run(spec: AtlasSpec, context: JobContext) -> dict:
     return atlas.to_dict()
 
 
-KIND = JobKind("atlas", "gait atlas (stable gaits over psi0 x zeta0)", AtlasJobCreate, AtlasSpec, worst_case, run)
+KIND = JobKind(
+    "atlas",
+    "gait atlas (stable gaits over psi0 x zeta0)",
+    AtlasJobCreate,
+    AtlasSpec,
+    worst_case,
+    run,
+    typical_fraction=0.047,
+    warm={"rows": 2, "columns": 2, "transient": 10},
+)

@@ -40,7 +40,12 @@ class JobKind:
     work budget), its stored ``spec`` (a frozen dataclass, :mod:`backend.jobs.specs`), its
     ``worst_case`` work (of a request or a spec alike), its ``run`` (spec, :class:`JobContext`) ->
     JSON result, in the job worker — None for a kind the runner runs trial by trial (MJTF) — and
-    its ``total`` pieces of work (what ``completed`` counts up to)."""
+    its ``total`` pieces of work (what ``completed`` counts up to). ``typical_fraction``: what such a
+    job takes, as a share of its worst case at the job worker's rate, before this machine has run
+    one (measured by scripts/bench_job_estimates.py; the service learns its own from finished jobs,
+    :mod:`backend.services.job_estimates`). ``warm``: a small request body (its fields but ``kind``)
+    whose run loads the kind's kernels: the job worker runs each at start, so that a first job does
+    not wait for them (an MFPT took 11 s cold, 5.6 s warm)."""
 
     name: str
     title: str
@@ -49,6 +54,8 @@ class JobKind:
     worst_case: Callable[[Any], WorstCase]
     run: Callable[[Any, JobContext], dict] | None
     total: Callable[[Any], int] = one_chunk
+    typical_fraction: float = 1.0
+    warm: dict | None = None
 
 
 @contextmanager

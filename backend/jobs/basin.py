@@ -71,4 +71,13 @@ def run(spec: BasinSpec, context: JobContext) -> dict:
     return basin.to_dict()
 
 
-KIND = JobKind("basin", "basin grid", BasinJobCreate, BasinSpec, worst_case, run)
+KIND = JobKind(
+    "basin",
+    "basin grid",
+    BasinJobCreate,
+    BasinSpec,
+    worst_case,
+    run,
+    typical_fraction=0.072,
+    warm={"controls": [{"psi0_deg": 30.0, "zeta0": 0.9}], "grid": 2, "jumps": 2},
+)

@@ -82,4 +82,4 @@ def run(spec: ControlStudySpec, context: JobContext) -> dict:
 
 
 KIND = JobKind("control-study", "controllers (closed-loop benchmark)", ControlStudyJobCreate, ControlStudySpec,
-               worst_case, run)  # fmt: skip
+               worst_case, run, typical_fraction=4.5, warm={"seeds": 1, "jumps": 2})  # fmt: skip

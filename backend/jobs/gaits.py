@@ -48,4 +48,13 @@ def run(spec: GaitSearchSpec, context: JobContext) -> dict:
     return {"gaits": [gait.to_dict() for gait in gaits]}
 
 
-KIND = JobKind("gaits", "gait search", GaitSearchJobCreate, GaitSearchSpec, worst_case, run)
+KIND = JobKind(
+    "gaits",
+    "gait search",
+    GaitSearchJobCreate,
+    GaitSearchSpec,
+    worst_case,
+    run,
+    typical_fraction=0.14,
+    warm={"controls": [{"psi0_deg": 30.0, "zeta0": 0.9}], "grid": 1},
+)

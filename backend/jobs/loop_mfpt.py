@@ -119,4 +119,13 @@ def run(spec: LoopMfptSpec, context: JobContext) -> dict:
     return run_splitting(context.model, context.robot.leg_length, config, progress=context.progress)
 
 
-KIND = JobKind("loop-mfpt", "MFPT of a controller (splitting)", LoopMfptJobCreate, LoopMfptSpec, worst_case, run)
+KIND = JobKind(
+    "loop-mfpt",
+    "MFPT of a controller (splitting)",
+    LoopMfptJobCreate,
+    LoopMfptSpec,
+    worst_case,
+    run,
+    typical_fraction=0.003,
+    warm={"controller": "pid", "replicas": 2, "runs": 2, "noise": {"velocity": 0.05}},
+)

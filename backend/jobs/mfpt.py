@@ -99,4 +99,13 @@ def run(spec: MfptSpec, context: JobContext) -> dict:
     return mfpt(model, controls, noise, start=start, grid=mfpt_grid_of(spec), progress=context.progress).to_dict()
 
 
-KIND = JobKind("mfpt", "MFPT (mean first-passage time, Markov chain)", MfptJobCreate, MfptSpec, worst_case, run)
+KIND = JobKind(
+    "mfpt",
+    "MFPT (mean first-passage time, Markov chain)",
+    MfptJobCreate,
+    MfptSpec,
+    worst_case,
+    run,
+    typical_fraction=0.0024,
+    warm={"grid": 4},
+)

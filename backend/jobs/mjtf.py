@@ -61,5 +61,6 @@ class MJTFSpec:
 
 KIND = JobKind(
     "mjtf", "Mean Jumps To Failure", MJTFJobCreate, MJTFSpec, worst_case, run=None,
-    total=lambda spec: len(spec.zeta0s) * spec.trials,
+    total=lambda spec: len(spec.zeta0s) * spec.trials, typical_fraction=0.1,
+    warm={"zeta0s": [0.9], "trials": 2, "cap": 20},
 )  # fmt: skip

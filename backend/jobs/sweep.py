@@ -78,4 +78,13 @@ def run(spec: SweepSpec, context: JobContext) -> dict:
     return sweep.to_dict()
 
 
-KIND = JobKind("sweep", "zeta0 sweep", SweepJobCreate, SweepSpec, worst_case, run)
+KIND = JobKind(
+    "sweep",
+    "zeta0 sweep",
+    SweepJobCreate,
+    SweepSpec,
+    worst_case,
+    run,
+    typical_fraction=0.077,
+    warm={"steps": 2, "basin_grid": 2, "basin_jumps": 2},
+)

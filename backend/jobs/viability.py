@@ -89,4 +89,13 @@ def run(spec: ViabilitySpec, context: JobContext) -> dict:
     }
 
 
-KIND = JobKind("viability", "viability kernel", ViabilityJobCreate, ViabilitySpec, worst_case, run)
+KIND = JobKind(
+    "viability",
+    "viability kernel",
+    ViabilityJobCreate,
+    ViabilitySpec,
+    worst_case,
+    run,
+    typical_fraction=0.29,
+    warm={"states": 4, "actions": 2},
+)

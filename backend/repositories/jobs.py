@@ -8,6 +8,7 @@ outcome by the database (:func:`outcome_moments`), never read one by one.
 
 from __future__ import annotations
 
+import datetime
 from collections.abc import Iterable
 
 from sqlalchemy import func, select, update
@@ -88,6 +89,20 @@ def unfinished(session: Session) -> list[Job]:
     """The jobs queued, running or cancelling, oldest first (the queue, bounded by its budget)."""
     waiting = (JobState.QUEUED, JobState.RUNNING, JobState.CANCELLING)
     return list(session.scalars(select(Job).where(Job.state.in_(waiting)).order_by(Job.id)))
+
+
+def done_mark(session: Session) -> tuple[int, int]:
+    """``(count, newest id)`` of the jobs done: changes whenever one more is."""
+    count, newest = session.execute(select(func.count(), func.max(Job.id)).where(Job.state == JobState.DONE)).one()
+    return int(count), int(newest or 0)
+
+
+def recent_done(session: Session, limit: int) -> list[tuple[str, dict, datetime.datetime, datetime.datetime]]:
+    """``(kind, spec, started_at, finished_at)`` of the newest ``limit`` jobs done, newest first."""
+    query = (select(Job.kind, Job.spec, Job.started_at, Job.finished_at)
+             .where(Job.state == JobState.DONE, Job.started_at.is_not(None), Job.finished_at.is_not(None))
+             .order_by(Job.id.desc()).limit(limit))  # fmt: skip
+    return [tuple(row) for row in session.execute(query)]
 
 
 def queued_ids(session: Session) -> list[int]:

@@ -40,6 +40,9 @@ class JobOut(BaseModel):
     submitted_by: str | None = Field(None, description="who submitted it: X-Parkour-Client, else the address")
     queue_position: int | None = Field(None, description="1: runs next; null when not queued")
     eta_s: float | None = Field(
+        None, description="seconds until it should end: its time and the jobs' ahead as expected on this machine"
+    )
+    eta_max_s: float | None = Field(
         None, description="seconds until it ends at the latest (its work and the work ahead at their worst)"
     )
 

@@ -7,7 +7,9 @@ one client — a script, the panel: the ``X-Parkour-Client`` header, else its ad
 most :data:`~backend.schemas.job_budget.CLIENT_SHARE` of it, so one script cannot starve the panel. A job
 past either is refused with a 429 (:class:`~backend.errors.QueueFull`) saying what is queued.
 A queued job's place is its rank among the queued jobs by id (the runner takes them oldest
-first); its estimate is the work ahead of it and its own at the job worker's rate, at the latest.
+first); its estimates are the time of the jobs ahead of it and its own: ``eta_s`` as expected on
+this machine (:mod:`backend.services.job_estimates`), ``eta_max_s`` at the latest (every job at
+its worst case, at the job worker's rate).
 """
 
 from __future__ import annotations
@@ -22,28 +24,39 @@ from backend.jobs import UnreadableSpec, decode, worst_case_jumps
 from backend.repositories import jobs as stored_jobs
 from backend.schemas.job_budget import CLIENT_SHARE, JOB_RATE_JUMPS_PER_S, MAX_QUEUED_JOBS, QUEUE_BUDGET_JUMPS
 from backend.schemas.jobs import JobState
+from backend.services import job_estimates
+from backend.services.job_estimates import Paces
 from backend.store.models import Job
 
 
 @dataclass(frozen=True)
 class Standing:
     """Where an unfinished job stands: ``position`` 1 runs next (None: running), ``eta_s`` the
-    seconds until it ends at the latest."""
+    seconds until it should end (expected on this machine), ``eta_max_s`` until it ends at the latest."""
 
     position: int | None
     eta_s: float
+    eta_max_s: float
+
+
+def _share_left(job: Job) -> float:
+    """The share of its work a job has still to do: all of it while queued, the share of its total
+    not completed while running."""
+    if job.state == JobState.QUEUED or not job.total:
+        return 1.0
+    return max(job.total - job.completed, 0) / job.total
+
+
+def _worst(job: Job) -> int:
+    try:
+        return worst_case_jumps(decode(job.spec))[0]
+    except UnreadableSpec:
+        return 0  # a spec of another version of the code: it will fail when it runs, taking no time
 
 
 def work_left(job: Job) -> int:
-    """The job's work still to do, in jumps at its worst: all of it while queued, the share of its
-    total not completed while running."""
-    try:
-        worst, _ = worst_case_jumps(decode(job.spec))
-    except UnreadableSpec:
-        return 0  # a spec of another version of the code: it will fail when it runs, taking no time
-    if job.state == JobState.QUEUED or not job.total:
-        return worst
-    return round(worst * max(job.total - job.completed, 0) / job.total)
+    """The job's work still to do, in jumps at its worst."""
+    return round(_worst(job) * _share_left(job))
 
 
 def check_room(session: Session, body, client: str) -> None:
@@ -74,22 +87,36 @@ def check_room(session: Session, body, client: str) -> None:
 
 
 def standings(session: Session) -> dict[int, Standing]:
-    """Every unfinished job's standing, by id (one query of the unfinished jobs)."""
-    return standings_of(stored_jobs.unfinished(session))
+    """Every unfinished job's standing, by id (one query of the unfinished jobs, and of the done ones'
+    count for the paces)."""
+    return standings_of(stored_jobs.unfinished(session), job_estimates.paces(session))
 
 
-def standings_of(unfinished: Iterable[Job]) -> dict[int, Standing]:
-    """:func:`standings` from the unfinished jobs, oldest first."""
+def standings_of(unfinished: Iterable[Job], paces: Paces | None = None) -> dict[int, Standing]:
+    """:func:`standings` from the unfinished jobs, oldest first, and this machine's ``paces`` (None:
+    each kind's typical one)."""
+    paces = Paces() if paces is None else paces
     unfinished = list(unfinished)
+    worst = {job.id: _worst(job) for job in unfinished}
+
+    def left(job: Job) -> tuple[float, float]:  # (expected, at the latest) [s] of what it has still to do
+        share = _share_left(job)
+        expected = share * paces.expected_seconds(job.kind, worst[job.id], job_estimates.spec_key(job.kind, job.spec))
+        # "At the latest" is never sooner than expected: a kind whose jumps cost more than the map's
+        # (a closed loop's law) runs slower than the worker's rate on its worst case.
+        return expected, max(share * worst[job.id] / JOB_RATE_JUMPS_PER_S, expected)
+
     started = [job for job in unfinished if job.state != JobState.QUEUED]  # running (or cancelling)
-    ahead = sum(work_left(job) for job in started)
-    result = {job.id: Standing(None, ahead / JOB_RATE_JUMPS_PER_S) for job in started}
+    expected = sum(left(job)[0] for job in started)
+    latest = sum(left(job)[1] for job in started)
+    result = {job.id: Standing(None, expected, latest) for job in started}
     position = 0
     for job in unfinished:
         if job.state == JobState.QUEUED:
             position += 1
-            ahead += work_left(job)
-            result[job.id] = Standing(position, ahead / JOB_RATE_JUMPS_PER_S)
+            more, most = left(job)
+            expected, latest = expected + more, latest + most
+            result[job.id] = Standing(position, expected, latest)
     return result
 
 

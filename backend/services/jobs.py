@@ -146,4 +146,5 @@ def public(job: Job, standing: Standing | None = None) -> JobOut:
         submitted_by=job.submitted_by,
         queue_position=None if standing is None else standing.position,
         eta_s=None if standing is None else standing.eta_s,
+        eta_max_s=None if standing is None else standing.eta_max_s,
     )

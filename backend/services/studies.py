@@ -7,7 +7,9 @@ Module-level and picklable, like the quick calls; the kernels load inside the ru
 
 from __future__ import annotations
 
-from backend.jobs import JobContext, job_kind
+import math
+
+from backend.jobs import KINDS, JobContext, job_kind, spec_of
 from backend.services.presets import resolve_model
 from backend.workers.progress import report
 
@@ -26,3 +28,33 @@ def run_study(spec, chunk_map, progress) -> dict:
     robot = resolve_model(None, spec.model.preset).robot  # a stored preset is resolved already
     context = JobContext(spec.model.params(), robot, chunk_map, progress)
     return job_kind(spec.kind).run(spec, context)
+
+
+def warm_job_kinds() -> None:
+    """What the job worker runs first: the quick calls' kernels, then each kind's small ``warm``
+    job (its kernels loaded from numba's cache, or compiled once), so that a first job of a kind
+    does not wait for them. MJTF, which the runner runs trial by trial, by its study."""
+    from backend.services.quick_calls import warm_up
+
+    warm_up()
+    for kind in KINDS:
+        if kind.warm is None:
+            continue
+        spec = spec_of(kind.request(**({"kind": kind.name} | kind.warm)))
+        if kind.run is not None:
+            run_study(spec, _in_process(), _no_progress)
+        else:
+            from sim_core.robustness.mjtf import mjtf_study
+
+            mjtf_study(spec.model.params(), math.radians(spec.psi0_deg), spec.zeta0s, noise=spec.noise.model(),
+                       trials=spec.trials, cap=spec.cap)  # fmt: skip
+
+
+def _in_process():
+    from sim_core.chunks import in_process
+
+    return in_process
+
+
+def _no_progress(done: int, total: int) -> None:
+    pass

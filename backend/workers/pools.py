@@ -217,8 +217,9 @@ def _stop(executor: concurrent.futures.ProcessPoolExecutor) -> None:
 class Compute:
     """The service's pools: ``quick`` for API calls, ``jobs`` for job chunks, ``reads`` for the
     run list's pages and exports. ``warm_up`` is what the quick and job workers run first (the
-    kernels), ``reads_warm_up`` what the read workers do (the store and the schemas); without
-    them :meth:`warm` only starts the workers."""
+    kernels; ``jobs_warm_up``, where given, the job worker's: every job kind's), ``reads_warm_up``
+    what the read workers do (the store and the schemas); without them :meth:`warm` only starts
+    the workers."""
 
     def __init__(
         self,
@@ -227,9 +228,10 @@ class Compute:
         *,
         warm_up: Callable[[], None] = started,
         reads_warm_up: Callable[[], None] = started,
+        jobs_warm_up: Callable[[], None] | None = None,
     ):
         self.quick = quick or ComputePool("quick", max_pending=QUICK_PENDING, warm_up=warm_up)
-        self.jobs = jobs or ComputePool("jobs", max_pending=JOB_PENDING, warm_up=warm_up)
+        self.jobs = jobs or ComputePool("jobs", max_pending=JOB_PENDING, warm_up=jobs_warm_up or warm_up)
         self.reads = ComputePool(
             "reads", READ_WORKERS, max_pending=READ_PENDING, niceness=READ_NICENESS, warm_up=reads_warm_up
         )

@@ -40,13 +40,18 @@ function duration(seconds) {
 
 // Where a job stands in the queue and when it should be done, as the service estimates them
 // (``queue_position``: 1 = next to run, null when not queued; ``eta_s``: seconds until it should
-// finish, or null); "" when it gives neither (an older service does not).
+// finish as expected on this machine, or null; ``eta_max_s``: at the latest, said where it is well
+// above); "" when it gives neither (an older service does not).
 export function queueWords(job) {
   const words = [];
   if (Number.isInteger(job.queue_position) && job.queue_position >= 1) {
     words.push(job.queue_position === 1 ? "next to run" : `${ordinal(job.queue_position)} in the queue`);
   }
-  if (typeof job.eta_s === "number" && Number.isFinite(job.eta_s) && job.eta_s >= 0) words.push(`done in about ${duration(job.eta_s)}`);
+  const seconds = (value) => typeof value === "number" && Number.isFinite(value) && value >= 0;
+  if (seconds(job.eta_s)) {
+    const most = seconds(job.eta_max_s) && job.eta_max_s > 1.5 * job.eta_s ? ` (at most ${duration(job.eta_max_s)})` : "";
+    words.push(`done in about ${duration(job.eta_s)}${most}`);
+  }
   return words.join(", ");
 }
 

@@ -205,7 +205,7 @@ def test_the_jobs_tab_pages_through_every_job_and_says_where_a_queued_one_stands
 
     def queued(route):
         listed = route.fetch().json()
-        listed["items"][0] |= {"state": "queued", "queue_position": 2, "eta_s": 150.0}
+        listed["items"][0] |= {"state": "queued", "queue_position": 2, "eta_s": 150.0, "eta_max_s": 3600.0}
         listed["items"][1] |= {"state": "queued", "queue_position": 1, "eta_s": None}
         for job in listed["items"][2:]:
             job.pop("queue_position", None)
@@ -218,7 +218,8 @@ def test_the_jobs_tab_pages_through_every_job_and_says_where_a_queued_one_stands
     page.click("nav [data-tab=simulate]")
     page.click("nav [data-tab=jobs]")
     until(page, f"document.querySelector('#job-{ids[0]} .state').textContent === 'queued'")
-    assert page.inner_text(f"#job-{ids[0]} small.queue") == "2nd in the queue, done in about 3 min"
+    # The expectation, and the worst-case bound where it is well above (issue 40: only the bound was said).
+    assert page.inner_text(f"#job-{ids[0]} small.queue") == "2nd in the queue, done in about 3 min (at most 1 h 0 min)"
     assert page.inner_text(f"#job-{ids[1]} small.queue") == "next to run"
     assert page.query_selector(f"#job-{ids[2]} small.queue") is None, "nothing said when the API says nothing"
     # Unfinished jobs on the page are asked for again, not streamed one by one: a browser's six

@@ -7,14 +7,16 @@ import pytest
 from sqlalchemy import update
 
 from backend.errors import QueueFull
-from backend.jobs import worst_case_jumps
+from backend.jobs import job_kind, worst_case_jumps
 from backend.jobs.mjtf import MJTFJobCreate
 from backend.schemas.job_budget import JOB_RATE_JUMPS_PER_S
 from backend.services import job_queue, jobs
+from backend.services.job_estimates import OVERHEAD_S
 from backend.store.models import Job
 from tests.backend.services.jobs_helpers import SMALL
 
 WORK = worst_case_jumps(MJTFJobCreate(**SMALL))[0]  # 2 levels x 10 trials x 200 jumps = 4000
+MJTF_PACE = job_kind("mjtf").typical_fraction
 
 
 @pytest.fixture
@@ -33,7 +35,10 @@ def test_queued_jobs_stand_in_line_oldest_first_with_estimates(session, budget):
     assert [job.queue_position for job in submitted] == [1, 2, 3]
     assert [job.submitted_by for job in submitted] == ["script"] * 3
     now = [jobs.get_job(session, job.id) for job in submitted]
-    assert [job.eta_s for job in now] == pytest.approx([k * WORK / JOB_RATE_JUMPS_PER_S for k in (1, 2, 3)])
+    expected = OVERHEAD_S + MJTF_PACE * WORK / JOB_RATE_JUMPS_PER_S  # no job done here yet: the kind's typical pace
+    latest = max(WORK / JOB_RATE_JUMPS_PER_S, expected)  # never sooner than expected (a job's overhead)
+    assert [job.eta_s for job in now] == pytest.approx([k * expected for k in (1, 2, 3)])
+    assert [job.eta_max_s for job in now] == pytest.approx([k * latest for k in (1, 2, 3)])
 
 
 def test_a_running_job_counts_what_it_has_left_and_moves_the_line_up(session, budget):
@@ -41,8 +46,11 @@ def test_a_running_job_counts_what_it_has_left_and_moves_the_line_up(session, bu
     session.execute(update(Job).where(Job.id == first.id).values(state="running", completed=first.total // 2))
     session.commit()
     running, waiting = jobs.get_job(session, first.id), jobs.get_job(session, second.id)
-    assert running.queue_position is None and running.eta_s == pytest.approx(WORK / 2 / JOB_RATE_JUMPS_PER_S)
-    assert waiting.queue_position == 1 and waiting.eta_s == pytest.approx(1.5 * WORK / JOB_RATE_JUMPS_PER_S)
+    expected = OVERHEAD_S + MJTF_PACE * WORK / JOB_RATE_JUMPS_PER_S
+    latest = max(WORK / JOB_RATE_JUMPS_PER_S, expected)
+    assert running.queue_position is None and waiting.queue_position == 1
+    assert (running.eta_s, waiting.eta_s) == pytest.approx((expected / 2, 1.5 * expected)), "half of it left"
+    assert (running.eta_max_s, waiting.eta_max_s) == pytest.approx((latest / 2, 1.5 * latest))
     page = jobs.list_jobs(session, state=None, limit=10, cursor=None)
     assert {job.id: job.queue_position for job in page.items} == {first.id: None, second.id: 1}
 
@@ -52,7 +60,7 @@ def test_an_ended_job_has_no_place_and_takes_no_room(session, budget):
     session.execute(update(Job).where(Job.id == done.id).values(state="done", completed=done.total))
     session.commit()
     ended = jobs.get_job(session, done.id)
-    assert ended.queue_position is None and ended.eta_s is None
+    assert ended.queue_position is None and ended.eta_s is None and ended.eta_max_s is None
     assert [_submit(session, "script").queue_position for _ in range(6)] == [1, 2, 3, 4, 5, 6], "the done job is free"
 
 

@@ -35,3 +35,17 @@ def test_run_study_basin_and_sweep_continue_undecided_cells_up_to_the_jump_limit
     sweep = SweepJobCreate(kind="sweep", zeta0_low=0.93, zeta0_high=0.94, steps=2, basin_grid=4, basin_jumps=10,
                            basin_jump_limit=200, guess=StateIn(xdot=-0.93, ydot=-0.34))  # fmt: skip
     assert run(sweep)["basin"]["jump_limit"] == 200
+
+
+def test_every_kind_warms_with_a_small_job_of_its_own(monkeypatch):
+    """The job worker's start (studies.warm_job_kinds): each registered kind's ``warm`` body is a
+    request it takes, and its run (MJTF's study) goes through — so a first job does not load kernels."""
+    from backend.jobs import KINDS
+    from backend.services import studies
+
+    ran = []
+    real_run_study = studies.run_study
+    monkeypatch.setattr(studies, "run_study", lambda spec, *args: ran.append(spec.kind) or real_run_study(spec, *args))
+    studies.warm_job_kinds()
+    assert all(kind.warm is not None for kind in KINDS), "every kind warms"
+    assert ran == [kind.name for kind in KINDS if kind.run is not None]
