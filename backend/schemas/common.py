@@ -20,17 +20,14 @@ ControllerKind = enum.StrEnum("ControllerKind", {name.replace("-", "_").upper():
 ControllerKind.__doc__ = "A closed-loop law (the registry, sim_core.control.laws.LAWS)."
 
 
-# A leg angle in (0, 90) degrees, a hair taken off each end: the kernels take radians, and an angle
-# a hair inside (5e-324 degrees) would be 0 there. The schema says the bounds it holds to, so every
-# value the OpenAPI document allows is accepted.
+# A leg angle in (0, 90) degrees, a hair taken off the low end: the kernels take radians, and an
+# angle a hair above 0 (5e-324 degrees) would be 0 there (every double below 90 stays below pi/2).
+# The schema says the bounds it holds to, so every value the OpenAPI document allows is accepted.
 PSI0_HAIR_DEG = 1e-9
 Psi0Deg = Annotated[
     float,
-    Field(
-        ge=PSI0_HAIR_DEG, le=90.0 - PSI0_HAIR_DEG,
-        description=f"leg angle at touchdown [degrees], in (0, 90): [{PSI0_HAIR_DEG:g}, 90 - {PSI0_HAIR_DEG:g}]",
-    ),
-]  # fmt: skip
+    Field(ge=PSI0_HAIR_DEG, lt=90.0, description=f"leg angle at touchdown [degrees], in [{PSI0_HAIR_DEG:g}, 90)"),
+]
 
 
 def _iso_8601(value: object) -> object:
