@@ -16,6 +16,7 @@ import logging
 import math
 
 from fastapi import FastAPI, Request, status
+from fastapi.exception_handlers import http_exception_handler
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
@@ -84,9 +85,10 @@ def install(app: FastAPI) -> None:
         )
 
     async def http_error(request: Request, error: StarletteHTTPException):
-        if error.status_code == status.HTTP_405_METHOD_NOT_ALLOWED:
-            return methods.not_allowed(request, methods.allowed_methods(request))
-        return JSONResponse({"detail": error.detail}, status_code=error.status_code, headers=error.headers)
+        allowed = methods.allowed_methods(request) if error.status_code == status.HTTP_405_METHOD_NOT_ALLOWED else None
+        if allowed:
+            return methods.not_allowed(request, allowed)
+        return await http_exception_handler(request, error)  # FastAPI's own, for every other status
 
     app.add_exception_handler(StarletteHTTPException, http_error)
     app.add_exception_handler(ParameterError, bad_parameter)

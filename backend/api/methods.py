@@ -4,8 +4,8 @@ Starlette answers a method a path does not take with a 405 whose ``Allow`` names
 the first route that matched the path only — ``OPTIONS /runs/1`` said ``GET`` though the path
 also takes PATCH and DELETE — and a method that a literal path does not take but a sibling with a
 parameter does (``PATCH /runs/aggregate``) reaches that sibling, whose id cannot be read: a 422
-about ``run_id`` for a path that names no run. Here both become one 405 listing every method of
-every route the path matches, literal routes first.
+about ``run_id`` for a path that names no run. Here the first becomes a 405 listing every method
+of every route the path matches, the second a 405 listing the literal path's own.
 """
 
 from __future__ import annotations
