@@ -594,8 +594,12 @@ def robot(page, service):
         page.fill("input[name=tracker_port]", str(tracker_port))
         page.click("#connect")
         until(page, f"['disarmed', 'estopped'].includes({ROBOT_STATE})", timeout=10_000)
-        if page.evaluate(f"{ROBOT_STATE} === 'estopped'"):  # an earlier test pressed with no robot: it latched
+        # An earlier test pressed with no robot: the latch holds, and the connect sends its ESTOP —
+        # the robot may read 'disarmed' before it arrives. The service's latch, not the robot's
+        # state of the moment, says whether to reset (a CI run saw the banner after the check).
+        if httpx.get(f"{_base}/api/v1/robot").json()["estop"]["latched"]:
             auth = {"Authorization": f"Bearer {token}"}
+            until(page, f"{ROBOT_STATE} === 'estopped'", timeout=10_000)
             httpx.post(f"{_base}/api/v1/robot/reset", headers=auth).raise_for_status()
             page.wait_for_selector("#estop-banner", state="hidden")
         until(page, f"{ROBOT_STATE} === 'disarmed'", timeout=10_000)
