@@ -22,6 +22,7 @@ from sim_core.model.noise import NO_NOISE
 from tests.backend.api.bodies import RUN
 from tests.frontend.browser import CSP_LISTENER, KEEP_MESSAGES, chromium, panel, said, screenshot, until
 from tests.helpers import free_port, served
+from tests.robot_rig import wait_for
 from tests.robot_runs import store_robot_run
 
 # A browser and a service (slow), and a robot answering in real time (the e-stop acknowledged within
@@ -936,8 +937,16 @@ def test_a_latched_estop_reaches_every_open_panel(page, service, robot):
         pressed = time.monotonic()
         history.locator("#estop-banner").wait_for(state="visible", timeout=SHOWN_WITHIN_MS)
         on_history = time.monotonic() - pressed
-        reason = httpx.get(f"{base}/api/v1/robot").json()["estop"]["reason"]
-        assert reason and history.inner_text("#estop-reason") == f"Reason: {reason}"
+
+        # The banner may first say "…; being saved)" while the latch file is written: the stream
+        # brings the saved reason next (a CI run read the banner between the two).
+        def saved_reason() -> str:
+            return httpx.get(f"{base}/api/v1/robot").json()["estop"]["reason"]
+
+        wait_for(lambda: "being saved" not in saved_reason(), "the latch saved", 30.0)
+        reason = saved_reason()
+        assert reason
+        until(history, f"document.querySelector('#estop-reason').textContent === {json.dumps('Reason: ' + reason)}")
         assert history.evaluate(EVENTS_STATE) == "live", "the stream brought it, not the fallback"
         late = context.new_page()
         opened = time.monotonic()
