@@ -72,9 +72,7 @@ def install(app: FastAPI) -> None:
             literal = methods.literal_methods(request)
             if literal and request.method not in literal:  # PATCH /runs/aggregate: no run id, a wrong method
                 return methods.not_allowed(request, literal)
-        return JSONResponse(
-            {"detail": compact_errors(error.errors())}, status_code=status.HTTP_422_UNPROCESSABLE_CONTENT
-        )
+        return JSONResponse({"detail": compact_errors(errors)}, status_code=status.HTTP_422_UNPROCESSABLE_CONTENT)
 
     async def server_error(request: Request, error: Exception):
         # Starlette's ServerErrorMiddleware calls this, outside the middlewares that add the headers.

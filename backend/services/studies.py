@@ -35,6 +35,7 @@ def warm_job_kinds() -> None:
     job (its kernels loaded from numba's cache, or compiled once), so that a first job of a kind
     does not wait for them. MJTF, which the runner runs trial by trial, by its study."""
     from backend.services.quick_calls import warm_up
+    from sim_core.chunks import in_process
 
     warm_up()
     for kind in KINDS:
@@ -42,18 +43,12 @@ def warm_job_kinds() -> None:
             continue
         spec = spec_of(kind.request(**({"kind": kind.name} | kind.warm)))
         if kind.run is not None:
-            run_study(spec, _in_process(), _no_progress)
+            run_study(spec, in_process, _no_progress)
         else:
             from sim_core.robustness.mjtf import mjtf_study
 
             mjtf_study(spec.model.params(), math.radians(spec.psi0_deg), spec.zeta0s, noise=spec.noise.model(),
                        trials=spec.trials, cap=spec.cap)  # fmt: skip
-
-
-def _in_process():
-    from sim_core.chunks import in_process
-
-    return in_process
 
 
 def _no_progress(done: int, total: int) -> None:

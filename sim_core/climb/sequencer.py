@@ -100,9 +100,10 @@ def jump(setup: ClimbSetup, start: JumpStart, next_leg: NextLeg) -> Jump:
     completed = failure is None and not floor
     rise = float(si.rises[0]) if completed else math.nan
     robot = setup.robot
-    if completed and _next_body_height(start, next_leg, rise, robot) < setup.floor:
+    landing = _next_body_height(start, next_leg, rise, robot) if completed else math.nan
+    if landing < setup.floor:
         completed, floor = False, True  # reached between the last sample and the touchdown
-    top = completed and setup.top is not None and _next_body_height(start, next_leg, rise, robot) > setup.top
+    top = completed and setup.top is not None and landing > setup.top
     completed = completed and not top  # landing above the top ends the climb there: no next touchdown
     flight = np.flatnonzero(samples.phase == FLIGHT)
     return Jump(
