@@ -7,6 +7,7 @@ SQLite, 127.0.0.1:8000, the loopback names).
 
 from __future__ import annotations
 
+import ipaddress
 import os
 import re
 from collections.abc import Iterable
@@ -39,13 +40,19 @@ class Settings:
     dask_address: str | None = None
     max_request_bytes: int = MAX_REQUEST_BYTES
     allowed_hosts: tuple[str, ...] = LOOPBACK_HOSTS  # normalised by host_name
+    reads_need_token: bool = False  # True when it listens beyond this machine: every read names who asks
 
     @classmethod
     def from_environment(
-        cls, data_dir: Path | None = None, database_url: str | None = None, allowed_hosts: Iterable[str] = ()
+        cls,
+        data_dir: Path | None = None,
+        database_url: str | None = None,
+        allowed_hosts: Iterable[str] = (),
+        listen_on: str = DEFAULT_HOST,
     ) -> Settings:
         """``allowed_hosts``: names to answer to beside the loopback's and ``$PARKOUR_ALLOWED_HOSTS``
-        (comma- or space-separated); wildcard addresses such as ``0.0.0.0`` are not names and are left out."""
+        (comma- or space-separated); wildcard addresses such as ``0.0.0.0`` are not names and are left out.
+        ``listen_on``: the address the service binds; beyond the loopback, reads need a token too."""
         from backend.store.database import sqlite_url  # SQLAlchemy loads here, not when the CLI lists options
         from backend.store.drivers import with_driver
 
@@ -60,4 +67,16 @@ class Settings:
             database_url=url,
             dask_address=os.environ.get("PARKOUR_DASK_ADDRESS") or None,
             allowed_hosts=tuple(hosts),
+            reads_need_token=not is_loopback(listen_on),
         )
+
+
+def is_loopback(address: str) -> bool:
+    """Whether binding ``address`` keeps the service on this machine (``127.0.0.1``, ``::1``,
+    ``localhost``); a wildcard (``0.0.0.0``) or a network address does not."""
+    if host_name(address) == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host_name(address)).is_loopback
+    except ValueError:
+        return False  # a name other than localhost may resolve anywhere

@@ -6,7 +6,8 @@ machine-readable form scripts rely on (keep it stable: extend, never break). Err
 can fix print one line and exit with code 2.
 
 ``parkour serve`` starts the service with the control panel and the 3D view; ``parkour export``
-writes a stored robot or replay run as an MCAP recording.
+writes a stored robot or replay run as an MCAP recording; ``parkour token`` gives the lab's people
+API tokens of their own.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from cli import (
     serve,
     simulate,
     sweep,
+    token,
     viability,
 )
 
@@ -58,6 +60,7 @@ COMMANDS = (
     export,
     bench,
     serve,
+    token,
 )
 for command in COMMANDS:
     app.add_typer(command.app)

@@ -56,7 +56,7 @@ def serve_command(
     from backend.store.drivers import StoreUnavailable, check_store
 
     try:
-        settings = Settings.from_environment(data_dir, allowed_hosts=[host])
+        settings = Settings.from_environment(data_dir, allowed_hosts=[host], listen_on=host)
         check_store(settings.database_url)
     except StoreUnavailable as error:
         typer.echo(f"error: {error}", err=True)

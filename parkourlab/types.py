@@ -31,7 +31,8 @@ class Run(TypedDict):
     docs/model.md §1); ``controls``: ``[psi0 [deg], zeta0 [l0]]`` per leg of the schedule;
     ``start_state``: ``[xdot, ydot]`` [sqrt(g l0)]; ``climb`` [l0]; ``duration_s`` [s]. A robot run
     also has its ``end_reason`` (as recorded) and ``touchdowns``; a closed loop (``loop``) its
-    ``controller`` and ``target`` height [m]; None where they do not apply."""
+    ``controller`` and ``target`` height [m]; None where they do not apply. ``created_by``: the
+    person who made it, ``notes_by`` who last wrote its notes or tags (None: before people had names)."""
 
     id: int
     experiment_id: int | None
@@ -55,6 +56,8 @@ class Run(TypedDict):
     controller: str | None
     target: float | None
     touchdowns: int | None
+    created_by: str | None
+    notes_by: str | None
 
 
 class RunDetail(Run):
@@ -79,7 +82,8 @@ class Experiment(TypedDict):
 class Job(TypedDict):
     """A batch job. ``completed`` of ``total`` units (trials for MJTF) are done; ``progress`` is
     their ratio in [0, 1]; ``spec`` is the job's body with the service's defaults filled in.
-    ``submitted_by``: who submitted it (its client's name, else its address); ``queue_position``
+    ``submitted_by``: the person who submitted it (their token's), ``submitted_via`` the tool (its
+    ``X-Parkour-Client`` label); ``queue_position``
     (1: next), ``eta_s`` [s] until it should end (as expected on the service's machine) and
     ``eta_max_s`` [s] until it ends at the latest: None once it is final."""
 
@@ -96,6 +100,7 @@ class Job(TypedDict):
     started_at: str | None
     finished_at: str | None
     submitted_by: str | None
+    submitted_via: str | None
     queue_position: int | None
     eta_s: float | None
     eta_max_s: float | None

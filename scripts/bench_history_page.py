@@ -18,9 +18,12 @@ clients each loop over pages of 50 on their own keep-alive connection, no pause:
 
 Prints p50/p95/max per side and set, and the new/base ratios per round. ``--writes 0.05`` makes
 that fraction of requests store a run (each commit makes the read workers count totals afresh).
+``--searchers 10`` adds that many clients beside them, each searching notes and tags for random
+text (3 to 8 letters, which mostly matches nothing: ``search`` in the output), as people typing
+into History's search box do; the other clients' pages show what the searches cost everyone.
 ``--same-queries`` asks the base the new queries too, for a base that answers them.
 Usage: PYTHONPATH=. python scripts/bench_history_page.py --base REV [--runs 100000] [--clients 20]
-       [--rounds 3] [--seconds 8] [--writes 0] [--same-queries]
+       [--rounds 3] [--seconds 8] [--writes 0] [--searchers 0] [--same-queries]
 """
 
 from __future__ import annotations
@@ -151,18 +154,31 @@ def _run(run_id: int, rng: random.Random) -> dict:
     }
 
 
-async def _client(host: str, port: int, token: str, deadline: float, queries: list, writes: float, seed_value: int):
-    """One client: (set, latency [s], status, has a total) of each request until ``deadline``."""
+SEARCHED = "abcdefghijklmnopqrstuvwxyz"
+
+
+def _searches(rng: random.Random):
+    """A searcher's queries: random text of 3 to 8 letters, newest runs first."""
+    while True:
+        text = "".join(rng.choice(SEARCHED) for _ in range(rng.randint(3, 8)))
+        yield "search", ({"sort": "-id", "q": text}, 1)
+
+
+async def _client(host: str, port: int, token: str, deadline: float, queries: list, writes: float, seed_value: int,
+                  searcher: bool = False):  # fmt: skip
+    """One client: (set, latency [s], status, has a total) of each request until ``deadline``
+    (``searcher``: only searches for random text, never a write)."""
     rng, out, connection = random.Random(seed_value), [], Connection(host, port)
+    searches = _searches(rng) if searcher else None
     write_headers = {"Authorization": f"Bearer {token}", "Content-Type": "application/json"}
     body = json.dumps(RUN).encode()
     while time.monotonic() < deadline:
-        if rng.random() < writes:
+        if searches is None and rng.random() < writes:
             started = time.perf_counter()
             status = await connection.request("POST", "/api/v1/runs", write_headers, body)
             out.append(("write", time.perf_counter() - started, status))
             continue
-        name, (params, pages) = rng.choice(queries)
+        name, (params, pages) = next(searches) if searches is not None else rng.choice(queries)
         query = urllib.parse.urlencode(params | {"limit": PAGE, "offset": PAGE * rng.randrange(pages)})
         started = time.perf_counter()
         status = await connection.request("GET", f"/api/v1/runs?{query}", {})
@@ -170,12 +186,15 @@ async def _client(host: str, port: int, token: str, deadline: float, queries: li
     return out
 
 
-def _client_process(base: str, token: str, seconds: float, clients: int, queries: list, writes: float, first: int):
+def _client_process(base: str, token: str, seconds: float, clients: int, queries: list, writes: float, first: int,
+                    searchers: int = 0):  # fmt: skip
     host, _, port = urllib.parse.urlsplit(base).netloc.partition(":")
 
     async def run() -> list:
         deadline = time.monotonic() + seconds
         tasks = [_client(host, int(port), token, deadline, queries, writes, first + k) for k in range(clients)]
+        tasks += [_client(host, int(port), token, deadline, queries, writes, first + 500 + k, searcher=True)
+                  for k in range(searchers)]  # fmt: skip
         return [request for client in await asyncio.gather(*tasks) for request in client]
 
     return asyncio.run(run())
@@ -191,17 +210,28 @@ def service_cpu(pid: int) -> tuple[float, float]:
 
 
 def phase(
-    base: str, token: str, clients: int, seconds: float, queries: list, writes: float, seed_value: int, pid: int = 0
+    base: str,
+    token: str,
+    clients: int,
+    seconds: float,
+    queries: list,
+    writes: float,
+    seed_value: int,
+    pid: int = 0,
+    searchers: int = 0,
 ) -> dict:
-    """``clients`` clients for ``seconds``: per set of queries, p50/p95/max [ms] and requests, and
-    the CPU per request of the service's process, its workers and the whole machine [ms]."""
+    """``clients`` clients (and ``searchers`` searching at random) for ``seconds``: per set of
+    queries, p50/p95/max [ms] and requests, and the CPU per request of the service's process, its
+    workers and the whole machine [ms]."""
     before = service_cpu(pid) if pid else (0.0, 0.0)
     machine_before = machine_cpu_seconds()
     per_process = [clients // CLIENT_PROCESSES + (k < clients % CLIENT_PROCESSES) for k in range(CLIENT_PROCESSES)]
+    searching = [searchers // CLIENT_PROCESSES + (k < searchers % CLIENT_PROCESSES) for k in range(CLIENT_PROCESSES)]
     context = multiprocessing.get_context("spawn")
     with concurrent.futures.ProcessPoolExecutor(CLIENT_PROCESSES, mp_context=context) as pool:
-        futures = [pool.submit(_client_process, base, token, seconds, n, queries, writes, seed_value + 1000 * k)
-                   for k, n in enumerate(per_process) if n]  # fmt: skip
+        futures = [pool.submit(_client_process, base, token, seconds, n, queries, writes, seed_value + 1000 * k,
+                               searching[k])
+                   for k, n in enumerate(per_process) if n or searching[k]]  # fmt: skip
         requests = [request for future in futures for request in future.result()]
     summary = {"requests": len(requests), "per_s": len(requests) / seconds,
                "errors": sorted({status for _, _, status in requests if status >= 400})}  # fmt: skip
@@ -255,6 +285,7 @@ def side_by_side_options(doc: str, *, runs: int, rounds: int, seconds: float, po
 def main() -> None:
     parser = side_by_side_options(__doc__, runs=100_000, rounds=3, seconds=8.0, port=8791)
     parser.add_argument("--writes", type=float, default=0.0, help="the fraction of requests that store a run")
+    parser.add_argument("--searchers", type=int, default=0, help="clients beside them, each searching for random text")
     parser.add_argument(
         "--same-queries",
         action="store_true",
@@ -294,7 +325,7 @@ def main() -> None:
             for name in sides if round_ % 2 == 0 else reversed(list(sides)):
                 _, port, queries = sides[name]
                 entry = phase(f"http://127.0.0.1:{port}", tokens[name], args.clients, args.seconds, _named(queries),
-                              args.writes, round_, processes[name].pid)  # fmt: skip
+                              args.writes, round_, processes[name].pid, args.searchers)  # fmt: skip
                 results["rounds"][name].append(entry)
     finally:
         stop_sides(processes, git_worktree, base_tree, scratch)
@@ -310,12 +341,13 @@ def _named(queries: list) -> list:
 
 
 def _report(results: dict, args) -> None:
-    print(f"{args.runs:,} runs (seeded in {results['seed_s']:.0f} s; migration 0008 on them: "
+    print(f"{args.runs:,} runs (seeded in {results['seed_s']:.0f} s; migrations 0008 on, on them: "
           f"{results['migrate_s']:.1f} s), {args.clients} clients, {args.rounds} rounds of {args.seconds:g} s "
-          f"per side, writes {args.writes:.0%}; base = {args.base}")  # fmt: skip
+          f"per side, writes {args.writes:.0%}, {args.searchers} searching beside them; "
+          f"base = {args.base}")  # fmt: skip
     rounds = results["rounds"]
     for name, entries in rounds.items():
-        for kind in ("common", "new", "write"):
+        for kind in ("common", "new", "write", "search"):
             if kind not in entries[0]:
                 continue
             p50 = statistics.median(entry[kind]["p50_ms"] for entry in entries)

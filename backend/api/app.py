@@ -22,6 +22,7 @@ from fastapi.staticfiles import StaticFiles
 
 from backend.api import errors, security, statuses
 from backend.api.deps import Database
+from backend.api.identity import Identities
 from backend.api.routes import calibrations, catalog, experiments, jobs, robot, runs, sim, site, view
 from backend.api.token_file import api_token
 from backend.services import exports, quick_calls, studies
@@ -32,6 +33,7 @@ from backend.services.storage_waits import Waiting, now_or_when_room
 from backend.services.view import ViewContext, ViewFactory, ViewStarter
 from backend.settings import Settings
 from backend.store.database import ensure_reserve, make_engine, migrate, session_factory
+from backend.store.people import PeopleFile
 from backend.workers.pools import Compute
 from backend.workers.store_reads import RunReads, StoreReads, loaded
 
@@ -129,6 +131,7 @@ def create_app(
     app.state.sessions = sessions
     app.state.database = Database(sessions)
     app.state.token = token
+    app.state.identities = Identities(token, PeopleFile(settings.data_dir))
     app.state.runner = runner if run_jobs else None
     app.state.robot = robot_service
     app.state.compute = compute

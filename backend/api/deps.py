@@ -14,10 +14,13 @@ from typing import Annotated, TypeVar
 from fastapi import Depends, Header, HTTPException, Query, Request, status
 from fastapi import Path as FastAPIPath
 from fastapi.concurrency import run_in_threadpool
+from fastapi.exceptions import RequestValidationError
 from sqlalchemy.orm import Session, sessionmaker
 
 from backend import schemas
+from backend.api.identity import who_label
 from backend.api.security import require_token
+from backend.repositories.run_filters import MIN_SEARCH
 from backend.repositories.runs import RunFilter
 from backend.services.job_runner import JobRunner
 from backend.services.robot import RobotService
@@ -79,7 +82,12 @@ async def run_filter(
         str | None, Query(min_length=1, max_length=16, description=f"a closed loop's law: {', '.join(NAMES)}")
     ] = None,
     q: Annotated[
-        str | None, Query(min_length=1, max_length=200, description="text in the notes or a tag (any case)")
+        str | None,
+        Query(
+            min_length=1,
+            max_length=200,
+            description=f"text in the notes or a tag (any case), at least {MIN_SEARCH} characters; blank: no search",
+        ),
     ] = None,
     zeta0_min: Annotated[float | None, Query(ge=0.0, le=1.0, allow_inf_nan=False)] = None,
     zeta0_max: Annotated[float | None, Query(ge=0.0, le=1.0, allow_inf_nan=False)] = None,
@@ -89,6 +97,10 @@ async def run_filter(
     created_before: Annotated[schemas.IsoDateTime | None, Query(description="ISO 8601, e.g. 2026-12-03")] = None,
 ) -> RunFilter:
     """The run filters shared by list, export and aggregate."""
+    q = q.strip() or None if q is not None else None
+    if q is not None and len(q) < MIN_SEARCH:  # what an index of trigrams can find
+        message = f"String should have at least {MIN_SEARCH} characters (a search reads an index of 3-letter pieces)"
+        raise RequestValidationError([{"loc": ("query", "q"), "msg": message, "type": "string_too_short", "input": q}])
     return RunFilter(
         experiment_id=experiment_id,
         kind=kind,
@@ -104,22 +116,27 @@ async def run_filter(
         psi0_max=psi0_max,
         created_after=created_after,
         created_before=created_before,
-        q=q.strip() or None if q is not None else None,
+        q=q,
     )
 
 
-def submitted_by(
-    request: Request,
+async def submitted_via(
     client: Annotated[
         str | None,
         Header(alias="X-Parkour-Client", pattern=schemas.CLIENT_PATTERN,
-               description="who submits (e.g. panel, a script's name): the job queue's share is per client"),
+               description="the tool that submits (e.g. panel, a script's name): a label kept with the job"),
     ] = None,
-) -> str:  # fmt: skip
-    """Who makes the request: the ``X-Parkour-Client`` header, else the client's address."""
-    if client:
-        return client
-    return request.client.host if request.client is not None else "unknown"
+) -> str | None:  # fmt: skip
+    """The tool a request says it comes from: the ``X-Parkour-Client`` header (a label only: who
+    submits is the token's person)."""
+    return client
+
+
+async def who(request: Request) -> str:
+    """Who makes the request, as records keep it: the token's person, else (a route open to
+    anyone, such as the e-stop) ``someone at <address>``. Async: a sync dependency would wait for a
+    request thread, and the e-stop must not wait for a pool that compute has filled."""
+    return who_label(request)
 
 
 async def robot_service(request: Request) -> RobotService:
@@ -166,7 +183,8 @@ Robot = Annotated[RobotService, Depends(robot_service)]
 Runner = Annotated[JobRunner | None, Depends(job_runner)]
 QuickCompute = Annotated[ComputePool, Depends(quick_compute)]
 Reads = Annotated[StoreReads, Depends(store_reads)]
-SubmittedBy = Annotated[str, Depends(submitted_by)]
+SubmittedVia = Annotated[str | None, Depends(submitted_via)]
+Who = Annotated[str, Depends(who)]
 SceneView = Annotated[object, Depends(scene_view)]  # frontend.viewer's view (the backend does not import it)
 AUTHORIZED = [Depends(require_token)]  # every mutating route's dependencies
 PageLimit = Annotated[int, Query(ge=1, le=schemas.MAX_PAGE, description="items per page")]

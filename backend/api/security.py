@@ -1,16 +1,20 @@
 """Who may change what, and what every request is held to before a route sees it.
 
-Mutating calls carry ``Authorization: Bearer <token>``; the token is created once in the data
-directory (``api_token``, mode 600: :mod:`backend.api.token_file` keeps it). Reads are open, and
-so is the robot's e-stop (stopping is always allowed: docs/service.md). :func:`install` puts four
-ASGI middlewares in front of the routes, outermost first:
+Mutating calls carry ``Authorization: Bearer <token>``: the service's own token (``api_token`` in
+the data directory, :mod:`backend.api.token_file`) or a person's (``parkour token add NAME``,
+:mod:`backend.store.people`); a person's read-only token reads but changes nothing (403). Reads are
+open on a service that listens on the loopback only; one that listens beyond this machine asks a
+token of every read too (its health check excepted). The robot's e-stop is open to anyone
+(stopping is always allowed: docs/service.md). :func:`install` puts four ASGI middlewares in front
+of the routes, outermost first:
 
 - :class:`SecurityHeaders`: a Content-Security-Policy without inline script, ``nosniff``,
   ``no-referrer``, framing by the service's own origin only — on every response;
 - :class:`HostAllowList`: a Host header not on the allow-list (the loopback names and the ones
   the settings add) is a 400, so a DNS-rebinding page cannot talk to the service; a WebSocket
   whose Origin is not an allowed host (http or https, any port) is refused;
-- :class:`TokenFirst`: a change without the token is a 401 before a byte of its body is read;
+- :class:`TokenFirst`: finds who the request comes from (:mod:`backend.api.identity`); a change
+  without a token that may make it is a 401 (403) before a byte of its body is read;
 - :class:`BodyLimit`: a body is counted as it arrives, chunked or not, and over the limit the
   service answers 413 without reading the rest.
 
@@ -20,7 +24,6 @@ Each refusal is JSON and closes the connection (the body it did not read goes wi
 from __future__ import annotations
 
 import re
-import secrets
 from collections.abc import Iterable
 from typing import Annotated
 from urllib.parse import urlsplit
@@ -33,6 +36,7 @@ from starlette.datastructures import Headers, MutableHeaders
 from starlette.routing import Match
 from starlette.types import ASGIApp, Receive, Scope, Send
 
+from backend.api.identity import person_of
 from backend.settings import Settings, host_name
 
 bearer = HTTPBearer(auto_error=False)
@@ -41,31 +45,34 @@ bearer = HTTPBearer(auto_error=False)
 async def require_token(
     request: Request, credentials: Annotated[HTTPAuthorizationCredentials | None, Depends(bearer)]
 ) -> None:
-    """Mutating calls carry ``Authorization: Bearer <token>``; the token is in the data directory.
+    """Mutating calls carry ``Authorization: Bearer <token>`` of someone who may change things.
 
     :class:`TokenFirst` has already refused a request without it before its body was read; as a
     dependency it also puts the scheme on the route in OpenAPI (``credentials``), and
     :class:`TokenFirst` asks the token of exactly the routes that declare it."""
-    if not token_matches(request.headers.get("authorization"), request.app.state.token):
+    person = person_of(request)
+    if person is None:
         raise HTTPException(status.HTTP_401_UNAUTHORIZED, TOKEN_REQUIRED, headers={"WWW-Authenticate": "Bearer"})
+    if not person.may_change:
+        raise HTTPException(status.HTTP_403_FORBIDDEN, read_only(person.name))
 
 
 MUTATING = frozenset({"POST", "PUT", "PATCH", "DELETE"})
 TOKEN_REQUIRED = "a valid bearer token is required for changes (see api_token in the data directory)"
+READ_TOKEN_REQUIRED = (
+    "a valid bearer token is required: this service listens beyond its own machine, so reads need one too "
+    "(parkour token add NAME --read-only makes one)"
+)
+WS_REFUSED = "a valid bearer token is required (sign in first)"
+# Open to anyone wherever the service listens: stopping the robot, and what a container's health check asks.
+OPEN_ANYWHERE = frozenset({"/api/v1/robot/estop", "/api/v1/health"})
 HOST_REFUSED = "host not allowed: the Host header must name this service (PARKOUR_ALLOWED_HOSTS adds names)"
 # A Host header (or an Origin's authority): a name or IPv4 address, or a bracketed IPv6 one; a port.
 _AUTHORITY = re.compile(r"(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+)(?::(?P<port>[0-9]{1,5}))?")
 
 
-# The one token check ---------------------------------------------------------------------------
-def token_matches(authorization: str | None, token: str) -> bool:
-    """Whether an ``Authorization`` header says ``Bearer <token>``: the one token check, for the
-    middleware and the ``require_token`` dependency alike (compared in constant time, as bytes, so
-    a header that is not ASCII is a mismatch, not an error)."""
-    scheme, _, credentials = (authorization or "").partition(" ")
-    if scheme.lower() != "bearer" or not credentials.strip():
-        return False
-    return secrets.compare_digest(credentials.strip().encode("utf-8", "replace"), token.encode())
+def read_only(name: str) -> str:
+    return f"{name}'s token is read-only: changes need a token with write access (parkour token add NAME)"
 
 
 def open_changes(routes) -> list[RouteContext]:
@@ -197,32 +204,49 @@ class HostAllowList:
 
 
 class TokenFirst:
-    """A change under /api/ without the token is a 401 before its body is read. The changes open
-    without it are the routes that do not declare ``require_token`` (the e-stop, the simulations);
-    anything else, an unknown path included, needs the token."""
+    """Finds who each request under /api/ comes from (left in its state: ``person_of``) and
+    refuses, before a body is read: a change without a token that may make it (401, or 403 for a
+    read-only one) — the changes open without it are the routes that do not declare
+    ``require_token`` (the e-stop, the simulations), anything else, an unknown path included, needs
+    it; and, where the settings say reads need a token, a read or a websocket with none (401; a
+    websocket is closed, code 1008, before it is accepted)."""
 
     def __init__(self, app: ASGIApp, service: FastAPI) -> None:
         self.app, self.service = app, service
         self._open: list[RouteContext] | None = None  # found at the first change: the routes are all in by then
 
     def needs_token(self, scope: Scope) -> bool:
-        if scope["method"] not in MUTATING or not scope["path"].startswith("/api/"):
+        if scope["method"] not in MUTATING:
             return False
         if self._open is None:
             self._open = open_changes(self.service.routes)  # a route added later needs the token: fails closed
         return not any(route.matches(scope)[0] is Match.FULL for route in self._open)
 
+    def refusal(self, scope: Scope, person) -> tuple[int, str] | None:
+        if scope["type"] == "http" and self.needs_token(scope):
+            if person is None:
+                return status.HTTP_401_UNAUTHORIZED, TOKEN_REQUIRED
+            return None if person.may_change else (status.HTTP_403_FORBIDDEN, read_only(person.name))
+        reads_need_token = self.service.state.settings.reads_need_token
+        if reads_need_token and person is None and scope["path"] not in OPEN_ANYWHERE:
+            return status.HTTP_401_UNAUTHORIZED, READ_TOKEN_REQUIRED
+        return None
+
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        refused = (
-            scope["type"] == "http"
-            and self.needs_token(scope)
-            and not token_matches(Headers(scope=scope).get("authorization"), self.service.state.token)
-        )
-        if refused:
-            code, detail = status.HTTP_401_UNAUTHORIZED, TOKEN_REQUIRED
-            await _refuse(scope, receive, send, code, detail, WWW_Authenticate="Bearer")
-        else:
+        if scope["type"] not in ("http", "websocket") or not scope["path"].startswith("/api/"):
             await self.app(scope, receive, send)
+            return
+        person, _ = self.service.state.identities.of_scope(scope)
+        scope.setdefault("state", {})["person"] = person
+        refused = self.refusal(scope, person)
+        if refused is None:
+            await self.app(scope, receive, send)
+        elif scope["type"] == "websocket":
+            # a close's reason holds at most 123 bytes
+            await send({"type": "websocket.close", "code": status.WS_1008_POLICY_VIOLATION, "reason": WS_REFUSED})
+        else:
+            headers = {"WWW_Authenticate": "Bearer"} if refused[0] == status.HTTP_401_UNAUTHORIZED else {}
+            await _refuse(scope, receive, send, *refused, **headers)
 
 
 class BodyLimit:

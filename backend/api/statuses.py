@@ -20,6 +20,7 @@ from backend.api.security import require_token
 MEANINGS = {
     400: "the Host (or a cross-site Origin) is not one this service answers to",
     401: "the bearer token is missing or wrong",
+    403: "the bearer token is a read-only one: changes need write access",
     404: "no such record (the path's, or one the body names)",
     409: "the request clashes with what is stored or with the robot's state; the detail says how",
     413: "the body is over the service's limit",
@@ -45,6 +46,7 @@ BY_OPERATION: dict[tuple[str, str], frozenset[int]] = {
     ("POST", "/api/v1/calibrations"): frozenset({404, 409}),
     ("POST", "/api/v1/jobs"): frozenset({404, 429}),
     ("GET", "/api/v1/robot/events"): frozenset({503}),
+    ("GET", "/api/v1/auth"): frozenset({401}),
     ("POST", "/api/v1/robot/connect"): ROBOT,
     ("POST", "/api/v1/robot/disconnect"): ROBOT,
     ("POST", "/api/v1/robot/arm"): ROBOT,
@@ -68,7 +70,7 @@ def statuses_of(route: RouteContext, method: str) -> frozenset[int]:
     if method not in ("GET", "HEAD"):
         found |= WRITES
     if any(dependency.call is require_token for dependency in route.dependant.dependencies):
-        found.add(401)
+        found |= {401, 403}
     if "{" in route.path_format:
         found.add(404)
     return frozenset(found)

@@ -7,13 +7,12 @@ every request. This module only keeps it: :func:`api_token` reads it, or makes i
 
 from __future__ import annotations
 
-import contextlib
 import errno
 import logging
-import os
 import secrets
-import tempfile
 from pathlib import Path
+
+from backend.store.files import write_atomically
 
 TOKEN_FILE = "api_token"
 MIN_TOKEN_LENGTH = 16  # token_urlsafe(32) makes 43 characters; a token set by hand may be shorter, not this short
@@ -24,7 +23,7 @@ log = logging.getLogger("parkourlab.api")
 def api_token(data_dir: Path) -> tuple[str, bool]:
     """The bearer token for mutating calls: ``(token, created_now)``; created once, kept in the data dir.
 
-    The file is written whole or not at all (:func:`_write_atomically`): a first start on a full
+    The file is written whole or not at all (:func:`write_atomically`): a first start on a full
     disk fails, saying so, and leaves no file — it used to leave an empty one, which the next start
     took as the token (every change then answered 401). An empty or corrupt file is replaced by a
     new token, with a warning naming it (``created_now`` is then true: ``parkour serve`` prints it)."""
@@ -37,7 +36,7 @@ def api_token(data_dir: Path) -> tuple[str, bool]:
     path.parent.mkdir(parents=True, exist_ok=True)
     token = secrets.token_urlsafe(32)
     try:
-        _write_atomically(path, (token + "\n").encode())
+        write_atomically(path, (token + "\n").encode())
     except OSError as error:
         if error.errno in (errno.ENOSPC, errno.EDQUOT):
             raise OSError(error.errno, f"the disk holding {path.parent} is full: cannot store the API token") from error
@@ -56,28 +55,3 @@ def _read_token(path: Path) -> tuple[str | None, str]:
     if len(token) < MIN_TOKEN_LENGTH or not token.isprintable() or any(char.isspace() for char in token):
         return None, f"corrupt (not one token of {MIN_TOKEN_LENGTH} or more printable characters)"
     return token, ""
-
-
-def _write_atomically(path: Path, data: bytes) -> None:
-    """Write ``data`` to a temporary file beside ``path`` (mode 600), fsync it, rename it over
-    ``path`` and fsync the directory: whoever reads ``path`` — after a crash or a full disk too —
-    finds the old file or the whole new one, never part of one."""
-    descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        try:
-            remaining = memoryview(data)
-            while remaining:
-                remaining = remaining[os.write(descriptor, remaining) :]
-            os.fsync(descriptor)
-        finally:
-            os.close(descriptor)
-        os.replace(temporary, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(temporary)
-        raise
-    directory = os.open(path.parent, os.O_RDONLY)
-    try:
-        os.fsync(directory)
-    finally:
-        os.close(directory)

@@ -1,17 +1,25 @@
 """Which runs a list, an export or an aggregate covers (:class:`RunFilter`), as SQL conditions.
 
-Every criterion but the search ``q`` reads an index. What a connection keeps of the lists it read
-(totals, orders) is :mod:`~backend.repositories.run_list_cache`'s.
+Every criterion reads an index; the search ``q`` the one migration 0012 made (SQLite's FTS5
+trigram table ``run_search``, PostgreSQL's trigram indexes). What a connection keeps of the lists
+it read (totals, orders) is :mod:`~backend.repositories.run_list_cache`'s.
 """
 
 from __future__ import annotations
 
 import datetime
 from dataclasses import dataclass
+from typing import ClassVar
 
-from sqlalchemy import Integer, Select, String, bindparam, func, literal_column, select
+from sqlalchemy import Integer, Select, String, bindparam, column, func, literal, literal_column, select, table
+from sqlalchemy.ext.compiler import compiles
+from sqlalchemy.sql.expression import ColumnElement
+from sqlalchemy.sql.visitors import InternalTraversal
+from sqlalchemy.types import Boolean
 
 from backend.store.models import Run, RunTag
+
+MIN_SEARCH = 3  # characters: a trigram index finds any text of three or more
 
 
 @dataclass(frozen=True)
@@ -19,7 +27,8 @@ class RunFilter:
     """Which runs a list, export or aggregate covers; None leaves a criterion out. Ranges are
     inclusive; ``created_before`` is exclusive. ``end_reason`` matches a reason as stored or every
     reason of its kind ("error" matches "error: …"); ``q`` is text found in a run's notes or in one
-    of its tags, case-insensitively (ASCII letters on SQLite)."""
+    of its tags, case-insensitively, at least :data:`MIN_SEARCH` characters (what an index of
+    trigrams finds; a shorter one is a ValueError)."""
 
     experiment_id: int | None = None
     kind: str | None = None
@@ -37,10 +46,23 @@ class RunFilter:
     created_before: datetime.datetime | None = None
     q: str | None = None
 
+    def __post_init__(self):
+        if self.q is not None and len(self.q) < MIN_SEARCH:
+            raise ValueError(f"q: a search needs at least {MIN_SEARCH} characters, got {self.q!r}")
 
-def _containing(text: str) -> str:
-    """A LIKE pattern (escaped with ``\\``) for values that contain ``text``."""
-    return "%" + text.replace("\\", "\\\\").replace("%", "\\%").replace("_", "\\_") + "%"
+
+def _sql_text(value: str):
+    """A constant string written into the statement, not bound: the two spellings of a search
+    (:class:`_PerDialect`) then bind one parameter alike, the text searched for."""
+    return literal_column("'" + value.replace("'", "''") + "'", String)
+
+
+def _containing(text):
+    """A LIKE pattern (escaped with ``\\``) for values that contain ``text`` (an SQL expression)."""
+    escaped = text
+    for special in ("\\", "%", "_"):
+        escaped = func.replace(escaped, _sql_text(special), _sql_text("\\" + special), type_=String)
+    return _sql_text("%") + escaped + _sql_text("%")
 
 
 def _same_or_kind_of(v):
@@ -53,10 +75,48 @@ def _tagged(tag, runs_tagged=None):
     return (runs_tagged or _among_tagged)(RunTag.tag == tag)
 
 
-def _search(pattern, runs_tagged=None):
-    return Run.notes.ilike(pattern, escape="\\") | (runs_tagged or _among_tagged)(
+_RUN_SEARCH = table("run_search", column("rowid"), column("run_search"))  # migration 0012's FTS5 table
+
+
+class _PerDialect(ColumnElement):
+    """A condition written one way for SQLite and another for the other databases."""
+
+    type = Boolean()
+    inherit_cache = True
+    _is_implicitly_boolean = True  # a condition as it stands (no "= 1" where there is no boolean type)
+    _traverse_internals: ClassVar = [("sqlite", InternalTraversal.dp_clauseelement),
+                                     ("other", InternalTraversal.dp_clauseelement)]  # fmt: skip
+
+    def __init__(self, sqlite, other):
+        self.sqlite, self.other = sqlite, other
+
+
+# In parentheses: the statement around it cannot see inside (an OR beside an AND would bind wrong).
+@compiles(_PerDialect)
+def _other(element, compiler, **kw):
+    return f"({compiler.process(element.other, **kw)})"
+
+
+@compiles(_PerDialect, "sqlite")
+def _sqlite(element, compiler, **kw):
+    return f"({compiler.process(element.sqlite, **kw)})"
+
+
+def _search(text, runs_tagged=None, since=None):
+    """Runs whose notes or one of whose tags contain ``text`` (a value or a bindparam), in any case
+    (``since``: of the runs from that id on). SQLite: a phrase query of the trigram FTS table (the
+    text quoted, so it is never read as FTS syntax); PostgreSQL: ``ILIKE`` (its trigram indexes
+    read it), the text's wildcards escaped."""
+    if not isinstance(text, ColumnElement):
+        text = literal(text, String)  # one parameter, shared by both spellings
+    phrase = _sql_text('"') + func.replace(text, _sql_text('"'), _sql_text('""'), type_=String) + _sql_text('"')
+    found = select(_RUN_SEARCH.c.rowid).where(_RUN_SEARCH.c.run_search.op("MATCH")(phrase))
+    indexed = Run.id.in_(found if since is None else found.where(_RUN_SEARCH.c.rowid >= since))
+    pattern = _containing(text)
+    scanned = Run.notes.ilike(pattern, escape="\\") | (runs_tagged or _among_tagged)(
         RunTag.tag.ilike(pattern, escape="\\")
     )
+    return _PerDialect(indexed, scanned)
 
 
 # How a condition on the tags becomes one on the runs: the list of the runs tagged (the tags'
@@ -72,7 +132,7 @@ def _among_tagged_since(since):
 
 # Each filter criterion as the condition it puts on a query, given its value (a literal, or a
 # bindparam in a cached page statement; see _BOUND for the values a criterion binds). Every
-# criterion but q has an index; q reads the notes of the runs and the tags' index.
+# criterion reads an index.
 _CONDITIONS = {
     "experiment_id": lambda v: Run.experiment_id == v,
     "kind": lambda v: Run.kind == v,
@@ -91,7 +151,7 @@ _CONDITIONS = {
     "q": _search,
 }
 _READ_TAGS = frozenset({"tag", "q"})  # the criteria that read run_tags: they take how (runs_tagged) too
-_BOUND = {"q": _containing}  # a criterion's value as its condition takes it (the others: as given)
+_BOUND: dict = {}  # a criterion's value as its condition takes it, where not as given
 _TYPED = {"end_reason": String, "q": String}  # bindparams whose type a concatenation or LIKE needs
 
 
@@ -122,7 +182,9 @@ def where_criteria(query: Select, criteria: tuple[str, ...], *, since: bool = Fa
     runs_tagged = _among_tagged_since(first_id) if since else _among_tagged
     for criterion in criteria:
         value = bindparam(criterion, type_=_TYPED.get(criterion))
-        if criterion in _READ_TAGS:
+        if criterion == "q":
+            query = query.where(_search(value, runs_tagged, first_id))
+        elif criterion in _READ_TAGS:
             query = query.where(_CONDITIONS[criterion](value, runs_tagged))
         else:
             query = query.where(_CONDITIONS[criterion](value))

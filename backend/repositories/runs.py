@@ -30,7 +30,8 @@ from backend.store.run_record import RunRecord
 LISTED_JSON = ("model", "controls", "start_state")
 LISTED = (Run.id, Run.experiment_id, Run.kind, Run.status, Run.created_at, Run.duration_s, Run.code_version,
           Run.jumps, Run.jumps_completed, Run.failure_code, Run.climb, Run.notes, Run.end_reason, Run.loop,
-          Run.controller, Run.target, Run.touchdowns, Run.trajectory.is_not(None).label("has_trajectory"),
+          Run.controller, Run.target, Run.touchdowns, Run.created_by, Run.notes_by,
+          Run.trajectory.is_not(None).label("has_trajectory"),
           *(cast(getattr(Run, name), Text).label(name) for name in LISTED_JSON))  # fmt: skip
 # A run's tags as one text (group_concat on SQLite, string_agg on PostgreSQL), split by a character
 # no tag can hold (a tag is letters, digits and . _ : / -: schemas.common.Label).
@@ -42,7 +43,7 @@ _TAG_LIST = (
 JSON_COLUMNS = ("model", "controls", "start_state")
 EXPORTED = (Run.id, Run.experiment_id, Run.kind, Run.status, Run.created_at, Run.duration_s, Run.code_version,
             Run.notes, Run.jumps, Run.jumps_completed, Run.failure_code, Run.climb, Run.end_reason, Run.loop,
-            Run.controller, Run.target, Run.touchdowns,
+            Run.controller, Run.target, Run.touchdowns, Run.created_by, Run.notes_by,
             *(cast(getattr(Run, name), Text).label(name) for name in JSON_COLUMNS))  # fmt: skip
 # What a list sorts by: each an indexed column (id, then the column's order; -name: descending).
 SORTED_BY = ("id", "created_at", "climb", "zeta0", "psi0_deg", "duration_s", "jumps_completed", "kind", "status",
@@ -54,14 +55,17 @@ END_REASON_LENGTH = 200
 EXPORT_BATCH = 1000
 
 
-def add_run(session: Session, record: RunRecord, *, experiment_id: int | None = None) -> Run:
-    """Add ``record`` to the session as a new run row (the caller commits); its tags deduplicated
-    and sorted, its filter columns copied from its model and first leg."""
+def add_run(
+    session: Session, record: RunRecord, *, experiment_id: int | None = None, created_by: str | None = None
+) -> Run:
+    """Add ``record`` to the session as a new run row made by ``created_by`` (the caller commits);
+    its tags deduplicated and sorted, its filter columns copied from its model and first leg."""
     columns = asdict(record)
     tags = columns.pop("tags")
     psi0_deg, zeta0 = record.controls[0]
     columns |= outcome_columns(record.kind, record.results)
-    run = Run(experiment_id=experiment_id, alpha=record.model["alpha"], psi0_deg=psi0_deg, zeta0=zeta0, **columns)
+    run = Run(experiment_id=experiment_id, alpha=record.model["alpha"], psi0_deg=psi0_deg, zeta0=zeta0,
+              created_by=created_by, **columns)  # fmt: skip
     run.run_tags = [RunTag(tag=tag) for tag in sorted(set(tags))]
     session.add(run)
     return run

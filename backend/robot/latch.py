@@ -36,11 +36,15 @@ log = logging.getLogger("parkourlab.robot")
 class LatchState:
     """The latch as it is now. ``held``: an e-stop was pressed and no RESET acknowledged since;
     ``acknowledged``: the robot has confirmed the ESTOP on the current connection (until then the
-    link sends it in place of heartbeats); ``since``: the press [``time.time()``], or None."""
+    link sends it in place of heartbeats); ``since``: the press [``time.time()``], or None;
+    ``pressed_by``: who pressed it (held), ``reset_by`` and ``reset_at``: who last reset it, when."""
 
     held: bool = False
     acknowledged: bool = False
     since: float | None = None
+    pressed_by: str | None = None
+    reset_by: str | None = None
+    reset_at: float | None = None
     durable: bool = True  # in the file (or no file is kept); False from a change until it is written
 
     @property
@@ -85,6 +89,20 @@ class EstopLatch:
             self._state = LatchState(held=True, acknowledged=False, since=time.time(), durable=self.path is None)
             self._save()
 
+    def attribute(self, pressed_by: str) -> None:
+        """Who pressed the e-stop that holds the latch (the service knows after the robot's ESTOP went out)."""
+        with self._lock:
+            if self._state.held:
+                self._state = replace(self._state, pressed_by=pressed_by, durable=self.path is None)
+                self._save()
+
+    def reset_by(self, person: str) -> None:
+        """Who reset the latch just released (kept with the time, for whoever looks later)."""
+        with self._lock:
+            if not self._state.held:
+                self._state = replace(self._state, reset_by=person, reset_at=time.time(), durable=self.path is None)
+                self._save()
+
     def acknowledged(self) -> None:
         """The robot confirmed the ESTOP on the current connection."""
         with self._lock:
@@ -98,9 +116,11 @@ class EstopLatch:
                 self._state = replace(self._state, acknowledged=False)
 
     def release(self) -> None:
-        """The robot acknowledged a RESET."""
+        """The robot acknowledged a RESET (who asked for it: :meth:`reset_by`)."""
         with self._lock:
-            self._state = LatchState(durable=self.path is None)
+            self._state = LatchState(
+                durable=self.path is None, reset_by=self._state.reset_by, reset_at=self._state.reset_at
+            )
             self._save()
 
     def flush(self, timeout: float | None = None) -> bool:
@@ -123,7 +143,13 @@ class EstopLatch:
         except (OSError, ValueError, KeyError, TypeError) as error:
             log.warning("e-stop latch file %s unreadable (%s): the latch holds until a reset", self.path, error)
             return LatchState(held=True, since=None)
-        return LatchState(held=held, since=since if held else None)
+        who = {
+            name: saved.get(name) if isinstance(saved.get(name), str) else None for name in ("pressed_by", "reset_by")
+        }
+        reset_at = saved.get("reset_at") if isinstance(saved.get("reset_at"), int | float) else None
+        if held:
+            return LatchState(held=True, since=since, pressed_by=who["pressed_by"])
+        return LatchState(reset_by=who["reset_by"], reset_at=reset_at)
 
     def _save(self) -> None:
         """Hand the state as it is now (under the lock) to the writer thread."""
@@ -137,7 +163,8 @@ class EstopLatch:
         temporary = self.path.with_name(self.path.name + ".tmp")
         try:
             with open(temporary, "w") as file:
-                json.dump({"held": state.held, "since": state.since}, file)
+                json.dump({"held": state.held, "since": state.since, "pressed_by": state.pressed_by,
+                           "reset_by": state.reset_by, "reset_at": state.reset_at}, file)  # fmt: skip
                 file.flush()
                 os.fsync(file.fileno())
             os.replace(temporary, self.path)

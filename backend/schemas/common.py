@@ -116,7 +116,11 @@ class Health(BaseModel):
 
 
 class TokenAccepted(BaseModel):
+    """Whose the bearer token is, and what it may do."""
+
     accepted: Literal[True]
+    name: str = Field(description="the person the token signs in (lab: the service's own token, api_token)")
+    access: Literal["write", "read"] = Field(description="write: reads and changes; read: reads only")
 
 
 class Page(BaseModel, Generic[Item]):

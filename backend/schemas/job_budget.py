@@ -9,9 +9,11 @@ from __future__ import annotations
 # scripts/bench_job_rate.py on 2 cores). Larger jobs are refused with a 422 naming the limit.
 WORK_BUDGET_JUMPS = 500_000_000
 # The queue's budget: queued and running work together (each job at its worst, a running one's
-# share still to do), about eight hours of the job worker; one client (a script, the panel) may
-# hold at most CLIENT_SHARE of it, so another always finds room. Past either, a 429 says so.
+# share still to do), about eight hours of the job worker; one person (whatever tools they submit
+# through: their token names them) may hold at most PERSON_SHARE of it, and have at most
+# PERSON_QUEUED_JOBS waiting, so another always finds room. Past any of these, a 429 says so.
 QUEUE_BUDGET_JUMPS = 8 * WORK_BUDGET_JUMPS
-CLIENT_SHARE = 0.5
+PERSON_SHARE = 0.5
 MAX_QUEUED_JOBS = 1000  # jobs waiting at once, however small
+PERSON_QUEUED_JOBS = 250  # one person's jobs waiting at once: a flood of small ones leaves room for others
 JOB_RATE_JUMPS_PER_S = 135_000  # the job worker's rate (the low end of scripts/bench_job_rate.py): for estimates

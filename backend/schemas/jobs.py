@@ -12,7 +12,7 @@ from backend.schemas.common import (
     Page,
 )
 
-CLIENT_PATTERN = r"^[\w.:@/-]{1,64}$"  # the X-Parkour-Client header: who submits, for the queue's fairness
+CLIENT_PATTERN = r"^[\w.:@/-]{1,64}$"  # the X-Parkour-Client header: the tool that submits (a label)
 
 
 class JobState(enum.StrEnum):
@@ -37,7 +37,10 @@ class JobOut(BaseModel):
     created_at: datetime.datetime
     started_at: datetime.datetime | None
     finished_at: datetime.datetime | None
-    submitted_by: str | None = Field(None, description="who submitted it: X-Parkour-Client, else the address")
+    submitted_by: str | None = Field(
+        None, description="who submitted it: the token's person (null: a job stored before people had names)"
+    )
+    submitted_via: str | None = Field(None, description="the tool it came through: its X-Parkour-Client header")
     queue_position: int | None = Field(None, description="1: runs next; null when not queued")
     eta_s: float | None = Field(
         None, description="seconds until it should end: its time and the jobs' ahead as expected on this machine"

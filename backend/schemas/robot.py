@@ -168,6 +168,11 @@ class EstopLatchOut(BaseModel):
     since: float | int | None = Field(description="when it was pressed [Unix time, s], or null")
     reason: str | None
     durable: bool = Field(True, description="the latch as it is now is saved: a restart of the service finds it")
+    pressed_by: str | None = Field(
+        None, description="who pressed the e-stop that holds it (a person, or someone at an address)"
+    )
+    reset_by: str | None = Field(None, description="who last reset the latch")
+    reset_at: float | int | None = Field(None, description="when it was last reset [Unix time, s]")
 
 
 class RobotStatus(BaseModel):

@@ -124,6 +124,10 @@ class RunOut(RunBase):
         None, description="robot and replay runs: the touchdowns recorded, which is what their jumps ask for "
         "(jumps_completed counts the jumps between them, one fewer); null for simulations",
     )  # fmt: skip
+    created_by: str | None = Field(
+        None, description="who made it (the token's person); null for runs stored before people had names"
+    )
+    notes_by: str | None = Field(None, description="who last wrote its notes or tags; null if nobody has")
 
 
 class RunDetail(RunOut):

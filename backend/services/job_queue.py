@@ -1,11 +1,13 @@
-"""The job queue: a budget of queued work, each client's share of it, and where each job stands.
+"""The job queue: a budget of queued work, each person's share of it, and where each job stands.
 
 Jobs run one at a time (:mod:`backend.services.job_runner`). What is queued and running is bounded
 by :data:`~backend.schemas.job_budget.QUEUE_BUDGET_JUMPS` of work, each job counted at its worst
 (:func:`~backend.jobs.worst_case_jumps`, each kind's own count; a running one by the share it has still to do), and
-one client — a script, the panel: the ``X-Parkour-Client`` header, else its address — may hold at
-most :data:`~backend.schemas.job_budget.CLIENT_SHARE` of it, so one script cannot starve the panel. A job
-past either is refused with a 429 (:class:`~backend.errors.QueueFull`) saying what is queued.
+one person — the token's, whatever tools they submit through — may hold at most
+:data:`~backend.schemas.job_budget.PERSON_SHARE` of it and have at most
+:data:`~backend.schemas.job_budget.PERSON_QUEUED_JOBS` waiting, so one person's scripts cannot
+starve another's panel. A job past any of these is refused with a 429
+(:class:`~backend.errors.QueueFull`) saying what is queued.
 A queued job's place is its rank among the queued jobs by id (the runner takes them oldest
 first); its estimates are the time of the jobs ahead of it and its own: ``eta_s`` as expected on
 this machine (:mod:`backend.services.job_estimates`), ``eta_max_s`` at the latest (every job at
@@ -22,7 +24,13 @@ from sqlalchemy.orm import Session
 from backend.errors import QueueFull
 from backend.jobs import UnreadableSpec, decode, worst_case_jumps
 from backend.repositories import jobs as stored_jobs
-from backend.schemas.job_budget import CLIENT_SHARE, JOB_RATE_JUMPS_PER_S, MAX_QUEUED_JOBS, QUEUE_BUDGET_JUMPS
+from backend.schemas.job_budget import (
+    JOB_RATE_JUMPS_PER_S,
+    MAX_QUEUED_JOBS,
+    PERSON_QUEUED_JOBS,
+    PERSON_SHARE,
+    QUEUE_BUDGET_JUMPS,
+)
 from backend.schemas.jobs import JobState
 from backend.services import job_estimates
 from backend.services.job_estimates import Paces
@@ -59,15 +67,16 @@ def work_left(job: Job) -> int:
     return round(_worst(job) * _share_left(job))
 
 
-def check_room(session: Session, body, client: str) -> None:
-    """Refuse ``body`` (a job request) with :class:`QueueFull` if the queue, or ``client``'s share
-    of it, has no room for its work at its worst."""
+def check_room(session: Session, body, person: str) -> None:
+    """Refuse ``body`` (a job request) with :class:`QueueFull` if the queue, or ``person``'s share
+    of it, has no room for its work at its worst, or ``person`` has as many jobs waiting as one may."""
     unfinished = stored_jobs.unfinished(session)
     wanted, _ = worst_case_jumps(body)
     queued = sum(work_left(job) for job in unfinished)
     waiting = sum(job.state == JobState.QUEUED for job in unfinished)
-    mine = sum(work_left(job) for job in unfinished if job.submitted_by == client)
-    share = int(CLIENT_SHARE * QUEUE_BUDGET_JUMPS)
+    mine = sum(work_left(job) for job in unfinished if job.submitted_by == person)
+    my_waiting = sum(job.state == JobState.QUEUED and job.submitted_by == person for job in unfinished)
+    share = int(PERSON_SHARE * QUEUE_BUDGET_JUMPS)
     ahead = f"{len(unfinished)} jobs unfinished, {_jumps(queued)} of work ({_hours(queued)})"
     if waiting >= MAX_QUEUED_JOBS:
         raise QueueFull(f"the job queue is full: {waiting} jobs wait, the most it holds; {ahead}. "
@@ -78,10 +87,15 @@ def check_room(session: Session, body, client: str) -> None:
             f"of {_jumps(QUEUE_BUDGET_JUMPS)} ({_hours(QUEUE_BUDGET_JUMPS)}); {ahead}. "
             "Wait for jobs to finish, cancel some, or ask for less"
         )
+    if my_waiting >= PERSON_QUEUED_JOBS:
+        raise QueueFull(
+            f"{person} has {my_waiting} jobs waiting, the most one person may, kept so others always find room; "
+            f"{ahead}. Wait for your jobs to finish, or cancel some"
+        )
     if mine + wanted > share:
         raise QueueFull(
-            f"{client} already holds {_jumps(mine)} of queued work; with this job's {_jumps(wanted)} it would pass "
-            f"a client's share of {_jumps(share)} ({_hours(share)}), kept so others always find room. "
+            f"{person} already holds {_jumps(mine)} of queued work; with this job's {_jumps(wanted)} it would pass "
+            f"a person's share of {_jumps(share)} ({_hours(share)}), kept so others always find room. "
             "Wait for your jobs to finish, or cancel some"
         )
 

@@ -30,15 +30,18 @@ if TYPE_CHECKING:
 FINAL = frozenset({JobState.DONE, JobState.CANCELLED, JobState.FAILED})  # a job in one of these never changes again
 
 
-def create_job(session: Session, body, runner: JobRunner | None = None, *, client: str | None = None) -> JobOut:
-    """Store a job (any of :data:`backend.jobs.JOB_KINDS`, a stored preset resolved) submitted by ``client``
-    and hand it to ``runner``; MJTF totals count trials, other kinds chunks. The queue's room is
-    checked under the write lock (:mod:`backend.services.job_queue`: a 429 past its budget or the
-    client's share), and its experiment read under it (``locked``), so a concurrent delete of it
-    waits for this commit (and then refuses: the experiment has a job) or has removed it first (404)."""
+def create_job(
+    session: Session, body, runner: JobRunner | None = None, *, person: str | None = None, via: str | None = None
+) -> JobOut:
+    """Store a job (any of :data:`backend.jobs.JOB_KINDS`, a stored preset resolved) submitted by
+    ``person`` (through the tool ``via``) and hand it to ``runner``; MJTF totals count trials, other
+    kinds chunks. The queue's room is checked under the write lock
+    (:mod:`backend.services.job_queue`: a 429 past its budget or the person's share), and its
+    experiment read under it (``locked``), so a concurrent delete of it waits for this commit (and
+    then refuses: the experiment has a job) or has removed it first (404)."""
     body = with_preset_resolved(session, body)
     lock_for_write(session)
-    check_room(session, body, client or "unknown")
+    check_room(session, body, person or "unknown")
     if body.experiment_id is not None:
         locked(session, Experiment, body.experiment_id, "experiment")
     spec = spec_of(body)  # stored as its own versioned record: backend/jobs/specs.py says why
@@ -51,7 +54,8 @@ def create_job(session: Session, body, runner: JobRunner | None = None, *, clien
             state=JobState.QUEUED,
             total=job_kind(spec.kind).total(spec),
             code_version=current_code_version(),
-            submitted_by=client,
+            submitted_by=person,
+            submitted_via=via,
         ),
     )
     session.commit()
@@ -144,6 +148,7 @@ def public(job: Job, standing: Standing | None = None) -> JobOut:
         started_at=job.started_at,
         finished_at=job.finished_at,
         submitted_by=job.submitted_by,
+        submitted_via=job.submitted_via,
         queue_position=None if standing is None else standing.position,
         eta_s=None if standing is None else standing.eta_s,
         eta_max_s=None if standing is None else standing.eta_max_s,

@@ -194,25 +194,27 @@ class RobotService:
         self._connected().disarm()
         return self.status()
 
-    def reset(self) -> dict:
+    def reset(self, by: str | None = None) -> dict:  # by: who asked (the latch keeps it)
         self._refuse_during_run("reset")
         self._connected().reset()
+        if by is not None:
+            self.latch.reset_by(by)
         return self.status()
 
-    def estop(self) -> dict:
+    def estop(self, by: str | None = None) -> dict:
         """Emergency stop at any moment, bounded, connected or not (:func:`robot_estop.press`): ends
         a live run (still stored) whether or not the robot acknowledges, and latches. Answers
         ``acknowledged`` and ``latency_ms``; not acknowledged, a ``reason`` — the robot's watchdog
         then disarms it, as the link has stopped its heartbeats. Takes no lock: it must not wait
         for anything that moves."""
-        return {**press(self.latch, self.link, self._run), **self.status()}
+        return {**press(self.latch, self.link, self._run, by), **self.status()}
 
-    async def estop_now(self) -> dict:
+    async def estop_now(self, by: str | None = None) -> dict:
         """:meth:`estop` on the service's e-stop thread, for an ``async`` route: answers within
         ANSWER_WAIT whatever the link, the request pool or the locks are doing."""
         with self._estop_guard:
             if self._estop_pending is None or self._estop_pending.done():
-                self._estop_pending = self._estop_executor.submit(self.estop)
+                self._estop_pending = self._estop_executor.submit(self.estop, by)
             pending = self._estop_pending
         waiting = asyncio.wrap_future(pending)
         done, _ = await asyncio.wait({waiting}, timeout=ANSWER_WAIT)  # wait() never cancels it
@@ -225,9 +227,8 @@ class RobotService:
         return {"acknowledged": False, "latency_ms": ANSWER_WAIT * 1000.0, "reason": reason, **self.status()}
 
     # Live runs -------------------------------------------------------------------------------
-    def start_run(self, body: RobotRunCreate, started_by: str | None = None) -> RunSnapshot:
-        """Store the run (status running), then start its control loop and journal writer.
-        ``started_by``: who asked, as other panels are told (the operator's name or the client)."""
+    def start_run(self, body: RobotRunCreate, started_by: str | None = None, person: str | None = None) -> RunSnapshot:
+        """Store the run, start its loop and journal. ``started_by``: as panels are told; ``person``: its creator."""
         link = self._connected()
         with self._lock:
             self._refuse_during_run("start another")
@@ -244,7 +245,7 @@ class RobotService:
             with self.sessions() as session:
                 where = {"url": link.url, "robot_address": f"0x{link.robot_address:016X}"}
                 run_id = open_robot_run(
-                    session, body, self.robot, tracker.calibration, started_by=started_by, link=where
+                    session, body, self.robot, tracker.calibration, started_by=started_by, link=where, person=person
                 )
             target_m = None if body.closed_loop is None else body.closed_loop.target_m
             run = LiveRun(

@@ -23,9 +23,10 @@ NOT_CONNECTED = (
 )
 
 
-def press(latch: EstopLatch, link: RobotLink | None, run) -> dict:
-    """Stop ``run`` (a live run, or None), e-stop the robot on ``link`` (None: latch only), then
-    wait for the latch file. ``acknowledged``, ``latency_ms`` and, when not acknowledged, ``reason``."""
+def press(latch: EstopLatch, link: RobotLink | None, run, by: str | None = None) -> dict:
+    """Stop ``run`` (a live run, or None), e-stop the robot on ``link`` (None: latch only), note who
+    pressed it (``by``), then wait for the latch file. ``acknowledged``, ``latency_ms`` and, when not
+    acknowledged, ``reason``."""
     if run is not None and not run.done.is_set():
         run.stop("e-stop")  # before the e-stop: the control loop sends nothing more
     if link is None:
@@ -33,6 +34,8 @@ def press(latch: EstopLatch, link: RobotLink | None, run) -> dict:
         result = EstopResult(False, 0.0, NOT_CONNECTED)
     else:
         result = link.estop()
+    if by is not None:
+        latch.attribute(by)  # after the robot's ESTOP: who pressed it never delays it
     latch.flush(LATCH_SAVE_WAIT)  # after the robot's ESTOP: the robot never waits for the disk
     answer = {"acknowledged": result.acknowledged, "latency_ms": result.latency * 1000.0}
     if not result.acknowledged:
@@ -48,7 +51,7 @@ def latch_status(latch: EstopLatch, link: RobotLink | None) -> dict:
     state = latch.state
     if not state.held and link is not None and link.state == LinkState.ESTOPPED:
         return {"latched": True, "acknowledged": True, "since": None, "durable": state.durable,
-                "reason": "the robot reports itself e-stopped; it holds until a reset"}  # fmt: skip
+                "reason": "the robot reports itself e-stopped; it holds until a reset", **_who(state)}  # fmt: skip
     reason = state.reason()
     if state.pending and (link is None or link.state == LinkState.DISCONNECTED):
         reason = NOT_CONNECTED_LATCH
@@ -61,4 +64,9 @@ def latch_status(latch: EstopLatch, link: RobotLink | None) -> dict:
         "since": state.since,
         "durable": state.durable,
         "reason": reason,
+        **_who(state),
     }
+
+
+def _who(state) -> dict:
+    return {"pressed_by": state.pressed_by, "reset_by": state.reset_by, "reset_at": state.reset_at}

@@ -41,11 +41,13 @@ INTERRUPTED = "interrupted: the service stopped during the run; kept to its last
 
 
 def open_robot_run(
-    session, request, robot, calibration, *, started_by: str | None = None, link: dict | None = None
-) -> int:
+    session, request, robot, calibration, *, started_by: str | None = None, link: dict | None = None,
+    person: str | None = None,
+) -> int:  # fmt: skip
     """Store a live run as it starts (status ``running``); returns its id. ``request`` is the
     :class:`~backend.schemas.RobotRunCreate`, ``robot`` the physical parameters, ``started_by`` who
-    started it, ``link`` the radio link it runs on (``url``, ``robot_address``)."""
+    started it as the panels are told, ``person`` the token's (the run's ``created_by``), ``link``
+    the radio link it runs on (``url``, ``robot_address``)."""
     model = robot.to_model()
     if request.experiment_id is not None:  # before anything moves: a 404, and the robot stays as it is
         stored_experiments.locked_experiment(session, request.experiment_id)
@@ -69,7 +71,7 @@ def open_robot_run(
         ),
         tags=tuple(request.tags),
     )
-    run = stored_runs.add_run(session, record, experiment_id=request.experiment_id)
+    run = stored_runs.add_run(session, record, experiment_id=request.experiment_id, created_by=person)
     session.commit()
     return run.id
 
@@ -168,9 +170,10 @@ def touchdown_results(touchdowns: list[Touchdown], controls: list[LegControl], r
     }
 
 
-def replay_run(session, run_id: int, robot=None) -> Run:
-    """A stored robot run's tracker frames analysed again (kind ``replay``): touchdowns, gains and
-    the model's prediction, with today's detection — e.g. after a calibration or detector change."""
+def replay_run(session, run_id: int, robot=None, *, person: str | None = None) -> Run:
+    """A stored robot run's tracker frames analysed again (kind ``replay``) at ``person``'s asking:
+    touchdowns, gains and the model's prediction, with today's detection — e.g. after a calibration
+    or detector change."""
     robot = robot or get_preset("paper")
     source = stored_runs.find(session, run_id)
     if source is None:
@@ -201,14 +204,14 @@ def replay_run(session, run_id: int, robot=None) -> Run:
         ),
         tags=(*source.tags, "replay"),
     )
-    replay = stored_runs.add_run(session, record, experiment_id=source.experiment_id)
+    replay = stored_runs.add_run(session, record, experiment_id=source.experiment_id, created_by=person)
     session.commit()
     return replay
 
 
-def replay(session, run_id: int) -> RunDetail:
+def replay(session, run_id: int, *, person: str | None = None) -> RunDetail:
     """:func:`replay_run` with the paper's robot, answered as the API gives a run."""
-    return run_detail(replay_run(session, run_id))
+    return run_detail(replay_run(session, run_id, person=person))
 
 
 def recorded_leg_for(source: Run) -> Callable[[int], LegControl]:

@@ -47,7 +47,7 @@ SIMULATED_UNITS = {"time": "sqrt(l0/g)", "x": "l0", "y": "l0", "foot_x": "l0", "
 RECORDED_UNITS = {"time": "s", "x": "m", "y": "m", "pitch": "rad"}
 
 
-async def create(in_session: InSession, compute, body: RunCreate) -> RunDetail:
+async def create(in_session: InSession, compute, body: RunCreate, *, person: str | None = None) -> RunDetail:
     """Simulate ``body`` in ``compute``'s quick worker (a :class:`~backend.workers.pools.ComputePool`)
     and store it: the model it names resolved, the experiment it names checked before the
     simulation is paid for, the simulation awaited (no request thread waits for it), the run stored
@@ -56,15 +56,15 @@ async def create(in_session: InSession, compute, body: RunCreate) -> RunDetail:
     if body.experiment_id is not None:
         await in_session(check_run_request, body)
     record = await compute.call(simulate_run, body)
-    return await in_session(store_run, body, record)
+    return await in_session(store_run, body, record, person=person)
 
 
-def create_run(session: Session, body: RunCreate, compute=None) -> RunDetail:
+def create_run(session: Session, body: RunCreate, compute=None, *, person: str | None = None) -> RunDetail:
     """:func:`create` without an event loop: simulated in ``compute``'s workers or, without one, here."""
     check_run_request(session, body)
     # Simulated before the lock is taken: it takes a while.
     record = simulate_run(body) if compute is None else compute.run(simulate_run, body)
-    return store_run(session, body, record)
+    return store_run(session, body, record, person=person)
 
 
 def check_run_request(session: Session, body: RunCreate) -> None:
@@ -73,12 +73,12 @@ def check_run_request(session: Session, body: RunCreate) -> None:
         stored_experiments.get(session, body.experiment_id)
 
 
-def store_run(session: Session, body: RunCreate, record: RunRecord) -> RunDetail:
-    """Store ``record``, simulated for ``body``, with the request's experiment and tags."""
+def store_run(session: Session, body: RunCreate, record: RunRecord, *, person: str | None = None) -> RunDetail:
+    """Store ``record``, simulated for ``body`` asked by ``person``, with the request's experiment and tags."""
     if body.experiment_id is not None:  # still there (a concurrent delete waits for this commit)
         stored_experiments.locked_experiment(session, body.experiment_id)
     run = stored_runs.add_run(
-        session, dataclasses.replace(record, tags=tuple(body.tags)), experiment_id=body.experiment_id
+        session, dataclasses.replace(record, tags=tuple(body.tags)), experiment_id=body.experiment_id, created_by=person
     )
     session.commit()
     stored_runs.stored_has_trajectory(run, record.trajectory is not None)
@@ -89,8 +89,11 @@ def get(session: Session, run_id: int) -> RunDetail:
     return run_detail(stored_runs.get_run(session, run_id))
 
 
-def update(session: Session, run_id: int, *, tags: list[str] | None = None, notes: str | None = None) -> RunOut:
-    """Relabel a run or rewrite its notes; ``None`` leaves a field as it is. One transaction under
+def update(
+    session: Session, run_id: int, *, tags: list[str] | None = None, notes: str | None = None, person: str | None = None
+) -> RunOut:
+    """Relabel a run or rewrite its notes, as ``person`` (kept as ``notes_by``); ``None`` leaves a
+    field as it is. One transaction under
     the write lock: the tags it replaces are the ones stored, not ones a concurrent edit replaced
     since they were read (that race inserted a tag twice, a 500, or kept two edits' tags)."""
     run = stored_runs.locked_run(session, run_id)
@@ -98,6 +101,8 @@ def update(session: Session, run_id: int, *, tags: list[str] | None = None, note
         stored_runs.relabel(run, tags)
     if notes is not None:
         run.notes = notes
+    if tags is not None or notes is not None:
+        run.notes_by = person
     stored_runs.flushed(session, run)
     session.commit()
     return run_out(run)
@@ -217,4 +222,6 @@ def _fields(run: Run) -> dict:
         "controller": run.controller,
         "target": run.target,
         "touchdowns": run.touchdowns,
+        "created_by": run.created_by,
+        "notes_by": run.notes_by,
     }

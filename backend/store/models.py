@@ -104,6 +104,8 @@ class Run(Base):
     controller: Mapped[str | None] = mapped_column(String(16), index=True)
     target: Mapped[float | None] = mapped_column(index=True)  # [m]
     touchdowns: Mapped[int | None]  # robot and replay runs: touchdowns recorded (what their jumps count)
+    created_by: Mapped[str | None] = mapped_column(String(64))  # the person (null: stored before people had names)
+    notes_by: Mapped[str | None] = mapped_column(String(64))  # who last wrote its notes or tags
 
     experiment: Mapped[Experiment | None] = relationship(back_populates="runs")
     run_tags: Mapped[list[RunTag]] = relationship(cascade="all, delete-orphan", lazy="selectin")
@@ -178,7 +180,8 @@ class Job(Base):
     updated_at: Mapped[datetime.datetime] = mapped_column(default=utcnow, onupdate=utcnow)
     started_at: Mapped[datetime.datetime | None]
     finished_at: Mapped[datetime.datetime | None]
-    submitted_by: Mapped[str | None] = mapped_column(String(64))  # the queue's fairness counts work per client
+    submitted_by: Mapped[str | None] = mapped_column(String(64))  # the person: the queue's shares are per person
+    submitted_via: Mapped[str | None] = mapped_column(String(64))  # the tool (X-Parkour-Client), a label only
 
     trials: Mapped[list[Trial]] = relationship(back_populates="job", cascade="all, delete-orphan")
 
@@ -222,3 +225,13 @@ class ModelPreset(Base):
     runs: Mapped[list]
     code_version: Mapped[str] = mapped_column(String(64))
     created_at: Mapped[datetime.datetime] = mapped_column(default=utcnow, index=True)
+
+
+# What migrations make beside the models' tables, which the models do not describe: History's
+# search index (0012: SQLite's FTS5 table and its shadow tables, PostgreSQL's trigram indexes).
+UNMODELLED = ("run_search", "ix_runs_notes_trgm", "ix_run_tags_tag_trgm")
+
+
+def modelled(_object, name, _type, _reflected, _compare_to) -> bool:
+    """Alembic's ``include_object``: whether the models describe ``name`` (see :data:`UNMODELLED`)."""
+    return not (name or "").startswith(UNMODELLED)

@@ -29,7 +29,13 @@ tokenInput.addEventListener("change", () => {
   checkToken();
 });
 
-// Whether the service accepts the token in the field, shown beside it (reads need none).
+// Whose the token is, as the service says (the person's name; "read": a token that changes nothing).
+function signedInAs(who) {
+  if (!who || typeof who.name !== "string") return "accepted";
+  return who.access === "read" ? `signed in as ${who.name} (reads only)` : `signed in as ${who.name}`;
+}
+
+// Whether the service accepts the token in the field, and whose it is, shown beside it.
 async function checkToken() {
   const token = tokenInput.value.trim();
   let state = "none", text = "none: you can look, not change";
@@ -37,7 +43,7 @@ async function checkToken() {
     try {
       const response = await fetch(`${API}/auth`, { headers: { Authorization: `Bearer ${token}` } });
       state = response.ok ? "accepted" : "refused";
-      text = response.ok ? "accepted" : "not accepted: open the link parkour serve prints";
+      text = response.ok ? signedInAs(await response.json()) : "not accepted: open the link parkour serve prints";
     } catch (error) {
       state = "unknown";
       text = "could not be checked: the service did not answer";

@@ -33,7 +33,8 @@ export function statusSeen(status) {
 function showLatch(status) {
   const estop = status.estop || { latched: status.state === "estopped", reason: null };
   $("#estop-banner").hidden = !estop.latched;
-  $("#estop-reason").textContent = estop.latched && estop.reason ? `Reason: ${estop.reason}` : "";
+  const by = typeof estop.pressed_by === "string" && estop.pressed_by ? ` Pressed by ${estop.pressed_by}.` : "";
+  $("#estop-reason").textContent = estop.latched && estop.reason ? `Reason: ${estop.reason}.${by}` : "";
 }
 
 function seen(summary) {

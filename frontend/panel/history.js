@@ -79,15 +79,18 @@ function runRow(run) {
     cell("ending", null, endingBadge(run.end_reason)), cell("loop", run.loop), cell("controller", run.controller ?? "—"),
     cell("target", targetText(run)), cell("controls", controlsText(run)), jumpsCell(run), cell("climb", run.climb.toFixed(3)),
     cell("failure", run.failure_code ?? ""), attributes(element("td", run.tags.join(" ")), { class: "tags col-tags" }), notes,
-    created(run.created_at), actions);
+    created(run), actions);
   row.id = `run-${run.id}`;
   return row;
 }
 
-function created(at) {
-  const moment = new Date(at);
-  return attributes(cell("created", moment.toLocaleString(undefined, { dateStyle: "short", timeStyle: "short" })),
-    { title: moment.toLocaleString() });
+// When a run was made and by whom (``created_by``, ``notes_by``: null for runs stored before people had names).
+function created(run) {
+  const moment = new Date(run.created_at);
+  const by = run.created_by ? [attributes(element("small", `by ${run.created_by}`), { class: "by" })] : [];
+  const notes = run.notes_by ? `; notes by ${run.notes_by}` : "";
+  return attributes(cell("created", moment.toLocaleString(undefined, { dateStyle: "short", timeStyle: "short" }), ...by),
+    { title: `${moment.toLocaleString()}${run.created_by ? ` by ${run.created_by}` : ""}${notes}` });
 }
 
 function recordingLink(run) {
@@ -103,7 +106,9 @@ export async function loadRuns() {
   const asked = ++listing;
   formToView();
   const offset = (view.page - 1) * view.size;
-  const page = await call("GET", `/runs?limit=${view.size}&offset=${offset}&sort=${encodeURIComponent(view.sort)}&${filterQuery()}`);
+  // A refused filter (a search under 3 letters) is said at its field.
+  const at = { form: form(), locations: { "query.q": "q" }, action: "Filter" };
+  const page = await call("GET", `/runs?limit=${view.size}&offset=${offset}&sort=${encodeURIComponent(view.sort)}&${filterQuery()}`, undefined, at);
   if (asked !== listing) return;  // the tab's first listing answered after the filter's
   if (!page.items.length && page.total > 0 && offset >= page.total) {  // past the end (fewer runs match now)
     view.page = Math.ceil(page.total / view.size);

@@ -55,14 +55,24 @@ export function queueWords(job) {
   return words.join(", ");
 }
 
+// Who submitted a job and through what (``submitted_by``: the person; ``submitted_via``: the tool's
+// label), when the service says; "" for a job stored before people had names.
+export function submitterWords(job) {
+  if (typeof job.submitted_by !== "string" || !job.submitted_by) return "";
+  const via = typeof job.submitted_via === "string" && job.submitted_via ? ` via ${job.submitted_via}` : "";
+  return `by ${job.submitted_by}${via}`;
+}
+
 function jobRow(job) {
   const progress = attributes(element("progress", null), { max: 1, value: job.progress, "aria-label": `job ${job.id} progress` });
   const state = attributes(element("td", job.state), { class: "state" });
   if (job.error) state.title = job.error;
   const cancel = ["queued", "running"].includes(job.state) ? [attributes(element("button", "Cancel"), { class: "cancel", "data-id": job.id })] : [];
   const queue = queueWords(job);
+  const by = submitterWords(job);
+  const what = attributes(element("td", describeJob(job), ...(by ? [attributes(element("small", by), { class: "by" })] : [])), { class: "what" });
   const row = element("tr", null,
-    element("td", String(job.id)), element("td", job.kind), attributes(element("td", describeJob(job)), { class: "what" }), state,
+    element("td", String(job.id)), element("td", job.kind), what, state,
     attributes(element("td", null, progress, ` ${job.completed}/${job.total}`,
       ...(queue ? [attributes(element("small", queue), { class: "queue" })] : [])), { class: "progress" }),
     element("td", null, attributes(element("button", "Show"), { class: "show", "data-id": job.id, "data-kind": job.kind })),

@@ -82,7 +82,7 @@ class ViewerSession:
         said = gui.add_markdown("")
 
         def press(_event) -> None:
-            answer = robot_service.estop()
+            answer = robot_service.estop(by="someone at the 3D view")
             heard = (
                 "acknowledged by the robot" if answer.get("acknowledged") else answer.get("reason", "not acknowledged")
             )

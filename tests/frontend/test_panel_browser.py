@@ -63,7 +63,7 @@ def test_the_sign_in_link_keeps_the_token_out_of_the_address_bar_and_says_it_is_
         until(fresh, f"{status} === 'accepted'")
         assert token not in fresh.url and "#" not in fresh.url, "the token left the address bar"
         assert fresh.evaluate("localStorage.getItem('parkourlab-token')") == token
-        assert fresh.input_value("#token") == token and fresh.inner_text("#token-status") == "accepted"
+        assert fresh.input_value("#token") == token and fresh.inner_text("#token-status") == "signed in as lab"
         assert fresh.get_attribute("#token", "aria-invalid") == "false"
         fresh.fill("#token", "not-the-token")
         fresh.dispatch_event("#token", "change")

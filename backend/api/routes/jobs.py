@@ -12,7 +12,7 @@ from fastapi.encoders import jsonable_encoder
 from fastapi.responses import StreamingResponse
 
 from backend import schemas
-from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, RecordId, Runner, SubmittedBy
+from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, RecordId, Runner, SubmittedVia, Who
 from backend.jobs import JobCreate
 from backend.services import jobs
 
@@ -22,10 +22,11 @@ router = APIRouter(prefix="/api/v1/jobs", tags=["jobs"])
 
 
 @router.post("", status_code=202, dependencies=AUTHORIZED, response_model=schemas.JobOut)
-async def create_job(body: JobCreate, db: Db, runner: Runner, client: SubmittedBy) -> schemas.JobOut:
-    """Queue a job. Past the queue's budget of work, or this client's share of it, a 429 says what
-    is queued (docs/service.md); ``queue_position`` and ``eta_s`` say where it stands."""
-    return await db(jobs.create_job, body, runner, client=client)
+async def create_job(body: JobCreate, db: Db, runner: Runner, person: Who, via: SubmittedVia) -> schemas.JobOut:
+    """Queue a job, as the token's person (``submitted_by``; ``X-Parkour-Client`` only labels the
+    tool: ``submitted_via``). Past the queue's budget of work, or this person's share of it, a 429
+    says what is queued (docs/service.md); ``queue_position`` and ``eta_s`` say where it stands."""
+    return await db(jobs.create_job, body, runner, person=person, via=via)
 
 
 @router.get("", response_model=schemas.JobPage)

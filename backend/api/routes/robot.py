@@ -10,7 +10,7 @@ from fastapi import APIRouter, Query, Request, WebSocket, WebSocketDisconnect
 from fastapi.responses import StreamingResponse
 
 from backend import schemas
-from backend.api.deps import AUTHORIZED, Robot
+from backend.api.deps import AUTHORIZED, Robot, Who
 from backend.api.robot_events import open_event_stream
 
 router = APIRouter(prefix="/api/v1/robot", tags=["robot"])
@@ -70,27 +70,28 @@ def robot_disarm(robot: Robot) -> schemas.RobotStatus:
 
 
 @router.post("/reset", dependencies=AUTHORIZED, response_model=schemas.RobotStatus)
-def robot_reset(robot: Robot) -> schemas.RobotStatus:
-    return schemas.RobotStatus.model_validate(robot.reset())
+def robot_reset(robot: Robot, person: Who) -> schemas.RobotStatus:
+    return schemas.RobotStatus.model_validate(robot.reset(by=person))
 
 
 # No token, async, and on the robot service's own e-stop thread: a request pool filled by compute
 # cannot hold it back.
 @router.post("/estop", response_model=schemas.RobotEstopOut, response_model_exclude_unset=True)
-async def robot_estop(robot: Robot) -> schemas.RobotEstopOut:
+async def robot_estop(robot: Robot, person: Who) -> schemas.RobotEstopOut:
     """Emergency stop, at any moment and without the token; answers within 200 ms. A live run
     ends (and is stored). ``acknowledged`` says whether the robot confirmed it (``latency_ms``);
     if not (``reason``: link blocked or lost), the robot's 1 s watchdog disarms it."""
-    return schemas.RobotEstopOut.model_validate(await robot.estop_now())
+    return schemas.RobotEstopOut.model_validate(await robot.estop_now(by=person))
 
 
 @router.post("/runs", status_code=202, dependencies=AUTHORIZED, response_model=schemas.RobotStatus)
-def robot_run(body: schemas.RobotRunCreate, robot: Robot, request: Request) -> schemas.RobotStatus:
+def robot_run(body: schemas.RobotRunCreate, robot: Robot, person: Who) -> schemas.RobotStatus:
     """Start a live run: stored at once (status running, ``run.id``), journaled while it runs,
-    complete when it ends (see GET /api/v1/robot). Every panel is told who started it: ``operator``,
-    or the client's address. While it runs, link changes are refused (409 naming it)."""
-    client = request.client.host if request.client is not None else "unknown"
-    robot.start_run(body, started_by=body.operator or f"a client at {client}")
+    complete when it ends (see GET /api/v1/robot). Every panel is told who started it: the token's
+    person (with ``operator`` beside it when that names someone else at the table), who is also the
+    run's ``created_by``. While it runs, link changes are refused (409 naming it)."""
+    started_by = person if body.operator in (None, person) else f"{person} (operator: {body.operator})"
+    robot.start_run(body, started_by=started_by, person=person)
     return schemas.RobotStatus.model_validate(robot.status())
 
 

@@ -11,7 +11,18 @@ from fastapi.responses import Response, StreamingResponse
 from pydantic import Field
 
 from backend import schemas
-from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, PresetQuery, QuickCompute, Reads, RecordId, RunQuery
+from backend.api.deps import (
+    AUTHORIZED,
+    Cursor,
+    Db,
+    PageLimit,
+    PresetQuery,
+    QuickCompute,
+    Reads,
+    RecordId,
+    RunQuery,
+    Who,
+)
 from backend.services import calibrations, mcap_export, robot_records
 from backend.services import runs as service
 
@@ -23,10 +34,11 @@ class McapResponse(Response):
 
 
 @router.post("", status_code=201, dependencies=AUTHORIZED, response_model=schemas.RunDetail)
-async def create_run(body: schemas.RunCreate, db: Db, compute: QuickCompute) -> schemas.RunDetail:
-    """Simulate (in the quick compute worker) and store a run. The simulation is awaited, so no
-    request thread waits for it; the database work before and after takes one briefly."""
-    return await service.create(db, compute, body)
+async def create_run(body: schemas.RunCreate, db: Db, compute: QuickCompute, person: Who) -> schemas.RunDetail:
+    """Simulate (in the quick compute worker) and store a run, made by the token's person
+    (``created_by``). The simulation is awaited, so no request thread waits for it; the database
+    work before and after takes one briefly."""
+    return await service.create(db, compute, body, person=person)
 
 
 @router.get("", response_model=schemas.RunPage)
@@ -125,14 +137,14 @@ async def touchdown_predictions(
 
 
 @router.post("/{run_id}/replay", status_code=201, dependencies=AUTHORIZED, response_model=schemas.RunDetail)
-async def replay(run_id: RecordId, db: Db) -> schemas.RunDetail:
+async def replay(run_id: RecordId, db: Db, person: Who) -> schemas.RunDetail:
     """Analyse a robot run's recorded tracker frames again, stored as a run of kind replay."""
-    return await db(robot_records.replay, run_id)
+    return await db(robot_records.replay, run_id, person=person)
 
 
 @router.patch("/{run_id}", dependencies=AUTHORIZED, response_model=schemas.RunOut)
-async def update_run(run_id: RecordId, body: schemas.RunUpdate, db: Db) -> schemas.RunOut:
-    return await db(service.update, run_id, tags=body.tags, notes=body.notes)
+async def update_run(run_id: RecordId, body: schemas.RunUpdate, db: Db, person: Who) -> schemas.RunOut:
+    return await db(service.update, run_id, tags=body.tags, notes=body.notes, person=person)
 
 
 @router.delete("/{run_id}", status_code=204, dependencies=AUTHORIZED)

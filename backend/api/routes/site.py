@@ -20,12 +20,13 @@ import fastapi_offline
 import plotly
 from fastapi import APIRouter, Request
 from fastapi.openapi.docs import swagger_ui_default_parameters
-from fastapi.responses import FileResponse, HTMLResponse, RedirectResponse, Response
+from fastapi.responses import FileResponse, HTMLResponse, JSONResponse, RedirectResponse, Response
 from starlette.middleware.gzip import GZipMiddleware
 from starlette.types import ASGIApp
 
 from backend import schemas
-from backend.api.deps import AUTHORIZED, Db
+from backend.api.deps import Db
+from backend.api.identity import READ_COOKIE, bearer_token
 from backend.services.provenance import current_code_version
 from backend.store.database import ping
 
@@ -132,8 +133,23 @@ async def health(db: Db, request: Request) -> schemas.Health:
     )
 
 
-@router.get("/api/v1/auth", tags=["service"], dependencies=AUTHORIZED, response_model=schemas.TokenAccepted)
-async def check_token() -> schemas.TokenAccepted:
-    """Whether the bearer token is the service's: 200 if so, 401 if not. The panel shows it beside
-    the token field; reads need no token, changes do."""
-    return schemas.TokenAccepted(accepted=True)
+@router.get("/api/v1/auth", tags=["service"], response_model=schemas.TokenAccepted)
+async def check_token(request: Request, response: Response) -> schemas.TokenAccepted:
+    """Whose the bearer token is: 200 with the person's name and access (``write``: reads and
+    changes; ``read``: reads only), 401 if nobody has it. The panel shows it beside the token field.
+
+    It also leaves the token in an HttpOnly, SameSite=Strict cookie on the API's path, which the
+    service takes for reads only: a browser's event streams and websockets cannot send a header, and
+    a service listening beyond this machine asks a token of every read (backend/api/identity.py)."""
+    person, by_header = request.app.state.identities.of_scope(request.scope)
+    if person is None or not by_header:
+        refused = JSONResponse({"detail": TOKEN_UNKNOWN}, status_code=401, headers={"WWW-Authenticate": "Bearer"})
+        refused.delete_cookie(READ_COOKIE, path="/api/")
+        return refused
+    secure = request.url.scheme == "https"
+    token = bearer_token(request.headers.get("authorization"))
+    response.set_cookie(READ_COOKIE, token, path="/api/", httponly=True, samesite="strict", secure=secure)
+    return schemas.TokenAccepted(accepted=True, name=person.name, access=person.access.value)
+
+
+TOKEN_UNKNOWN = "the bearer token is missing or nobody's: parkour token add NAME makes one (api_token is the lab's)"

@@ -2,7 +2,7 @@
 
 from alembic import context
 
-from backend.store.models import Base
+from backend.store.models import Base, modelled
 
 config = context.config
 engine = config.attributes["engine"]
@@ -11,6 +11,7 @@ with engine.begin() as connection:
     context.configure(
         connection=connection,
         target_metadata=Base.metadata,
+        include_object=modelled,  # the search index is the migrations' alone
         render_as_batch=engine.dialect.name == "sqlite",  # SQLite alters tables by copying them
     )
     with context.begin_transaction():

@@ -34,13 +34,15 @@ def test_link_changes_during_a_run_are_refused_naming_it(client, auth, connected
     )
     assert started.status_code == 202, started.text
     run = started.json()["run"]
-    assert run["started_by"] == "Ada" and run["active"]
+    assert run["started_by"] == "lab (operator: Ada)" and run["active"], "the token's person, and who is at the table"
     bad_url = {**body, "url": "socket://127.0.0.1:1"}
     calls = (("connect", body), ("connect", bad_url), ("disconnect", None), ("arm", None), ("reset", None))
     for call, json in (*calls, ("runs", {"controls": CONTROLS})):
         refused = client.post(f"/api/v1/robot/{call}", json=json, headers=auth)
         detail = refused.json()["detail"]
-        assert refused.status_code == 409 and f"live run {run['id']}" in detail and "by Ada" in detail, (call, detail)
+        assert (
+            refused.status_code == 409 and f"live run {run['id']}" in detail and "by lab (operator: Ada)" in detail
+        ), (call, detail)
     status = client.get("/api/v1/robot").json()
     assert status["run"]["active"] and status["state"] == "running", "the run goes on, untouched"
     stopped = client.post("/api/v1/robot/runs/stop", headers=auth).json()  # stopping is always allowed
@@ -48,11 +50,15 @@ def test_link_changes_during_a_run_are_refused_naming_it(client, auth, connected
     assert client.post("/api/v1/robot/disconnect", headers=auth).status_code == 200
 
 
-def test_a_run_started_without_a_name_names_the_client(client, auth, connected):
-    run = client.post("/api/v1/robot/runs", json={"controls": CONTROLS, "jumps": 200}, headers=auth).json()["run"]
-    assert run["started_by"] == "a client at testclient"
+def test_a_run_started_without_an_operator_names_the_tokens_person(client, auth, connected, settings):
+    from backend.store.people import PeopleFile
+
+    ada = {"Authorization": f"Bearer {PeopleFile(settings.data_dir).add('ada')}"}
+    run = client.post("/api/v1/robot/runs", json={"controls": CONTROLS, "jumps": 200, "operator": "ada"},
+                      headers=ada).json()["run"]  # fmt: skip
+    assert run["started_by"] == "ada", "an operator who is the person is said once"
     stored = client.get(f"/api/v1/runs/{run['id']}").json()
-    assert stored["results"]["started_by"] == "a client at testclient"
+    assert stored["results"]["started_by"] == "ada" and stored["created_by"] == "ada"
 
 
 def test_a_connect_that_fails_leaves_the_working_link(client, auth, connected):

@@ -14,8 +14,8 @@ import stat
 
 import pytest
 
-from backend.api import token_file
 from backend.api.token_file import TOKEN_FILE, api_token
+from backend.store import files
 from tests.backend.disk import fill, tmpfs
 
 
@@ -41,7 +41,7 @@ def test_a_full_disk_fails_the_first_start_and_leaves_no_file(tmp_path, monkeypa
     def no_space(_descriptor, _data):
         raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(token_file.os, "write", no_space)
+    monkeypatch.setattr(files.os, "write", no_space)
     with pytest.raises(OSError, match="is full: cannot store the API token") as raised:
         api_token(tmp_path)
     assert raised.value.errno == errno.ENOSPC
@@ -54,7 +54,7 @@ def test_a_full_disk_fails_the_first_start_and_leaves_no_file(tmp_path, monkeypa
 def test_a_crash_before_the_rename_keeps_the_old_token(tmp_path, monkeypatch):
     """The old file stays until the new one is whole: replacing is a rename, never a rewrite in place."""
     (tmp_path / TOKEN_FILE).write_text("")  # to be replaced...
-    monkeypatch.setattr(token_file.os, "replace", lambda *_: (_ for _ in ()).throw(OSError(errno.EIO, "I/O error")))
+    monkeypatch.setattr(files.os, "replace", lambda *_: (_ for _ in ()).throw(OSError(errno.EIO, "I/O error")))
     with pytest.raises(OSError, match="I/O error"):
         api_token(tmp_path)
     assert (tmp_path / TOKEN_FILE).read_text() == "", "...but only by a whole new file"

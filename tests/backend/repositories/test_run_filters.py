@@ -1,5 +1,7 @@
 """Which runs a filter selects (backend/repositories/run_filters.py): the conditions."""
 
+import re
+
 import pytest
 
 from backend.repositories.run_filters import RunFilter, bound_values
@@ -41,13 +43,52 @@ def stored(session):
         (RunFilter(q="DRY"), 1),  # a tag, in any case
         (RunFilter(q="50%"), 1),  # LIKE's wildcards are text here
         (RunFilter(q="_grip"), 1),
-        (RunFilter(q="%"), 1),
+        (RunFilter(q="%_g"), 1),
+        (RunFilter(q='"wet'), 0),  # FTS syntax is text here too
+        (RunFilter(q="wet wall"), 1),  # a phrase, not two words
+        (RunFilter(q="wall wet"), 0),
+        (RunFilter(q="stopped at the top"), 1),
+        (RunFilter(q="slipped on the wet"), 1),
+        (RunFilter(q="the"), 2),
     ],
 )
 def test_each_filter_selects_what_it_says(stored, where, count):
     assert matching_count(stored, where) == count
 
 
-def test_only_the_criteria_set_are_bound_and_a_search_as_its_pattern():
+def test_only_the_criteria_set_are_bound():
     assert bound_values(RunFilter()) == {}
-    assert bound_values(RunFilter(kind="sim", q="50%_x")) == {"kind": "sim", "q": "%50\\%\\_x%"}
+    assert bound_values(RunFilter(kind="sim", q="50%_x")) == {"kind": "sim", "q": "50%_x"}
+
+
+def test_a_search_needs_three_characters():
+    with pytest.raises(ValueError, match="at least 3 characters"):
+        RunFilter(q="ab")
+
+
+def test_a_search_reads_the_index_and_follows_every_change(stored):
+    """Migration 0012's triggers keep the index: a note rewritten, a tag added or removed, a run
+    deleted; and a search is a look-up in it, not a scan of the runs."""
+    from sqlalchemy import select, text
+
+    from backend.repositories.run_filters import filtered
+    from backend.store.models import Run, RunTag
+
+    run = stored.get(Run, 4)
+    run.notes = "now it slipped"
+    run.run_tags.append(RunTag(tag="icy"))
+    stored.commit()
+    assert matching_count(stored, RunFilter(q="slipped")) == 2 and matching_count(stored, RunFilter(q="ICY")) == 1
+    run.run_tags.clear()
+    run.notes = ""
+    stored.commit()
+    assert matching_count(stored, RunFilter(q="slipped")) == 1 and matching_count(stored, RunFilter(q="icy")) == 0
+    stored.delete(stored.get(Run, 2))
+    stored.commit()
+    assert matching_count(stored, RunFilter(q="slipped")) == 0
+    query = filtered(select(Run.id), RunFilter(q="slipped"))
+    statement = query.compile(stored.bind, compile_kwargs={"literal_binds": True})
+    plan = " ".join(row[-1] for row in stored.execute(text(f"EXPLAIN QUERY PLAN {statement}")))
+    # the index's look-up; the runs only through an index of theirs, never their rows (the notes) one by one
+    assert "run_search VIRTUAL TABLE INDEX" in plan and not re.search(r"SCAN runs(?! USING)", plan), plan
+    assert "LIKE" not in str(statement), statement

@@ -152,7 +152,7 @@ def test_the_count_since_a_base_reads_the_ids_range_not_a_criterions_index(tmp_p
     with engine.connect() as connection:
         for criteria in [("zeta0_min", "zeta0_max"), ("tag",), ("q", "kind")]:
             statement = _count_statement(criteria, since=True).compile(engine)
-            values = {"zeta0_min": 0.8, "zeta0_max": 0.9, "tag": "a", "q": "%x%", "kind": "sim", "since": 7}
+            values = {"zeta0_min": 0.8, "zeta0_max": 0.9, "tag": "a", "q": "xyz", "kind": "sim", "since": 7}
             parameters = statement.construct_params(values)
             positional = tuple(parameters[name] for name in statement.positiontup)
             plan = connection.exec_driver_sql(f"EXPLAIN QUERY PLAN {statement}", positional)
@@ -160,6 +160,8 @@ def test_the_count_since_a_base_reads_the_ids_range_not_a_criterions_index(tmp_p
             for step in steps:  # runs by a range of ids (or the ids of tags), tags from the base's id on
                 if " runs " in f"{step} ":
                     assert "rowid>?" in step or "rowid=?" in step, steps
+                elif "run_search" in step:  # the search index's look-up, with its rowid from the base's on
+                    assert step.startswith("SCAN run_search VIRTUAL TABLE INDEX") and step.endswith(">"), steps
                 else:
                     assert "run_tags" in step and "run_id>?" in step, steps
     engine.dispose()

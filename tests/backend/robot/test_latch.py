@@ -38,6 +38,26 @@ def test_a_held_latch_survives_a_restart_and_a_release_too(tmp_path):
     assert not (tmp_path / "estop-latch.json.tmp").exists(), "written whole, then renamed"
 
 
+def test_who_pressed_it_and_who_reset_it_survive_a_restart(tmp_path):
+    path = tmp_path / "estop-latch.json"
+    latch = EstopLatch(path)
+    latch.engage()
+    latch.attribute("someone at 10.0.0.7")
+    latch.flush()
+    assert EstopLatch(path).state.pressed_by == "someone at 10.0.0.7"
+    latch.release()
+    latch.reset_by("ada")
+    latch.flush()
+    restarted = EstopLatch(path).state
+    assert not restarted.held and restarted.pressed_by is None
+    assert restarted.reset_by == "ada" and restarted.reset_at is not None
+    latch.reset_by("bob")  # a reset of a released latch: still who last reset it
+    latch.engage()  # pressed again: whoever presses it now is named by the service
+    latch.reset_by("eve")  # a reset that has not released it names nobody
+    latch.flush()
+    assert EstopLatch(path).state.held and EstopLatch(path).state.reset_by is None
+
+
 def test_a_latch_file_that_cannot_be_read_holds(tmp_path):
     path = tmp_path / "estop-latch.json"
     for text in ("{", json.dumps({"held": "no"}), json.dumps([1]), json.dumps({"since": 3.0})):

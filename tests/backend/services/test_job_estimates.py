@@ -26,7 +26,7 @@ LARGE_WORK = worst_case_jumps(MJTFJobCreate(**LARGE))[0]
 
 def _done(session, body, seconds: float) -> int:
     """A job of ``body`` stored as done after ``seconds`` [s] of running."""
-    job = jobs.create_job(session, body, client="script")
+    job = jobs.create_job(session, body, person="script")
     finished = T0 + datetime.timedelta(seconds=seconds)
     session.execute(update(Job).where(Job.id == job.id).values(state="done", started_at=T0, finished_at=finished))
     session.commit()
@@ -47,7 +47,7 @@ def test_the_pace_is_learned_from_the_kinds_done_jobs(session, pace):
     learned = job_estimates.paces(session)
     assert learned.of("mjtf") == pytest.approx(pace, rel=1e-2) and learned.learned["mjtf"] == 3  # times to the µs
     assert learned.of("viability") == job_kind("viability").typical_fraction, "another kind: its own"
-    queued = jobs.create_job(session, MJTFJobCreate(**SMALL), client="panel")
+    queued = jobs.create_job(session, MJTFJobCreate(**SMALL), person="panel")
     expected = OVERHEAD_S + pace * WORK / JOB_RATE_JUMPS_PER_S
     assert queued.eta_s == pytest.approx(expected, rel=1e-2)
     assert queued.eta_max_s == pytest.approx(max(WORK / JOB_RATE_JUMPS_PER_S, queued.eta_s))
@@ -79,7 +79,7 @@ def test_at_the_latest_is_never_sooner_than_expected(session):
     worker's rate, and the bound says so rather than a time before the expected one."""
     from backend.jobs.control_study import ControlStudyJobCreate
 
-    queued = jobs.create_job(session, ControlStudyJobCreate(kind="control-study", seeds=10, jumps=100), client="panel")
+    queued = jobs.create_job(session, ControlStudyJobCreate(kind="control-study", seeds=10, jumps=100), person="panel")
     assert job_kind("control-study").typical_fraction > 1 and queued.eta_max_s == pytest.approx(queued.eta_s)
 
 
@@ -87,8 +87,8 @@ def test_a_job_done_before_with_the_same_spec_is_expected_to_take_what_it_took(s
     """An MFPT's chain comes from the cache the second time (0.05 s where the first took 11 s): a
     repeat is expected to take what the same job took last, whatever its kind's pace."""
     first = _done(session, MJTFJobCreate(**LARGE), 0.3)
-    again = jobs.create_job(session, MJTFJobCreate(**LARGE), client="panel")
-    other = jobs.create_job(session, MJTFJobCreate(**(LARGE | {"seed": 5})), client="panel")
+    again = jobs.create_job(session, MJTFJobCreate(**LARGE), person="panel")
+    other = jobs.create_job(session, MJTFJobCreate(**(LARGE | {"seed": 5})), person="panel")
     assert again.eta_s == pytest.approx(0.3, rel=1e-2), f"job {first} took 0.3 s"
     paces = job_estimates.paces(session)
     assert other.eta_s - again.eta_s == pytest.approx(paces.expected_seconds("mjtf", LARGE_WORK), rel=1e-2)

@@ -23,11 +23,11 @@ MJTF_PACE = job_kind("mjtf").typical_fraction
 def budget(monkeypatch):
     """A queue of room for ten SMALL jobs, at most six of them one client's."""
     monkeypatch.setattr(job_queue, "QUEUE_BUDGET_JUMPS", 10 * WORK)
-    monkeypatch.setattr(job_queue, "CLIENT_SHARE", 0.6)
+    monkeypatch.setattr(job_queue, "PERSON_SHARE", 0.6)
 
 
 def _submit(session, client: str, **changes):
-    return jobs.create_job(session, MJTFJobCreate(**(SMALL | changes)), client=client)
+    return jobs.create_job(session, MJTFJobCreate(**(SMALL | changes)), person=client)
 
 
 def test_queued_jobs_stand_in_line_oldest_first_with_estimates(session, budget):
@@ -89,3 +89,15 @@ def test_a_cancelled_job_gives_its_room_back(session, budget):
     queued = [_submit(session, "script") for _ in range(6)]
     jobs.cancel_job(session, queued[0].id)
     assert _submit(session, "script").queue_position == 6
+
+
+def test_one_person_cannot_fill_the_waiting_line_with_small_jobs(session, budget, monkeypatch):
+    """Issue 40: 1,047 one-jump jobs from one client made every other client's job a 429."""
+    monkeypatch.setattr(job_queue, "QUEUE_BUDGET_JUMPS", 100 * WORK)
+    monkeypatch.setattr(job_queue, "PERSON_QUEUED_JOBS", 3)
+    for _ in range(3):
+        _submit(session, "alice")
+    with pytest.raises(QueueFull) as refused:
+        _submit(session, "alice")
+    assert str(refused.value).startswith("alice has 3 jobs waiting, the most one person may")
+    assert _submit(session, "bob").queue_position == 4, "another person still finds room"

@@ -6,7 +6,7 @@ from alembic.migration import MigrationContext
 from sqlalchemy import inspect
 
 from backend.store.database import make_engine, migrate, sqlite_url
-from backend.store.models import Base
+from backend.store.models import Base, modelled
 
 
 def test_upgrade_from_empty_matches_the_models(empty_database_url):
@@ -14,7 +14,8 @@ def test_upgrade_from_empty_matches_the_models(empty_database_url):
     migrate(engine)
     assert set(inspect(engine).get_table_names()) >= {"experiments", "runs", "run_tags", "jobs", "trials"}
     with engine.connect() as connection:
-        differences = compare_metadata(MigrationContext.configure(connection), Base.metadata)
+        context = MigrationContext.configure(connection, opts={"include_object": modelled})  # not the search index
+        differences = compare_metadata(context, Base.metadata)
     assert differences == [], f"models changed without a migration: {differences}"
     migrate(engine)  # idempotent at head
     engine.dispose()
@@ -102,3 +103,29 @@ def test_runs_stored_before_0008_get_their_outcome_columns(empty_database_url):
         (5, None, "open", None, None, 1),
         (6, None, "open", None, None, 0),
     ]
+
+
+def test_the_search_index_is_built_and_kept(empty_database_url):
+    """Migration 0012: History's search reads an index (SQLite's FTS5 trigram table, kept by
+    triggers; PostgreSQL's pg_trgm indexes), filled from the runs stored before it."""
+    from sqlalchemy import text
+
+    engine = make_engine(empty_database_url)
+    migrate(engine, "0011")
+    with engine.begin() as connection:
+        connection.execute(text(
+            "INSERT INTO runs (id, kind, status, created_at, duration_s, code_version, model, controls, start_state, "
+            "jumps, alpha, psi0_deg, zeta0, jumps_completed, climb, results, notes, loop) VALUES (7, 'sim', 'done', "
+            "'2026-12-01 00:00:00', 1, 'x', '{}', '[]', '[]', 1, 15, 30, 0.9, 1, 1, '{}', 'Slipped twice', 'open')"
+        ))  # fmt: skip
+        connection.execute(text("INSERT INTO run_tags (run_id, tag) VALUES (7, 'wet-wall')"))
+    migrate(engine)
+    with engine.connect() as connection:
+        if engine.dialect.name == "sqlite":
+            found = "SELECT rowid FROM run_search WHERE run_search MATCH :q"
+            assert connection.execute(text(found), {"q": '"slipped"'}).scalars().all() == [7], "filled at migration"
+            assert connection.execute(text(found), {"q": '"wet-wall"'}).scalars().all() == [7]
+        else:
+            names = set(connection.execute(text("SELECT indexname FROM pg_indexes")).scalars())
+            assert {"ix_runs_notes_trgm", "ix_run_tags_tag_trgm"} <= names
+    engine.dispose()

@@ -157,11 +157,12 @@ def test_past_the_queue_budget_a_job_is_a_429_naming_it(client, auth, monkeypatc
     assert client.get("/api/v1/jobs").json()["items"] == []
 
 
-def test_the_submitter_is_the_client_header_else_the_address(client, auth):
+def test_the_submitter_is_the_tokens_person_and_the_header_labels_the_tool(client, auth):
     body = {"zeta0s": [0.9], "trials": 2, "cap": 20}
     named = client.post("/api/v1/jobs", json=body, headers=auth | {"X-Parkour-Client": "panel"}).json()
     unnamed = client.post("/api/v1/jobs", json=body, headers=auth).json()
-    assert named["submitted_by"] == "panel" and unnamed["submitted_by"] == "testclient"
+    assert (named["submitted_by"], named["submitted_via"]) == ("lab", "panel"), "api_token is the lab's"
+    assert (unnamed["submitted_by"], unnamed["submitted_via"]) == ("lab", None)
     bad = client.post("/api/v1/jobs", json=body, headers=auth | {"X-Parkour-Client": "<script>"})
     assert bad.status_code == 422 and bad.json()["detail"][0]["loc"] == ["header", "X-Parkour-Client"]
 

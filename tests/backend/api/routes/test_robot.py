@@ -74,6 +74,9 @@ def test_estop_needs_no_token_and_reaches_the_robot(client, auth, connected):
     assert stopped["acknowledged"] is True and "reason" not in stopped and stopped["latency_ms"] >= 0
     assert stopped["state"] == "estopped" and connected.firmware.state.name == "ESTOPPED"
     assert client.post("/api/v1/robot/reset").status_code == 401, "releasing it needs the token"
+    assert client.get("/api/v1/robot").json()["estop"]["pressed_by"] == "someone at testclient"
+    released = client.post("/api/v1/robot/reset", headers=auth).json()["estop"]
+    assert not released["latched"] and released["reset_by"] == "lab" and released["reset_at"] > 0
 
 
 @pytest.mark.realtime
@@ -186,7 +189,7 @@ def test_open_loop_live_run_is_stored_with_the_model_beside_it(client, auth, con
     }
     tracker = results["tracker"]
     assert tracker["received"] == tracker["frames"] and (tracker["protocol"], tracker["version"]) == ("pkt1", "1")
-    assert results["link"]["url"] == connected.url and results["started_by"] == "a client at testclient"
+    assert results["link"]["url"] == connected.url and results["started_by"] == "lab"
 
 
 def test_a_live_run_is_filed_under_its_experiment_and_a_missing_one_moves_nothing(client, auth, connected):

@@ -311,8 +311,14 @@ def test_search_finds_text_in_notes_and_tags_in_any_case(client, auth):
     client.patch(f"/api/v1/runs/{runs[2]}", json={"notes": "50% humidity_high"}, headers=auth)
     assert _listed(client, q="wet") == [runs[1], runs[0]]
     assert _listed(client, q="Slipped") == [runs[1]]
-    assert _listed(client, q="50%") == [runs[2]] and _listed(client, q="%") == [runs[2]], "% is a character"
-    assert _listed(client, q="y_h") == [runs[2]] and _listed(client, q="y_") == [runs[2]], "_ is a character"
+    assert _listed(client, q="50%") == [runs[2]] and _listed(client, q="% h") == [runs[2]], "% is a character"
+    assert _listed(client, q="y_h") == [runs[2]] and _listed(client, q="ty_") == [runs[2]], "_ is a character"
+    assert _listed(client, q="%%%") == [] and _listed(client, q="___") == [], "no wildcards"
+    assert _listed(client, q='"50') == [] and _listed(client, q="wet OR dry") == [], "nor a search language"
+    assert _listed(client, q="wet-wall") == [runs[0]] and _listed(client, q="SLIPPED on a") == [runs[1]]
+    short = client.get("/api/v1/runs", params={"q": " ab "})
+    assert short.status_code == 422 and short.json()["detail"][0]["loc"] == ["query", "q"]
+    assert "at least 3 characters" in short.json()["detail"][0]["msg"]
     assert client.get("/api/v1/runs", params={"q": "wet", "limit": 1}).json()["total"] == 2
     assert _listed(client, q="  ") == _listed(client), "blank: no search"
     assert client.get("/api/v1/runs", params={"q": "x" * 201}).status_code == 422

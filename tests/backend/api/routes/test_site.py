@@ -18,8 +18,8 @@ def test_health_index_and_offline_docs(client):
 
 
 def test_auth_says_whether_the_token_is_accepted(client, auth):
-    """What the panel shows beside its token field: 200 for the service's token, 401 otherwise."""
-    assert client.get("/api/v1/auth", headers=auth).json() == {"accepted": True}
+    """What the panel shows beside its token field: 200 and whose it is, 401 for nobody's."""
+    assert client.get("/api/v1/auth", headers=auth).json() == {"accepted": True, "name": "lab", "access": "write"}
     assert client.get("/api/v1/auth").status_code == 401
     assert client.get("/api/v1/auth", headers={"Authorization": "Bearer not-the-token"}).status_code == 401
 
