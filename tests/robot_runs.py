@@ -3,7 +3,10 @@ the tracker's frames, journaled in two entries (JSON-safe: a missing pitch as nu
 the journal writer does.
 
 The tracker clock starts at :data:`TRACKER_EPOCH` (a camera's clock is not the run's), a few
-frames have no pitch, and the run has commands, telemetry and link changes stamped in Unix time.
+frames have no pitch, and the run has commands, telemetry and link changes stamped in Unix time
+(:func:`store_robot_run`: as runs stored them before they stamped the tracker's time too).
+:func:`store_lagging_run` is a closed loop whose frames arrived at a fraction of real time, its
+commands and telemetry stamped on both clocks as a live run stamps them.
 """
 
 from __future__ import annotations
@@ -62,6 +65,63 @@ def store_robot_run(session) -> int:
             "transitions": [{"time": start + 0.05, "from": "disarmed", "to": "armed", "reason": "arm"}] * (1 - first),
             "tracker": {"dropped": 2 * first, "loss": 0.001 * first},
         } for first, (lo, hi) in enumerate(((0, half), (half, frames["time"].size)))]  # fmt: skip
+
+    return store_journaled_run(session, REQUEST, entries, disarm="disarmed")
+
+
+LAG_SPEED = 0.37  # the tracker's seconds per Unix second in the lagging run (issue 40's robot)
+FIRST_FRAME_AFTER = 0.02  # [s] from the run's start to its first frame's arrival
+DETECTED_AFTER = 0.15  # [s] of tracker time from a touchdown to the frame that shows it (its flight begun)
+TELEMETRY_EVERY = 0.05  # [s] Unix time between telemetry
+
+
+def store_lagging_run(session, speed: float = LAG_SPEED) -> int:
+    """A closed-loop robot run whose tracker frames arrived at ``speed`` times real time; its id.
+
+    Frame time ``t`` arrives at Unix time ``start + FIRST_FRAME_AFTER + (t - TRACKER_EPOCH) / speed``.
+    Stamped as a live run stamps them (``tracker_time``: the newest frame received then, None before
+    the first): the two start commands; after each touchdown, a command at the arrival of the
+    first frame ``DETECTED_AFTER`` past it (1 ms later); telemetry every ``TELEMETRY_EVERY`` s.
+    Link changes carry Unix time only: armed before the first frame, running at frame 100's
+    arrival (1 ms later), disarmed 0.2 s after the last."""
+    robot = get_preset("paper")
+    schedule = ControlSchedule.from_degrees(LEGS)
+    frames = climb_frames()
+    times = frames["time"]
+    touchdowns = detect_touchdowns(times, frames["x"], frames["y"], robot, lambda k: schedule[k + 1])
+
+    def entries(start: float) -> list[dict]:
+        arrivals = start + FIRST_FRAME_AFTER + (times - TRACKER_EPOCH) / speed
+
+        def stamped(at: float) -> dict:
+            newest = int(np.searchsorted(arrivals, at, side="right")) - 1
+            return {"time": at, "tracker_time": float(times[newest]) if newest >= 0 else None}
+
+        law = [
+            _command(0, 1 - td.index % 2)
+            | {"why": f"pid after touchdown {td.index}", "controller": "pid", "clipped": False, "state": [0.1, None]}
+            | stamped(float(arrivals[np.searchsorted(times, td.time + DETECTED_AFTER)]) + 0.001)
+            for td in touchdowns
+            if td.time + DETECTED_AFTER <= times[-1]
+        ]
+        end = float(arrivals[-1]) + 0.2
+        telemetry = [_telemetry(0, seq) | stamped(at) for seq, at in enumerate(np.arange(start, end, TELEMETRY_EVERY))]
+        transitions = [
+            {"time": start + 0.01, "from": "disarmed", "to": "armed", "reason": "arm"},
+            {"time": float(arrivals[100]) + 0.001, "from": "armed", "to": "running", "reason": "start"},
+            {"time": end, "from": "running", "to": "disarmed", "reason": "jumps done"},
+        ]
+        return [{
+            "frames": {name: values.tolist() for name, values in frames.items()},
+            "touchdowns": [
+                {"touchdown": td.to_dict(), "control": [schedule[td.index + 1].psi0_deg, schedule[td.index + 1].zeta0]}
+                for td in touchdowns
+            ],
+            "commands": [_command(0, leg) | stamped(start + 0.001 * leg) for leg in (0, 1)] + law,
+            "telemetry": telemetry,
+            "transitions": transitions,
+            "tracker": {"dropped": 0, "loss": 0.0},
+        }]  # fmt: skip
 
     return store_journaled_run(session, REQUEST, entries, disarm="disarmed")
 

@@ -44,7 +44,10 @@ __all__ = ["CLEAN_ENDINGS", "LiveRun", "Record", "RunSnapshot", "end_safely", "e
 class Record:
     """One thing the run recorded, for its journal: ``kind`` is ``touchdown`` (``value`` is the
     :class:`Touchdown` and the :class:`LegControl` it was made with), ``command``, ``telemetry`` or
-    ``tracker_gap`` (a dict); ``value`` is never changed after it is made."""
+    ``tracker_gap`` (a dict); ``value`` is never changed after it is made. A command and a telemetry
+    carry two stamps: ``time``, Unix [s], and ``tracker_time``, the tracker's time [s] of the
+    newest of the run's frames received then (None before its first): the recording places them by
+    the latter (:mod:`backend.services.mcap_clock`)."""
 
     kind: str
     value: object
@@ -186,8 +189,9 @@ def execute(
     def send(leg: Leg, control: LegControl, why: str, **law) -> None:
         link.set_leg(leg, control.psi0_deg, control.zeta0)
         commanded[leg] = control
-        run.record("command", {"time": time.time(), "leg": leg.name.lower(), "psi0_deg": control.psi0_deg,
-                               "zeta0": control.zeta0, "why": why, **law}, run.commands)  # fmt: skip
+        run.record("command", {"time": time.time(), "tracker_time": tracker.newest_time(run.first_pose),
+                               "leg": leg.name.lower(), "psi0_deg": control.psi0_deg, "zeta0": control.zeta0,
+                               "why": why, **law}, run.commands)  # fmt: skip
         run.publish()
 
     def leg_for(k: int) -> LegControl:
@@ -205,7 +209,7 @@ def execute(
         deadline = time.monotonic() + run.max_seconds
         watch = TrackerWatch(run.tracker_timeout, time.monotonic(), frames_heard(tracker))
         while run.end_reason is None:
-            _record_telemetry(run, link)  # first: a fall's telemetry is the run's record of it
+            _record_telemetry(run, link, tracker)  # first: a fall's telemetry is the run's record of it
             run.end_reason = _ending(run, link, restarts, deadline)
             gap = watch.look(time.monotonic(), tracker.arrived(), frames_heard(tracker), tracker.waiting())
             _record_gaps(run, watch)
@@ -243,7 +247,7 @@ def execute(
         run.end_reason = run.end_reason or (f"{LINK_LOST}: {error}" if lost else f"error: {error}")
     finally:
         run.end_reason = run.end_reason or "error: the control loop failed"
-        _record_telemetry(run, link)
+        _record_telemetry(run, link, tracker)
         run.robot_faults = tuple(fault_names(run.telemetry[-1]["faults"])) if run.telemetry else ()
         run.disarm = end_safely(link)  # whatever ended it, and whatever the link believes
         run.publish()
@@ -269,11 +273,12 @@ def _ending(run: LiveRun, link: RobotLink, restarts: int, deadline: float) -> st
     return None
 
 
-def _record_telemetry(run: LiveRun, link: RobotLink) -> None:
+def _record_telemetry(run: LiveRun, link: RobotLink, tracker: PoseHistory) -> None:
     """The robot's latest telemetry, if it is new, into the run's record."""
     telemetry = link.telemetry
     if telemetry is not None and (not run.telemetry or run.telemetry[-1]["seq"] != telemetry.seq):
-        run.record("telemetry", {"time": time.time(), **telemetry_dict(telemetry)}, run.telemetry)
+        stamps = {"time": time.time(), "tracker_time": tracker.newest_time(run.first_pose)}
+        run.record("telemetry", stamps | telemetry_dict(telemetry), run.telemetry)
 
 
 def _record_gaps(run: LiveRun, watch: TrackerWatch, *, ending: bool = False) -> None:

@@ -147,6 +147,15 @@ class PoseHistory:
             first = max(index, self._released)
             return first, self._poses[first - self._released :]
 
+    def newest_time(self, first: int = 0) -> float | None:
+        """The tracker's time [s] of the newest pose, or None while no pose from the ``first``-th
+        received on (a :meth:`count` index) has arrived: a live run's stamp on what it records, so
+        that its recording places it among its frames on one clock (docs/service.md, "Recordings")."""
+        with self._lock:
+            if self._released + len(self._poses) <= first:
+                return None
+            return self._poses[-1].time
+
     def poses_since(self, since: float) -> list[Pose]:
         with self._lock:
             return self._poses[bisect.bisect_left(self._times, since) :]

@@ -1,6 +1,7 @@
 """A robot or replay run as an MCAP recording (https://mcap.dev), which Foxglove and Rerun open.
 
-JSON channels (topics, schemas and units: :mod:`backend.services.mcap_schemas`):
+The run's own channels, protobuf messages of package ``parkourlab`` (topics, fields and units:
+:mod:`backend.services.mcap_schemas`):
 
 - ``/tracker/pose``: one message per tracker frame;
 - ``/touchdowns``: one per detected touchdown, with the controls it was made with;
@@ -11,15 +12,13 @@ JSON channels (topics, schemas and units: :mod:`backend.services.mcap_schemas`):
 
 Beside them, the same poses and numbers in the formats Foxglove and Rerun draw as they open the
 file (:mod:`backend.services.mcap_visuals`): the body as Foxglove's ``PoseInFrame``,
-``FrameTransform`` and ``PointCloud`` in protobuf, and the height and touchdown series as ROS 2
-number arrays, which Rerun plots.
+``FrameTransform`` and ``PointCloud`` in protobuf, the link's changes and the commands as
+Foxglove's ``Log``, and the height and touchdown series as ROS 2 number arrays, which Rerun plots.
 
-Timestamps (log time = publish time, UTC nanoseconds since the Unix epoch): a tracker-clock time
-``t`` (frames, touchdowns, predictions) is placed at the run's start (``created_at``) plus ``t``
-minus the first frame's time, so the first frame is at the start; commands, telemetry and link
-changes carry Unix times of their own and are placed at them. The two clocks then agree to the
-few milliseconds between the run's start and its first frame. Messages are written in log-time
-order, zstd-compressed in chunks, with a summary (message counts per channel).
+Timestamps (log time = publish time, UTC nanoseconds since the Unix epoch) are all on one clock,
+the tracker's, begun at the run's start: the rule is :mod:`backend.services.mcap_clock`'s.
+Messages are written in log-time order (at one time, in the order the channels are registered),
+zstd-compressed in chunks, with a summary (message counts per channel).
 
 A replay run has no frames, commands or telemetry of its own: its recording is its source run's
 (frames, commands, telemetry, link, and times from the source's start) with the replay's own
@@ -31,18 +30,18 @@ Simulated runs are not recordings (nondimensional, no clock) and are refused wit
 
 from __future__ import annotations
 
-import datetime
 import json
 import math
 from collections.abc import Iterator
 from dataclasses import dataclass
+from functools import partial
 from typing import BinaryIO
 
 from sqlalchemy.orm import Session
 
 from backend.errors import Conflict
 from backend.repositories import runs as stored_runs
-from backend.services.mcap_schemas import CHANNELS
+from backend.services.mcap_clock import TrackerClock, utc
 from backend.services.robot_records import recorded_leg_for
 from backend.store.models import Run
 from backend.store.trajectory_blob import unpack_trajectory
@@ -50,13 +49,18 @@ from experiments.manifest import json_safe
 
 EXPORTED_KINDS = ("robot", "replay")
 METADATA_NAME = "parkourlab.run"
-NS_PER_S = 1_000_000_000
+TIME_CONVENTION = (
+    "log time = publish time = UTC ns on the tracker's clock: recorded_at + (t - the first frame's t); t a frame's, "
+    "touchdown's or prediction's tracker time, a command's or telemetry's tracker_time (the newest frame's when it "
+    "was sent or heard), else its Unix time carried to the tracker's clock through the run's (time, tracker_time) "
+    "pairs (backend/services/mcap_clock.py)"
+)
 
 
 @dataclass(frozen=True)
 class Recording:
     """What a run's MCAP holds before it is written: each topic's messages as (log time [ns],
-    message), in the order they happened — a JSON dict on the channels of
+    message), in the order they happened — a dict of its fields on the channels of
     :mod:`~backend.services.mcap_schemas`, a protobuf message or a float on those of
     :mod:`~backend.services.mcap_visuals` — and the run's metadata (:func:`_metadata`)."""
 
@@ -94,10 +98,9 @@ def recording_of(session: Session, run_id: int) -> Recording:
             raise Conflict(f"replay run {run_id}'s source run {source_id} is gone: its frames were not kept")
     frames = unpack_trajectory(source.trajectory) if source.trajectory is not None else None
     first_frame_time = float(frames["time"][0]) if frames is not None and frames["time"].size else 0.0
-    start_ns = _utc_ns(source.created_at)
-
-    def at(tracker_time: float) -> int:
-        return start_ns + round((tracker_time - first_frame_time) * NS_PER_S)
+    commands, telemetry = source.results.get("commands", []), source.results.get("telemetry", [])
+    clock = TrackerClock.of([*commands, *telemetry], source.created_at, first_frame_time)
+    at = clock.log_time
 
     results = run.results
     touchdowns = results.get("touchdowns", [])
@@ -114,30 +117,31 @@ def recording_of(session: Session, run_id: int) -> Recording:
             (at(td["time"]), _touchdown(td, controls[k] if k < len(controls) else None, rises))
             for k, td in enumerate(touchdowns)
         ],
-        "/commands": _unix_timed(source.results.get("commands", [])),
-        "/telemetry": _unix_timed(source.results.get("telemetry", [])),
+        "/commands": _on_clock(clock, commands),
+        "/telemetry": _on_clock(clock, telemetry),
         "/model/prediction": [
             (at(touchdowns[k]["time"]), message)
             for k, message in enumerate(_predictions(results.get("prediction"), touchdowns, rises))
         ],
-        "/robot/link": _unix_timed(source.results.get("transitions", [])),
+        "/robot/link": _on_clock(clock, source.results.get("transitions", [])),
     }
     return Recording(run.id, messages | mcap_visuals.drawn(messages), _metadata(run, source))
 
 
 def write_recording(recording: Recording, stream: BinaryIO) -> None:
     """The recording as MCAP on ``stream``: a schema and channel per topic (even one without
-    messages; the JSON channels first), the metadata record, then every message in log-time order."""
+    messages; the run's own channels first), the metadata record, then every message in log-time order."""
     from mcap.writer import Writer  # the exports load it, not the service's start
+    from mcap_protobuf.schema import register_schema
 
-    from backend.services import mcap_visuals
+    from backend.services import mcap_schemas, mcap_visuals
 
     writer = Writer(stream)
     writer.start(profile="", library="parkourlab")
     channels = {}
-    for topic, schema in CHANNELS.items():
-        schema_id = writer.register_schema(schema["title"], "jsonschema", json.dumps(schema).encode())
-        channels[topic] = (writer.register_channel(topic, "json", schema_id), _json)
+    for topic, name in mcap_schemas.TOPICS.items():
+        schema_id = register_schema(writer, mcap_schemas.message_class(name))
+        channels[topic] = (writer.register_channel(topic, "protobuf", schema_id), partial(mcap_schemas.encode, topic))
     channels |= mcap_visuals.register(writer)
     writer.add_metadata(METADATA_NAME, recording.metadata)
     timed = sorted(
@@ -146,13 +150,9 @@ def write_recording(recording: Recording, stream: BinaryIO) -> None:
         key=lambda item: item[0],
     )  # fmt: skip
     for time, topic, sequence, message in timed:
-        channel_id, encode = channels[topic]
-        writer.add_message(channel_id, log_time=time, data=encode(message), publish_time=time, sequence=sequence)
+        channel_id, encoder = channels[topic]
+        writer.add_message(channel_id, log_time=time, data=encoder(message), publish_time=time, sequence=sequence)
     writer.finish()
-
-
-def _json(message: object) -> bytes:
-    return json.dumps(json_safe(message), allow_nan=False, separators=(",", ":")).encode()
 
 
 def _poses(frames: dict | None) -> Iterator[dict]:
@@ -196,9 +196,10 @@ def _predictions(prediction: dict | None, touchdowns: list[dict], rises: list) -
     ]
 
 
-def _unix_timed(records: list[dict]) -> list[tuple[int, dict]]:
-    """Records stamped with their own Unix ``time`` [s], in the order they were recorded."""
-    return [(round(record["time"] * NS_PER_S), record) for record in records]
+def _on_clock(clock: TrackerClock, records: list[dict]) -> list[tuple[int, dict]]:
+    """Records stamped with a Unix ``time`` [s] and perhaps a ``tracker_time`` [s], at their log
+    times on the tracker's clock, in the order they were recorded."""
+    return [(clock.record_time(record), record) for record in records]
 
 
 def _metadata(run: Run, source: Run) -> dict[str, str]:
@@ -207,8 +208,8 @@ def _metadata(run: Run, source: Run) -> dict[str, str]:
         "run_id": run.id,
         "kind": run.kind,
         "status": run.status,
-        "created_at": _utc(run.created_at).isoformat(),
-        "recorded_at": _utc(source.created_at).isoformat(),
+        "created_at": utc(run.created_at).isoformat(),
+        "recorded_at": utc(source.created_at).isoformat(),
         "source_run_id": source.id if source is not run else None,
         "code_version": run.code_version,
         "model": run.model,
@@ -220,18 +221,6 @@ def _metadata(run: Run, source: Run) -> dict[str, str]:
         "end_reason": results.get("end_reason"),
         "disarm": results.get("disarm"),
         "tracker": results.get("tracker"),
-        "time_convention": "log time = UTC ns; tracker times at recorded_at + (t - first frame's t); "
-        "commands, telemetry, link at their own Unix time",
+        "time_convention": TIME_CONVENTION,
     }
     return {name: value if isinstance(value, str) else json.dumps(json_safe(value)) for name, value in values.items()}
-
-
-def _utc(moment: datetime.datetime) -> datetime.datetime:
-    """A stored time as aware UTC (SQLite gives it back naive, in UTC)."""
-    return moment if moment.tzinfo is not None else moment.replace(tzinfo=datetime.UTC)
-
-
-def _utc_ns(moment: datetime.datetime) -> int:
-    aware = _utc(moment)
-    epoch = datetime.datetime(1970, 1, 1, tzinfo=datetime.UTC)
-    return (aware - epoch) // datetime.timedelta(microseconds=1) * 1000

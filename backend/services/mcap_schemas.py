@@ -1,131 +1,123 @@
-"""The JSON channels of a run's MCAP recording (:mod:`backend.services.mcap_export`): topic,
-schema name and JSON Schema of each, in the order they are registered (the channels drawn in
-Foxglove's and Rerun's own formats are :mod:`backend.services.mcap_visuals`).
+"""The run's own channels of its MCAP recording (:mod:`backend.services.mcap_export`): topic and
+protobuf message of each, in the order they are registered (the channels drawn in Foxglove's and
+Rerun's own formats are :mod:`backend.services.mcap_visuals`).
 
-These channels' messages are JSON (``message_encoding="json"``) and their schemas JSON Schemas
-(``encoding="jsonschema"``), so Foxglove, Rerun and the ``mcap`` tools read them without code of
-ours. Units: SI (metres, seconds, radians) unless a name says degrees (``_deg``) or the field
-says nondimensional (section states in sqrt(g l0), height gains in l0). Times inside a message
-are the clock that took them: ``tracker_time`` the tracker's [s], ``time`` Unix time [s]; a
-message's MCAP log and publish time is in UTC nanoseconds (the module above says how).
+Protobuf (``message_encoding="protobuf"``, the schema a ``FileDescriptorSet``), not JSON: Rerun's
+MCAP importer (0.41) shows a JSON channel as each message's bytes whatever its JSON Schema says,
+while it decodes any protobuf message into a struct of its fields; Foxglove and the ``mcap`` tools
+read both. The messages are proto3 in package ``parkourlab``, built here from :data:`MESSAGES`
+(no generated code to keep in step): each field is ``name: type`` with type ``double``,
+``uint32``, ``sint32``, ``bool``, ``string`` or a message of the package; ``?`` after it: it may
+be absent (proto3 ``optional``; JSON's null), ``[]``: repeated (NaN for an unknown number).
+
+Units: SI (metres, seconds, radians) unless a name says degrees (``_deg``) or below says
+otherwise: section states in sqrt(g l0), height gains and leg lengths in l0. Times: ``time``
+Unix time [s] of this PC, ``tracker_time`` the tracker's time [s] (a command's and a telemetry's:
+the newest frame's when it was sent or heard; absent before the run's first frame, and in runs
+stored before it was recorded). A message's log time is on the tracker's clock
+(:mod:`backend.services.mcap_clock`).
 """
 
 from __future__ import annotations
 
-NUMBER = {"type": "number"}
-NUMBER_OR_NULL = {"type": ["number", "null"]}
-INTEGER = {"type": "integer"}
-STRING = {"type": "string"}
-SECTION_STATE = {
-    "type": "array",
-    "items": NUMBER_OR_NULL,
-    "minItems": 2,
-    "maxItems": 2,
-    "description": "(xdot, ydot) at touchdown [sqrt(g l0)], flipped to the left wall",
+import math
+from functools import cache
+
+from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
+from google.protobuf.descriptor_pb2 import FieldDescriptorProto as Field
+from google.protobuf.message import Message
+
+PACKAGE = "parkourlab"
+
+# message -> its fields in order (field number = place + 1). Units: the module's docstring.
+MESSAGES: dict[str, tuple[str, ...]] = {
+    # One tracker frame: the body in wall coordinates, x across the chute from its centre line, y up
+    # [m]; pitch [rad] counter-clockwise with x right and y up, absent where the markers gave none.
+    "TrackerPose": ("tracker_time: double", "x: double", "y: double", "pitch: double?"),
+    # A leg's touchdown angle [deg] and length [l0].
+    "Control": ("psi0_deg: double", "zeta0: double"),
+    # A detected touchdown: wall -1 left, 1 right; state (xdot, ydot) [sqrt(g l0)] flipped to the left
+    # wall; heights [m]; the controls it was made with; rise: the height gained from the one before
+    # [l0] (absent for the first).
+    "Touchdown": ("index: uint32", "tracker_time: double", "wall: sint32", "state: double[]", "body_height: double",
+                  "foot_height: double", "poses_fitted: uint32", "control: Control?", "rise: double?"),
+    # A leg command the PC sent: leg "left" or "right"; why: "start" or the law's step that chose it;
+    # closed loop, the law (controller), whether it was clipped, and its state after the step.
+    "Command": ("time: double", "tracker_time: double?", "leg: string", "psi0_deg: double", "zeta0: double",
+                "why: string", "controller: string?", "clipped: bool?", "state: double[]"),
+    # A TELEMETRY message from the robot (docs/protocol.md): the servos' leg angles [deg] and lengths
+    # [l0], left and right; battery [mV]; faults (bits).
+    "Telemetry": ("time: double", "tracker_time: double?", "seq: uint32", "state: string", "psi_servo_deg: double[]",
+                  "zeta_servo: double[]", "battery_mv: uint32", "faults: uint32"),
+    # The model's prediction of touchdown index (0: the measured start), the Poincaré map iterated with
+    # the measured controls, beside what was measured; rises [l0] absent for touchdown 0.
+    "Prediction": ("index: uint32", "state: double[]", "measured_state: double[]", "rise: double?",
+                   "measured_rise: double?"),
+    # A change of the robot link's state.
+    "LinkTransition": ("time: double", "from: string", "to: string", "reason: string"),
+}  # fmt: skip
+
+# topic -> message name, in the order the channels are registered.
+TOPICS: dict[str, str] = {
+    "/tracker/pose": "TrackerPose",
+    "/touchdowns": "Touchdown",
+    "/commands": "Command",
+    "/telemetry": "Telemetry",
+    "/model/prediction": "Prediction",
+    "/robot/link": "LinkTransition",
 }
-CONTROL = {
-    "type": ["object", "null"],
-    "properties": {"psi0_deg": NUMBER, "zeta0": NUMBER},
-    "required": ["psi0_deg", "zeta0"],
-    "description": "a leg's touchdown angle [deg] and length [l0]; null where not recorded",
+
+_SCALARS = {
+    "double": Field.TYPE_DOUBLE,
+    "uint32": Field.TYPE_UINT32,
+    "sint32": Field.TYPE_SINT32,
+    "bool": Field.TYPE_BOOL,
+    "string": Field.TYPE_STRING,
 }
 
 
-def _object(title: str, description: str, properties: dict, required: list[str] | None = None) -> dict:
-    return {
-        "$schema": "https://json-schema.org/draft/2020-12/schema",
-        "title": title,
-        "description": description,
-        "type": "object",
-        "properties": properties,
-        "required": list(properties) if required is None else required,
-    }
+def file_descriptor() -> descriptor_pb2.FileDescriptorProto:
+    """:data:`MESSAGES` as one proto3 file, ``parkourlab/recording.proto``."""
+    proto = descriptor_pb2.FileDescriptorProto(name="parkourlab/recording.proto", package=PACKAGE, syntax="proto3")
+    for name, fields in MESSAGES.items():
+        message = proto.message_type.add(name=name)
+        for number, spec in enumerate(fields, start=1):
+            field_name, kind = (part.strip() for part in spec.split(":"))
+            base = kind.rstrip("?[]")
+            field = message.field.add(name=field_name, number=number)
+            field.label = Field.LABEL_REPEATED if kind.endswith("[]") else Field.LABEL_OPTIONAL
+            if base in _SCALARS:
+                field.type = _SCALARS[base]
+            else:
+                field.type, field.type_name = Field.TYPE_MESSAGE, f".{PACKAGE}.{base}"
+            if kind.endswith("?") and base in _SCALARS:  # a message field has presence already
+                field.proto3_optional = True
+                field.oneof_index = len(message.oneof_decl)
+                message.oneof_decl.add(name=f"_{field_name}")
+    return proto
 
 
-TRACKER_POSE = _object(
-    "parkourlab.TrackerPose",
-    "One tracker frame: the body in wall coordinates (x across the chute from its centre line, y up)",
-    {
-        "tracker_time": {**NUMBER, "description": "the tracker's own time of the frame [s]"},
-        "x": {**NUMBER, "description": "[m] across the chute, from its centre line"},
-        "y": {**NUMBER, "description": "[m] up"},
-        "pitch": {**NUMBER_OR_NULL, "description": "[rad] counter-clockwise (x right, y up); null if untracked"},
-    },
-)
+@cache
+def message_class(name: str) -> type[Message]:
+    """The protobuf class of message ``name`` of :data:`MESSAGES` (one pool, built once)."""
+    return message_factory.GetMessageClass(_pool().FindMessageTypeByName(f"{PACKAGE}.{name}"))
 
-TOUCHDOWN = _object(
-    "parkourlab.Touchdown",
-    "A detected touchdown: its section state, heights, the controls it was made with, the height gained",
-    {
-        "index": {**INTEGER, "description": "0-based touchdown number"},
-        "tracker_time": {**NUMBER, "description": "[s] the tracker's time of the touchdown"},
-        "wall": {"type": "integer", "enum": [-1, 1], "description": "-1 the left wall, 1 the right"},
-        "state": SECTION_STATE,
-        "body_height": {**NUMBER, "description": "[m]"},
-        "foot_height": {**NUMBER, "description": "[m]"},
-        "poses_fitted": INTEGER,
-        "control": CONTROL,
-        "rise": {**NUMBER_OR_NULL, "description": "height gain from the touchdown before [l0]; null for the first"},
-    },
-)
 
-COMMAND = _object(
-    "parkourlab.Command",
-    "A leg command the PC sent the robot",
-    {
-        "time": {**NUMBER, "description": "Unix time it was sent [s]"},
-        "leg": {"type": "string", "enum": ["left", "right"]},
-        "psi0_deg": NUMBER,
-        "zeta0": NUMBER,
-        "why": {**STRING, "description": "'start', or the PID step that chose it"},
-    },
-)
+def encode(topic: str, message: dict) -> bytes:
+    """A channel's message, given as a dict of its fields (None: absent; a key the message does not
+    have is left out), serialised as its protobuf message."""
+    cls = message_class(TOPICS[topic])
+    fields = cls.DESCRIPTOR.fields_by_name
+    return cls(**{key: _nan_for_none(value) for key, value in message.items() if key in fields}).SerializeToString()
 
-_LEFT_RIGHT = {"type": "array", "items": NUMBER, "minItems": 2, "maxItems": 2}
-TELEMETRY = _object(
-    "parkourlab.Telemetry",
-    "A TELEMETRY message from the robot (docs/protocol.md)",
-    {
-        "time": {**NUMBER, "description": "Unix time it was received [s]"},
-        "seq": INTEGER,
-        "state": STRING,
-        "psi_servo_deg": {**_LEFT_RIGHT, "description": "the servos' leg angles, left and right [deg]"},
-        "zeta_servo": {**_LEFT_RIGHT, "description": "the servos' leg lengths, left and right [l0]"},
-        "battery_mv": {**INTEGER, "description": "[mV]"},
-        "faults": INTEGER,
-    },
-)
 
-PREDICTION = _object(
-    "parkourlab.Prediction",
-    "The model's prediction of touchdown k: the Poincaré map iterated from the first measured touchdown with the"
-    " measured controls, beside the measured state",
-    {
-        "index": {**INTEGER, "description": "the touchdown predicted (0 is the measured start)"},
-        "state": SECTION_STATE,
-        "measured_state": SECTION_STATE,
-        "rise": {**NUMBER_OR_NULL, "description": "predicted height gain into this touchdown [l0]; null for 0"},
-        "measured_rise": {**NUMBER_OR_NULL, "description": "measured height gain into this touchdown [l0]"},
-    },
-)
+def _nan_for_none(value: object) -> object:
+    """A list's unknown numbers (JSON keeps NaN as null) as NaN: a repeated double has no null."""
+    return [math.nan if item is None else item for item in value] if isinstance(value, list) else value
 
-LINK = _object(
-    "parkourlab.LinkTransition",
-    "A change of the robot link's state",
-    {
-        "time": {**NUMBER, "description": "Unix time of the change [s]"},
-        "from": STRING,
-        "to": STRING,
-        "reason": STRING,
-    },
-)
 
-# topic -> schema, in the order the channels are registered.
-CHANNELS: dict[str, dict] = {
-    "/tracker/pose": TRACKER_POSE,
-    "/touchdowns": TOUCHDOWN,
-    "/commands": COMMAND,
-    "/telemetry": TELEMETRY,
-    "/model/prediction": PREDICTION,
-    "/robot/link": LINK,
-}
+@cache
+def _pool() -> descriptor_pool.DescriptorPool:
+    pool = descriptor_pool.DescriptorPool()
+    pool.Add(file_descriptor())
+    return pool

@@ -1,8 +1,8 @@
 """The channels of a run's MCAP recording that Foxglove and Rerun draw as they open it
-(:mod:`backend.services.mcap_export` writes them beside the JSON channels of
+(:mod:`backend.services.mcap_export` writes them beside the run's own channels of
 :mod:`backend.services.mcap_schemas`; docs/service.md, "Recordings").
 
-Each is derived from the JSON channels and adds nothing to them; it is there to be drawn:
+Each is derived from the run's own channels and adds nothing to them; it is there to be drawn:
 
 - the tracked body in Foxglove's own schemas, encoded as protobuf (``foxglove-schemas-protobuf``),
   which Foxglove's 3D panel and Rerun's MCAP importer (its ``foxglove`` decoder) both read:
@@ -10,6 +10,8 @@ Each is derived from the JSON channels and adds nothing to them; it is there to 
   ``CoordinateFrame``), ``/tracker/transform`` (``foxglove.FrameTransform`` from frame ``chute`` to
   frame ``body``; Rerun: ``Transform3D``) and ``/tracker/body`` (``foxglove.PointCloud`` of one
   point, the body; Rerun: ``Points3D``), one message per tracker frame;
+- ``/robot/log`` (``foxglove.Log``; Rerun: ``TextLog``): a line per link change (a warning when the
+  link is lost or the robot e-stopped) and per command sent, in the order they happened;
 - number series as ROS 2 ``std_msgs/msg/Float64MultiArray`` (CDR) holding one number each, which
   Rerun's importer (its ``ros2msg`` decoder) turns into ``Scalars`` — a plot — and Foxglove's Plot
   panel reads as ``.data[0]``: the body's height per frame, and per touchdown the body's and the
@@ -31,6 +33,7 @@ from operator import methodcaller
 from typing import TYPE_CHECKING
 
 from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
+from foxglove_schemas_protobuf.Log_pb2 import Log
 from foxglove_schemas_protobuf.PackedElementField_pb2 import PackedElementField
 from foxglove_schemas_protobuf.PointCloud_pb2 import PointCloud
 from foxglove_schemas_protobuf.PoseInFrame_pb2 import PoseInFrame
@@ -50,7 +53,9 @@ PROTOBUF_CHANNELS: dict[str, type[Message]] = {
     "/tracker/pose_in_frame": PoseInFrame,
     "/tracker/transform": FrameTransform,
     "/tracker/body": PointCloud,
+    "/robot/log": Log,
 }
+WARNED_STATES = ("disconnected", "estopped")  # a link change into these is logged as a warning
 
 # topic -> what its one number is, in the order the channels are registered.
 SERIES: dict[str, str] = {
@@ -84,9 +89,8 @@ _CDR_LE = b"\x00\x01\x00\x00"
 
 
 def drawn(messages: dict[str, list[tuple[int, dict]]]) -> dict[str, list[tuple[int, object]]]:
-    """This module's channels, topic -> [(log time [ns], message)], from the JSON channels'
-    ``/tracker/pose``, ``/touchdowns`` and ``/model/prediction`` (times kept): protobuf messages
-    for :data:`PROTOBUF_CHANNELS`, floats for :data:`SERIES`."""
+    """This module's channels, topic -> [(log time [ns], message)], from the run's own channels
+    (field dicts; times kept): protobuf messages for :data:`PROTOBUF_CHANNELS`, floats for :data:`SERIES`."""
     poses = messages["/tracker/pose"]
     touchdowns = messages["/touchdowns"]
     predictions = messages["/model/prediction"]
@@ -94,6 +98,7 @@ def drawn(messages: dict[str, list[tuple[int, dict]]]) -> dict[str, list[tuple[i
         "/tracker/pose_in_frame": [(time, pose_in_frame(time, pose)) for time, pose in poses],
         "/tracker/transform": [(time, body_transform(time, pose)) for time, pose in poses],
         "/tracker/body": [(time, body_point(time, pose)) for time, pose in poses],
+        "/robot/log": robot_log(messages["/robot/link"], messages["/commands"]),
         "/plot/height": [(time, pose["y"]) for time, pose in poses],
         "/plot/touchdown/body_height": [(time, td["body_height"]) for time, td in touchdowns],
         "/plot/touchdown/foot_height": [(time, td["foot_height"]) for time, td in touchdowns],
@@ -145,6 +150,30 @@ def body_point(time_ns: int, pose: dict) -> PointCloud:
     message.timestamp.FromNanoseconds(time_ns)
     message.pose.position.SetInParent()  # the identity pose, written out: the origin ...
     message.pose.orientation.w = 1.0  # ... and no turn
+    return message
+
+
+def robot_log(transitions: list[tuple[int, dict]], commands: list[tuple[int, dict]]) -> list[tuple[int, Log]]:
+    """Link changes and commands (``/robot/link``'s and ``/commands``' messages) as log lines, in time order."""
+    lines = [
+        (
+            time,
+            Log.WARNING if change["to"] in WARNED_STATES else Log.INFO,
+            "robot/link",
+            f"link {change['from']} -> {change['to']}: {change['reason']}",
+        )
+        for time, change in transitions
+    ]
+    lines += [(time, Log.INFO, "commands", f"{command['leg']} leg psi0 {command['psi0_deg']:.3f} deg, zeta0 "
+               f"{command['zeta0']:.4f} l0: {command['why']}") for time, command in commands]  # fmt: skip
+    return [
+        (time, _log(time, level, name, text)) for time, level, name, text in sorted(lines, key=lambda line: line[0])
+    ]
+
+
+def _log(time_ns: int, level: int, name: str, text: str) -> Log:
+    message = Log(level=level, name=name, message=text)
+    message.timestamp.FromNanoseconds(time_ns)
     return message
 
 

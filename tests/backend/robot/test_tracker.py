@@ -68,6 +68,23 @@ def test_indices_count_every_pose_received_when_old_ones_are_let_go(monkeypatch)
     assert [pose.time for pose in history.poses_from(0)] == [7.0, 8.0, 9.0, 10.0, 11.0], "from the oldest kept"
 
 
+def test_the_newest_time_is_the_newest_pose_s_once_a_run_s_first_has_arrived(monkeypatch):
+    """A live run's stamp on its commands and telemetry: the tracker's time, never before its own frames."""
+    from backend.robot import tracker
+
+    monkeypatch.setattr(tracker, "HISTORY", 5)
+    history = tracker.PoseHistory(Calibration())
+    assert history.newest_time() is None, "no pose yet"
+    for k in range(3):
+        history.add(Pose(100.0 + 0.01 * k, 0.0, 0.0))
+    first_pose = history.count()  # a run starts here: the poses before it are not its own
+    assert history.newest_time() == 100.02 and history.newest_time(first_pose) is None
+    for k in range(3, 12):
+        history.add(Pose(100.0 + 0.01 * k, 0.0, 0.0))
+    assert history.newest_time(first_pose) == 100.11, "the newest, past the history kept"
+    assert history.newest_time(12) is None
+
+
 def test_a_source_says_when_its_last_pose_arrived_and_whether_datagrams_wait_unread():
     source = UdpPoseSource()
     try:

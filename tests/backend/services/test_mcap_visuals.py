@@ -1,12 +1,12 @@
 """The channels of a run's MCAP recording that Foxglove and Rerun draw (backend/services/mcap_visuals.py),
 read back three ways: protobuf decoded by mcap-protobuf-support, the ROS 2 arrays by
 mcap-ros2-support, and the whole file by Rerun's own MCAP importer (``rerun mcap convert`` with its
-default decoders), each compared with the run's frames, touchdowns and prediction."""
+default decoders), each compared with the run's frames, touchdowns and prediction. Rerun shows the
+run's own channels (backend/services/mcap_schemas.py) field by field too, on the tracker's clock."""
 
 from __future__ import annotations
 
 import io
-import json
 import math
 import os
 import struct
@@ -17,7 +17,7 @@ from collections import defaultdict
 import numpy as np
 import pyarrow as pa
 import pytest
-from mcap.decoder import DecoderFactory
+from google.protobuf.json_format import MessageToDict
 from mcap.reader import make_reader
 from mcap_protobuf.decoder import DecoderFactory as ProtobufDecoders
 from mcap_ros2.decoder import DecoderFactory as Ros2Decoders
@@ -26,15 +26,16 @@ from rerun.chunk import RrdReader
 
 from backend.repositories import runs as run_store
 from backend.services.mcap_export import export_run
-from backend.services.mcap_schemas import CHANNELS
+from backend.services.mcap_schemas import TOPICS
 from backend.services.mcap_visuals import PROTOBUF_CHANNELS, SERIES, series_cdr
 from backend.services.robot_records import replay_run
 from backend.store.trajectory_blob import unpack_trajectory
-from tests.robot_runs import store_robot_run
+from tests.robot_runs import store_lagging_run, store_robot_run
 
 RTOL_F32 = 1e-6  # Rerun keeps positions and quaternions as float32
 ATOL_F32 = 1e-7  # [m] near zero
 PITCH = 0.02  # [rad] the pitch tests/robot_runs.py gives the frames it does not leave untracked
+BODY_CHANNELS = ("/tracker/pose_in_frame", "/tracker/transform", "/tracker/body")  # one message per frame
 
 
 @pytest.fixture
@@ -46,20 +47,22 @@ def run_and_recording(session):
     return run, stream.getvalue()
 
 
-class JsonDecoders(DecoderFactory):
-    def decoder_for(self, message_encoding, schema):
-        return json.loads if message_encoding == "json" else None
-
-
 def decoded(data: bytes) -> dict[str, list[tuple[int, object]]]:
     """topic -> [(log time, decoded message)] in log-time order: protobuf and ROS 2 channels
-    decoded by their MCAP support libraries, JSON by json."""
-    decoders = [ProtobufDecoders(), Ros2Decoders(), JsonDecoders()]
-    reader = make_reader(io.BytesIO(data), decoder_factories=decoders)
+    decoded by their MCAP support libraries; the run's own channels as dicts of their fields (an
+    absent one: None)."""
+    reader = make_reader(io.BytesIO(data), decoder_factories=[ProtobufDecoders(), Ros2Decoders()])
     messages = defaultdict(list)
     for _schema, channel, message, value in reader.iter_decoded_messages(log_time_order=True):
-        messages[channel.topic].append((message.log_time, value))
+        messages[channel.topic].append((message.log_time, fields(value) if channel.topic in TOPICS else value))
     return messages
+
+
+def fields(message) -> dict:
+    """A protobuf message's fields as Rerun shows them: each by name, None where absent (an empty list too)."""
+    present = MessageToDict(message, preserving_proto_field_name=True, always_print_fields_with_no_presence=True)
+    return {field.name: None if present.get(field.name) == [] else present.get(field.name)
+            for field in message.DESCRIPTOR.fields}  # fmt: skip
 
 
 def expected_orientation(pitch: float | None) -> tuple[float, float, float, float]:
@@ -74,7 +77,7 @@ def test_the_body_is_foxglove_s_pose_transform_and_point_in_protobuf(run_and_rec
     frames = unpack_trajectory(run.trajectory)
     poses = messages["/tracker/pose"]
     assert len(poses) == frames["time"].size == 336
-    for topic in PROTOBUF_CHANNELS:
+    for topic in BODY_CHANNELS:
         assert [time for time, _ in messages[topic]] == [time for time, _ in poses], topic
 
     for (time, pose), (_, framed), (_, transform), (_, cloud) in zip(
@@ -98,8 +101,8 @@ def test_the_body_is_foxglove_s_pose_transform_and_point_in_protobuf(run_and_rec
     assert_allclose([m.pose.position.z for _, m in messages["/tracker/pose_in_frame"]], frames["y"], rtol=0)
 
 
-def test_the_pose_in_frame_keeps_the_json_pose_up_on_z(run_and_recording):
-    """/tracker/pose_in_frame was JSON before it was protobuf: nothing of /tracker/pose is lost."""
+def test_the_pose_in_frame_keeps_the_tracker_pose_up_on_z(run_and_recording):
+    """Nothing of /tracker/pose (the wall's x and y up) is lost in Foxglove's frame (x and z up)."""
     _run, data = run_and_recording
     messages = decoded(data)
     (_, tracked), (_, framed) = messages["/tracker/pose"][1], messages["/tracker/pose_in_frame"][1]
@@ -213,13 +216,47 @@ def test_rerun_opens_the_recording_as_a_transform_points_and_plots(run_and_recor
     assert scalars("/plot/touchdown/rise") == results["rises"]
     assert scalars("/plot/prediction/rise") == results["prediction"]["rises"]
 
-    # The JSON channels arrive whole, as the messages' bytes.
-    raw = [json.loads(bytes(value)) for (value,) in component(entities["/touchdowns"], "McapMessage:data")]
-    assert [td["index"] for td in raw] == [0, 1, 2, 3, 4] and raw[1]["rise"] == results["rises"][0]
     drawn = {path for path, rows in entities.items() if any(name.startswith(("Scalars:", "Points3D:",
-             "Transform3D:", "InstancePoses3D:")) for row in rows for name in row)}  # fmt: skip
+             "Transform3D:", "InstancePoses3D:", "TextLog:")) for row in rows for name in row)}  # fmt: skip
     assert drawn == {*PROTOBUF_CHANNELS, *SERIES}
-    assert {*CHANNELS} <= set(entities)
+    log = [text for (text,) in component(entities["/robot/log"], "TextLog:text")]
+    assert log == [
+        f"{c['leg']} leg psi0 {c['psi0_deg']:.3f} deg, zeta0 {c['zeta0']:.4f} l0: start"
+        for c in results["commands"][:2]
+    ] + ["link disarmed -> armed: arm", log[3]], "in the order they happened"
+    assert component(entities["/robot/log"], "TextLog:level") == [["INFO"]] * 4
+
+
+def test_rerun_shows_every_channel_of_the_run_field_by_field(run_and_recording, tmp_path):
+    """Issue 40: the run's own channels were JSON, which Rerun 0.41 shows as each message's bytes."""
+    _run, data = run_and_recording
+    entities = rerun_entities(data, tmp_path)
+    assert not [path for path, rows in entities.items() for row in rows if "McapMessage:data" in row], "no blobs"
+    for topic, name in TOPICS.items():
+        structs = [value for (value,) in component(entities[topic], f"parkourlab.{name}:message")]
+        assert structs == [message for _, message in decoded(data)[topic]], topic
+        assert component(entities[topic], "message_log_time") == [time for time, _ in decoded(data)[topic]], topic
+
+
+def test_rerun_places_a_lagging_run_s_commands_at_the_frames_they_followed(session, tmp_path):
+    """Frames at 0.37x real time: in Rerun's log-time timeline, each command and telemetry sits at
+    the frame whose tracker time it carries, and the law's commands each after its touchdown."""
+    stream = io.BytesIO()
+    export_run(session, store_lagging_run(session), stream)
+    entities = rerun_entities(stream.getvalue(), tmp_path)
+
+    def timed(topic: str) -> list[tuple[int, dict]]:
+        rows = [row for row in entities[topic] if row.get(f"parkourlab.{TOPICS[topic]}:message") is not None]
+        return [(row["message_log_time"], row[f"parkourlab.{TOPICS[topic]}:message"][0]) for row in rows]
+
+    frame_at = {pose["tracker_time"]: time for time, pose in timed("/tracker/pose")}
+    stamped = [(time, record) for topic in ("/commands", "/telemetry") for time, record in timed(topic)
+               if record["tracker_time"] is not None]  # fmt: skip
+    assert len(stamped) > 150 and all(time == frame_at[record["tracker_time"]] for time, record in stamped)
+    touchdowns = [time for time, _ in timed("/touchdowns")]
+    law = [time for time, command in timed("/commands") if command["why"].startswith("pid after")]
+    assert all(touchdown < time for touchdown, time in zip(touchdowns, law, strict=True))
+    assert all(time < touchdown for time, touchdown in zip(law, touchdowns[1:], strict=False))
 
 
 def test_a_replay_opens_in_rerun_with_its_own_touchdowns(session, tmp_path):

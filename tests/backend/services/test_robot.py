@@ -4,12 +4,16 @@ Through the API, tests/backend/api/routes/test_robot.py covers e-stop, a lost li
 """
 
 import asyncio
+import io
 import logging
 import socket
 import threading
 import time
 
 import pytest
+from google.protobuf.json_format import MessageToDict
+from mcap.reader import make_reader
+from mcap_protobuf.decoder import DecoderFactory
 
 from backend import errors
 from backend.repositories import runs as run_store
@@ -17,7 +21,9 @@ from backend.robot.link import LinkError
 from backend.robot.live_run import LiveRun, RunSnapshot
 from backend.robot.messages import Fault, RobotState
 from backend.robot.virtual import VirtualRobot
-from backend.schemas import LegIn, RobotConnect, RobotRunCreate
+from backend.schemas import ClosedLoopIn, LegIn, RobotConnect, RobotRunCreate
+from backend.services.mcap_export import export_run
+from backend.services.mcap_schemas import TOPICS, message_class
 from backend.services.robot import ANSWER_WAIT, RobotUnavailable
 from backend.services.robot_records import replay_run, touchdown_results
 from backend.store.trajectory_blob import unpack_trajectory
@@ -29,6 +35,7 @@ LEGS = [LegIn(psi0_deg=30.0, zeta0=0.87), LegIn(psi0_deg=30.0, zeta0=0.9)]  # [l
 JUMPS = 4
 RUN_WAIT_S = 30.0  # [s] an upper bound for a 4-jump run at 4x speed, not a timing assertion
 ANSWER_BOUND_S = 2.0  # [s] "answers instead of hanging": generous, not a latency claim
+FRAME_PERIOD = 0.01  # [s] of tracker time: the virtual robot's camera runs at 100 Hz
 FLAP_S = 4.0  # [s] the radio flaps in the service's test (tests/backend/robot/test_supervisor.py flaps longer)
 FLAP_ANSWER_S = 20.0  # [s] a connect, a close or the threads' end, instead of a hang: generous
 
@@ -93,6 +100,49 @@ def test_a_long_live_run_scans_only_the_poses_of_its_last_flight(connected, sess
     assert frames > 1000 and longest < frames / 10, f"a scan went over {longest} of {frames} poses"
     assert max(size for size, _ in windows) < frames / 10, "a scan looks back over one flight at most"
     print(f"{frames} poses in {len(windows)} scans of at most {longest} poses")
+
+
+@pytest.mark.slow
+@pytest.mark.robot_speed(0.37)
+def test_a_lagging_robot_s_records_are_stamped_with_the_tracker_s_time(connected, session):
+    """Issue 40: the virtual robot climbing at 0.37x real time, closed loop. Each command and
+    telemetry carries the tracker time of the newest frame the service had, and its recording places
+    it there: each of the law's commands at the touchdown it answers, before the next."""
+    request = RobotRunCreate(controls=LEGS, jumps=JUMPS, closed_loop=ClosedLoopIn(target_m=0.4))
+    connected.start_run(request)
+    status = connected.wait_run(RUN_WAIT_S)
+    assert not status.active and status.end_reason == "jumps done", status.end_reason
+    results = run_store.get_run(session, status.run_id).results
+    frames = unpack_trajectory(run_store.get_run(session, status.run_id).trajectory)["time"]
+    for topic, records in (("/commands", results["commands"]), ("/telemetry", results["telemetry"])):
+        fields = message_class(TOPICS[topic]).DESCRIPTOR.fields_by_name
+        assert [set(record) - set(fields) for record in records] == [set()] * len(records), "nothing left out"
+        stamps = [record["tracker_time"] for record in records if record["tracker_time"] is not None]
+        assert stamps and set(stamps) <= set(frames.tolist()), f"{topic}: a frame's time, the run's own"
+        assert stamps == sorted(stamps)
+
+    stream = io.BytesIO()
+    export_run(session, status.run_id, stream)
+    reader = make_reader(io.BytesIO(stream.getvalue()), decoder_factories=[DecoderFactory()])
+    placed = {topic: [] for topic in TOPICS}
+    for _schema, channel, message, decoded in reader.iter_decoded_messages(topics=list(TOPICS)):
+        placed[channel.topic].append(
+            (
+                message.log_time,
+                MessageToDict(decoded, preserving_proto_field_name=True, always_print_fields_with_no_presence=True),
+            )
+        )
+    frame_at = {pose["tracker_time"]: time for time, pose in placed["/tracker/pose"]}
+    stamped = [(time, record) for topic in ("/commands", "/telemetry") for time, record in placed[topic]
+               if "tracker_time" in record]  # fmt: skip
+    assert all(time == frame_at[record["tracker_time"]] for time, record in stamped)
+    touchdowns = [time for time, _ in placed["/touchdowns"]]
+    law = [time for time, command in placed["/commands"] if command["why"].startswith("pid after touchdown")]
+    assert len(law) == len(touchdowns) == JUMPS
+    # The loop may answer from the frame just before the touchdown time its fit puts between frames.
+    early_ns = 2 * FRAME_PERIOD * 1e9
+    assert all(touchdown - early_ns < time for touchdown, time in zip(touchdowns, law, strict=True))
+    assert all(time < touchdown for time, touchdown in zip(law, touchdowns[1:], strict=False)), "before the next"
 
 
 def test_a_recorded_run_replays_to_the_same_touchdowns(connected, session, make_run):
