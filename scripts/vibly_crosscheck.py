@@ -11,14 +11,30 @@ one below the first node counts as failed.
 It prints and writes (``--out``/vibly_crosscheck.json): the fraction of state-action pairs with the
 same failure flag, the same bin and the same viability (``Q_V``); the fraction of states with the
 same kernel membership (``S_V``) and the spread of the measure's difference (``S_M``); the largest
-difference of the state reached; each side's seconds and the speed ratio; and a figure
+difference of the state reached; the speed, two ways side by side; and a figure
 (``--out``/vibly_crosscheck.png): both ``Q_V`` over state x action and where they differ.
+
+The speed, two ways:
+
+* wall clock: each side's whole run on every core (vibly's process pool, the engine's numba
+  threads), its ratio. The machine's load skews it; the load average at start and end is printed.
+* CPU time per pair on one core: vibly's ``p_map`` (with ``sa2xp``/``xp2s``) stepped pair by pair
+  in this process over the grid (or ``--cpu-pairs`` of its pairs drawn at random), against the
+  engine's transition map of the whole grid with numba held to one thread (best of 3), both by
+  ``time.process_time``: the step maps alone, each on one core, which other work on the machine
+  hardly changes.
 
 vibly needs only numpy, scipy, matplotlib and numba (all in the project's environment); it is put
 on ``sys.path`` from ``--vibly``, a checkout of github.com/sheim/vibly.
 
 Usage: python scripts/vibly_crosscheck.py --vibly PATH --out DIR [--states 180] [--actions 161]
-       [--vibly-npz FILE]  (reuse vibly's results saved by an earlier run instead of recomputing)
+       [--cpu-pairs N] [--vibly-npz FILE]  (reuse vibly's results saved by an earlier run instead of
+       recomputing; the wall-clock ratio then mixes two runs)
+
+A checkout of vibly: ``git clone https://github.com/sheim/vibly /tmp/vibly`` (only its source is
+read). Time on the shared 2-core machine, load average 3 to 7: the demo grid 8 minutes (vibly's
+pool 4, its one-core pass 2.5), the 60 x 41 grid under a minute; the engine's compile comes on top
+on an empty numba cache.
 """
 
 from __future__ import annotations
@@ -30,14 +46,16 @@ import sys
 import time
 from pathlib import Path
 
+import numba
 import numpy as np
 
-from sim_core.viability.engine import ViabilityGrid, compute_viability, viability_of_map
+from sim_core.viability.engine import ViabilityGrid, compute_viability, transition_map, viability_of_map
 from sim_core.viability.slip_hopper import SlipHopper, slip_step, slip_step_map
 
 DEMO_STATES = 180  # computeQ_slip.py: s_grid = np.linspace(0.1, 1, 181)[:-1]
 DEMO_ACTIONS = 161  # computeQ_slip.py: a_grid = np.linspace(-10 / 180 * np.pi, 70 / 180 * np.pi, 161)
 SHOWN_DISAGREEMENTS = 20
+ENGINE_CPU_REPEATS = 3  # the engine's one-thread map is timed this often, the best kept
 
 
 def demo_axes(states: int, actions: int) -> tuple[np.ndarray, np.ndarray]:
@@ -48,8 +66,8 @@ def demo_axes(states: int, actions: int) -> tuple[np.ndarray, np.ndarray]:
     return s_axis, a_axis
 
 
-def run_vibly(vibly_path: Path, s_axis: np.ndarray, a_axis: np.ndarray) -> dict:
-    """vibly's computeQ_slip.py on the grid, timed part by part."""
+def vibly_slip(vibly_path: Path):
+    """vibly's package, its SLIP model and ``p_map`` set up as computeQ_slip.py sets them up."""
     sys.path.insert(0, str(vibly_path))
     import viability as vibly  # vibly's own package, found through --vibly
     from models import slip
@@ -61,6 +79,12 @@ def run_vibly(vibly_path: Path, s_axis: np.ndarray, a_axis: np.ndarray) -> dict:
     p["total_energy"] = slip.compute_total_energy(x0, p)
     p_map = slip.p_map
     p_map.p, p_map.x, p_map.sa2xp, p_map.xp2s = p, x0, slip.sa2xp, slip.xp2s
+    return vibly, slip, p_map, p
+
+
+def run_vibly(vibly_path: Path, s_axis: np.ndarray, a_axis: np.ndarray) -> dict:
+    """vibly's computeQ_slip.py on the grid, timed part by part."""
+    vibly, slip, p_map, p = vibly_slip(vibly_path)
     grids = {"states": (s_axis,), "actions": (a_axis,)}
     began = time.perf_counter()
     p_map(*slip.sa2xp((0.5, 0.5), p))  # compiles vibly's numba functions before the pool forks
@@ -101,6 +125,39 @@ def run_engine(s_axis: np.ndarray, a_axis: np.ndarray, hopper: SlipHopper):
     pairs = np.repeat(states, len(actions), axis=0), np.tile(actions, (len(states), 1))
     reached = slip_step(*pairs, hopper)[0][:, 0].reshape(grid.shape)
     return result, reached, compile_seconds
+
+
+def vibly_cpu_per_pair(vibly_path: Path, s_axis: np.ndarray, a_axis: np.ndarray, count: int) -> tuple[float, int]:
+    """vibly's CPU seconds per pair on one core: ``p_map`` stepped pair by pair in this process, over
+    every grid pair (``count`` 0) or ``count`` of them drawn at random (seed 0); and the pairs stepped."""
+    _, slip, p_map, p = vibly_slip(vibly_path)
+    pairs = [(s, a) for s in s_axis for a in a_axis]
+    if 0 < count < len(pairs):
+        pairs = [pairs[i] for i in np.random.default_rng(0).choice(len(pairs), count, replace=False)]
+    p_map(*slip.sa2xp((0.5, 0.5), p))  # compiled before the clock starts
+    began = time.process_time()
+    for state_action in pairs:
+        x, params = p_map.sa2xp(state_action, p)
+        x_next, _ = p_map(x, params)
+        p_map.xp2s(x_next, params)
+    return (time.process_time() - began) / len(pairs), len(pairs)
+
+
+def engine_cpu_per_pair(s_axis: np.ndarray, a_axis: np.ndarray, hopper: SlipHopper) -> float:
+    """The engine's CPU seconds per pair on one core: its transition map of the grid with numba held
+    to one thread, best of ENGINE_CPU_REPEATS (already compiled by :func:`run_engine`)."""
+    grid, step_map = ViabilityGrid((s_axis,), (a_axis,)), slip_step_map(hopper)
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        times = []
+        for _ in range(ENGINE_CPU_REPEATS):
+            began = time.process_time()
+            transition_map(step_map, grid)
+            times.append(time.process_time() - began)
+    finally:
+        numba.set_num_threads(threads)
+    return min(times) / grid.pairs
 
 
 def compare(ref: dict, result, reached: np.ndarray, s_axis: np.ndarray, a_axis: np.ndarray) -> dict:
@@ -197,10 +254,13 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--states", type=int, default=DEMO_STATES, help="apex-height nodes (demo: 180)")
     parser.add_argument("--actions", type=int, default=DEMO_ACTIONS, help="angle-of-attack nodes (demo: 161)")
     parser.add_argument("--vibly-npz", type=Path, help="vibly's results saved by an earlier run, not recomputed")
+    parser.add_argument(
+        "--cpu-pairs", type=int, default=0, help="pairs vibly steps on one core for its CPU time (0: every pair)"
+    )
     args = parser.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
     s_axis, a_axis = demo_axes(args.states, args.actions)
-    load_at_start = os.getloadavg()[0]
+    load_at_start = os.getloadavg()
     if args.vibly_npz:
         ref = dict(np.load(args.vibly_npz))
         if ref["Q_map"].shape != (args.states, args.actions):
@@ -212,6 +272,8 @@ def main(argv: list[str] | None = None) -> dict:
     result, reached, compile_seconds = run_engine(s_axis, a_axis, hopper)
     vibly_seconds = float(ref["seconds_q_map"] + ref["seconds_qv"] + ref["seconds_project"])
     engine_seconds = result.seconds_map + result.seconds_kernel
+    engine_cpu = engine_cpu_per_pair(s_axis, a_axis, hopper)
+    vibly_cpu, vibly_cpu_pairs = vibly_cpu_per_pair(args.vibly.resolve(), s_axis, a_axis, args.cpu_pairs)
     report = {
         "grid": {
             "states": args.states,
@@ -237,9 +299,16 @@ def main(argv: list[str] | None = None) -> dict:
             "speed_ratio": vibly_seconds / engine_seconds,
             "speed_ratio_with_compile": vibly_seconds / (engine_seconds + compile_seconds),
         },
+        "cpu_per_pair_one_core": {
+            "vibly": vibly_cpu,
+            "vibly_pairs_stepped": vibly_cpu_pairs,
+            "parkourlab": engine_cpu,
+            "ratio": vibly_cpu / engine_cpu,
+        },
         "machine": {
             "cpus": os.cpu_count(),
             "load_average_at_start": load_at_start,
+            "load_average_at_end": os.getloadavg(),
             "vibly_reused_from": str(args.vibly_npz) if args.vibly_npz else None,
         },
     }
@@ -260,7 +329,18 @@ def main(argv: list[str] | None = None) -> dict:
         f"ParkourLab {engine_seconds:.3f} s (map {result.seconds_map:.3f}, kernel {result.seconds_kernel:.4f}); "
         f"compile {compile_seconds:.1f} s"
     )
-    print(f"speed ratio {seconds['speed_ratio']:.0f}x ({seconds['speed_ratio_with_compile']:.1f}x with compile)")
+    cpu, machine = report["cpu_per_pair_one_core"], report["machine"]
+    print(
+        f"speed, wall clock on {machine['cpus']} cores:  {seconds['speed_ratio']:.0f}x "
+        f"({seconds['speed_ratio_with_compile']:.1f}x with compile)"
+    )
+    print(
+        f"speed, CPU per pair on one core: {cpu['ratio']:.0f}x "
+        f"(vibly {cpu['vibly'] * 1e3:.2f} ms over {cpu['vibly_pairs_stepped']} pairs, "
+        f"ParkourLab {cpu['parkourlab'] * 1e6:.1f} us)"
+    )
+    load = " / ".join(f"{value:.2f}" for value in machine["load_average_at_start"])
+    print(f"load average (1 / 5 / 15 min) {load} at start, {machine['load_average_at_end'][0]:.2f} at end")
     print(f"wrote {args.out / 'vibly_crosscheck.json'} and {args.out / 'vibly_crosscheck.png'}")
     return report
 
