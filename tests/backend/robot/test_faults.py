@@ -45,7 +45,7 @@ def _delta(after: dict, before: dict) -> dict:
     return {name: after[name] - before[name] for name in after}
 
 
-def test_a_garbage_flood_is_counted_changes_nothing_and_lets_the_estop_through(answering):
+def test_a_garbage_flood_is_counted_changes_nothing_and_lets_the_estop_through(answering, patient_estop):
     rig, link = answering
     before, seen = link.counters(), len(link.transitions)
     flood = rig.flood()

@@ -137,7 +137,7 @@ def test_a_service_killed_outright_takes_its_radio_process_with_it_and_the_robot
         robot.stop()
 
 
-def test_the_link_through_a_radio_process_arms_commands_and_stops_the_robot():
+def test_the_link_through_a_radio_process_arms_commands_and_stops_the_robot(patient_estop):
     robot = VirtualRobot().start()
     link = RobotLink(robot.url, radio_process=True)
     try:

@@ -278,8 +278,7 @@ def test_every_ending_disarms_the_robot(connected, virtual, session, end):
     assert run_store.get_run(session, run.run_id).results["disarm"] == "disarmed"
 
 
-@pytest.mark.realtime
-def test_an_estop_ending_leaves_the_robot_estopped(connected, virtual):
+def test_an_estop_ending_leaves_the_robot_estopped(connected, virtual, patient_estop):
     robot, _ = virtual
     _running(connected, connected.start_run(RobotRunCreate(controls=LEGS, jumps=1000)))
     assert connected.estop()["acknowledged"] is True

@@ -65,8 +65,7 @@ def test_robot_calls_need_the_token(client, virtual):
     assert client.get("/api/v1/robot").json()["state"] == "disconnected"
 
 
-@pytest.mark.realtime
-def test_estop_needs_no_token_and_reaches_the_robot(client, auth, connected):
+def test_estop_needs_no_token_and_reaches_the_robot(client, auth, connected, patient_estop):
     client.post("/api/v1/robot/arm", headers=auth)
     response = client.post("/api/v1/robot/estop")  # no token: stopping is always allowed
     assert response.status_code == 200, response.text
@@ -76,8 +75,7 @@ def test_estop_needs_no_token_and_reaches_the_robot(client, auth, connected):
     assert client.post("/api/v1/robot/reset").status_code == 401, "releasing it needs the token"
 
 
-@pytest.mark.realtime
-def test_estop_answers_while_the_request_pool_is_full(client, auth, connected, monkeypatch):
+def test_estop_answers_while_the_request_pool_is_full(client, auth, connected, monkeypatch, patient_estop):
     """45 stored-run requests hold every request thread (each waits inside the route, storing its
     run): the e-stop, async and on its own thread, answers all the same. Real compute under load:
     test_estop_load.py."""
@@ -201,8 +199,7 @@ def test_a_live_run_is_filed_under_its_experiment_and_a_missing_one_moves_nothin
     assert client.get(f"/api/v1/runs/{status['run']['stored_run_id']}").json()["experiment_id"] == experiment
 
 
-@pytest.mark.realtime
-def test_estop_during_a_run_ends_it_and_keeps_the_data(client, auth, connected):
+def test_estop_during_a_run_ends_it_and_keeps_the_data(client, auth, connected, patient_estop):
     client.post("/api/v1/robot/runs", json={"controls": CONTROLS, "jumps": 1000}, headers=auth)
     _wait_for_touchdowns(client, 3)
     stopped = client.post("/api/v1/robot/estop").json()
