@@ -50,7 +50,7 @@ from dataclasses import dataclass
 
 from backend.robot.firmware import Firmware
 from backend.robot.link import LinkState, RobotLink
-from backend.robot.messages import Command, Kind, RobotState, Telemetry, decode, encode
+from backend.robot.messages import Command, Kind, RobotState, SetLeg, Telemetry, decode, encode
 from backend.robot.supervisor import LinkSupervisor
 from backend.robot.virtual import VirtualRobot
 from backend.robot.xbee import (
@@ -119,10 +119,20 @@ class PtyRobot:
         period: float = 0.05,
         firmware: Firmware | None = None,
         answers: bool = False,
+        line: str = "pty",
     ):
         """Talking only, in ``state`` every ``period`` [s]; or, given ``firmware``, answering as it
         decides (``state`` and ``period`` are then the firmware's own); or ``answers``: talking, and
-        both radios answering by the firmware's rules (no watchdog)."""
+        both radios answering by the firmware's rules (no watchdog).
+
+        ``line``: ``"pty"`` (:attr:`path`, :attr:`by_id`), or ``"socket"``: a TCP line on a port of
+        its own (:attr:`url`, ``socket://127.0.0.1:PORT``, bound here to port 0), for tests that need
+        no serial device. A pty is ``/dev/pts/N``, a name the kernel hands out again at once and that
+        any program may open: another service still retrying a ``/dev/pts/N`` that was its robot's
+        reads part of this rig's frames and writes its own (issue 40). A socket line's robot hears one
+        PC at a time: a new connection replaces the old, as a radio answers whoever sends; jam,
+        hang-up and plug-in are the pty's only."""
+        assert line in ("pty", "socket"), line
         self.state, self.source64, self.period = state, source64, period
         self.firmware = firmware
         self.answers = answers
@@ -137,7 +147,14 @@ class PtyRobot:
         self._dir = tempfile.mkdtemp(prefix="pty-robot-")
         self.by_id = os.path.join(self._dir, "usb-XBee_rig-if00-port0")  # as /dev/serial/by-id/… names a radio
         self.master = self._slave = None
-        self._open()
+        self._listener = self._connection = None  # a socket line's
+        if line == "pty":
+            self._open()
+            self.url = self.path
+        else:
+            self.path = self.by_id = None
+            self._listener = socket.create_server(("127.0.0.1", 0))
+            self.url = f"socket://127.0.0.1:{self._listener.getsockname()[1]}"
         self._line = threading.Lock()  # whole frames on the line, and the pty's fds swapped only under it
         self._firmware_lock = threading.Lock()  # the firmware is shared by the rig's thread and a flood
         self._silent = False  # out of range: nothing arrives either way
@@ -159,12 +176,15 @@ class PtyRobot:
         self._thread.join(2)
         with self._line:
             self._close()
+        if self._listener is not None:
+            self._listener.close()
         shutil.rmtree(self._dir, ignore_errors=True)
 
     # Faults ------------------------------------------------------------------------------------
     def jam(self) -> int:
         """Fill the PC→robot buffer (nobody reads it): every write on the line now blocks. Returns
         the bytes it took."""
+        assert self._listener is None, "a pty's fault"
         self._deaf = True  # an answering robot stops reading too
         time.sleep(2 * TICK)  # a read under way ends
         flags = fcntl.fcntl(self._slave, fcntl.F_GETFL)
@@ -224,8 +244,14 @@ class PtyRobot:
         return self._flood
 
     def commands(self, since: float = 0.0) -> list[Kind]:
-        """The commands (ARM, DISARM, ESTOP …) the robot received after ``since`` (monotonic), in order."""
-        return [m.kind for t, m in list(self.received) if t > since and isinstance(m, Command)]
+        """Every command the robot received after ``since`` (monotonic), in order, heartbeats aside:
+        ARM, DISARM, ESTOP … and SET_LEG."""
+        kinds = [
+            Kind.SET_LEG if isinstance(m, SetLeg) else getattr(m, "kind", None)
+            for t, m in list(self.received)
+            if t > since
+        ]
+        return [kind for kind in kinds if kind is not None]
 
     # The rig's thread ----------------------------------------------------------------------------
     def _open(self) -> None:
@@ -237,6 +263,11 @@ class PtyRobot:
         os.symlink(self.path, self.by_id)
 
     def _close(self) -> None:
+        if self._listener is not None:  # a socket line: the PC's connection, if any
+            if self._connection is not None:
+                self._connection.close()
+            self._connection = self.master = None
+            return
         with contextlib.suppress(FileNotFoundError):
             os.unlink(self.by_id)
         for fd in (self.master, self._slave):
@@ -245,7 +276,16 @@ class PtyRobot:
                     os.close(fd)
         self.master = self._slave = None
 
+    def _answer(self) -> None:
+        """A socket line: a PC that connects is the one the robot hears from now on."""
+        if select.select([self._listener], [], [], 0)[0]:
+            connection, _ = self._listener.accept()
+            with self._line:
+                self._close()
+                self._connection, self.master = connection, connection.fileno()
+
     def _ask(self, what: str) -> None:
+        assert self._listener is None, "a pty's fault"
         done = threading.Event()
         self._requests.append((what, done))
         assert done.wait(REQUEST_S), f"the rig did not {what} within {REQUEST_S:g} s"
@@ -268,6 +308,8 @@ class PtyRobot:
         reads = self.firmware is not None or self.answers
         while not self._stop.is_set():
             parser = self._serve_requests(parser)
+            if self._listener is not None:
+                self._answer()
             master = self.master
             if not reads or master is None or self._deaf:
                 time.sleep(TICK if reads else max(0.0, min(TICK, next_talk - time.monotonic())))
@@ -276,6 +318,10 @@ class PtyRobot:
                     chunk = os.read(master, 4096)
                 except OSError:
                     chunk = b""
+                if not chunk and self._connection is not None:  # the PC closed the link
+                    with self._line:
+                        self._close()
+                    parser = FrameParser()
                 if not self._silent:
                     for data in parser.feed(chunk):
                         self._hear(data)

@@ -185,14 +185,20 @@ class RobotLink:
         self.limits.check(psi0_deg, zeta0)
         self._command(SetLeg(self._next_seq(), leg, psi0_deg, zeta0))
 
-    def estop(self, timeout: float = ESTOP_TIMEOUT) -> EstopResult:
-        """Emergency stop: repeat ESTOP every ESTOP_REPEAT until acknowledged or ``timeout`` [s].
+    # [s] estop()'s budget when it is given none: the service's. A class attribute, so that a test on a
+    # loaded machine, checking that an e-stop gets through rather than how fast, can widen it.
+    estop_timeout = ESTOP_TIMEOUT
+
+    def estop(self, timeout: float | None = None) -> EstopResult:
+        """Emergency stop: repeat ESTOP every ESTOP_REPEAT until acknowledged or ``timeout`` [s]
+        (default :attr:`estop_timeout`).
 
         Tried whatever the link believes (a link seen as lost may still reach the robot), and never
         raises: a blocked or closed port only ends the attempt sooner. Not acknowledged, the
         heartbeats stop, so the robot's own watchdog disarms it within its heartbeat timeout, and
         the heartbeat thread repeats this ESTOP every HEARTBEAT_PERIOD until it is acknowledged
         (then the link is e-stopped) or a reset. Either way the latch holds until a reset."""
+        timeout = self.estop_timeout if timeout is None else timeout
         started = time.monotonic()
         deadline = started + timeout
         write_by = deadline - WRITE_TIMEOUT  # a write started by then ends, even blocked, by the deadline

@@ -5,8 +5,10 @@ Set PARKOUR_SCREENSHOTS=1 to refresh docs/screenshots/ from this run.
 
 import io
 import json
+import os
 import re
 import socket
+import tempfile
 import time
 from pathlib import Path
 
@@ -1196,7 +1198,7 @@ def test_no_plot_offers_the_cloud(page):
 
 
 def _shot_xss(page, name, selector=None):
-    folder = Path("/tmp/xss_shots")
+    folder = Path(tempfile.gettempdir()) / f"xss_shots-{os.getpid()}"  # this run's: not another run's folder
     folder.mkdir(exist_ok=True)
     (page.locator(selector) if selector else page).screenshot(path=str(folder / f"{name}.png"))
 

@@ -4,6 +4,7 @@ stream gone with its client or its service, and a bound on how many are open."""
 
 import json
 import signal
+import socket
 import threading
 import time
 
@@ -32,11 +33,13 @@ def database_url():
 
 @pytest.fixture
 def served(settings, compute):
-    """``(base URL, app, auth headers)``: the app under a real uvicorn on a free port, in a thread."""
-    port = free_port()
+    """``(base URL, app, auth headers)``: the app under a real uvicorn, in a thread, on a socket bound
+    here to a port of its own (a port picked free and bound later may be taken in between)."""
+    listening = socket.create_server(("127.0.0.1", 0))
+    port = listening.getsockname()[1]
     app = create_app(settings, run_jobs=False, compute=compute)
     server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
-    thread = threading.Thread(target=server.run, name="uvicorn", daemon=True)
+    thread = threading.Thread(target=server.run, kwargs={"sockets": [listening]}, name="uvicorn", daemon=True)
     thread.start()
     deadline = time.monotonic() + 30
     while not server.started:
@@ -45,6 +48,7 @@ def served(settings, compute):
     yield f"http://127.0.0.1:{port}", app, {"Authorization": f"Bearer {app.state.token}"}
     server.should_exit = True
     thread.join(10)
+    listening.close()
     assert not thread.is_alive(), "uvicorn stopped (no stream was left open)"
 
 
@@ -108,8 +112,7 @@ def test_the_first_event_is_the_robot_now_and_the_stream_is_held_to_the_security
         assert refused.status_code == 400 and "host not allowed" in refused.json()["detail"]
 
 
-@pytest.mark.realtime
-def test_a_press_latches_in_the_stream_and_a_reset_releases_it(served, virtual):
+def test_a_press_latches_in_the_stream_and_a_reset_releases_it(served, virtual, patient_estop):
     base, _app, auth = served
     robot, tracker_port = virtual
     with _client() as client:

@@ -1,7 +1,11 @@
 """The e-stop latch through the API: it holds across a lost link, an automatic reconnect, a connect
-by hand and a service restart, until a RESET is acknowledged (issue 24's reproduction)."""
+by hand and a service restart, until a RESET is acknowledged (issue 24's reproduction).
 
-import socket
+The robot is on a socket line of its own (``PtyRobot(line="socket")``), not a pty: a ``/dev/pts/N``
+may be opened by another program on the machine (issue 40: a restart test beside another service's
+pty robot heard no telemetry), and nothing here is about serial devices.
+"""
+
 import time
 
 import pytest
@@ -9,12 +13,12 @@ from fastapi.testclient import TestClient
 
 from backend.api.app import create_app
 from backend.robot.messages import Kind, RobotState
-from tests.helpers import free_port
 from tests.robot_rig import PtyRobot, wait_for
 
 LOST_ON_THE_AIR = 0x21  # a Transmit Status: network ACK failure (the robot's radio did not take it)
 DELIVERED = 0x00
 SILENCE_S = 1.6  # [s] the robot out of range: longer than the link's 1 s heartbeat timeout
+ESTOP_REPEATS = 3  # the link's ESTOPs in a row, in place of heartbeats: more than one heartbeat period's worth
 
 
 @pytest.fixture
@@ -25,13 +29,13 @@ def database_url():
 @pytest.fixture
 def deaf_robot():
     """An armed robot behind a pty whose radio talks but loses every frame the PC sends."""
-    rig = PtyRobot(RobotState.ARMED, answers=True).start()
+    rig = PtyRobot(RobotState.ARMED, answers=True, line="socket").start()
     yield rig
     rig.stop()
 
 
 def _connect(client, auth, rig) -> dict:
-    body = {"url": rig.path, "tracker_port": free_port(socket.SOCK_DGRAM)}
+    body = {"url": rig.url, "tracker_port": 0}  # no tracker here: any free port, bound by the service
     response = client.post("/api/v1/robot/connect", json=body, headers=auth)
     assert response.status_code == 200, response.text
     return response.json()
@@ -41,7 +45,13 @@ def _kinds_since(rig, since: int) -> list[Kind]:
     return [getattr(message, "kind", None) for message in rig.sent[since:]]
 
 
-@pytest.mark.realtime
+def _estops_sent(rig, since: int) -> list[Kind]:
+    """What the PC sent from ``since`` on, once it has sent ESTOP_REPEATS ESTOPs: counted in frames,
+    not timed, so a loaded machine only makes the wait longer."""
+    wait_for(lambda: _kinds_since(rig, since).count(Kind.ESTOP) >= ESTOP_REPEATS, f"{ESTOP_REPEATS} ESTOPs sent")
+    return _kinds_since(rig, since)
+
+
 def test_an_unacknowledged_estop_holds_across_an_automatic_reconnect(client, auth, deaf_robot):
     rig = deaf_robot
     assert _connect(client, auth, rig)["state"] == "armed"
@@ -57,10 +67,8 @@ def test_an_unacknowledged_estop_holds_across_an_automatic_reconnect(client, aut
 
     status = client.get("/api/v1/robot").json()
     assert status["estop"]["latched"] is True and status["estop"]["acknowledged"] is False, status["estop"]
-    since = len(rig.sent)
-    time.sleep(0.5)
-    sent = _kinds_since(rig, since)
-    assert Kind.ESTOP in sent and Kind.HEARTBEAT not in sent, f"the latched ESTOP in place of heartbeats: {sent}"
+    sent = _estops_sent(rig, len(rig.sent))
+    assert Kind.HEARTBEAT not in sent, f"the latched ESTOP in place of heartbeats: {sent}"
     arm = client.post("/api/v1/robot/arm", headers=auth)
     assert arm.status_code == 409 and "latch holds" in arm.json()["detail"], arm.text
     run = client.post("/api/v1/robot/runs", json={"controls": [{"psi0_deg": 30, "zeta0": 0.9}] * 2}, headers=auth)
@@ -78,7 +86,6 @@ def test_an_unacknowledged_estop_holds_across_an_automatic_reconnect(client, aut
     assert client.post("/api/v1/robot/arm", headers=auth).status_code == 200
 
 
-@pytest.mark.realtime  # a connect waits up to 3 s for the robot's telemetry: wall-clock timing (failed under load)
 def test_a_held_latch_survives_a_connect_by_hand_and_a_service_restart(settings, compute, client, auth, deaf_robot):
     rig = deaf_robot
     _connect(client, auth, rig)
@@ -93,9 +100,10 @@ def test_a_held_latch_survives_a_connect_by_hand_and_a_service_restart(settings,
         assert restarted.get("/api/v1/robot").json()["estop"]["latched"] is True
         since = len(rig.sent)
         _connect(restarted, auth, rig)
-        time.sleep(0.3)
-        sent = _kinds_since(rig, since)
-        assert sent and set(sent) <= {Kind.ESTOP, Kind.DISARM}, f"the ESTOP first, never a heartbeat: {sent}"
+        sent = _estops_sent(rig, since)
+        assert sent[0] == Kind.ESTOP and set(sent) <= {Kind.ESTOP, Kind.DISARM}, (
+            f"the ESTOP first, never a heartbeat: {sent}"
+        )
         assert restarted.post("/api/v1/robot/arm", headers=auth).status_code == 409
         rig.delivery_status = DELIVERED
         wait_for(lambda: restarted.get("/api/v1/robot").json()["state"] == "estopped", "the robot e-stopped")

@@ -314,8 +314,7 @@ def test_transmit_status_is_not_the_robots_voice():
         rig.stop()
 
 
-@pytest.mark.realtime
-def test_the_virtual_radio_reports_every_frame_delivered(robot, link):
+def test_the_virtual_radio_reports_every_frame_delivered(robot, link, patient_estop):
     link.arm()
     assert link.estop().acknowledged
     counters = link.counters
@@ -330,7 +329,7 @@ def test_both_ends_of_the_virtual_radio_disable_nagle(robot, link):
         assert sock.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY)
 
 
-def test_a_telemetry_written_before_the_robot_latched_does_not_unstop_the_link(robot, link):
+def test_a_telemetry_written_before_the_robot_latched_does_not_unstop_the_link(robot, link, patient_estop):
     # Read after the ESTOP's acknowledgement, an ARMED telemetry the robot wrote before it latched
     # would move the link to armed until the next one (CI saw it in a garbage flood under load).
     link.arm()
@@ -355,8 +354,7 @@ def test_make_safe_disarms_whatever_the_link_believes(robot, link):
     assert link.make_safe() == LinkState.DISARMED and robot.firmware.state == RobotState.DISARMED
 
 
-@pytest.mark.realtime
-def test_make_safe_accepts_an_estopped_robot(robot, link):
+def test_make_safe_accepts_an_estopped_robot(robot, link, patient_estop):
     assert link.estop().acknowledged
     assert link.make_safe() == LinkState.ESTOPPED and robot.firmware.state == RobotState.ESTOPPED
 
@@ -555,8 +553,7 @@ def test_a_reboot_while_the_link_was_down_is_counted_on_reconnecting(robot, link
     assert link.transitions[-1].after == LinkState.DISARMED and link.transitions[-1].reason == link.last_restart
 
 
-@pytest.mark.realtime
-def test_a_robot_that_reboots_under_the_latch_is_estopped_again(robot, link):
+def test_a_robot_that_reboots_under_the_latch_is_estopped_again(robot, link, patient_estop):
     link.arm()
     assert link.estop().acknowledged
     robot.reboot()

@@ -3,6 +3,7 @@ URL names itself), the cadence it keeps with what it is handed, and a process th
 its service — closed, or killed outright — nor a Ctrl-C before the service's own shutdown."""
 
 import os
+import re
 import signal
 import socket
 import subprocess
@@ -85,17 +86,19 @@ def test_a_closed_port_refuses_to_write_and_reads_nothing():
     assert port.read() == b"" and not port.is_open and port.frames_out == 0 and port.pid is None
 
 
-@pytest.mark.parametrize(
-    ("url", "reason"),
-    [
-        ("socket://127.0.0.1:1", r"cannot open socket://127\.0\.0\.1:1: .*refused"),
-        ("/etc/hostname", "not a character device"),
-    ],
-)
-def test_a_port_that_cannot_be_opened_is_named_and_leaves_no_process(url, reason):
-    port = ProcessPort(url, 57_600, ROBOT_ADDRESS)
-    with pytest.raises(LinkError, match=reason):
-        port.open()
+@pytest.mark.parametrize("what", ["refused", "a regular file"])
+def test_a_port_that_cannot_be_opened_is_named_and_leaves_no_process(what, tmp_path):
+    with socket.socket() as bound:  # bound here and never listening: connections to it are refused
+        bound.bind(("127.0.0.1", 0))
+        if what == "refused":
+            url = f"socket://127.0.0.1:{bound.getsockname()[1]}"
+            reason = rf"cannot open {re.escape(url)}: .*refused"
+        else:
+            url, reason = str(tmp_path / "hostname"), "not a character device"
+            (tmp_path / "hostname").write_text("lab\n")
+        port = ProcessPort(url, 57_600, ROBOT_ADDRESS)
+        with pytest.raises(LinkError, match=reason):
+            port.open()
     assert not port.is_open and port.pid is None
 
 
@@ -137,7 +140,7 @@ def test_a_service_killed_outright_takes_its_radio_process_with_it_and_the_robot
         robot.stop()
 
 
-def test_the_link_through_a_radio_process_arms_commands_and_stops_the_robot():
+def test_the_link_through_a_radio_process_arms_commands_and_stops_the_robot(patient_estop):
     robot = VirtualRobot().start()
     link = RobotLink(robot.url, radio_process=True)
     try:

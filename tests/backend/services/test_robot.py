@@ -6,7 +6,6 @@ Through the API, tests/backend/api/routes/test_robot.py covers e-stop, a lost li
 import asyncio
 import io
 import logging
-import socket
 import threading
 import time
 
@@ -28,7 +27,7 @@ from backend.services.robot import ANSWER_WAIT, RobotUnavailable
 from backend.services.robot_records import replay_run, touchdown_results
 from backend.store.trajectory_blob import unpack_trajectory
 from sim_core import ParameterError, get_preset
-from tests.helpers import answer_within, free_port
+from tests.helpers import answer_within
 from tests.robot_rig import FOREIGN, LinkCalls, PtyRobot, Radio, received_frame, telemetry
 
 LEGS = [LegIn(psi0_deg=30.0, zeta0=0.87), LegIn(psi0_deg=30.0, zeta0=0.9)]  # [left, right]
@@ -210,7 +209,7 @@ def test_estop_ends_a_live_run_even_unacknowledged(service):
 def test_estop_on_a_jammed_line_answers_in_bound_and_honestly(service):
     rig = PtyRobot(RobotState.ARMED).start()
     try:
-        status = service.connect(RobotConnect(url=rig.path, tracker_port=free_port(socket.SOCK_DGRAM)))
+        status = service.connect(RobotConnect(url=rig.path, tracker_port=0))
         assert status["state"] == "armed"
         rig.jam()
         stopped = answer_within(ANSWER_BOUND_S, asyncio.run, service.estop_now())
@@ -254,7 +253,7 @@ def test_the_services_link_has_one_owner_while_it_flaps(service, monkeypatch, ca
     baseline = threading.active_count()
     radio = Radio(seed=3)
     robot = VirtualRobot("127.0.0.1", radio.port).start()
-    body = RobotConnect(url=radio.url, tracker_port=free_port(socket.SOCK_DGRAM))
+    body = RobotConnect(url=radio.url, tracker_port=0)
     assert answer_within(FLAP_ANSWER_S, service.connect, body)["state"] == "disarmed"
     robot.stop()
     radio.flap(FLAP_S)
@@ -328,8 +327,7 @@ def test_every_ending_disarms_the_robot(connected, virtual, session, end):
     assert run_store.get_run(session, run.run_id).results["disarm"] == "disarmed"
 
 
-@pytest.mark.realtime
-def test_an_estop_ending_leaves_the_robot_estopped(connected, virtual):
+def test_an_estop_ending_leaves_the_robot_estopped(connected, virtual, patient_estop):
     robot, _ = virtual
     _running(connected, connected.start_run(RobotRunCreate(controls=LEGS, jumps=1000)))
     assert connected.estop()["acknowledged"] is True

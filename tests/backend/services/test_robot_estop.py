@@ -60,7 +60,7 @@ def test_a_press_with_no_robot_connected_latches_and_the_next_connect_stops_the_
 
 @pytest.mark.parametrize("connected_robot", [False, True])
 def test_the_answer_waits_for_the_latch_file_never_the_robot_for_the_disk(
-    sessions, latch_path, virtual, monkeypatch, connected_robot
+    sessions, latch_path, virtual, monkeypatch, connected_robot, patient_estop
 ):
     """A slow disk: the robot is e-stopped before the file is written, and the answer comes after it
     (a kill -9 right after the answer found the latch released 4 times in 7)."""

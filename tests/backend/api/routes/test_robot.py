@@ -2,7 +2,6 @@
 but the e-stop, live runs recorded like simulated runs and safe to stop, the live view's stream."""
 
 import math
-import socket
 import threading
 import time
 
@@ -12,7 +11,7 @@ from starlette.websockets import WebSocketDisconnect
 from backend.api.app import REQUEST_THREADS
 from backend.robot.messages import RobotState
 from backend.robot.virtual import VirtualRobot
-from tests.helpers import answer_within, free_port
+from tests.helpers import answer_within
 from tests.robot_rig import PtyRobot
 
 POOL_THREADS = REQUEST_THREADS  # the request thread pool's
@@ -65,8 +64,7 @@ def test_robot_calls_need_the_token(client, virtual):
     assert client.get("/api/v1/robot").json()["state"] == "disconnected"
 
 
-@pytest.mark.realtime
-def test_estop_needs_no_token_and_reaches_the_robot(client, auth, connected):
+def test_estop_needs_no_token_and_reaches_the_robot(client, auth, connected, patient_estop):
     client.post("/api/v1/robot/arm", headers=auth)
     response = client.post("/api/v1/robot/estop")  # no token: stopping is always allowed
     assert response.status_code == 200, response.text
@@ -79,8 +77,7 @@ def test_estop_needs_no_token_and_reaches_the_robot(client, auth, connected):
     assert not released["latched"] and released["reset_by"] == "lab" and released["reset_at"] > 0
 
 
-@pytest.mark.realtime
-def test_estop_answers_while_the_request_pool_is_full(client, auth, connected, monkeypatch):
+def test_estop_answers_while_the_request_pool_is_full(client, auth, connected, monkeypatch, patient_estop):
     """45 stored-run requests hold every request thread (each waits inside the route, storing its
     run): the e-stop, async and on its own thread, answers all the same. Real compute under load:
     test_estop_load.py."""
@@ -125,7 +122,7 @@ def test_estop_without_a_robot_says_so(client):
 def test_estop_on_a_jammed_line_answers_without_hanging(client, auth):
     rig = PtyRobot(RobotState.ARMED).start()
     try:
-        body = {"url": rig.path, "tracker_port": free_port(socket.SOCK_DGRAM)}  # a pty, as socat gives one
+        body = {"url": rig.path, "tracker_port": 0}  # a pty, as socat gives one; no tracker: any free port
         response = client.post("/api/v1/robot/connect", json=body, headers=auth)
         assert response.status_code == 200 and response.json()["state"] == "armed", response.text
         rig.jam()
@@ -204,8 +201,7 @@ def test_a_live_run_is_filed_under_its_experiment_and_a_missing_one_moves_nothin
     assert client.get(f"/api/v1/runs/{status['run']['stored_run_id']}").json()["experiment_id"] == experiment
 
 
-@pytest.mark.realtime
-def test_estop_during_a_run_ends_it_and_keeps_the_data(client, auth, connected):
+def test_estop_during_a_run_ends_it_and_keeps_the_data(client, auth, connected, patient_estop):
     client.post("/api/v1/robot/runs", json={"controls": CONTROLS, "jumps": 1000}, headers=auth)
     _wait_for_touchdowns(client, 3)
     stopped = client.post("/api/v1/robot/estop").json()
