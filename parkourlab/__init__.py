@@ -15,8 +15,10 @@ from parkourlab.errors import (
     JobFailed,
     JobTimeout,
     NotFound,
+    NotReady,
     ParkourError,
     QueueFull,
+    ServiceUnavailable,
     ServiceUnreachable,
     Unauthorized,
 )
@@ -30,8 +32,10 @@ __all__ = [
     "JobFailed",
     "JobTimeout",
     "NotFound",
+    "NotReady",
     "ParkourError",
     "QueueFull",
+    "ServiceUnavailable",
     "ServiceUnreachable",
     "Unauthorized",
 ]

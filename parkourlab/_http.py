@@ -26,6 +26,11 @@ DATA_DIR_ENV = "PARKOUR_DATA_DIR"  # the service's own: its data directory holds
 TOKEN_FILE = "api_token"
 NO_TOKEN = f"this client has no token: pass Client(token=...) or set ${TOKEN_ENV} (<data dir>/{TOKEN_FILE})"
 CHUNK_BYTES = 1 << 16  # of a download, written as it comes
+# [s] The service bounds a call's computation at 60 s (backend/workers/pools.py, QUICK_TIMEOUT) and
+# then answers 503 saying so; a client that gave up at the same moment showed a bare ReadTimeout
+# instead of that message (issue 40). So the client waits longer than the service by default.
+DEFAULT_TIMEOUT = 90.0
+CONNECT_TIMEOUT = 10.0  # [s] to open a connection: a service that is not there fails fast
 
 
 def service_url(url: str | None) -> str:
@@ -85,15 +90,26 @@ class Http:
     ) -> None:
         self.url, self.token = url, token
         headers = {"X-Parkour-Client": name} | ({"Authorization": f"Bearer {token}"} if token else {})
-        self.client = httpx.Client(base_url=url, headers=headers, timeout=timeout, transport=transport)
+        limit = httpx.Timeout(timeout, connect=min(timeout, CONNECT_TIMEOUT))
+        self.client = httpx.Client(base_url=url, headers=headers, timeout=limit, transport=transport)
 
     def close(self) -> None:
         self.client.close()
 
-    def call(self, method: str, path: str, *, params: Mapping[str, Any] | None = None, body: Any = None) -> Any:
-        """``METHOD path`` with query ``params`` and JSON ``body``; the answer's JSON (None when empty)."""
+    def call(
+        self,
+        method: str,
+        path: str,
+        *,
+        params: Mapping[str, Any] | None = None,
+        body: Any = None,
+        timeout: float | None = None,
+    ) -> Any:
+        """``METHOD path`` with query ``params`` and JSON ``body``; the answer's JSON (None when empty).
+        ``timeout`` [s]: this call's, when shorter than the client's (a poll's)."""
+        limit = self.client.timeout if timeout is None else httpx.Timeout(timeout, connect=CONNECT_TIMEOUT)
         try:
-            response = self.client.request(method, path, params=query(params or {}), json=body)
+            response = self.client.request(method, path, params=query(params or {}), json=body, timeout=limit)
         except httpx.TransportError as error:
             raise self._unreachable(error) from error
         if response.is_error:
@@ -140,8 +156,10 @@ class Http:
         return target
 
     def _unreachable(self, error: httpx.TransportError) -> ServiceUnreachable:
-        if isinstance(error, httpx.TimeoutException):
-            reason = f"no answer in time ({type(error).__name__})"
+        if isinstance(error, httpx.ConnectTimeout):
+            reason = f"no connection within {CONNECT_TIMEOUT:g} s"
+        elif isinstance(error, httpx.TimeoutException):
+            reason = f"no answer within the client's timeout ({type(error).__name__})"
         elif isinstance(error, httpx.ConnectError) and "refused" in str(error).lower():
             reason = "connection refused"
         else:

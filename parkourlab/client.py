@@ -24,10 +24,11 @@ from typing import Any, Literal, Unpack
 import httpx
 
 from parkourlab import frames
-from parkourlab._http import Http, client_name, find_token, service_url
+from parkourlab._http import DEFAULT_TIMEOUT, Http, client_name, find_token, service_url
 from parkourlab.bodies import Leg, State, legs, mapping, present, state
 from parkourlab.jobs import JobCalls
 from parkourlab.types import RUN_FILTERS, Experiment, Page, Run, RunDetail, RunFilters
+from parkourlab.waiting import POLL_TIMEOUT, wait_until_ready
 
 RunSort = Literal[
     "-id", "id", "-created_at", "created_at", "-climb", "climb", "-zeta0", "zeta0", "-duration_s", "duration_s"
@@ -45,7 +46,10 @@ class Client(JobCalls):
     token: the bearer token for changes (create, edit, delete, submit, cancel); default
         ``$PARKOUR_API_TOKEN``, else — for a service on this machine only — the ``api_token`` file
         in ``$PARKOUR_DATA_DIR`` or ``./data``, as ``parkour serve`` writes it. Reads need none.
-    timeout: [s] for each HTTP request (not for :meth:`wait`, which has its own).
+    timeout: [s] for each HTTP request (not for :meth:`wait`, which has its own). The default, 90 s,
+        is longer than the 60 s the service gives a computation before it stops it and answers 503
+        saying so: that message reaches the script (:class:`~parkourlab.ServiceUnavailable`)
+        instead of a timeout of the client's own.
     name: who this client is to the service (the job queue gives each client a share); default
         ``python@<host>``.
     transport: an ``httpx`` transport to use instead of the network (tests).
@@ -58,7 +62,7 @@ class Client(JobCalls):
         url: str | None = None,
         *,
         token: str | None = None,
-        timeout: float = 60.0,
+        timeout: float = DEFAULT_TIMEOUT,
         transport: httpx.BaseTransport | None = None,
         name: str | None = None,
     ) -> None:
@@ -80,8 +84,21 @@ class Client(JobCalls):
 
     # The service -------------------------------------------------------------------------------
     def health(self) -> dict[str, Any]:
-        """``{"status": "ok", "database": "sqlite"|"postgresql", "code_version": …}``."""
+        """``{"status": "ok"|"warming", "warming": [pool, …], "database": "sqlite"|"postgresql",
+        "code_version": …, "notices": […]}``: ``warming`` while the service's workers for reads
+        and simulations are still loading, just after a start (docs/service.md, "Health")."""
         return self._http.call("GET", "/api/v1/health")
+
+    def wait_ready(self, *, timeout: float = 300.0, poll_interval: float = 0.5) -> dict[str, Any]:
+        """Wait until the service answers and its health is ``ok`` (its reads and simulations no
+        longer wait for workers loading); returns that health. ``timeout`` [s]: then
+        :class:`~parkourlab.NotReady`, naming what still warms. Each look is a short call: a
+        service not listening yet, or not answering one look, is looked at again."""
+
+        def look() -> dict[str, Any]:
+            return self._http.call("GET", "/api/v1/health", timeout=POLL_TIMEOUT)
+
+        return wait_until_ready(look, self.url, timeout=timeout, poll_interval=poll_interval)
 
     def controllers(self) -> list[dict[str, Any]]:
         """The closed-loop laws this service knows, in order: ``{"name", "summary", "sets_leg_angle"}``

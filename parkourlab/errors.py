@@ -79,6 +79,12 @@ class QueueFull(ApiError):
     says what is queued. Wait for jobs to finish (or cancel some) and submit again."""
 
 
+class ServiceUnavailable(ApiError):
+    """503: the service could not do it now, and says why in its message — its workers busy, or a
+    computation that passed the service's own time limit and was stopped. Try again shortly
+    (:meth:`parkourlab.Client.wait_ready` waits for a service that has just started)."""
+
+
 class InvalidRequest(ApiError, ValueError):
     """422: a field out of its range or of the wrong type; ``errors`` names each field and the
     API's message, with the bound it broke."""
@@ -91,6 +97,19 @@ class JobFailed(ParkourError):
         self.job = job
         why = f": {job['error']}" if job.get("error") else ""
         super().__init__(f"job {job['id']} ({job['kind']}) ended {job['state']}{why}")
+
+
+class NotReady(ParkourError, TimeoutError):
+    """:meth:`parkourlab.Client.wait_ready` ran out of time; ``health`` is the last answer (None if
+    the service never answered), ``timeout`` the seconds waited."""
+
+    def __init__(self, url: str, health: dict[str, Any] | None, timeout: float) -> None:
+        self.url, self.health, self.timeout = url, health, timeout
+        if health is None:
+            what = "it did not answer"
+        else:
+            what = f"still {health['status']} ({', '.join(health.get('warming') or ()) or 'nothing named'})"
+        super().__init__(f"the ParkourLab service at {url} was not ready after {timeout:g} s: {what}")
 
 
 class JobTimeout(ParkourError, TimeoutError):
@@ -118,7 +137,7 @@ _REASONS = {
     507: "storage full",
 }
 _CLASSES: dict[int, type[ApiError]] = {
-    401: Unauthorized, 404: NotFound, 409: Conflict, 422: InvalidRequest, 429: QueueFull,
+    401: Unauthorized, 404: NotFound, 409: Conflict, 422: InvalidRequest, 429: QueueFull, 503: ServiceUnavailable,
 }  # fmt: skip
 _LOCATIONS = ("body", "query", "path", "header")
 

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 from parkourlab import frames
 from parkourlab.bodies import Leg, State, legs, mapping, present, state
 from parkourlab.types import Job, JobResults, JobState
-from parkourlab.waiting import wait_for
+from parkourlab.waiting import POLL_TIMEOUT, wait_for
 
 if TYPE_CHECKING:
     from parkourlab._http import Http
@@ -231,9 +231,10 @@ class JobCalls:
         spec |= {"zeta0_high": zeta0_high, "rows": rows, "columns": columns, "transient": transient}
         return self.submit_job("atlas", **spec, model=mapping(model), experiment_id=experiment_id)
 
-    def job(self, job: JobRef) -> Job:
-        """A job's state now: ``state``, ``completed`` of ``total``, ``progress`` in [0, 1], ``error``."""
-        return self._http.call("GET", f"/api/v1/jobs/{job_id(job)}")
+    def job(self, job: JobRef, *, timeout: float | None = None) -> Job:
+        """A job's state now: ``state``, ``completed`` of ``total``, ``progress`` in [0, 1], ``error``.
+        ``timeout`` [s]: this call's, if not the client's."""
+        return self._http.call("GET", f"/api/v1/jobs/{job_id(job)}", timeout=timeout)
 
     def jobs(
         self, *, state: JobState | None = None, experiment_id: int | None = None, page_size: int = 200
@@ -259,8 +260,13 @@ class JobCalls:
         ``poll_interval`` [s] between looks. ``check``: a failed or cancelled job raises
         :class:`~parkourlab.JobFailed` (False: it is returned)."""
         ident = job_id(job)
+        # Each look a short call of its own: the wait is as long as the job, no request is.
         return wait_for(
-            lambda: self.job(ident), timeout=timeout, poll_interval=poll_interval, progress=progress, check=check
+            lambda: self.job(ident, timeout=POLL_TIMEOUT),
+            timeout=timeout,
+            poll_interval=poll_interval,
+            progress=progress,
+            check=check,
         )
 
     def results(self, job: JobRef) -> JobResults:

@@ -1,4 +1,5 @@
-"""Waiting for a job: poll its state until it is final, with a progress bar on a terminal."""
+"""Waiting by short looks, never one long call: for a job, its state until it is final, with a
+progress bar on a terminal; for a service just started, its health until it is ``ok``."""
 
 from __future__ import annotations
 
@@ -8,8 +9,10 @@ from collections.abc import Callable
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TaskProgressColumn, TextColumn, TimeElapsedColumn
 
-from parkourlab.errors import JobFailed, JobTimeout
+from parkourlab.errors import JobFailed, JobTimeout, NotReady, ServiceUnreachable
 from parkourlab.types import FINAL_JOB_STATES, Job
+
+POLL_TIMEOUT = 10.0  # [s] for one look at a job or at the service's health: a read of the store, milliseconds
 
 
 def wait_for(
@@ -53,3 +56,21 @@ def wait_for(
     if check and job["state"] != "done":
         raise JobFailed(job)
     return job
+
+
+def wait_until_ready(fetch: Callable[[], dict], url: str, *, timeout: float, poll_interval: float) -> dict:
+    """Call ``fetch`` (the service's health) every ``poll_interval`` [s] until it answers with status
+    ``ok``, and return that answer. A look that finds no service (not listening yet, or no answer
+    in time) is followed by another; past ``timeout`` [s], :class:`NotReady` with the last answer."""
+    deadline = time.monotonic() + timeout
+    health = None
+    while True:
+        try:
+            health = fetch()
+            if health["status"] == "ok":
+                return health
+        except ServiceUnreachable:
+            pass
+        if time.monotonic() >= deadline:
+            raise NotReady(url, health, timeout)
+        time.sleep(min(poll_interval, max(0.0, deadline - time.monotonic())))

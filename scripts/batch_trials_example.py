@@ -11,7 +11,7 @@ It talks to ``$PARKOUR_URL`` (default http://127.0.0.1:8000) with the token of
 
 from __future__ import annotations
 
-from parkourlab import Client
+from parkourlab import Client, ParkourError
 
 PSI0_DEG = 30.0  # leg angle at touchdown [deg]
 ZETA0S = [0.86, 0.88, 0.90, 0.92]  # leg length at touchdown [l0]: the energy levels swept
@@ -21,12 +21,21 @@ TAG = "batch-example"
 
 def main() -> None:
     with Client() as client:
+        client.wait_ready(timeout=300)  # [s] a service just started loads its workers first
         experiment = client.create_experiment("zeta0 batch", description="scripts/batch_trials_example.py")
-        for zeta0 in ZETA0S:
-            client.create_run(
-                [(PSI0_DEG, zeta0)], START, jumps=20, tags=[TAG, f"zeta0:{zeta0}"], experiment_id=experiment["id"]
+        try:
+            for zeta0 in ZETA0S:
+                client.create_run(
+                    [(PSI0_DEG, zeta0)], START, jumps=20, tags=[TAG, f"zeta0:{zeta0}"], experiment_id=experiment["id"]
+                )
+            job = client.submit_mjtf(
+                ZETA0S, psi0_deg=PSI0_DEG, trials=32, cap=300, seed=1, experiment_id=experiment["id"]
             )
-        job = client.submit_mjtf(ZETA0S, psi0_deg=PSI0_DEG, trials=32, cap=300, seed=1, experiment_id=experiment["id"])
+        except ParkourError:  # leave nothing behind: the runs made so far, then the experiment
+            for run in client.runs(experiment_id=experiment["id"]):
+                client.delete_run(run["id"])
+            client.delete_experiment(experiment["id"])
+            raise
         client.wait(job, progress=True, timeout=600)  # [s]
         mjtf = {level["zeta0"]: level for level in client.results(job)["levels"]}
 

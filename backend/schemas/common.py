@@ -107,7 +107,15 @@ class StateIn(Strict):
 
 
 class Health(BaseModel):
-    status: Literal["ok"]
+    status: Literal["ok", "warming"] = Field(
+        description="warming: just started, the workers that answer reads and simulations are still loading"
+        " (a request now waits for them); ok: they are ready"
+    )
+    warming: list[str] = Field(
+        default_factory=list,
+        description="the worker pools still loading: reads (the run list, exports), quick (simulations,"
+        " POST /runs), jobs (every job kind's kernels: jobs wait in the queue meanwhile, status stays ok)",
+    )
     database: str = Field(description="the database's dialect: sqlite or postgresql")
     code_version: str
     notices: list[str] = Field(

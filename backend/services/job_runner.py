@@ -12,8 +12,10 @@ lost and none duplicated (the unique key refuses a second copy). Sweeps, basins 
 are deterministic: they run whole through the chunk map, report progress per chunk, and store
 their result on the job when done; a restart recomputes them. Cancelling marks the job; the runner
 sees it within ``CANCEL_POLL`` and stops the worker at once (a chunk under way is dropped: its
-trials are not committed, and nothing else depends on it). On a full disk a job pauses: what it
-computed waits in memory and is committed when there is room again (:mod:`backend.services.storage_waits`);
+trials are not committed, and nothing else depends on it). A service stopping is seen as soon: the
+job stays running, for the next start to resume, and no queued job starts. On a full disk a job
+pauses: what it computed waits in memory and is committed when there is room again
+(:mod:`backend.services.storage_waits`);
 stopped meanwhile, it stays running and the next start resumes it. The jobs a crash left unfinished
 are settled on the runner's thread too, so a full disk never holds up the service's start.
 """
@@ -99,10 +101,12 @@ class JobRunner:
             return
         for job_id in unfinished:
             self.queue.put(job_id)
-        while (job_id := self.queue.get()) is not None:
+        # Stopping, the queued jobs stay queued: a job started now would start a job worker that
+        # the service, ending, might no longer stop.
+        while (job_id := self.queue.get()) is not None and not self._stopping.is_set():
             try:
                 self.run(job_id)
-            except Stopped:  # paused on a full disk at shutdown: still running, the next start resumes it
+            except Stopped:  # stopped mid-job (or paused on a full disk): still running, the next start resumes it
                 return
             except Exception as error:  # a job's failure is recorded; the runner goes on
                 log.exception("job %s failed", job_id)
@@ -241,7 +245,7 @@ class JobRunner:
 
     def _await(self, job_id: int, future: concurrent.futures.Future, progress: Callable | None = None):
         """The worker's result, looking every CANCEL_POLL for a cancel (then the worker is stopped
-        and Cancelled raised) and passing on the progress it reports."""
+        and Cancelled raised) or the service stopping (Stopped), and passing on the progress it reports."""
         while True:
             try:
                 return future.result(CANCEL_POLL)
@@ -250,6 +254,11 @@ class JobRunner:
             finally:
                 for done, total in self.pool.progress() if progress is not None else ():
                     progress(done, total)
+            if self._stopping.is_set():
+                # The service is stopping: the job stays running, and the next start resumes it.
+                # Waiting on would hold the shutdown up to stop()'s timeout, and the worker's end
+                # (the service stops its pools next) would fail the job as a dead worker.
+                raise Stopped
             if self._cancel_requested(job_id):
                 self.pool.restart(f"job {job_id} was cancelled")
                 raise Cancelled

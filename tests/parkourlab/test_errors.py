@@ -8,16 +8,17 @@ from parkourlab.errors import (
     InvalidRequest,
     NotFound,
     QueueFull,
+    ServiceUnavailable,
     Unauthorized,
     error_for,
     field_name,
 )
 
+STATUSES = [(401, Unauthorized), (404, NotFound), (409, Conflict), (422, InvalidRequest), (429, QueueFull),
+            (503, ServiceUnavailable), (500, ApiError)]  # fmt: skip
 
-@pytest.mark.parametrize(
-    ("status", "kind"),
-    [(401, Unauthorized), (404, NotFound), (409, Conflict), (422, InvalidRequest), (429, QueueFull), (503, ApiError)],
-)
+
+@pytest.mark.parametrize(("status", "kind"), STATUSES)
 def test_each_status_its_exception(status, kind):
     error = error_for(status, {"detail": "why"}, "GET /api/v1/x")
     assert type(error) is kind and error.status == status and error.detail == "why"

@@ -2,9 +2,12 @@
 
 from datetime import UTC, datetime
 
+import httpx
 import pytest
 
-from parkourlab._http import client_name, find_token, is_loopback, query, service_url
+from backend.workers.pools import QUICK_TIMEOUT
+from parkourlab import Client, ServiceUnavailable, ServiceUnreachable
+from parkourlab._http import DEFAULT_TIMEOUT, Http, client_name, find_token, is_loopback, query, service_url
 
 
 @pytest.fixture
@@ -65,3 +68,30 @@ def test_the_client_names_itself_as_the_header_allows(name, sent):
 
 def test_by_default_the_client_is_python_at_this_host():
     assert client_name(None).startswith("python@")
+
+
+def _answering(handler) -> Http:
+    return Http("http://lab-pc:8000", None, DEFAULT_TIMEOUT, httpx.MockTransport(handler), "test")
+
+
+def test_a_503_raises_with_the_services_own_message():
+    busy = "busy: 64 quick computations are waiting already; retry shortly"
+    http = _answering(lambda request: httpx.Response(503, json={"detail": busy}, headers={"Retry-After": "1"}))
+    with pytest.raises(ServiceUnavailable) as raised:
+        http.call("POST", "/api/v1/runs", body={})
+    assert raised.value.status == 503 and raised.value.detail == busy
+    assert str(raised.value) == f"POST /api/v1/runs: 503 service unavailable: {busy}"
+
+
+def test_the_client_waits_longer_than_the_service_gives_a_computation():
+    """Issue 40: both gave up at 60 s, and the script saw a ReadTimeout, not the service's 503."""
+    assert DEFAULT_TIMEOUT > QUICK_TIMEOUT
+    assert Client("http://lab-pc:8000")._http.client.timeout.read == DEFAULT_TIMEOUT
+
+
+def test_no_answer_in_time_is_unreachable_and_says_it_was_the_clients_timeout():
+    def slow(request):
+        raise httpx.ReadTimeout("timed out", request=request)
+
+    with pytest.raises(ServiceUnreachable, match=r"no answer within the client's timeout \(ReadTimeout\)"):
+        _answering(slow).call("GET", "/api/v1/runs")

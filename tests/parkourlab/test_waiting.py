@@ -1,13 +1,15 @@
 """parkourlab/waiting.py: a wait polls until the job is final, draws its bar only on a terminal,
-and stops at its timeout."""
+and stops at its timeout; a wait for the service until its health is ok."""
 
 import io
 
 import pytest
 from rich.console import Console
 
-from parkourlab.errors import JobFailed, JobTimeout
-from parkourlab.waiting import wait_for
+from parkourlab.errors import JobFailed, JobTimeout, NotReady, ServiceUnreachable
+from parkourlab.waiting import wait_for, wait_until_ready
+
+URL = "http://127.0.0.1:8000"
 
 
 def job(state: str, completed: int, total: int = 4) -> dict:
@@ -53,3 +55,27 @@ def test_failed_jobs_raise_unless_told_not_to():
     with pytest.raises(JobFailed, match="job 7 \\(mjtf\\) ended failed: worker died"):
         wait_for(states(failed), timeout=None, poll_interval=0, progress=False, check=True)
     assert wait_for(states(failed), timeout=None, poll_interval=0, progress=False, check=False) == failed
+
+
+def health(status: str, *warming: str) -> dict:
+    return {"status": status, "warming": list(warming), "database": "sqlite", "code_version": "x", "notices": []}
+
+
+def test_wait_until_ready_looks_again_at_a_service_not_up_or_warming():
+    def not_listening() -> dict:
+        raise ServiceUnreachable(URL, "connection refused")
+
+    answers = iter([not_listening, lambda: health("warming", "reads", "quick"), lambda: health("ok", "jobs")])
+    ready = wait_until_ready(lambda: next(answers)(), URL, timeout=60, poll_interval=0)
+    assert ready["status"] == "ok" and ready["warming"] == ["jobs"], "the job worker may still load"
+
+
+def test_wait_until_ready_times_out_naming_what_still_warms():
+    with pytest.raises(NotReady, match=r"not ready after 0.05 s: still warming \(quick\)"):
+        wait_until_ready(lambda: health("warming", "quick"), URL, timeout=0.05, poll_interval=0.01)
+
+    def never() -> dict:
+        raise ServiceUnreachable(URL, "connection refused")
+
+    with pytest.raises(NotReady, match="it did not answer"):
+        wait_until_ready(never, URL, timeout=0.05, poll_interval=0.01)

@@ -124,9 +124,13 @@ def swagger_init(request: Request) -> Response:
 
 @router.get("/api/v1/health", tags=["service"], response_model=schemas.Health)
 async def health(db: Db, request: Request) -> schemas.Health:
-    """Up, on which database; ``notices`` says what it waits for (a full disk: the writes that wait)."""
+    """Up, on which database; ``warming`` until the workers that answer reads and simulations have
+    loaded (``warming`` lists the pools still loading); ``notices`` says what it waits for (a full
+    disk: the writes that wait)."""
+    compute = request.app.state.compute
     return schemas.Health(
-        status="ok",
+        status="ok" if compute.ready() else "warming",
+        warming=compute.warming(),
         database=await db(ping),
         code_version=current_code_version(),
         notices=list(request.app.state.waiting.notices()),

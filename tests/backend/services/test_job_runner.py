@@ -232,3 +232,27 @@ def test_a_job_pauses_on_a_full_disk_and_goes_on_when_there_is_room(sessions, se
     done = job_now(sessions, job.id)
     assert (done.state, done.completed, len(failures)) == ("done", 20, 2)
     assert len(stored_trials(session, job.id)) == 20 and "paused" in caplog.text and "goes on" in caplog.text
+
+
+def test_a_stopping_service_leaves_the_running_job_to_resume_and_starts_no_other(sessions, session, compute):
+    """Issue 40: stopped mid-chunk, the runner ended only at stop()'s timeout, the job worker's end
+    failed the running job, and the queued one then started a fresh worker that outlived the
+    service. Now stop() returns within a look or two, the running job stays running (the next start
+    resumes it) and the queued one stays queued."""
+    runner = job_runner.JobRunner(sessions, compute.jobs, chunk_trials=20_000)
+    long_job = jobs.create_job(session, MJTFJobCreate(zeta0s=[0.9], trials=20_000, cap=20_000, seed=1, guess=GUESS))
+    queued = jobs.create_job(session, MJTFJobCreate(**SMALL))
+    runner.start()
+    try:
+        runner.submit(long_job.id)
+        runner.submit(queued.id)
+        wait_until(sessions, long_job.id, lambda j: j.state == "running")
+        time.sleep(0.5)  # the chunk is in the worker
+        asked = time.monotonic()
+        runner.stop(timeout=WAIT_S)
+        took = time.monotonic() - asked
+        assert not runner.thread.is_alive() and took < 5.0, f"stop took {took:.1f} s (the runner looks every 0.2 s)"
+        assert job_now(sessions, long_job.id).state == "running", "left for the next start to resume"
+        assert job_now(sessions, queued.id).state == "queued"
+    finally:
+        compute.jobs.restart("the test's long chunk")  # the service stops its pools after the runner

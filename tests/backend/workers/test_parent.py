@@ -46,3 +46,27 @@ pool = ComputePool("orphaned")
 print(pool.run(os.getpid, timeout=60), flush=True)
 time.sleep(600)
 """
+
+
+def test_a_worker_that_starts_after_its_service_is_gone_ends_at_once():
+    """Issue 40: a worker spawned as the service ended was re-parented before it looked, took its
+    new parent for the service, and waited for ever. The service's pid comes from the service."""
+    gone = subprocess.Popen([sys.executable, "-c", "pass"])
+    gone.wait()  # a process id that is no one's parent now
+    worker = subprocess.Popen(
+        [sys.executable, "-c", LATE_WORKER.format(parent=gone.pid)], cwd=Path(__file__).parents[3]
+    )
+    try:
+        assert worker.wait(10 * PARENT_CHECK_S + 10) == 0, "it ended by itself"
+    except subprocess.TimeoutExpired:
+        worker.kill()
+        worker.wait()
+        pytest.fail("a worker whose service was gone as it started did not end")
+
+
+LATE_WORKER = """
+import time
+from backend.workers.parent import watch_parent
+watch_parent({parent})
+time.sleep(600)
+"""

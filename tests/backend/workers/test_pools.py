@@ -2,6 +2,7 @@
 dead or stopped worker is replaced."""
 
 import asyncio
+import functools
 import os
 import signal
 import time
@@ -138,3 +139,35 @@ def test_the_service_pools_take_the_warm_ups_they_are_handed():
     compute = Compute(warm_up=_warm_up, reads_warm_up=_was_warmed)  # no process starts until a call
     assert compute.quick.warm_up is compute.jobs.warm_up is _warm_up and compute.reads.warm_up is _was_warmed
     assert (compute.quick.workers, compute.jobs.workers, compute.reads.workers) == (1, 1, 2)
+
+
+def test_a_pool_is_warming_until_its_warm_up_has_run():
+    pool = ComputePool("warming", warm_up=functools.partial(_sleep, 0.5))
+    try:
+        assert not pool.warming, "never warmed: nothing to wait for"
+        pool.warm()
+        assert pool.warming, "a worker's start alone takes longer than this look"
+        pool.run(_pid, timeout=WAIT_S)  # one worker: the call runs after the warm-up
+        assert not pool.warming
+    finally:
+        pool.close()
+
+
+def test_the_service_is_ready_once_its_request_pools_are_warm_and_the_job_worker_warms_after():
+    """The job worker's warm-up (every job kind's kernels) starts once the quick pool is warm: at
+    the same time, it took the cores the requests' pools load on."""
+    compute = Compute(warm_up=functools.partial(_sleep, 0.5), reads_warm_up=_warm_up, jobs_warm_up=_warm_up)
+    try:
+        assert compute.ready() and compute.warming() == []
+        compute.warm()
+        assert not compute.ready() and "quick" in compute.warming() and "jobs" not in compute.warming()
+        compute.quick.run(_pid, timeout=WAIT_S)
+        compute.reads.run(_pid, timeout=WAIT_S)
+        compute.reads.run(_pid, timeout=WAIT_S)
+        deadline = time.monotonic() + WAIT_S
+        while not compute.ready() or compute.warming():  # the reads' second worker; the job worker's turn
+            assert time.monotonic() < deadline, compute.warming()
+            time.sleep(0.05)
+        assert compute.jobs.run(_was_warmed, timeout=WAIT_S) is True, "the job worker was warmed"
+    finally:
+        compute.close()

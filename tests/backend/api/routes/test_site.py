@@ -72,3 +72,26 @@ def test_api_answers_are_not_compressed(client):
 )  # fmt: skip
 def test_which_clients_take_gzip(header, takes):
     assert takes_gzip(header) is takes
+
+
+class _Warming:
+    """The service's pools as just after a start: the reads and the job worker still loading."""
+
+    def ready(self) -> bool:
+        return False
+
+    def warming(self) -> list[str]:
+        return ["reads", "jobs"]
+
+
+def test_health_says_warming_and_what_until_the_request_pools_are_warm(client):
+    state = client.app.state
+    pools, state.compute = state.compute, _Warming()
+    try:
+        health = client.get("/api/v1/health")
+    finally:
+        state.compute = pools
+    assert health.status_code == 200, "up and answering: a start-up probe passes"
+    assert (health.json()["status"], health.json()["warming"]) == ("warming", ["reads", "jobs"])
+    never_warmed = client.get("/api/v1/health").json()  # the tests' pools: nothing to wait for
+    assert never_warmed["status"] == "ok" and never_warmed["warming"] == []
