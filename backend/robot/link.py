@@ -185,13 +185,10 @@ class RobotLink:
         self.limits.check(psi0_deg, zeta0)
         self._command(SetLeg(self._next_seq(), leg, psi0_deg, zeta0))
 
-    # [s] estop()'s budget when it is given none: the service's. A class attribute, so that a test on a
-    # loaded machine, checking that an e-stop gets through rather than how fast, can widen it.
-    estop_timeout = ESTOP_TIMEOUT
+    estop_timeout = ESTOP_TIMEOUT  # [s] estop()'s default; a test of reaching, not of speed, widens it
 
     def estop(self, timeout: float | None = None) -> EstopResult:
-        """Emergency stop: repeat ESTOP every ESTOP_REPEAT until acknowledged or ``timeout`` [s]
-        (default :attr:`estop_timeout`).
+        """Emergency stop: repeat ESTOP every ESTOP_REPEAT until acknowledged or ``timeout`` [s] (or estop_timeout).
 
         Tried whatever the link believes (a link seen as lost may still reach the robot), and never
         raises: a blocked or closed port only ends the attempt sooner. Not acknowledged, the

@@ -12,9 +12,8 @@ telemetry (:meth:`RobotLink.make_safe`). An open loop goes on through tracker ga
 Only the loop's thread writes the run's records. Everyone else sees them two ways, neither of
 which shares anything mutable: :attr:`LiveRun.snapshot`, an immutable :class:`RunSnapshot`
 replaced whole after every change (the panel, the live 3D view), and :attr:`LiveRun.journal`, a
-queue of :class:`Record` s — each appended record, once, in order — that the run's journal writer
-drains to the store (:mod:`backend.services.robot_journal`).
-"""
+queue of :class:`Record` s — each appended record, once, in order — that the journal writer drains
+(:mod:`backend.services.robot_journal`)."""
 
 from __future__ import annotations
 
@@ -44,10 +43,9 @@ __all__ = ["CLEAN_ENDINGS", "LiveRun", "Record", "RunSnapshot", "end_safely", "e
 class Record:
     """One thing the run recorded, for its journal: ``kind`` is ``touchdown`` (``value`` is the
     :class:`Touchdown` and the :class:`LegControl` it was made with), ``command``, ``telemetry`` or
-    ``tracker_gap`` (a dict); ``value`` is never changed after it is made. A command and a telemetry
-    carry two stamps: ``time``, Unix [s], and ``tracker_time``, the tracker's time [s] of the
-    newest of the run's frames received then (None before its first): the recording places them by
-    the latter (:mod:`backend.services.mcap_clock`)."""
+    ``tracker_gap`` (a dict); ``value`` is never changed after it is made. A command or telemetry has
+    ``time`` (Unix [s]) and ``tracker_time`` (of the run's newest frame then, or None), which places
+    it in a recording (:mod:`backend.services.mcap_clock`)."""
 
     kind: str
     value: object
