@@ -11,7 +11,7 @@ from __future__ import annotations
 import datetime
 from collections.abc import Iterable
 
-from sqlalchemy import func, select, update
+from sqlalchemy import Text, cast, func, select, update
 from sqlalchemy.orm import Session
 
 from backend.repositories.common import fetch, newest_first, page
@@ -85,10 +85,17 @@ def recover_interrupted(session: Session) -> None:
     )
 
 
-def unfinished(session: Session) -> list[Job]:
-    """The jobs queued, running or cancelling, oldest first (the queue, bounded by its budget)."""
+# What the queue's room and standings read of each unfinished job, every submission: rows of these
+# columns, the spec as its stored text (what it costs is worked out once per text: job_queue.py).
+QUEUED_COLUMNS = (Job.id, Job.kind, Job.state, Job.total, Job.completed, Job.submitted_by,
+                  cast(Job.spec, Text).label("spec"))  # fmt: skip
+
+
+def unfinished(session: Session) -> list:
+    """The jobs queued, running or cancelling, oldest first (the queue, bounded by its budget), as
+    rows of :data:`QUEUED_COLUMNS` (``row.id``, ``row.spec``: JSON text ...)."""
     waiting = (JobState.QUEUED, JobState.RUNNING, JobState.CANCELLING)
-    return list(session.scalars(select(Job).where(Job.state.in_(waiting)).order_by(Job.id)))
+    return list(session.execute(select(*QUEUED_COLUMNS).where(Job.state.in_(waiting)).order_by(Job.id)))
 
 
 def done_mark(session: Session) -> tuple[int, int]:

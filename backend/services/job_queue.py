@@ -16,6 +16,8 @@ its worst case, at the job worker's rate).
 
 from __future__ import annotations
 
+import functools
+import json
 from collections.abc import Iterable
 from dataclasses import dataclass
 
@@ -55,11 +57,27 @@ def _share_left(job: Job) -> float:
     return max(job.total - job.completed, 0) / job.total
 
 
-def _worst(job: Job) -> int:
+def _measures(job: Job) -> tuple[int, str]:
+    """A job's work at its worst [jumps] and its :func:`~backend.services.job_estimates.spec_key`;
+    ``job.spec`` is the stored JSON text (:func:`~backend.repositories.jobs.unfinished`) or a dict."""
+    text = job.spec if isinstance(job.spec, str) else json.dumps(job.spec, sort_keys=True)
+    return _measures_of_text(job.kind, text)
+
+
+@functools.lru_cache(maxsize=4096)
+def _measures_of_text(kind: str, text: str) -> tuple[int, str]:
+    # Once per spec text, not per job and request: each submission measures every unfinished job,
+    # and decoding 300 queued specs twice took a submission from 2.5 to 15 ms (scripts/bench_job_submit.py).
+    spec = json.loads(text)
     try:
-        return worst_case_jumps(decode(job.spec))[0]
+        worst = worst_case_jumps(decode(spec))[0]
     except UnreadableSpec:
-        return 0  # a spec of another version of the code: it will fail when it runs, taking no time
+        worst = 0  # a spec of another version of the code: it will fail when it runs, taking no time
+    return worst, job_estimates.spec_key(kind, spec)
+
+
+def _worst(job: Job) -> int:
+    return _measures(job)[0]
 
 
 def work_left(job: Job) -> int:
@@ -72,9 +90,10 @@ def check_room(session: Session, body, person: str) -> None:
     of it, has no room for its work at its worst, or ``person`` has as many jobs waiting as one may."""
     unfinished = stored_jobs.unfinished(session)
     wanted, _ = worst_case_jumps(body)
-    queued = sum(work_left(job) for job in unfinished)
+    left = {job.id: work_left(job) for job in unfinished}
+    queued = sum(left.values())
     waiting = sum(job.state == JobState.QUEUED for job in unfinished)
-    mine = sum(work_left(job) for job in unfinished if job.submitted_by == person)
+    mine = sum(left[job.id] for job in unfinished if job.submitted_by == person)
     my_waiting = sum(job.state == JobState.QUEUED and job.submitted_by == person for job in unfinished)
     share = int(PERSON_SHARE * QUEUE_BUDGET_JUMPS)
     ahead = f"{len(unfinished)} jobs unfinished, {_jumps(queued)} of work ({_hours(queued)})"
@@ -111,14 +130,15 @@ def standings_of(unfinished: Iterable[Job], paces: Paces | None = None) -> dict[
     each kind's typical one)."""
     paces = Paces() if paces is None else paces
     unfinished = list(unfinished)
-    worst = {job.id: _worst(job) for job in unfinished}
+    measures = {job.id: _measures(job) for job in unfinished}
 
     def left(job: Job) -> tuple[float, float]:  # (expected, at the latest) [s] of what it has still to do
         share = _share_left(job)
-        expected = share * paces.expected_seconds(job.kind, worst[job.id], job_estimates.spec_key(job.kind, job.spec))
+        worst, key = measures[job.id]
+        expected = share * paces.expected_seconds(job.kind, worst, key)
         # "At the latest" is never sooner than expected: a kind whose jumps cost more than the map's
         # (a closed loop's law) runs slower than the worker's rate on its worst case.
-        return expected, max(share * worst[job.id] / JOB_RATE_JUMPS_PER_S, expected)
+        return expected, max(share * worst / JOB_RATE_JUMPS_PER_S, expected)
 
     started = [job for job in unfinished if job.state != JobState.QUEUED]  # running (or cancelling)
     expected = sum(left(job)[0] for job in started)
