@@ -15,6 +15,7 @@ from fastapi import Depends, Header, HTTPException, Query, Request, status
 from fastapi import Path as FastAPIPath
 from fastapi.concurrency import run_in_threadpool
 from fastapi.exceptions import RequestValidationError
+from pydantic import Field
 from sqlalchemy.orm import Session, sessionmaker
 
 from backend import schemas
@@ -30,6 +31,7 @@ from backend.workers.store_reads import StoreReads
 from sim_core.control.registry import NAMES
 
 T = TypeVar("T")
+MAX_FILTER_IDS = 1000  # runs named at once in a filter (History's basket holds 50)
 VIEW_NOT_STARTED = "the 3D view is not running (it starts with `parkour serve`)"
 
 
@@ -89,6 +91,10 @@ async def run_filter(
             description=f"text in the notes or a tag (any case), at least {MIN_SEARCH} characters; blank: no search",
         ),
     ] = None,
+    ids: Annotated[
+        list[Annotated[int, Field(ge=1, le=schemas.MAX_ID)]] | None,
+        Query(max_length=MAX_FILTER_IDS, description="only these runs (a basket): ids=3&ids=7"),
+    ] = None,
     zeta0_min: Annotated[float | None, Query(ge=0.0, le=1.0, allow_inf_nan=False)] = None,
     zeta0_max: Annotated[float | None, Query(ge=0.0, le=1.0, allow_inf_nan=False)] = None,
     psi0_min: Annotated[float | None, Query(ge=0.0, le=90.0, allow_inf_nan=False)] = None,
@@ -117,6 +123,7 @@ async def run_filter(
         created_after=created_after,
         created_before=created_before,
         q=q,
+        ids=tuple(sorted(set(ids))) if ids else None,
     )
 
 

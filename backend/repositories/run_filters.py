@@ -28,7 +28,7 @@ class RunFilter:
     inclusive; ``created_before`` is exclusive. ``end_reason`` matches a reason as stored or every
     reason of its kind ("error" matches "error: …"); ``q`` is text found in a run's notes or in one
     of its tags, case-insensitively, at least :data:`MIN_SEARCH` characters (what an index of
-    trigrams finds; a shorter one is a ValueError)."""
+    trigrams finds; a shorter one is a ValueError); ``ids`` keeps only the runs named (a basket)."""
 
     experiment_id: int | None = None
     kind: str | None = None
@@ -45,6 +45,7 @@ class RunFilter:
     created_after: datetime.datetime | None = None
     created_before: datetime.datetime | None = None
     q: str | None = None
+    ids: tuple[int, ...] | None = None  # these runs only (a basket)
 
     def __post_init__(self):
         if self.q is not None and len(self.q) < MIN_SEARCH:
@@ -149,10 +150,12 @@ _CONDITIONS = {
     "created_before": lambda v: Run.created_at < v,
     "tag": _tagged,
     "q": _search,
+    "ids": lambda v: Run.id.in_(v),
 }
 _READ_TAGS = frozenset({"tag", "q"})  # the criteria that read run_tags: they take how (runs_tagged) too
 _BOUND: dict = {}  # a criterion's value as its condition takes it, where not as given
 _TYPED = {"end_reason": String, "q": String}  # bindparams whose type a concatenation or LIKE needs
+_EXPANDING = frozenset({"ids"})  # bindparams of a list of values (IN)
 
 
 def bound_values(where: RunFilter) -> dict:
@@ -181,7 +184,7 @@ def where_criteria(query: Select, criteria: tuple[str, ...], *, since: bool = Fa
     first_id = bindparam("since", type_=Integer) if since else None
     runs_tagged = _among_tagged_since(first_id) if since else _among_tagged
     for criterion in criteria:
-        value = bindparam(criterion, type_=_TYPED.get(criterion))
+        value = bindparam(criterion, type_=_TYPED.get(criterion), expanding=criterion in _EXPANDING)
         if criterion == "q":
             query = query.where(_search(value, runs_tagged, first_id))
         elif criterion in _READ_TAGS:

@@ -2,7 +2,7 @@
 // parameter-vs-outcome plot. It outlives pages and filters (a run stays in it until removed), and
 // the address bar names it (history_view.js), so a link brings it back. Every value from the API
 // reaches the page as text (dom.js).
-import { $, say, call, on } from "./api.js";
+import { API, $, say, call, on } from "./api.js";
 import { element, attributes } from "./dom.js";
 import { PLOT_CONFIG, layout } from "./plots.js";
 
@@ -15,6 +15,8 @@ export function onBasketChange(callback) { changed = callback; }
 export const basketIds = () => [...runs.keys()];
 export const basketRuns = () => [...runs.values()];
 export const inBasket = (id) => runs.has(id);
+// The basket as run filters (``ids=3&ids=7``): its export and grouping are of these runs alone.
+export const basketQuery = () => new URLSearchParams(basketIds().map((id) => ["ids", String(id)]));
 
 export function addRun(run) {
   if (runs.has(run.id)) { runs.set(run.id, run); return true; }
@@ -87,6 +89,8 @@ function draw() {
     attributes(element("button", "×"), { type: "button", class: "basket-remove", "data-run": run.id,
       "aria-label": `remove run ${run.id} from the basket`, title: "remove from the basket" }))));
   $("#basket-empty").hidden = list.length > 0;
+  $("#basket-export").hidden = $("#basket-group").hidden = !list.length;
+  $("#basket-export").href = `${API}/runs/export?format=csv&${basketQuery()}`;  // the basket, not the filter
   box.dataset.count = String(list.length);
   drawPlot();
 }

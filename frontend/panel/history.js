@@ -8,7 +8,7 @@ import { selectTab } from "./tabs.js";
 import { element, fillTable, attributes } from "./dom.js";
 import { VIEWER } from "./view.js";
 import { FILTERS, COLUMNS, readView, showView } from "./history_view.js";
-import { addRun, removeRun, refreshRun, inBasket, basketIds, basketRuns, onBasketChange, restoreBasket } from "./basket.js";
+import { addRun, removeRun, refreshRun, inBasket, basketIds, basketRuns, basketQuery, onBasketChange, restoreBasket } from "./basket.js";
 import { loadExperiments, onExperimentRuns, showExperiment, closeExperiment } from "./experiment.js";
 import { GROUP_BY, showAggregate, hideAggregate } from "./aggregate.js";
 import { cell, controlsText, endingBadge, jumpsCell, statusCell, targetText } from "./run_cells.js";
@@ -122,7 +122,7 @@ export async function loadRuns() {
   showPager(page.items.length, page.total);
   showSort();
   remember();
-  if (view.by) await showAggregate(filterQuery(), view.by, view.bins);
+  if (view.by) await showAggregate(groupQuery(), view.by, view.bins);
 }
 
 function showPager(count, total) {
@@ -201,8 +201,16 @@ onExperimentRuns((id) => {
   return again();
 });
 
-// Runs grouped by a parameter, over the runs the filters select (aggregate.js).
+// Runs grouped by a parameter, over the runs the filters select or the basket's (aggregate.js).
+let groupingBasket = false;
+const groupQuery = () => (groupingBasket ? basketQuery() : filterQuery());
+on("#basket-group", "click", () => {
+  groupingBasket = true;
+  $("#aggregate-box").hidden = false;
+  $("#aggregate-box").scrollIntoView({ block: "nearest" });
+});
 on("#group-runs", "click", () => {
+  groupingBasket = false;
   $("#aggregate-box").hidden = false;
   $("#aggregate-box").scrollIntoView({ block: "nearest" });
 });
@@ -211,7 +219,7 @@ on("#aggregate-form", "submit", async (event) => {
   view.by = $("#aggregate-by").value;
   view.bins = String(new FormData(event.target).get("bins") || "").trim();
   remember();
-  await showAggregate(filterQuery(), view.by, view.bins);
+  await showAggregate(groupQuery(), view.by, view.bins);
 });
 on("#aggregate-close", "click", () => {
   view.by = view.bins = "";

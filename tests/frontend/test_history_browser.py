@@ -343,3 +343,24 @@ def test_the_basket_plots_a_parameter_against_an_outcome_and_compares(page):
     page.click("#basket-clear")
     assert _basket(page) == [] and page.is_hidden("#basket-plot-box")
     page.select_option("#history-form select[name=kind]", "")
+
+
+def test_the_basket_exports_and_groups_its_own_runs_not_the_filters(page, service):
+    """Issue 40: CSV export and Group followed the filter (400 rows for a 4-run basket)."""
+    base = service[0]
+    page.click("nav [data-tab=history]")
+    page.click("#basket-clear")
+    assert page.is_hidden("#basket-export") and page.is_hidden("#basket-group")
+    until(page, f"{RANGE}.startsWith('runs 1–50 of {RUNS + 16:,} ')")
+    chosen = _shown_ids(page)[:4]
+    for run_id in chosen:
+        page.check(f"#run-{run_id} input[type=checkbox]")
+    link = page.get_attribute("#basket-export", "href")
+    exported = httpx.get(f"{base}{link}").text.splitlines()
+    assert len(exported) == 1 + 4 and sorted(int(row.split(",")[0]) for row in exported[1:]) == sorted(chosen)
+    page.click("#basket-group")
+    page.select_option("#aggregate-by", "kind")
+    page.click("#aggregate-go")
+    until(page, "document.querySelector('#aggregate-table caption').textContent.startsWith('4 runs grouped')")
+    page.click("#aggregate-close")
+    page.click("#basket-clear")

@@ -73,6 +73,22 @@ def test_export_csv_and_json(client, auth):
     assert client.get("/api/v1/runs/export", params={"format": "xml"}).status_code == 422
 
 
+def test_a_basket_exports_groups_and_lists_by_its_ids(client, auth):
+    """Issue 40: CSV export and Group followed the filter (400 rows for a 4-run basket)."""
+    ids = _seed_runs(client, auth)
+    basket = [ids[2], ids[0]]
+    exported = client.get("/api/v1/runs/export", params={"format": "csv", "ids": basket})
+    assert sorted(int(row["id"]) for row in csv.DictReader(io.StringIO(exported.text))) == sorted(basket)
+    grouped = client.get("/api/v1/runs/aggregate", params={"by": "zeta0", "ids": basket}).json()
+    assert sum(group["runs"] for group in grouped["groups"]) == 2
+    assert sorted(_listed(client, ids=basket)) == sorted(basket) and _listed(client, ids=basket, tag="low") == [ids[0]]
+    for _ in range(2):  # the second time from the read worker's kept statement
+        page = client.get("/api/v1/runs", params={"ids": [ids[1], ids[2]], "sort": "-climb"}).json()
+        assert page["total"] == 2 and sorted(run["id"] for run in page["items"]) == [ids[1], ids[2]]
+    too_many = client.get("/api/v1/runs", params={"ids": list(range(1, 1002))})
+    assert too_many.status_code == 422 and too_many.json()["detail"][0]["loc"] == ["query", "ids"]
+
+
 def test_a_robot_run_downloads_as_mcap(client, auth):
     with client.app.state.sessions() as session:
         robot_run = store_robot_run(session)
