@@ -14,6 +14,7 @@ import "./connect.js";
 import "./simulate.js";
 import { showView } from "./view.js";
 import { fillChoosers } from "./catalog.js";
+import { watchWarming } from "./warming.js";
 
 initTabs((name) => {
   if (name === "history") loadExperiments().then(loadRuns).then(loadCalibrations).catch(() => {});
@@ -24,3 +25,4 @@ initTabs((name) => {
 });
 // The choosers are filled first: a link to a History view may choose a controller.
 fillChoosers().catch(() => {}).then(() => restoreView()).catch(() => {});  // a link to a History view (?tab=history&…) opens it
+watchWarming();  // "warming up" while the service's workers load after a start

@@ -264,3 +264,29 @@ def test_a_rule_across_fields_is_said_in_the_forms_labels_at_the_field(page):
     until(page, "document.querySelector('#job-form .field-error') !== null")
     marked = page.evaluate("document.querySelector('#job-form .field-error').textContent")
     assert '("controllers" x "trials" x "jumps per trial")' in marked and "seeds" not in marked, marked
+
+
+def test_a_warming_service_is_said_until_it_is_ready(browser, service):
+    """Issue 40: right after a start the first pages took seconds with nothing said. The panel
+    asks GET /health: while it says "warming", the banner says so (naming what loads), and it
+    says when the service is ready."""
+    base, _ = service
+    answers = iter([{"status": "warming", "warming": ["reads", "quick"]}] * 3)
+
+    def health(route):
+        answer = next(answers, None)
+        if answer is None:
+            route.continue_()  # the service's own: ok by now
+        else:
+            route.fulfill(json=answer | {"database": "sqlite", "code_version": "x", "notices": []})
+
+    context = browser.new_context()
+    context.route("**/api/v1/health", health)
+    page = context.new_page()
+    try:
+        page.goto(f"{base}/panel/")
+        until(page, f"{BANNER}.startsWith('The service is warming up (History')")
+        assert "History's reads, simulations" in page.inner_text("#messages")
+        until(page, f"{BANNER} === 'The service is ready.'")
+    finally:
+        context.close()
