@@ -60,7 +60,7 @@ export function queueWords(job) {
 export function submitterWords(job) {
   if (typeof job.submitted_by !== "string" || !job.submitted_by) return "";
   const via = typeof job.submitted_via === "string" && job.submitted_via ? ` via ${job.submitted_via}` : "";
-  return `by ${job.submitted_by}${via}`;
+  return `${job.submitted_by}${via}`;
 }
 
 function jobRow(job) {
@@ -69,10 +69,9 @@ function jobRow(job) {
   if (job.error) state.title = job.error;
   const cancel = ["queued", "running"].includes(job.state) ? [attributes(element("button", "Cancel"), { class: "cancel", "data-id": job.id })] : [];
   const queue = queueWords(job);
-  const by = submitterWords(job);
-  const what = attributes(element("td", describeJob(job), ...(by ? [attributes(element("small", by), { class: "by" })] : [])), { class: "what" });
   const row = element("tr", null,
-    element("td", String(job.id)), element("td", job.kind), what, state,
+    element("td", String(job.id)), element("td", job.kind), attributes(element("td", describeJob(job)), { class: "what" }),
+    attributes(element("td", submitterWords(job)), { class: "by" }), state,
     attributes(element("td", null, progress, ` ${job.completed}/${job.total}`,
       ...(queue ? [attributes(element("small", queue), { class: "queue" })] : [])), { class: "progress" }),
     element("td", null, attributes(element("button", "Show"), { class: "show", "data-id": job.id, "data-kind": job.kind })),

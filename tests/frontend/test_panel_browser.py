@@ -948,16 +948,17 @@ def test_a_latched_estop_reaches_every_open_panel(page, service, robot):
             return httpx.get(f"{base}/api/v1/robot").json()["estop"]["reason"]
 
         wait_for(lambda: "being saved" not in saved_reason(), "the latch saved", 30.0)
-        reason = saved_reason()
-        assert reason
-        until(history, f"document.querySelector('#estop-reason').textContent === {json.dumps('Reason: ' + reason)}")
+        latch = httpx.get(f"{base}/api/v1/robot").json()["estop"]
+        assert latch["reason"] and latch["pressed_by"] == "lab", "the panel's press carries its token: it says who"
+        said = f"Reason: {latch['reason']}. Pressed by lab."
+        until(history, f"document.querySelector('#estop-reason').textContent === {json.dumps(said)}")
         assert history.evaluate(EVENTS_STATE) == "live", "the stream brought it, not the fallback"
         late = context.new_page()
         opened = time.monotonic()
         late.goto(f"{base}/")
         late.locator("#estop-banner").wait_for(state="visible", timeout=SHOWN_WITHIN_MS)
         on_opening = time.monotonic() - opened  # the page answers no one while Plotly loads
-        assert late.inner_text("#estop-reason") == f"Reason: {reason}" and late.is_visible("#simulate")
+        assert late.inner_text("#estop-reason") == said and late.is_visible("#simulate")
         loaded, shown = late.evaluate(LOADED_AT), late.evaluate("window.__bannerShownAt")
         print(f"banner shown: {1000 * on_history:.0f} ms after the press on History; on a new panel "
               f"{shown:.0f} ms after it began loading, by its own clock (DOMContentLoaded, once Plotly "

@@ -230,9 +230,9 @@ def test_the_jobs_tab_pages_through_every_job_and_says_where_a_queued_one_stands
     page.unroute_all(behavior="ignoreErrors")  # a refresh still in the handler must not outlive the test
 
 
-def test_the_panel_submits_jobs_as_panel_for_the_queues_share(page, service):
-    """The job queue keeps each client a share (docs/service.md): the panel names itself, so a script
-    on the same machine (the same address) cannot crowd it out."""
+def test_the_panel_submits_jobs_as_its_person_through_the_panel(page, service):
+    """The job queue keeps each person a share (docs/service.md): the job is the signed-in
+    person's (the lab token's here), and the panel names itself as the tool it came through."""
     base, _token = service
     page.click("nav [data-tab=jobs]")
     page.fill("input[name=trials]", "2")
@@ -241,7 +241,7 @@ def test_the_panel_submits_jobs_as_panel_for_the_queues_share(page, service):
     # Said once the service has answered the POST (the table may list earlier tests' jobs already).
     said(page, "scheduled")
     newest = httpx.get(f"{base}/api/v1/jobs?limit=1").json()["items"][0]
-    assert newest["submitted_by"] == "panel"
+    assert (newest["submitted_by"], newest["submitted_via"]) == ("lab", "panel")
 
 
 def test_a_rule_across_fields_is_said_in_the_forms_labels_at_the_field(page):

@@ -40,10 +40,10 @@ def test_the_panel_says_who_started_what(service):
             page.click("nav [data-tab=jobs]")
             page.fill("#job-form input[name=trials]", "2")
             page.click("#submit-job")
-            newest = "document.querySelector('#job-table tbody tr:first-child .by')?.textContent"
-            until(page, f"{newest} === 'by ada via panel'")
-            older = "document.querySelector('#job-table tbody tr:nth-child(2) .by')?.textContent"
-            assert page.evaluate(older) == "by bob via sweep-script", "the header labels the tool, not the person"
+            newest = "document.querySelector('#job-table tbody tr:first-child td.by')?.textContent"
+            until(page, f"{newest} === 'ada via panel'")
+            older = "document.querySelector('#job-table tbody tr:nth-child(2) td.by')?.textContent"
+            assert page.evaluate(older) == "bob via sweep-script", "the header labels the tool, not the person"
             screenshot(page, "who_started_what", "#jobs")
             page.click("nav [data-tab=history]")
             made_by = "document.querySelector('#run-table tbody tr .col-created .by')?.textContent"

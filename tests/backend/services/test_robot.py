@@ -226,7 +226,7 @@ def test_estop_now_answers_even_when_the_estop_thread_is_stuck(service, monkeypa
     release = threading.Event()
     calls = []
 
-    def stuck():
+    def stuck(_by=None):
         calls.append(1)
         release.wait(5)
         return {"acknowledged": True}

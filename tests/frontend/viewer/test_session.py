@@ -104,9 +104,11 @@ class Pressed:
 
     def __init__(self):
         self.presses = 0
+        self.pressed_by = None
 
-    def estop(self) -> dict:
+    def estop(self, by: str | None = None) -> dict:
         self.presses += 1
+        self.pressed_by = by
         return {"acknowledged": False, "reason": "the robot is not connected: nothing to send the ESTOP to"}
 
 
@@ -122,6 +124,7 @@ def test_the_views_own_page_has_an_estop_that_presses_the_services(server):
         try:
             browser.set_gui("EMERGENCY STOP", True)  # the browser's click
             wait_for(lambda: robot.presses == 1)
+            assert robot.pressed_by == "someone at the 3D view", "the latch says where it was pressed"
             wait_for(lambda: "E-stop sent" in session.gui_estop_said.content)
             assert "not connected" in session.gui_estop_said.content and "latched" in session.gui_estop_said.content
         finally:
