@@ -4,7 +4,7 @@ Mutating calls carry ``Authorization: Bearer <token>``: the service's own token 
 the data directory, :mod:`backend.api.token_file`) or a person's (``parkour token add NAME``,
 :mod:`backend.store.people`); a person's read-only token reads but changes nothing (403). Reads are
 open on a service that listens on the loopback only; one that listens beyond this machine asks a
-token of every read too (its health check excepted). The robot's e-stop is open to anyone
+token of every request (its health check and the e-stop excepted). The robot's e-stop is open to anyone
 (stopping is always allowed: docs/service.md). :func:`install` puts four ASGI middlewares in front
 of the routes, outermost first:
 
@@ -208,8 +208,9 @@ class TokenFirst:
     refuses, before a body is read: a change without a token that may make it (401, or 403 for a
     read-only one) — the changes open without it are the routes that do not declare
     ``require_token`` (the e-stop, the simulations), anything else, an unknown path included, needs
-    it; and, where the settings say reads need a token, a read or a websocket with none (401; a
-    websocket is closed, code 1008, before it is accepted)."""
+    it; and, where the settings say reads need a token, anything else with none but
+    :data:`OPEN_ANYWHERE` — reads, websockets, the simulations (401; a websocket is closed, code
+    1008, before it is accepted)."""
 
     def __init__(self, app: ASGIApp, service: FastAPI) -> None:
         self.app, self.service = app, service
