@@ -128,4 +128,16 @@ def test_the_search_index_is_built_and_kept(empty_database_url):
         else:
             names = set(connection.execute(text("SELECT indexname FROM pg_indexes")).scalars())
             assert {"ix_runs_notes_trgm", "ix_run_tags_tag_trgm"} <= names
+            # The search as History asks it can read them (in an OR with the tags' condition it could not).
+            from sqlalchemy import select
+
+            from backend.repositories.run_filters import RunFilter, filtered
+            from backend.store.models import Run
+
+            query = filtered(select(Run.id), RunFilter(q="slipped"))
+            connection.exec_driver_sql("SET enable_seqscan = off")  # a table of one run: else it scans anyway
+            statement = query.compile(engine, compile_kwargs={"literal_binds": True})
+            plan = "\n".join(connection.exec_driver_sql(f"EXPLAIN {statement}").scalars())
+            assert "Bitmap Index Scan on ix_runs_notes_trgm" in plan, plan  # the notes: never every run's
+            assert connection.execute(query).scalars().all() == [7]
     engine.dispose()
