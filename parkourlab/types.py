@@ -133,7 +133,7 @@ class RunFilters(TypedDict, total=False):
     """The filters every run query takes (list, export, aggregate, frame). Ranges are inclusive:
     zeta0 [l0] in [0, 1], psi0 [deg] in [0, 90] (the first leg's); datetimes or ISO 8601 text.
     ``end_reason``: as recorded, or its kind (``error`` matches ``error: …``); ``q``: text in the
-    notes or a tag (any case)."""
+    notes or a tag (any case, 3 characters or more); ``ids``: these runs only (up to 1,000)."""
 
     experiment_id: int
     kind: RunKind
@@ -144,6 +144,7 @@ class RunFilters(TypedDict, total=False):
     loop: RunLoop
     controller: str
     q: str
+    ids: list[int]
     zeta0_min: float
     zeta0_max: float
     psi0_min: float
