@@ -145,9 +145,9 @@ def listed_page(
     Every sort has an index (id's own too, ``ix_runs_id``: SQLite's table is no narrow order), so
     an unfiltered page at any offset reads an index and its rows: 1-5 ms at 100,000 runs. A
     filtered page needs the matching runs sorted; on SQLite it is cut from their whole order,
-    read once and kept on the connection until a run changes — an order by id until a run other
-    than the newest changes (:func:`~backend.repositories.run_list_cache.kept_order` adds the
-    runs since): :class:`~backend.repositories.run_list_cache.ListCache`. Sorting the runs of one kind by date
+    read once and kept on the connection until a run other than the newest changes
+    (:func:`~backend.repositories.run_list_cache.kept_order` puts the runs since in):
+    :class:`~backend.repositories.run_list_cache.ListCache`. Sorting the runs of one kind by date
     reads 25,000 rows (70 ms), every page after that its 50 (1-2 ms). A first page (``offset``
     below :data:`WHOLE_ORDER_FROM`) is read by itself the first time its order is asked for after
     a write, and the order read whole only when asked again before the next write: every write

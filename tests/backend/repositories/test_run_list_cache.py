@@ -11,12 +11,13 @@ from sqlalchemy import delete, func, select, update
 from backend.repositories import run_list_cache
 from backend.repositories.run_filters import RunFilter, filtered
 from backend.repositories.run_list_cache import ListCache, Stamp, _count_statement, list_cache, matching_count
-from backend.repositories.runs import add_run, listed_page, relabel
+from backend.repositories.runs import _sort_order, add_run, listed_page, relabel
 from backend.store.database import make_engine, migrate, session_factory, sqlite_url
 from backend.store.models import Run, RunTag
 from backend.store.run_record import RunRecord
 
 TAGS = ["a", "b", "slip-test", "c"]
+SORTS = ("-id", "id", "-climb", "zeta0", "status", "-end_reason", "end_reason")
 FILTERS = [RunFilter(), RunFilter(tag="a"), RunFilter(kind="robot"), RunFilter(q="slip"), RunFilter(status="failed"),
            RunFilter(zeta0_min=0.85, zeta0_max=0.92), RunFilter(kind="sim", tag="b"),
            RunFilter(q="SLIP", kind="sim")]  # fmt: skip
@@ -38,7 +39,8 @@ CHANGES = {
 def _record(rng: random.Random) -> RunRecord:
     return RunRecord(kind=rng.choice(["sim", "robot"]), status=rng.choice(["done", "failed"]), duration_s=1.0,
                      code_version="test", model={"alpha": 77.6}, controls=[[30.0, rng.uniform(0.8, 0.98)]],
-                     start_state=[-0.9, -0.2], jumps=4, jumps_completed=4, climb=1.0, results={},
+                     start_state=[-0.9, -0.2], jumps=4, jumps_completed=4, climb=round(rng.uniform(-1, 3), 1),
+                     results=rng.choice([{}, {"end_reason": "e-stop"}, {"end_reason": "stopped"}]),
                      tags=tuple(rng.sample(TAGS, rng.randrange(3))))  # fmt: skip
 
 
@@ -49,9 +51,14 @@ def _change(writer, name: str, rng: random.Random) -> None:
     if name == "add a run":
         add_run(writer, _record(rng)).notes = rng.choice(["", "slipped", "dry"])
     elif name == "edit the newest run":
-        writer.execute(update(Run).where(Run.id == newest).values(kind="robot", notes="slip at 3", status="failed"))
-    elif name == "retag the newest run":
-        relabel(writer.get(Run, newest), rng.sample(TAGS, 2))
+        writer.execute(
+            update(Run)
+            .where(Run.id == newest)
+            .values(kind="robot", notes="slip at 3", status="failed", climb=rng.uniform(-1, 3), zeta0=0.83)
+        )
+    elif name == "retag the newest run":  # tags other than its own: a relabel to the same tags changes nothing
+        run = writer.get(Run, newest)
+        relabel(run, next(tags for tags in iter(lambda: rng.sample(TAGS, 2), None) if set(tags) != set(run.tags)))
     elif name == "edit an old run":
         writer.execute(update(Run).where(Run.id == old).values(status="failed", notes="late slip", zeta0=0.9))
     elif name == "retag an old run":
@@ -80,8 +87,9 @@ def sessions(database_url, tmp_path):
 def test_totals_are_right_after_every_kind_of_change(sessions, seed):
     """A reader's totals, kept or counted since a base, equal a plain COUNT after each of 60 random
     changes by another connection, and its pages by id, cut from orders kept and brought up to
-    date, the runs in order; only the changes to older runs than the newest reshape the runs
-    (SQLite), so the bases and the orders by id outlive the others."""
+    date, the runs in order — by id and by other columns (nullable ones too), the runs added
+    since an order was read put at their places; only the changes to older runs than the newest
+    reshape the runs (SQLite), so the bases and the orders outlive the others."""
     rng = random.Random(seed)
     with sessions() as writer:
         for _ in range(30):
@@ -97,12 +105,18 @@ def test_totals_are_right_after_every_kind_of_change(sessions, seed):
                 expected = reference.scalar(filtered(select(func.count()).select_from(Run), where))
                 assert matching_count(reader, where) == expected, (step, name, where)
                 assert matching_count(reader, where) == expected, "the same again, kept"
-                for sort, order in (("-id", Run.id.desc()), ("id", Run.id.asc())):
-                    expected_ids = reference.scalars(filtered(select(Run.id), where).order_by(order)).all()
+                for sort in SORTS:
+                    ordered = filtered(select(Run.id), where).order_by(*_sort_order(sort))
+                    expected_ids = reference.scalars(ordered).all()
                     for _ in range(2):  # the second reads the order whole and keeps it (asked again)
-                        page, _, total = listed_page(reader, where, limit=200, cursor=None, sort=sort)
-                        assert [row["id"] for row in page] == expected_ids, (step, name, where, sort)
-                        assert total == len(expected_ids)
+                        # Pages of 7 by offset: each cut from the kept order (a page's rows are
+                        # sorted again as they are read, so one page of all would hide a misplaced run).
+                        listed = []
+                        for offset in range(0, len(expected_ids) + 1, 7):
+                            page, _, total = listed_page(reader, where, limit=7, cursor=None, sort=sort, offset=offset)
+                            listed += [row["id"] for row in page]
+                            assert total == len(expected_ids)
+                        assert listed == expected_ids, (step, name, where, sort)
             reference.commit()
             after = list_cache(reader.connection())
             if before is None:  # PostgreSQL: nothing kept
@@ -186,7 +200,7 @@ def test_a_cache_forgets_its_counts_past_its_bound(monkeypatch):
     assert list(cache.counts) == [("c",)]
 
 
-def test_a_renewed_cache_keeps_only_bases_and_orders_by_id_and_those_only_while_not_reshaped():
+def test_a_renewed_cache_keeps_only_bases_and_orders_and_those_only_while_not_reshaped():
     cache = ListCache(Stamp(1, 1, 10))
     cache.keep_count(("a",), 4)
     cache.keep_base(("a",), run_list_cache.Base(3, 10))
@@ -194,6 +208,7 @@ def test_a_renewed_cache_keeps_only_bases_and_orders_by_id_and_those_only_while_
     cache.keep_order((("a",), "-climb"), array("q", [1, 9]), 10)
     appended = cache.renewed(Stamp(2, 1, 11))
     assert appended.counts == {} and appended.bases == cache.bases
-    assert list(appended.orders) == [(("a",), "-id")] and appended.behind == {(("a",), "-id")}
+    assert list(appended.orders) == [(("a",), "-id"), (("a",), "-climb")]
+    assert appended.behind == {(("a",), "-id"), (("a",), "-climb")}, "each to be brought up to date when asked"
     reshaped = cache.renewed(Stamp(2, 2, 11))
     assert reshaped.bases == {} and not reshaped.orders and reshaped.ids_kept == 0
