@@ -14,7 +14,7 @@ from sqlalchemy import create_engine, text
 from sim_core import get_preset
 from sim_core.model.noise import NoiseModel
 from sim_core.robustness.mjtf import mjtf_study
-from tests.helpers import free_port, start_service
+from tests.helpers import start_service
 
 pytestmark = pytest.mark.slow  # two service starts: ~15 s
 
@@ -22,9 +22,9 @@ SPEC = {"zeta0s": [0.86, 0.9], "trials": 1200, "cap": 1500, "seed": 3, "guess": 
 
 
 def test_kill_nine_mid_job_resumes_exactly(tmp_path):
-    data_dir, port = tmp_path / "data", free_port()
-    base = f"http://127.0.0.1:{port}/api/v1"
-    first = start_service(data_dir, port, "--no-view")
+    data_dir = tmp_path / "data"
+    first = start_service(data_dir, 0, "--no-view")
+    base = f"http://127.0.0.1:{first.port}/api/v1"
     try:
         token = (data_dir / "api_token").read_text().strip()
         job = httpx.post(f"{base}/jobs", json=SPEC, headers={"Authorization": f"Bearer {token}"}).json()
@@ -39,7 +39,8 @@ def test_kill_nine_mid_job_resumes_exactly(tmp_path):
     assert 0 < completed < total, f"the kill must land mid-job (completed {completed} of {total})"
     print(f"SIGKILL with {completed} of {total} trials committed")
 
-    second = start_service(data_dir, port, "--no-view")
+    second = start_service(data_dir, 0, "--no-view")
+    base = f"http://127.0.0.1:{second.port}/api/v1"
     try:
         deadline = time.monotonic() + 120
         while (state := httpx.get(f"{base}/jobs/{job['id']}").json())["state"] != "done":
@@ -73,9 +74,9 @@ def test_kill_nine_during_a_live_run_keeps_it_interrupted_to_the_last_second(tmp
     from backend.robot.messages import Fault, RobotState  # only the robot tests load the robot side
 
     robot, tracker_port = virtual
-    data_dir, port = tmp_path / "data", free_port()
-    base = f"http://127.0.0.1:{port}/api/v1"
-    first = start_service(data_dir, port, "--no-view")
+    data_dir = tmp_path / "data"
+    first = start_service(data_dir, 0, "--no-view")
+    base = f"http://127.0.0.1:{first.port}/api/v1"
     try:
         auth = {"Authorization": f"Bearer {(data_dir / 'api_token').read_text().strip()}"}
         connect = {"url": robot.url, "tracker_port": tracker_port}
@@ -100,7 +101,8 @@ def test_kill_nine_during_a_live_run_keeps_it_interrupted_to_the_last_second(tmp
         time.sleep(0.05)
     assert robot.firmware.faults & Fault.HEARTBEAT_LOST
 
-    second = start_service(data_dir, port, "--no-view")
+    second = start_service(data_dir, 0, "--no-view")
+    base = f"http://127.0.0.1:{second.port}/api/v1"
     try:
         stored = httpx.get(f"{base}/runs/{seen['id']}").json()
         status = httpx.get(f"{base}/robot").json()
