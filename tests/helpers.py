@@ -5,9 +5,11 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import socket
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from collections import Counter
@@ -20,6 +22,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]  # the checkout
 SERVICE_START_TIMEOUT = 60.0  # [s] a cold start compiles nothing, but CI machines are slow
+SERVICE_START_TRIES = 5  # ports a service started on a free port tries, each taken before it bound it
 POOL_FILLERS = 45  # more requests than the service has request threads (backend/api/app.py), and anyio's 40
 # A /sim/map call of 1000 jumps: a few ms of kernel under the service's kernel lock, back to back.
 MAP_BODY = {"controls": [{"psi0_deg": 30, "zeta0": 0.87}], "start": {"xdot": -0.9, "ydot": -0.2}, "jumps": 1000}
@@ -39,33 +42,71 @@ def start_service(
     data_dir: Path, port: int, *options: str, tree: Path | None = None, log: Path | None = None
 ) -> subprocess.Popen:
     """``parkour serve --data-dir DATA_DIR --port PORT OPTIONS...`` in a subprocess, returned once
-    ``/api/v1/health`` answers; the caller ends it (``terminate``, or ``SIGKILL`` to test a crash).
-    ``tree``: the service's code from another checkout (a benchmark's base revision), run with this
-    venv; ``log``: a file for its stderr (default: none kept)."""
+    ``/api/v1/health`` answers and the service that answers takes DATA_DIR's token; the caller ends it
+    (``terminate``, or ``SIGKILL`` to test a crash). The process's ``port`` is the port it serves on.
+
+    ``port`` 0: a free one, and another if another program takes it before the service binds it (the
+    service exits, address already in use, or someone else's service answers there), up to
+    SERVICE_START_TRIES ports. ``tree``: the service's code from another checkout (a benchmark's
+    base revision), run with this venv; ``log``: a file for its stderr (default: a temporary one)."""
+    for _ in range(SERVICE_START_TRIES if port == 0 else 1):
+        process = _serve(data_dir, port or free_port(), options, tree, log)
+        if process is not None:
+            return process
+    if port:
+        pytest.fail(f"port {port} is another program's")
+    pytest.fail(f"the service found no free port in {SERVICE_START_TRIES} tries: each was taken before it bound it")
+
+
+def _serve(data_dir: Path, port: int, options, tree: Path | None, log: Path | None) -> subprocess.Popen | None:
+    """:func:`start_service` on ``port``: the process once it serves there; None if the port was
+    another program's (ours ended); a test failure, with the end of its stderr, if it ended or hung."""
     command = [sys.executable, "-m", "cli", "serve", "--data-dir", str(data_dir), "--port", str(port), *options]
     env = None if tree is None else dict(os.environ, PYTHONPATH=str(tree))
-    stderr = subprocess.DEVNULL if log is None else log.open("wb")
-    process = subprocess.Popen(command, cwd=tree, env=env, stdout=subprocess.DEVNULL, stderr=stderr)
-    deadline = time.monotonic() + SERVICE_START_TIMEOUT
-    while time.monotonic() < deadline:
-        try:
-            if httpx.get(f"http://127.0.0.1:{port}/api/v1/health", timeout=1).status_code == 200:
+    answer = None
+    with tempfile.TemporaryFile() if log is None else log.open("w+b") as stderr:
+        process = subprocess.Popen(command, cwd=tree, env=env, stdout=subprocess.DEVNULL, stderr=stderr)
+        process.port = port
+        deadline = time.monotonic() + SERVICE_START_TIMEOUT
+        while time.monotonic() < deadline and process.poll() is None:
+            if (answer := _whose(data_dir, port)) == "ours":
                 return process
-        except httpx.HTTPError:
+            if answer == "another's":  # ours cannot bind the port: it exits, or is ended here
+                break
             time.sleep(0.2)
-    process.kill()
-    process.wait()
-    pytest.fail(f"the service did not start within {SERVICE_START_TIMEOUT:g} s")
+        if process.poll() is None:
+            process.kill()
+        process.wait()
+        stderr.seek(0)
+        said = stderr.read().decode(errors="replace")
+    if answer == "another's" or "address already in use" in said.lower():
+        return None
+    if process.returncode == -signal.SIGKILL:
+        pytest.fail(f"the service did not start within {SERVICE_START_TIMEOUT:g} s: {said[-2000:]}")
+    pytest.fail(f"the service ended at start ({process.returncode}): {said[-2000:]}")
+
+
+def _whose(data_dir: Path, port: int) -> str | None:
+    """Who answers ``/api/v1/health`` on ``port``: ``"ours"`` (its ``/api/v1/auth`` takes DATA_DIR's
+    token; a service older than that route is taken as ours), ``"another's"``, or None (nobody yet)."""
+    base = f"http://127.0.0.1:{port}/api/v1"
+    try:
+        if httpx.get(f"{base}/health", timeout=1).status_code != 200:
+            return None
+        token = (data_dir / "api_token").read_text().strip()
+        accepted = httpx.get(f"{base}/auth", headers={"Authorization": f"Bearer {token}"}, timeout=1).status_code
+    except (httpx.HTTPError, OSError):  # nobody listens yet; or no token yet: not ours answering
+        return None
+    return "another's" if accepted == 401 else "ours"
 
 
 @contextmanager
 def served(data_dir: Path, *options: str) -> Iterator[tuple[str, str]]:
     """``parkour serve`` over ``data_dir`` on a free port (:func:`start_service`): its base URL and
     its API token. Afterwards SIGTERM, and it must end within 30 s (a hang fails the test)."""
-    port = free_port()
-    process = start_service(data_dir, port, *options)
+    process = start_service(data_dir, 0, *options)
     try:
-        yield f"http://127.0.0.1:{port}", (data_dir / "api_token").read_text().strip()
+        yield f"http://127.0.0.1:{process.port}", (data_dir / "api_token").read_text().strip()
     finally:
         process.terminate()
         process.wait(30)

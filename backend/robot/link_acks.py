@@ -58,9 +58,11 @@ def describe(message) -> str:
 class Acknowledgements:
     """The acknowledgements awaited, by sequence number (the reader delivers them: :meth:`heard`),
     the commands' resends (``resends``: copies after the first, written whole or not), and whether a
-    copy is being written now (``writing``: the heartbeat thread gives way to it)."""
+    copy is being written now (``writing``: the heartbeat thread gives way to it). ``clock`` [s]: the
+    time the resends and the bound are reckoned on (the monotonic clock; a test passes its own)."""
 
-    def __init__(self):
+    def __init__(self, clock: Callable[[], float] = time.monotonic):
+        self._clock = clock
         self._waiting: dict[int, tuple[threading.Event, list[Ack]]] = {}
         self._writing: set[int] = set()  # the seqs of the copies being written (waiting for the port)
         self.resends = 0
@@ -99,7 +101,7 @@ class Acknowledgements:
         or ``bound`` [s] has passed. A failed write (a jammed line: counted by the port) is tried
         again on the next copy. No copy is written while ``quiet()``: the wait goes on."""
         event, box = self.expect(message.seq)
-        started = time.monotonic()
+        started = self._clock()
         deadline = started + bound
         sends = failed = 0
         failures: dict[str, None] = {}  # why writes failed, each once, in order
@@ -107,7 +109,7 @@ class Acknowledgements:
         try:
             due = started
             while True:
-                if time.monotonic() >= due:
+                if self._clock() >= due:
                     if not sends or not quiet():
                         if sends:
                             self.resends += 1
@@ -123,16 +125,16 @@ class Acknowledgements:
                     # Each copy due a period after the last was due; more than a period late (a
                     # blocked write, a late wake-up): the cadence starts afresh.
                     due += COMMAND_RESEND
-                    if due <= time.monotonic():
-                        due = time.monotonic() + COMMAND_RESEND
-                if event.wait(max(0.0, min(due, deadline) - time.monotonic())):
+                    if due <= self._clock():
+                        due = self._clock() + COMMAND_RESEND
+                if event.wait(max(0.0, min(due, deadline) - self._clock())):
                     return box[0]
                 lost = gone()
-                if lost is not None or time.monotonic() >= deadline:
+                if lost is not None or self._clock() >= deadline:
                     break
         finally:
             self.forget(message.seq)
-        waited = time.monotonic() - started
+        waited = self._clock() - started
         why = f"no acknowledgement for {describe(message)} in {waited:.2f} s after {sends} sends"
         if failed:
             why += f" ({failed} failed: {'; '.join(failures)})"

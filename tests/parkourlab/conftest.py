@@ -7,7 +7,7 @@ from __future__ import annotations
 import pytest
 
 from parkourlab import Client
-from tests.helpers import free_port, start_service, stop_processes
+from tests.helpers import start_service, stop_processes
 
 START = (-0.93, -0.17)  # section state (xdot, ydot) [sqrt(g l0)] near the paper's period-1 gait
 ZETA0S = [0.84, 0.85, 0.86, 0.87, 0.88, 0.89, 0.9]  # seven runs: more than two pages of three
@@ -19,10 +19,10 @@ WAIT_TIMEOUT = 120.0  # [s] for a quick job on a slow, shared machine
 @pytest.fixture(scope="session")
 def service(tmp_path_factory):
     """``(url, token)`` of a running service with an empty store."""
-    data_dir, port = tmp_path_factory.mktemp("client") / "data", free_port()
-    process = start_service(data_dir, port, "--no-view")
+    data_dir = tmp_path_factory.mktemp("client") / "data"
+    process = start_service(data_dir, 0, "--no-view")
     try:
-        yield f"http://127.0.0.1:{port}", (data_dir / "api_token").read_text().strip()
+        yield f"http://127.0.0.1:{process.port}", (data_dir / "api_token").read_text().strip()
     finally:
         stop_processes(process)
 

@@ -58,11 +58,11 @@ class RecordingFirmware(Firmware):
 def saturated(tmp_path_factory):
     """``(client, auth, robot, job_id)``: the real service on a free port (SQLite in a temporary data
     directory), connected to a virtual robot, while the heavy job runs and the load keeps the pool full."""
-    port, data = free_port(), tmp_path_factory.mktemp("estop-load") / "data"
-    process = start_service(data, port, "--no-view")
+    data = tmp_path_factory.mktemp("estop-load") / "data"
+    process = start_service(data, 0, "--no-view")
     robot = VirtualRobot(firmware=RecordingFirmware()).start()
     auth = {"Authorization": "Bearer " + (data / "api_token").read_text().strip()}
-    client = httpx.Client(base_url=f"http://127.0.0.1:{port}", timeout=SYNC_BOUND_S)
+    client = httpx.Client(base_url=f"http://127.0.0.1:{process.port}", timeout=SYNC_BOUND_S)
     load = job = None
     try:
         body = {"url": robot.url, "tracker_port": free_port(socket.SOCK_DGRAM)}

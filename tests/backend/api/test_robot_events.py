@@ -14,7 +14,7 @@ import uvicorn
 
 from backend.api import robot_events
 from backend.api.app import create_app
-from tests.helpers import free_port, start_service
+from tests.helpers import start_service
 
 READ_GUARD_S = 5.0  # [s] a read that waits longer fails the test instead of hanging it (not a latency claim)
 STOP_GUARD_S = 20.0  # [s] likewise for a service asked to stop
@@ -187,11 +187,10 @@ def test_streams_past_the_bound_are_refused_until_one_closes(served, monkeypatch
 def test_a_service_with_an_open_stream_stops_on_sigterm(tmp_path):
     """uvicorn waits for every response to end before it stops: the stream sees the signal and
     ends, so `parkour serve` stops as it would without it (it used to wait forever)."""
-    port = free_port()
-    process = start_service(tmp_path / "data", port, "--no-view")
+    process = start_service(tmp_path / "data", 0, "--no-view")
     try:
         with _client() as client:
-            events = Events(client, f"http://127.0.0.1:{port}/api/v1/robot/events")
+            events = Events(client, f"http://127.0.0.1:{process.port}/api/v1/robot/events")
             assert events.next()["state"] == "disconnected"
             asked = time.monotonic()
             process.send_signal(signal.SIGTERM)

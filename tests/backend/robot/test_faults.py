@@ -27,13 +27,16 @@ RETRY_S = 0.3  # [s] the supervisor's retry period here (1 s in the service)
 ROBOT_WATCHDOG_S = 30.0  # [s] longer than the drop: only the supervisor's DISARM can disarm the robot
 FRAME_MAX = 64  # [bytes] more than any frame of ours: what a reopened line may start in the middle of
 LONG_FLAP_S = 120.0  # [s] of flapping in the slowest test
+# [s] the link's heartbeat timeout where the link must stay up (the flood, the late write): a hang
+# guard, so a loaded machine keeping the rig's thread from running is no lost link
+PATIENT_LINK_S = 5.0
 
 
 @pytest.fixture
 def answering():
     """An armed robot behind a pty that answers as the firmware does, and a link to it."""
     rig = PtyRobot(firmware=Firmware()).start()
-    link = RobotLink(rig.by_id, heartbeat_timeout=0.5)
+    link = RobotLink(rig.by_id, heartbeat_timeout=PATIENT_LINK_S)
     link.connect()
     link.arm()
     yield rig, link

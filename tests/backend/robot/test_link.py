@@ -21,6 +21,11 @@ ADDRESS_NOT_FOUND = 0x24
 JAMMED_ANSWER_S = 2.0  # [s] "answers instead of hanging": a generous bound, not a latency claim
 # [s] the same for a command, which tries again for its whole bound (the heartbeat timeout and a margin)
 COMMAND_ANSWER_S = 6.0
+# [s] the link's heartbeat timeout where a test needs the link to stay up: a hang guard, 50 of the
+# robot's telemetry periods, so a loaded machine that keeps the robot's thread from running for a
+# while is no lost link. A test of a lost link keeps a short one: there, a loss is what it waits for.
+PATIENT_LINK_S = 5.0
+WAIT_S = 10.0  # [s] _wait_for's bound: a hang guard, not a latency claim
 
 
 @pytest.fixture
@@ -32,13 +37,13 @@ def robot():
 
 @pytest.fixture
 def link(robot):
-    connection = RobotLink(robot.url, heartbeat_timeout=0.5)
+    connection = RobotLink(robot.url, heartbeat_timeout=PATIENT_LINK_S)
     connection.connect()
     yield connection
     connection.close()
 
 
-def _wait_for(predicate, timeout=3.0):
+def _wait_for(predicate, timeout=WAIT_S):
     deadline = time.monotonic() + timeout
     while not predicate():
         assert time.monotonic() < deadline, "timed out"
@@ -77,8 +82,9 @@ def test_estop_latches_until_reset_and_is_fast(robot, link):
 
 
 def test_robot_disarms_when_heartbeats_stop(robot):
-    robot.firmware.heartbeat_timeout = 0.3
-    link = RobotLink(robot.url)
+    # The firmware's own watchdog (1 s, ten of the PC's heartbeat periods): no loaded machine's late
+    # heartbeat disarms it before the test stops them.
+    link = RobotLink(robot.url, heartbeat_timeout=PATIENT_LINK_S)
     link.connect()
     try:
         link.arm()
@@ -409,12 +415,14 @@ class LosingAcks(Firmware):
 
 class Mute(Firmware):
     """The firmware, its radio silent (both its answers and its own heartbeats and telemetry) once
-    ``silent`` is set."""
+    ``silent`` is set, or from the moment it receives a command of kind ``silent_on``."""
 
     silent = False
+    silent_on: Kind | None = None
 
     def receive(self, message, now):
         replies = super().receive(message, now)
+        self.silent |= _kind_of(message) == self.silent_on
         return [] if self.silent else replies
 
     def tick(self, now):
@@ -449,7 +457,7 @@ def test_a_set_leg_whose_acknowledgement_is_lost_is_resent_and_applied_once():
 
 def test_a_command_never_acknowledged_names_itself_and_how_long_it_waited():
     firmware = LosingAcks(Kind.SET_LEG, lose=None)
-    robot, link = _linked(firmware, heartbeat_timeout=0.5)
+    robot, link = _linked(firmware)  # the service's heartbeat timeout: ten of the robot's telemetry periods
     try:
         error = answer_within(COMMAND_ANSWER_S, _raises_link_error, lambda: link.set_leg(Leg.RIGHT, 35.0, 0.88))
         match = re.fullmatch(
@@ -471,12 +479,14 @@ def test_a_command_never_acknowledged_names_itself_and_how_long_it_waited():
 
 def test_a_command_to_a_robot_gone_silent_says_the_link_was_lost():
     firmware = Mute()
-    robot, link = _linked(firmware, heartbeat_timeout=0.3)
+    # Silent from the ARM on, not from a moment the test picks: a test thread kept from running for
+    # the heartbeat timeout would otherwise send its ARM on a link already lost ("connect first").
+    firmware.silent_on = Kind.ARM
+    robot, link = _linked(firmware)  # the service's heartbeat timeout, 1 s: ten telemetry periods before the ARM
     try:
-        firmware.silent = True
         error = answer_within(COMMAND_ANSWER_S, _raises_link_error, link.arm)
         assert str(error).startswith("no acknowledgement for ARM (seq "), error
-        assert "the link was lost (no heartbeat from the robot for 0.3 s)" in str(error), error
+        assert "the link was lost (no heartbeat from the robot for 1 s)" in str(error), error
         assert link.state == LinkState.DISCONNECTED
     finally:
         link.close()

@@ -13,7 +13,8 @@ from tests.helpers import answer_within
 
 SET_LEG = SetLeg(812, Leg.RIGHT, 35.0, 0.88)
 HANG_S = 5.0  # [s] "answers instead of hanging": generous, not a latency claim
-BOUND = 4 * COMMAND_RESEND  # [s] a short bound for these tests
+BOUND = 4 * COMMAND_RESEND  # [s] a short bound for these tests, on a Ticking clock
+TICK = COMMAND_RESEND / 4  # [s] a Ticking clock's step
 UNANSWERED = re.compile(r"no acknowledgement for (.+) in ([\d.]+) s after (\d+) sends(.*)")
 
 
@@ -31,6 +32,19 @@ class Robot:
             raise LinkError("write blocked for 100 ms: the line is jammed")
         if len(self.sent) == self.answer_on:
             self.acks.heard(Ack(1, message.seq, Result.OK))
+
+
+class Ticking:
+    """A clock the test controls: each reading is TICK after the one before, however long the thread
+    was kept from running in between, so the copies sent before a bound passes do not depend on the
+    machine's load. (The waits between readings are real, and short: a fraction of COMMAND_RESEND.)"""
+
+    def __init__(self):
+        self.now = 0.0
+
+    def __call__(self) -> float:
+        self.now += TICK
+        return self.now
 
 
 def _unanswered(call) -> re.Match:
@@ -60,11 +74,12 @@ def test_a_late_acknowledgement_is_waited_for_and_the_same_message_resent():
 
 
 def test_a_command_never_acknowledged_names_itself_its_time_and_its_sends():
-    acks = Acknowledgements()
+    clock = Ticking()
+    acks = Acknowledgements(clock=clock)
     robot = Robot(acks)
     match = _unanswered(lambda: acks.send(SET_LEG, robot, bound=BOUND))
     assert match[1] == describe(SET_LEG) and match[4] == "", match[0]
-    assert float(match[2]) >= BOUND, "it waited out its bound"
+    assert float(match[2]) >= BOUND and clock.now >= BOUND, "it waited out its bound, on the test's clock"
     assert int(match[3]) == len(robot.sent) >= 2 and set(robot.sent) == {SET_LEG}
     assert acks.resends == len(robot.sent) - 1
 
@@ -82,13 +97,14 @@ def test_a_blocked_write_is_tried_again_and_named_if_nothing_gets_through():
     acks = Acknowledgements()
     robot = Robot(acks, answer_on=3, blocked=(1, 2))
     assert acks.send(SET_LEG, robot, bound=10.0).acked == 812 and len(robot.sent) == 3
+    acks = Acknowledgements(clock=Ticking())
     jammed = Robot(acks, blocked=tuple(range(1, 100)))
     match = _unanswered(lambda: acks.send(SET_LEG, jammed, bound=BOUND))
     assert "jammed" in match[4] and f"{len(jammed.sent)} failed" in match[4], match[0]
 
 
 def test_nothing_is_resent_while_quiet():
-    acks = Acknowledgements()
+    acks = Acknowledgements(clock=Ticking())
     robot = Robot(acks)
     match = _unanswered(lambda: acks.send(Command(4, Kind.RESET), robot, bound=BOUND, quiet=lambda: True))
     assert robot.sent == [Command(4, Kind.RESET)] and match[3] == "1" and acks.resends == 0

@@ -198,12 +198,14 @@ def test_cancel_stops_the_worker_mid_chunk(sessions, session, compute):
         runner.submit(job.id)
         wait_until(sessions, job.id, lambda j: j.state == "running")
         time.sleep(0.5)  # the chunk is in the worker
-        cancelled_at = time.monotonic()
+        restarts, cancelled_at = compute.jobs.restarts, time.monotonic()
         jobs.cancel_job(session, job.id)
         stopped = wait_until(sessions, job.id, lambda j: j.state in jobs.FINAL)
         took = time.monotonic() - cancelled_at
         assert stopped.state == "cancelled" and stopped.completed == 0 and stored_trials(session, job.id) == []
-        assert took < 5.0, f"cancel took {took:.1f} s (the runner looks every 0.2 s and stops the worker)"
+        # Stopped, not waited for: the runner stopped the worker (a chunk left to end would not be).
+        # How soon is the machine's to say (the runner looks every 0.2 s); wait_until bounds a hang.
+        assert compute.jobs.restarts == restarts + 1, "the cancel stopped the worker mid-chunk"
         print(f"cancelled mid-chunk in {took * 1000:.0f} ms")
         small = jobs.create_job(session, MJTFJobCreate(**(SMALL | {"trials": 2})))
         runner.submit(small.id)

@@ -49,6 +49,7 @@ def _stored(session, run) -> dict:
 
 
 @pytest.mark.slow
+@pytest.mark.realtime  # a closed loop answers each touchdown within a stance, and the bound is 60-250 ms of silence
 @pytest.mark.parametrize("timeout_ms", [60.0, 100.0, 250.0])
 def test_a_closed_loop_whose_tracker_goes_silent_ends_at_once_disarmed(relayed, session, timeout_ms):
     service, robot, relay = relayed
@@ -85,7 +86,8 @@ def test_an_open_loop_goes_on_through_a_tracker_gap_and_records_it(relayed, sess
     stored = _stored(session, run)
     assert stored.status == "done"
     gaps = stored.results["tracker_gaps"]
-    assert len(gaps) >= 1 and gaps[0]["kind"] == "silent" and gaps[0]["ms"] >= 300, gaps
+    # The relay's silence among them: a loaded machine may read the stream late and record more gaps.
+    assert any(gap["kind"] == "silent" and gap["ms"] >= 300 for gap in gaps), gaps
     assert relay.forwarded > gap_start
 
 
@@ -105,6 +107,7 @@ def test_a_fall_is_the_runs_end_reason_and_its_record(connected, virtual, sessio
 
 
 @pytest.mark.slow
+@pytest.mark.realtime  # a closed loop answers each touchdown within a stance; a late frame would end it as silent
 def test_a_closed_loop_whose_tracker_loses_the_body_ends_naming_it(service, session):
     """NatNet goes on streaming, but the robot's rigid body comes with its tracking-valid bit off."""
     from dataclasses import replace

@@ -356,6 +356,8 @@ def test_a_recorded_run_replays_to_the_same_touchdowns(client, auth, connected):
     assert client.post(f"/api/v1/runs/{simulated['id']}/replay", headers=auth).status_code == 409
 
 
+@pytest.mark.robot_speed(1.0)
+@pytest.mark.realtime  # a closed loop answers each touchdown within the next stance
 def test_a_closed_loop_designed_on_a_stored_calibration_takes_its_leg_offsets_off(client, auth, connected):
     """closed_loop.preset names a calibration: the LQR is designed on its fitted model and each
     command is the law's less the fitted offset of its leg; the stored run names the preset."""
