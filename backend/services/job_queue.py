@@ -85,9 +85,11 @@ def work_left(job: Job) -> int:
     return round(_worst(job) * _share_left(job))
 
 
-def check_room(session: Session, body, person: str) -> None:
+def check_room(session: Session, body, person: str) -> list:
     """Refuse ``body`` (a job request) with :class:`QueueFull` if the queue, or ``person``'s share
-    of it, has no room for its work at its worst, or ``person`` has as many jobs waiting as one may."""
+    of it, has no room for its work at its worst, or ``person`` has as many jobs waiting as one may.
+    Returns the unfinished jobs it read (rows of :func:`backend.repositories.jobs.unfinished`), so
+    the new job's standing needs no second read of them."""
     unfinished = stored_jobs.unfinished(session)
     wanted, _ = worst_case_jumps(body)
     left = {job.id: work_left(job) for job in unfinished}
@@ -117,6 +119,7 @@ def check_room(session: Session, body, person: str) -> None:
             f"a person's share of {_jumps(share)} ({_hours(share)}), kept so others always find room. "
             "Wait for your jobs to finish, or cancel some"
         )
+    return unfinished
 
 
 def standings(session: Session) -> dict[int, Standing]:

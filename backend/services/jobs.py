@@ -17,7 +17,8 @@ from backend.jobs import decode, encode, job_kind, spec_of
 from backend.repositories import jobs as stored_jobs
 from backend.repositories.common import locked
 from backend.schemas.jobs import JobOut, JobPage, JobResults, JobState, MJTFLevelOut
-from backend.services.job_queue import Standing, check_room, standings
+from backend.services import job_estimates
+from backend.services.job_queue import Standing, check_room, standings, standings_of
 from backend.services.presets import with_preset_resolved
 from backend.services.provenance import current_code_version
 from backend.store.database import lock_for_write
@@ -41,7 +42,7 @@ def create_job(
     then refuses: the experiment has a job) or has removed it first (404)."""
     body = with_preset_resolved(session, body)
     lock_for_write(session)
-    check_room(session, body, person or "unknown")
+    ahead = check_room(session, body, person or "unknown")
     if body.experiment_id is not None:
         locked(session, Experiment, body.experiment_id, "experiment")
     spec = spec_of(body)  # stored as its own versioned record: backend/jobs/specs.py says why
@@ -61,7 +62,8 @@ def create_job(
     session.commit()
     if runner is not None:
         runner.submit(job.id)
-    return public(job, standings(session).get(job.id))
+    # Its standing among the jobs read under the write lock: the queue as it stood at its submission.
+    return public(job, standings_of([*ahead, job], job_estimates.paces(session)).get(job.id))
 
 
 def get_job(session: Session, job_id: int) -> JobOut:
