@@ -68,6 +68,12 @@ def person_of(connection: HTTPConnection) -> Person | None:
     return connection.scope.get("state", {}).get("person")
 
 
+def signed_in_by_header(connection: HTTPConnection) -> bool:
+    """Whether :func:`person_of` came from the request's own ``Authorization`` header (False: from
+    the read cookie, or nobody)."""
+    return bool(connection.scope.get("state", {}).get("person_by_header"))
+
+
 def who_label(connection: HTTPConnection) -> str:
     """Who did it, as a record keeps it: the person's name, else the client's address (an
     e-stop needs no token: ``someone at 127.0.0.1``)."""

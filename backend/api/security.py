@@ -237,8 +237,8 @@ class TokenFirst:
         if scope["type"] not in ("http", "websocket") or not scope["path"].startswith("/api/"):
             await self.app(scope, receive, send)
             return
-        person, _ = self.service.state.identities.of_scope(scope)
-        scope.setdefault("state", {})["person"] = person
+        person, by_header = self.service.state.identities.of_scope(scope)
+        scope.setdefault("state", {}).update(person=person, person_by_header=by_header)
         refused = self.refusal(scope, person)
         if refused is None:
             await self.app(scope, receive, send)

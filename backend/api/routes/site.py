@@ -26,7 +26,7 @@ from starlette.types import ASGIApp
 
 from backend import schemas
 from backend.api.deps import Db
-from backend.api.identity import READ_COOKIE, bearer_token
+from backend.api.identity import READ_COOKIE, bearer_token, person_of, signed_in_by_header
 from backend.services.provenance import current_code_version
 from backend.store.database import ping
 
@@ -145,8 +145,8 @@ async def check_token(request: Request, response: Response) -> schemas.TokenAcce
     It also leaves the token in an HttpOnly, SameSite=Strict cookie on the API's path, which the
     service takes for reads only: a browser's event streams and websockets cannot send a header, and
     a service listening beyond this machine asks a token of every read (backend/api/identity.py)."""
-    person, by_header = request.app.state.identities.of_scope(request.scope)
-    if person is None or not by_header:
+    person = person_of(request)  # as backend/api/security.py's TokenFirst found it, once a request
+    if person is None or not signed_in_by_header(request):
         refused = JSONResponse({"detail": TOKEN_UNKNOWN}, status_code=401, headers={"WWW-Authenticate": "Bearer"})
         refused.delete_cookie(READ_COOKIE, path="/api/")
         return refused
