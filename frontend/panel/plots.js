@@ -45,7 +45,7 @@ export function plotSweep(target, result, title) {
 // Failures in the basin: one grey per kind, each named in the legend (plotly heatmaps have no
 // legend entry of their own, so a marker of the same grey stands in for each).
 const FAILURE_GREYS = ["#6b7280", "#c4c9d1", "#3f4650", "#9aa1ab", "#e3e6ea"];
-const FAILURE_WORDS = { slip: "slips", collapse: "leg collapses", no_liftoff: "no lift-off", no_flight: "no flight", invalid_state: "invalid state", floor: "fell to the floor" };
+const FAILURE_WORDS = { slip: "slips", collapse: "leg collapses", no_liftoff: "no lift-off", no_flight: "no flight", invalid_state: "invalid state", floor: "fell to the floor", no_touchdown: "no touchdown" };
 // Undecided cells (neither converged nor failed within the jump limit) in a colour of their own:
 // neither a failure's grey nor on the jumps' scale. The result counts the falling ones among them
 // (faster than sim_core's FALLING_SPEED: no limit decides them) but does not say which cells.

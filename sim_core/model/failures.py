@@ -17,6 +17,7 @@ NO_LIFTOFF = 3
 NO_FLIGHT = 4
 INVALID_STATE = 5
 FLOOR = 6  # a closed loop's run only: the body came down to the chute's floor
+NO_TOUCHDOWN = 7  # a world's flight (docs/model.md §8): the foot met no side within the flight's cap
 FLOOR_HEIGHT = 0.0  # [l0] that floor (sim_core.climb.records.FLOOR): where the climb's first foot touched
 
 
@@ -29,6 +30,7 @@ class Failure(IntEnum):
     NO_FLIGHT = NO_FLIGHT
     INVALID_STATE = INVALID_STATE
     FLOOR = FLOOR
+    NO_TOUCHDOWN = NO_TOUCHDOWN
 
     @property
     def code(self) -> str:
@@ -56,4 +58,5 @@ _MESSAGES = {
     Failure.NO_FLIGHT: "no flight phase: at lift-off the body does not head for the other wall",
     Failure.INVALID_STATE: "non-finite numbers or a state outside the model's domain",
     Failure.FLOOR: "the body reached the chute's floor",  # as the climb's end (sim_core.climb.records.ClimbEnd)
+    Failure.NO_TOUCHDOWN: "the foot reached no wall: the flight passed its time cap",
 }

@@ -48,6 +48,7 @@ __all__ = [
     "ZETA",
     "ZETA_DOT",
     "stance",
+    "stance_in_cone",
 ]
 
 RTOL = 1e-11  # 10x tighter than the bench baseline; docs/simulation.md gives the measured accuracy
@@ -128,7 +129,7 @@ def _record_row(record, row, state):
 
 @kernel
 def stance(zeta0, psi0, zeta_dot0, psi_dot0, alpha, c_zeta, c_psi, mu, final, record):
-    """Integrate one stance from touchdown to its end.
+    """Integrate one stance from touchdown to its end, the foot on a vertical wall.
 
     Args:
         zeta0, psi0, zeta_dot0, psi_dot0: touchdown state in polar coordinates about the foot
@@ -141,13 +142,21 @@ def stance(zeta0, psi0, zeta_dot0, psi_dot0, alpha, c_zeta, c_psi, mu, final, re
     Returns:
         ``(status, rows_recorded)``; status OK means lift-off (``zeta = 1``, ``zeta_dot > 0``).
     """
+    psi_limit = math.atan(mu)  # |tan psi| > mu  <=>  |psi| > atan(mu) on (-pi/2, pi/2)
+    return stance_in_cone(zeta0, psi0, zeta_dot0, psi_dot0, alpha, c_zeta, c_psi, -psi_limit, psi_limit, final, record)
+
+
+@kernel
+def stance_in_cone(zeta0, psi0, zeta_dot0, psi_dot0, alpha, c_zeta, c_psi, psi_low, psi_high, final, record):
+    """:func:`stance` on a foothold whose friction cone is ``psi_low < psi < psi_high`` [rad]: on
+    a segment of inclination ``beta`` with friction ``mu``, ``beta -/+ atan(mu)`` (docs/model.md
+    §8); a vertical wall's cone is ``-/+ atan(mu)``, the same comparisons as ``|psi| >= atan(mu)``."""
     state = (zeta0, psi0, zeta_dot0, psi_dot0, math.cos(psi0), math.sin(psi0), 0.0)
     _store(final, state)
     rows = _record_row(record, 0, state)
     if not (math.isfinite(zeta0 + psi0 + zeta_dot0 + psi_dot0) and 0.0 < zeta0 < 1.0):
         return INVALID_STATE, rows
-    psi_limit = math.atan(mu)  # |tan psi| > mu  <=>  |psi| > atan(mu) on (-pi/2, pi/2)
-    if abs(psi0) >= psi_limit:
+    if psi0 >= psi_high or psi0 <= psi_low:
         return SLIP, rows
     if zeta0 <= COLLAPSE_ZETA:  # touched down already collapsed: no step would start inside
         return COLLAPSE, rows
@@ -161,7 +170,7 @@ def stance(zeta0, psi0, zeta_dot0, psi_dot0, alpha, c_zeta, c_psi, mu, final, re
         new_psi = new_state[PSI]
         crossed_liftoff = new_zeta >= 1.0
         crossed_collapse = new_zeta <= COLLAPSE_ZETA
-        crossed_slip = abs(new_psi) >= psi_limit
+        crossed_slip = new_psi >= psi_high or new_psi <= psi_low
         crossed_cap = new_state[TIME] >= STANCE_TIME_CAP
         if not (crossed_liftoff or crossed_collapse or crossed_slip or crossed_cap):
             if not math.isfinite(new_zeta + new_psi + new_state[ZETA_DOT] + new_state[PSI_DOT]):
@@ -179,7 +188,7 @@ def stance(zeta0, psi0, zeta_dot0, psi_dot0, alpha, c_zeta, c_psi, mu, final, re
             elif event == 1 and crossed_collapse:
                 independent, target, code = ZETA, COLLAPSE_ZETA, COLLAPSE
             elif event == 2 and crossed_slip:
-                independent, target, code = PSI, math.copysign(psi_limit, new_psi), SLIP
+                independent, target, code = PSI, psi_high if new_psi >= psi_high else psi_low, SLIP
             elif event == 3 and crossed_cap:
                 independent, target, code = TIME, STANCE_TIME_CAP, NO_LIFTOFF
             else:

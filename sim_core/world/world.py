@@ -57,6 +57,16 @@ class World:
         return self.left if name == "left" else self.right
 
 
+def inclinations(points: np.ndarray, mirror: float) -> np.ndarray:
+    """Each segment's ``beta`` [rad] of a side whose stance frame maps ``x`` to ``mirror * x``
+    (``+1`` for the left side, ``-1`` for the right): for a (mirrored) segment from ``a`` to
+    ``b``, ``t = (b - a)/|b - a|``, ``n = (t_y, -t_x)``, ``beta = atan2(n_y, n_x)`` (docs/model.md
+    §8): 0 on a vertical wall, ``> 0`` where the surface faces upward."""
+    delta = np.diff(points, axis=0) * np.array([mirror, 1.0])
+    # n = (t_y, -t_x) up to the positive length: atan2 needs no normalising
+    return np.arctan2(-delta[:, 0], delta[:, 1])
+
+
 def parallel(d_hat: float, height: float = 1.0, mu: float = math.nan) -> World:
     """Two vertical walls ``d_hat`` apart (each one segment from ``y = 0`` to ``height``; the
     continuations go on past its ends): docs/model.md §2's chute as a world."""

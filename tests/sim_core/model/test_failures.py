@@ -6,7 +6,7 @@ from sim_core.model import failures
 from sim_core.model.failures import OK, Failure
 
 # Stored results refer to these: never renumber (docs/model.md §3.1).
-STABLE = {"slip": 1, "collapse": 2, "no_liftoff": 3, "no_flight": 4, "invalid_state": 5, "floor": 6}
+STABLE = {"slip": 1, "collapse": 2, "no_liftoff": 3, "no_flight": 4, "invalid_state": 5, "floor": 6, "no_touchdown": 7}
 
 
 def test_codes_and_numbers_are_the_stable_ones():

@@ -1,0 +1,98 @@
+"""A climb in a world, validated and typed (docs/model.md §8): ``parkour climb``'s engine.
+
+Touchdown 0 is on the left side with the foot on its polyline at height ``foot_y`` and the body
+arriving with velocity ``(xdot, ydot)`` (``xdot < 0``), as ``parkour map --state`` takes it. Jump
+``k`` uses schedule row ``k % m`` while the sides alternate. No noise, pitch or floor here.
+
+>>> from sim_core import ControlSchedule, get_preset
+>>> from sim_core.world.world import parallel
+>>> model = get_preset("paper").to_model()
+>>> run = climb_world(model, parallel(model.d_hat), ControlSchedule.from_degrees([(30, 0.9)]), (-1.0, 0.5), 3)
+>>> run.failure is None, run.states.shape, [int(side) for side in run.sides]
+(True, (4, 4), [0, 1, 0, 1])
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim_core.model.controls import ControlSchedule
+from sim_core.model.failures import OK, Failure
+from sim_core.model.params import ModelParams
+from sim_core.model.poincare import check_jumps, check_section_state
+from sim_core.model.validation import check_range
+from sim_core.world.geometry import LEFT, SIDE_NAMES, pack, segment_at, side_x
+from sim_core.world.stride import TOUCHDOWN_SIZE, world_orbit
+from sim_core.world.world import World
+
+
+@dataclass(frozen=True)
+class WorldClimb:
+    """The touchdowns of one climb in a world.
+
+    Attributes:
+        states: shape (k + 1, 4), the body at touchdowns 0..k: ``x, y, xdot, ydot`` in wall
+            coordinates [l0, sqrt(g l0)].
+        sides: shape (k + 1,), 0 left, 1 right. segments: shape (k + 1,), as docs/model.md §8.
+        failure: why the climb stopped early, or None. failed_jump: its 1-based jump, or None.
+    """
+
+    states: np.ndarray
+    sides: np.ndarray
+    segments: np.ndarray
+    failure: Failure | None
+    failed_jump: int | None
+
+    def to_dict(self) -> dict:
+        """The ``parkour climb --json`` contract: every touchdown (0 included, ``jump`` 0-based)
+        and the failure (``jump`` 1-based) or None."""
+        touchdowns = [
+            {
+                "jump": jump,
+                "side": SIDE_NAMES[int(self.sides[jump])],
+                "segment": int(self.segments[jump]),
+                "x": float(x),
+                "y": float(y),
+                "xdot": float(xdot),
+                "ydot": float(ydot),
+            }
+            for jump, (x, y, xdot, ydot) in enumerate(self.states)
+        ]
+        failure = None if self.failure is None else {"code": self.failure.code, "jump": self.failed_jump}
+        return {"touchdowns": touchdowns, "failure": failure}
+
+
+def first_touchdown(model: ModelParams, world: World, schedule: ControlSchedule, state, foot_y: float = 0.0):
+    """Touchdown 0 (docs/model.md §8): ``(row, segment)``, the body's ``x, y, xdot, ydot`` with the
+    foot on the left side at ``foot_y`` [l0] under schedule row 0, and the foot's segment."""
+    velocity = check_section_state(state)
+    foot_y = check_range("foot_y", foot_y)
+    sides = pack(world, model.mu)
+    leg = schedule[0]
+    foot_x = side_x(sides, LEFT, foot_y)
+    body = (foot_x + leg.zeta0 * math.cos(leg.psi0), foot_y + leg.zeta0 * math.sin(leg.psi0))
+    return np.array([*body, *velocity]), int(segment_at(sides, LEFT, foot_y))
+
+
+def climb_world(
+    model: ModelParams, world: World, schedule: ControlSchedule, state, jumps: int, *, foot_y: float = 0.0
+) -> WorldClimb:
+    """Climb ``jumps`` jumps in ``world`` from touchdown 0 (see the module). A failing jump ends
+    the climb; the result says which and why."""
+    jumps = check_jumps(jumps)
+    start, segment = first_touchdown(model, world, schedule, state, foot_y)
+    states = np.empty((jumps + 1, TOUCHDOWN_SIZE))
+    states[0] = start
+    sides = np.zeros(jumps + 1, dtype=np.int64)
+    segments = np.zeros(jumps + 1, dtype=np.int64)
+    sides[0], segments[0] = LEFT, segment
+    status, completed = world_orbit(
+        schedule.as_array(), 0, model.record(), pack(world, model.mu), states, sides, segments
+    )
+    if status == OK:
+        return WorldClimb(states, sides, segments, None, None)
+    kept = completed + 1
+    return WorldClimb(states[:kept].copy(), sides[:kept].copy(), segments[:kept].copy(), Failure(status), completed + 1)
