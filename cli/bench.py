@@ -55,4 +55,9 @@ def bench_command(
         "  baseline, projected",
         f"{result.basin_baseline_projected_seconds:,.0f} s ({result.basin_speedup:,.0f}x slower)",
     )
+    table.add_row(f"world of {result.world_segments} segments a side, one core",
+                  f"{result.world_kernel_strides_per_s:,.0f} strides/s "
+                  f"({result.world_cost_vs_parallel:.2f}x a parallel-walls stride's time)")  # fmt: skip
+    table.add_row("  its scipy twin", f"{result.world_baseline_strides_per_s:,.0f} strides/s")
+    table.add_row("  ratio, largest difference", f"{result.world_ratio:,.0f}x, {result.world_max_abs_diff:.2e}")
     Console().print(table)

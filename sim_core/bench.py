@@ -26,6 +26,11 @@ from sim_core.model.presets import PAPER_GAITS, START_GUESS, get_preset
 from sim_core.model.reference import reference_jumps
 from sim_core.model.validation import check_range
 from sim_core.section.gait_search import gait_of
+from sim_core.world.climb import first_touchdown
+from sim_core.world.geometry import pack
+from sim_core.world.reference import reference_world_jump
+from sim_core.world.stride import world_orbit_batch
+from sim_core.world.world import Side, World
 
 BASELINE_TOLERANCE = 1e-10
 
@@ -46,6 +51,12 @@ class BenchResult:
     basin_jumps_computed: int
     basin_baseline_projected_seconds: float
     basin_speedup: float
+    world_segments: int  # per side, of the world case's chute (docs/model.md §8)
+    world_kernel_strides_per_s: float
+    world_baseline_strides_per_s: float
+    world_ratio: float
+    world_max_abs_diff: float
+    world_cost_vs_parallel: float  # one core: a world stride's time over a parallel-walls stride's
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -119,6 +130,8 @@ def run_benchmark(
     kernel_rate = kernel_strides / kernel_time
     baseline_rate = baseline_strides / baseline_time
     baseline_basin_time = basin.jumps_computed / baseline_rate
+    say(f"world of {WORLD_SEGMENTS} segments a side: kernel on one core and the scipy twin")
+    world = _world_case(model, schedule, gait.state, rng, baseline_strides, kernel_strides, repeats)
     return BenchResult(
         kernel_strides_per_s=kernel_rate,
         baseline_strides_per_s=baseline_rate,
@@ -132,7 +145,73 @@ def run_benchmark(
         basin_jumps_computed=basin.jumps_computed,
         basin_baseline_projected_seconds=baseline_basin_time,
         basin_speedup=baseline_basin_time / basin_time,
+        world_segments=WORLD_SEGMENTS,
+        world_kernel_strides_per_s=world["kernel"],
+        world_baseline_strides_per_s=world["baseline"],
+        world_ratio=world["kernel"] / world["baseline"],
+        world_max_abs_diff=world["difference"],
+        world_cost_vs_parallel=kernel_rate / world["kernel"],
     )
+
+
+WORLD_SEGMENTS = 64  # a side of 32 footholds and the 32 stretches between them
+
+
+def bench_world(d_hat: float) -> World:
+    """The world case's chute: each side :data:`WORLD_SEGMENTS` segments from ``y = -4`` to 12
+    [l0], rippling 0.1 l0 about parallel walls ``d_hat`` apart, grip alternating between the
+    model's ``mu`` and 1.5, so most strides land (the ratio is of strides that do)."""
+    heights = np.linspace(-4.0, 12.0, WORLD_SEGMENTS + 1)
+    mu = np.resize([np.nan, 1.5], WORLD_SEGMENTS)
+    sides = [
+        Side(np.c_[sign * (d_hat / 2 + 0.1 * np.sin(2.3 * heights + phase)), heights], mu)
+        for sign, phase in ((-1.0, 0.0), (1.0, 1.0))
+    ]
+    return World(*sides, name="bench")
+
+
+def _world_case(model, schedule, gait_state, rng, baseline_strides, kernel_strides, repeats) -> dict:
+    """Strides per second in :func:`bench_world`, the kernel on one core against the scipy twin
+    (:mod:`sim_core.world.reference`, tolerance :data:`BASELINE_TOLERANCE`), from touchdowns on
+    the left side at heights 0..4 with the gait's velocity perturbed; their largest difference."""
+    world = bench_world(model.d_hat)
+    sides = pack(world, model.mu)
+    leg = schedule[0]
+    starts = np.empty((baseline_strides, 4))
+    segments = np.empty(baseline_strides, dtype=np.int64)
+    for i, foot_y in enumerate(rng.uniform(0.0, 4.0, baseline_strides)):
+        velocity = gait_state + rng.uniform(-0.1, 0.1, 2)
+        starts[i], segments[i] = first_touchdown(model, world, schedule, velocity, foot_y)
+    baseline_time, reference = _best_time(
+        lambda: [reference_world_jump(model, world, start, 0, leg, leg, tol=BASELINE_TOLERANCE) for start in starts],
+        repeats,
+    )
+
+    def run(count: int):
+        states = np.zeros((count, 2, 4))
+        states[:, 0] = np.resize(starts, (count, 4))
+        on_side = np.zeros((count, 2), dtype=np.int64)
+        on_segment = np.zeros((count, 2), dtype=np.int64)
+        on_segment[:, 0] = np.resize(segments, count)
+        status, completed = np.empty(count, dtype=np.int64), np.empty(count, dtype=np.int64)
+        world_orbit_batch(schedule.as_array()[np.newaxis], 0, model.record(), sides, states, on_side, on_segment,
+                          status, completed)  # fmt: skip
+        return status, states[:, 1]
+
+    status, landed = run(baseline_strides)  # compiles
+    expected = np.array([outcome[0] for outcome in reference])
+    both = (status == OK) & (expected == OK)
+    if not np.array_equal(status, expected) or not both.any():
+        raise RuntimeError("world kernel and its scipy twin disagree on which strides fail; the benchmark is void")
+    difference = float(np.max(np.abs(landed[both] - np.array([outcome[1] for outcome in reference])[both])))
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        kernel_time, _ = _best_time(lambda: run(kernel_strides), repeats)
+    finally:
+        numba.set_num_threads(threads)
+    return {"kernel": kernel_strides / kernel_time, "baseline": baseline_strides / baseline_time,
+            "difference": difference}  # fmt: skip
 
 
 def _best_time(work: Callable[[], object], repeats: int) -> tuple[float, object]:

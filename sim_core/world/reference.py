@@ -23,7 +23,7 @@ from sim_core.model.params import ModelParams
 from sim_core.world.geometry import FLIGHT_TIME_CAP
 from sim_core.world.world import World, inclinations
 
-FLIGHT_STEP = 1e-3  # [sqrt(l0/g)]: the bracketing step along the flight (a crossing shorter than it is missed)
+FLIGHT_STEP = 1e-2  # [sqrt(l0/g)]: the bracketing step along the flight (a crossing shorter than it is missed)
 
 
 def reference_world_jump(
@@ -50,13 +50,13 @@ def reference_world_jump(
         return SLIP, *failed
     alpha, c_zeta, c_psi = model.alpha, model.c_zeta, model.c_psi
 
-    def equations(_t, s):
-        r, v = s[:2], s[2:]
-        length = math.hypot(*r)
-        radial = r / length
-        across = np.array([-radial[1], radial[0]])
-        force = (alpha * (1.0 - length) - c_zeta * (v @ radial)) * radial - c_psi * (v @ across) * across
-        return [*v, force[0], force[1] - 1.0]
+    def equations(_t, s):  # plain floats: numpy on two-element vectors would time numpy, not scipy
+        x, y, vx, vy = s
+        length = math.hypot(x, y)
+        ux, uy = x / length, y / length  # along the leg; (-uy, ux) across it
+        along = alpha * (1.0 - length) - c_zeta * (vx * ux + vy * uy)
+        across = -c_psi * (-vx * uy + vy * ux)
+        return [vx, vy, along * ux - across * uy, along * uy + across * ux - 1.0]
 
     events = [
         _terminal(lambda _t, s: math.hypot(s[0], s[1]) - 1.0, 1.0),

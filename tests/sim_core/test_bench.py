@@ -21,6 +21,14 @@ BASIN_EXTENSION = {  # issue 4's
     "basin_baseline_projected_seconds",
     "basin_speedup",
 }
+WORLD_EXTENSION = {  # issue 41's: a world's stride against its scipy twin
+    "world_segments",
+    "world_kernel_strides_per_s",
+    "world_baseline_strides_per_s",
+    "world_ratio",
+    "world_max_abs_diff",
+    "world_cost_vs_parallel",
+}
 
 
 def test_benchmark_reports_all_figures():
@@ -34,11 +42,13 @@ def test_benchmark_reports_all_figures():
         basin_jumps=10,
         progress=stages.append,
     )
-    assert set(result.to_dict()) == CONTRACT | BASIN_EXTENSION
+    assert set(result.to_dict()) == CONTRACT | BASIN_EXTENSION | WORLD_EXTENSION
     assert 0 < result.basin_jumps_computed <= 8 * 8 * 10
     assert result.max_abs_diff <= 1e-8
     assert result.ratio == pytest.approx(result.kernel_strides_per_s / result.baseline_strides_per_s)
     assert result.cores >= 1 and stages
+    assert result.world_max_abs_diff <= 1e-8 and result.world_segments == 64
+    assert result.world_ratio == pytest.approx(result.world_kernel_strides_per_s / result.world_baseline_strides_per_s)
 
 
 def test_benchmark_rejects_bad_sizes():
