@@ -30,6 +30,8 @@ from sim_core.model.params import ModelParams
 from sim_core.model.validation import ParameterError
 from sim_core.robustness.mjtf_plan import CAPPED, jump_moments, jump_statistics, no_outcomes, plan_trials
 from sim_core.robustness.mjtf_trials import run_trials
+from sim_core.robustness.world_trials import run_world_trials
+from sim_core.world.world import World
 
 MAX_TRIALS = 1_000_000
 MAX_CAP = 1_000_000
@@ -99,6 +101,8 @@ class MJTFStudy:
     cap: int
     seed: int
     levels: tuple[MJTFLevel, ...]
+    world: str | None = None  # the world's name, None on the map's parallel walls (docs/model.md §8)
+    foot_y: float | None = None  # [l0] touchdown 0's foot in the world
 
     def to_dict(self) -> dict:
         """The ``parkour mjtf --json`` contract."""
@@ -112,6 +116,8 @@ class MJTFStudy:
             "cap": self.cap,
             "seed": self.seed,
             "levels": [level.to_dict() for level in self.levels],
+            "world": self.world,
+            "foot_y": self.foot_y,
         }
 
 
@@ -136,6 +142,8 @@ def mjtf_study(
     chunk_map: ChunkMap = in_process,
     chunk_trials: int = DEFAULT_CHUNK_TRIALS,
     progress: Progress | None = None,
+    world: World | None = None,
+    foot_y: float = 0.0,
 ) -> MJTFStudy:
     """MJTF at each zeta0 (symmetric legs, or one leg fixed as in :func:`sim_core.basins.sweep.energy_sweep`).
 
@@ -143,18 +151,29 @@ def mjtf_study(
     starts from its neighbour's. Level ``i`` draws its trials' seeds from stream ``i`` of
     ``seed``; the trials run in chunks of ``chunk_trials`` through ``chunk_map``
     (:mod:`sim_core.chunks`), so results do not depend on how the work is split.
+
+    In a ``world`` (docs/model.md §8) each trial climbs from touchdown 0 on the left side, its foot
+    at ``foot_y`` [l0], arriving with the level's gait velocity (the gait of parallel walls of
+    the model's ``d_hat``), until a jump fails, the body touches down below the floor, or the cap
+    (:mod:`sim_core.robustness.world_trials`).
     """
     trials, cap = check_trials(trials, cap)
     levels = level_starts(model, psi0, zeta0s, fixed_leg=fixed_leg, guess=guess)
     chunks = plan_trials(len(levels), trials, seed, chunk_trials)
-    results = chunk_map(run_trials, [chunk.arguments(model, levels, noise, cap) for chunk in chunks], progress)
+    arguments = [chunk.arguments(model, levels, noise, cap) for chunk in chunks]
+    if world is None:
+        results = chunk_map(run_trials, arguments, progress)
+    else:
+        results = chunk_map(run_world_trials, [(*chunk, world, foot_y) for chunk in arguments], progress)
     out = []
     for index, level in enumerate(levels):
         mine = [result for chunk, result in zip(chunks, results, strict=True) if chunk.level == index]
         jumps = np.concatenate([jumps for jumps, _ in mine])
         status = np.concatenate([status for _, status in mine])
         out.append(MJTFLevel(level.zeta0, level.energy, level.start, jumps, status, cap))
-    return MJTFStudy(psi0, fixed_leg, noise, trials, cap, int(seed), tuple(out))
+    name = None if world is None else world.name or "unnamed"
+    return MJTFStudy(psi0, fixed_leg, noise, trials, cap, int(seed), tuple(out), name,
+                     None if world is None else float(foot_y))  # fmt: skip
 
 
 @dataclass(frozen=True)
