@@ -105,7 +105,8 @@ class MJTFStudy:
     foot_y: float | None = None  # [l0] touchdown 0's foot in the world
 
     def to_dict(self) -> dict:
-        """The ``parkour mjtf --json`` contract."""
+        """The ``parkour mjtf --json`` contract (``world`` and ``foot_y`` only in a world)."""
+        in_world = {} if self.world is None else {"world": self.world, "foot_y": self.foot_y}
         return {
             "psi0_deg": round(math.degrees(self.psi0), 9),
             "fixed_leg": None
@@ -116,9 +117,7 @@ class MJTFStudy:
             "cap": self.cap,
             "seed": self.seed,
             "levels": [level.to_dict() for level in self.levels],
-            "world": self.world,
-            "foot_y": self.foot_y,
-        }
+        } | in_world
 
 
 def check_trials(trials: int, cap: int) -> tuple[int, int]:
