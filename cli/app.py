@@ -7,7 +7,7 @@ can fix print one line and exit with code 2.
 
 ``parkour serve`` starts the service with the control panel and the 3D view; ``parkour export``
 writes a stored robot or replay run as an MCAP recording; ``parkour token`` gives the lab's people
-API tokens of their own.
+API tokens of their own; ``parkour world`` lists, shows and makes the worlds of general chutes.
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ from cli import (
     sweep,
     token,
     viability,
+    world,
 )
 
 app = typer.Typer(
@@ -45,6 +46,7 @@ app = typer.Typer(
 # In the order of --help.
 COMMANDS = (
     simulate,
+    world,
     gaits,
     basin,
     sweep,

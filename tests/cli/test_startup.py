@@ -17,6 +17,7 @@ HEAVY = ("numba", "scipy", "sqlalchemy", "alembic", "dask", "distributed", "matp
 COMMANDS = ("map", "trajectory", "fixed-point", "gaits", "basin", "sweep", "mjtf", "mfpt", "viability", "pid", "atlas")
 COMMANDS += ("reproduce",)
 COMMANDS += ("robot-sim", "export", "bench", "serve")
+COMMANDS += ("world",)
 
 
 def _imported_by(*argv: str) -> set[str]:
@@ -48,3 +49,11 @@ def test_the_map_loads_the_kernels_but_not_the_optimiser_store_or_service():
     modules = _imported_by("map", "--jumps", "2", "--state", "-0.93", "-0.17", "--json")
     assert "numba" in modules and "sim_core.model.stride" in modules, "the probe really ran the map"
     assert [name for name in ("scipy.optimize", *HEAVY[2:]) if name in modules] == []
+
+
+def test_the_worlds_load_nothing_heavy(tmp_path):
+    """A world is data (sim_core.world.world, files, named, random_world): numpy, no kernels."""
+    for argv in (("world", "show", "staircase", "--json"), ("world", "random", "--out", str(tmp_path / "w.json"))):
+        modules = _imported_by(*argv)
+        assert "sim_core.world.named" in modules, "the probe really ran the command"
+        assert _heavy(modules) == [], f"parkour {' '.join(argv)}"
