@@ -19,6 +19,7 @@ from cli import (
     basin,
     bench,
     calibrate,
+    climb,
     control_study,
     export,
     gaits,
@@ -47,6 +48,7 @@ app = typer.Typer(
 COMMANDS = (
     simulate,
     world,
+    climb,
     gaits,
     basin,
     sweep,

@@ -19,10 +19,9 @@ import typer
 from cli.options import JsonOption, SeedOption, build_setup, handles_errors, option_named, print_json
 from sim_core.model.presets import DEFAULT_PRESET
 from sim_core.world.files import save_world, world_to_document
-from sim_core.world.footholds import inclinations
 from sim_core.world.named import CHUTE_HEIGHT, NAMED_WORLDS, resolve_world
 from sim_core.world.random_world import GAP, HOLD_LENGTH, INCLINE_DEG, MAX_HOLDS, MU, random_world
-from sim_core.world.world import SIDES, World
+from sim_core.world.world import SIDES, World, inclinations
 
 app = typer.Typer(name="world", help="Worlds of general chutes: list the named ones, show one, make random footholds.",
                   no_args_is_help=True, rich_markup_mode=None)  # fmt: skip

@@ -17,22 +17,6 @@ from sim_core.world.world import SIDES, Side
 NO_GRIP = 0.0
 
 
-def inclinations(points: np.ndarray, side: str) -> np.ndarray:
-    """Each listed segment's ``beta`` [rad], shape (n - 1,), for a side's vertices ``points``
-    (shape (n, 2), ``y`` increasing) on side ``side`` (``"left"`` or ``"right"``).
-
-    For a left segment from ``a`` to ``b``: tangent ``t = (b - a)/L``, normal ``n = (t_y, -t_x)``,
-    ``beta = atan2(n_y, n_x)``; a right segment is mirrored ``x -> -x`` first.
-
-    >>> from math import degrees
-    >>> [round(degrees(b), 6) for b in inclinations(np.array([[0.0, 0.0], [0.0, 1.0], [-1.0, 2.0]]), "left")]
-    [0.0, 45.0]
-    """
-    step = np.diff(np.asarray(points, dtype=float), axis=0)
-    across = step[:, 0] if side == "left" else -step[:, 0]
-    return np.arctan2(-across, step[:, 1]) + 0.0  # + 0.0: a vertical segment's beta is 0, not -0
-
-
 def foothold_side(
     side: str,
     wall_x: float,

@@ -20,10 +20,10 @@ from typing import NamedTuple
 import numpy as np
 
 from sim_core._jit import kernel
-from sim_core.world.world import World, inclinations
+from sim_core.world.world import SIDES, World, inclinations
 
 LEFT, RIGHT = 0, 1  # side indices in the kernels (JSON says "left" and "right")
-SIDE_NAMES = ("left", "right")
+SIDE_NAMES = SIDES  # in the kernels' order
 FLIGHT_TIME_CAP = 10.0  # [sqrt(l0/g)]: a flight this long met no side (docs/model.md §8, `no_touchdown`)
 SAME_TIME = 1e-12  # [sqrt(l0/g)]: crossings closer in time than this are a tie, won by the segment above
 
@@ -55,13 +55,13 @@ def pack(world: World, model_mu: float) -> SideArrays:
     friction = np.full((2, widest + 1), float(model_mu))
     beta = np.zeros((2, widest + 1))
     counts = np.empty(2, dtype=np.int64)
-    for index, (side, mirror) in enumerate(zip(sides, (1.0, -1.0), strict=True)):
+    for index, (side, name) in enumerate(zip(sides, SIDE_NAMES, strict=True)):
         n = side.points.shape[0]
         counts[index] = n
         points[index, :n] = side.points
         points[index, n:] = side.points[-1]
         friction[index, 1:n] = side.friction(model_mu)
-        beta[index, 1:n] = inclinations(side.points, mirror)
+        beta[index, 1:n] = inclinations(side.points, name)
     return SideArrays(points, counts, friction, beta)
 
 

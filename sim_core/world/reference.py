@@ -21,7 +21,7 @@ from sim_core.model.failures import COLLAPSE, INVALID_STATE, NO_FLIGHT, NO_LIFTO
 from sim_core.model.integrate import COLLAPSE_ZETA, STANCE_TIME_CAP
 from sim_core.model.params import ModelParams
 from sim_core.world.geometry import FLIGHT_TIME_CAP
-from sim_core.world.world import World, inclinations
+from sim_core.world.world import SIDES, World, inclinations
 
 FLIGHT_STEP = 1e-2  # [sqrt(l0/g)]: the bracketing step along the flight (a crossing shorter than it is missed)
 
@@ -40,7 +40,7 @@ def reference_world_jump(
     if velocity[0] >= 0.0:
         return INVALID_STATE, *failed
     foot = body - leg.zeta0 * np.array([math.cos(leg.psi0), math.sin(leg.psi0)])
-    beta, mu = _foothold(stance_side, mirror, foot[1], model.mu)
+    beta, mu = _foothold(stance_side, SIDES[side], foot[1], model.mu)
     cone = math.atan(mu)
 
     def off_normal(r):  # the leg's angle from the foothold's normal
@@ -93,13 +93,13 @@ def reference_world_jump(
     return OK, np.array([mirror * landed[0], landed[1], mirror * vx, vy - t]), 1 - side
 
 
-def _foothold(side, mirror: float, foot_y: float, model_mu: float) -> tuple[float, float]:
+def _foothold(side, name: str, foot_y: float, model_mu: float) -> tuple[float, float]:
     """``(beta, mu)`` of the segment under a foot at ``foot_y`` (a vertex belongs to the one above)."""
     heights = side.points[:, 1]
     segment = int(np.searchsorted(heights, foot_y, side="right")) - 1
     if segment < 0 or segment >= len(heights) - 1:
         return 0.0, model_mu
-    return float(inclinations(side.points, mirror)[segment]), float(side.friction(model_mu)[segment])
+    return float(inclinations(side.points, name)[segment]), float(side.friction(model_mu)[segment])
 
 
 def _terminal(function, direction: float):

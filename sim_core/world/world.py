@@ -57,14 +57,22 @@ class World:
         return self.left if name == "left" else self.right
 
 
-def inclinations(points: np.ndarray, mirror: float) -> np.ndarray:
-    """Each segment's ``beta`` [rad] of a side whose stance frame maps ``x`` to ``mirror * x``
-    (``+1`` for the left side, ``-1`` for the right): for a (mirrored) segment from ``a`` to
-    ``b``, ``t = (b - a)/|b - a|``, ``n = (t_y, -t_x)``, ``beta = atan2(n_y, n_x)`` (docs/model.md
-    §8): 0 on a vertical wall, ``> 0`` where the surface faces upward."""
-    delta = np.diff(points, axis=0) * np.array([mirror, 1.0])
-    # n = (t_y, -t_x) up to the positive length: atan2 needs no normalising
-    return np.arctan2(-delta[:, 0], delta[:, 1])
+def inclinations(points: np.ndarray, side: str) -> np.ndarray:
+    """Each listed segment's ``beta`` [rad], shape (n - 1,), for a side's vertices ``points``
+    (shape (n, 2), ``y`` increasing) on side ``side`` (``"left"`` or ``"right"``), in that side's
+    stance frame (docs/model.md §8): for a left segment from ``a`` to ``b``, tangent
+    ``t = (b - a)/L``, normal ``n = (t_y, -t_x)``, ``beta = atan2(n_y, n_x)``; a right segment is
+    mirrored ``x -> -x`` first. 0 on a vertical wall, ``> 0`` where the surface faces upward.
+
+    >>> from math import degrees
+    >>> [round(degrees(b), 6) for b in inclinations(np.array([[0.0, 0.0], [0.0, 1.0], [-1.0, 2.0]]), "left")]
+    [0.0, 45.0]
+    """
+    step = np.diff(np.asarray(points, dtype=float), axis=0)
+    across = step[:, 0] if side == "left" else -step[:, 0]
+    # n = (t_y, -t_x) up to the positive length: atan2 needs no normalising; + 0.0: a vertical
+    # segment's beta is 0, not -0
+    return np.arctan2(-across, step[:, 1]) + 0.0
 
 
 def parallel(d_hat: float, height: float = 1.0, mu: float = math.nan) -> World:

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
-from sim_core.world.footholds import NO_GRIP, foothold_side, holds_below, inclinations
+from sim_core.world.footholds import NO_GRIP, foothold_side, holds_below
+from sim_core.world.world import inclinations
 
 ATOL = 1e-12
 

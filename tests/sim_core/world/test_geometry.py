@@ -29,11 +29,11 @@ def test_a_vertex_belongs_to_the_segment_above_and_the_ends_go_on_vertically():
 def test_inclination_is_the_inward_normals_angle_in_the_sides_stance_frame():
     # A left side whose top leans away from the chute faces upward: beta > 0; one leaning in, beta < 0.
     away, inward = np.array([[-1.0, 0.0], [-2.0, 1.0]]), np.array([[-1.0, 0.0], [-0.5, 1.0]])
-    assert inclinations(away, 1.0)[0] == pytest.approx(UP(45))
-    assert inclinations(inward, 1.0)[0] == pytest.approx(-math.atan2(0.5, 1.0))
+    assert inclinations(away, "left")[0] == pytest.approx(UP(45))
+    assert inclinations(inward, "left")[0] == pytest.approx(-math.atan2(0.5, 1.0))
     # The right side's mirror image of a left side has the same inclinations in its own frame.
-    assert inclinations(away * [-1, 1], -1.0)[0] == pytest.approx(UP(45))
-    assert inclinations(np.array([[-1.0, 0.0], [-1.0, 3.0]]), 1.0)[0] == 0.0
+    assert inclinations(away * [-1, 1], "right")[0] == pytest.approx(UP(45))
+    assert inclinations(np.array([[-1.0, 0.0], [-1.0, 3.0]]), "left")[0] == 0.0
 
 
 def test_friction_left_open_is_the_models_and_the_continuations_have_it_with_no_incline():

@@ -10,7 +10,6 @@ from numpy.testing import assert_allclose
 from sim_core.model.errors import ParameterError
 from sim_core.model.presets import get_preset
 from sim_core.world.files import save_world, world_from_document, world_to_document
-from sim_core.world.footholds import inclinations
 from sim_core.world.named import (
     CHUTE_HEIGHT,
     NAMED_WORLDS,
@@ -20,6 +19,7 @@ from sim_core.world.named import (
     resolve_world,
 )
 from sim_core.world.validation import check_world
+from sim_core.world.world import inclinations
 
 # The widest a pair of legs reaches across at touchdown, zeta0 cos psi0 each, for zeta0 <= 0.95 and
 # psi0 >= 20° (the controls in use): a chute narrower than that leaves the body no room to fly.

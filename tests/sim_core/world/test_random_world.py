@@ -9,10 +9,10 @@ import pytest
 from numpy.testing import assert_array_equal
 
 from sim_core.model.errors import ParameterError
-from sim_core.world.footholds import inclinations
 from sim_core.world.named import CHUTE_HEIGHT, PAPER_D_HAT
 from sim_core.world.random_world import GAP, HOLD_LENGTH, INCLINE_DEG, MAX_HOLDS, MU, random_world
 from sim_core.world.validation import check_world
+from sim_core.world.world import inclinations
 
 ATOL = 1e-9
 SEEDS = range(200)
