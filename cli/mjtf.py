@@ -50,10 +50,16 @@ def mjtf_command(
         str | None, typer.Option("--fixed-leg", help="PSI0:ZETA0 of a leg held fixed; the other sweeps.")
     ] = None,
     guess: GuessOption = None,
+    world: Annotated[
+        str | None,
+        typer.Option("--world", help="Climb in this world (a file or a named world, docs/worlds.md) from touchdown 0."),
+    ] = None,
+    foot_y: Annotated[float, typer.Option("--foot-y", help="With --world: touchdown 0's foot height [l0].")] = 0.0,
     scheduler: SchedulerOption = None,
     as_json: JsonOption = False,
 ) -> None:
-    """Mean Jumps To Failure under noise, per energy level (zeta0)."""
+    """Mean Jumps To Failure under noise, per energy level (zeta0); with --world, climbing that
+    world from touchdown 0 at each level's gait velocity, ending at its floor too."""
     from sim_core.basins.sweep import zeta0_values
     from sim_core.robustness.mjtf import CAPPED, check_trials, mjtf_study
 
@@ -79,6 +85,7 @@ def mjtf_command(
         trials=trials,
         cap=cap,
         seed=seed,
+        **_in_world(world, foot_y, setup),
     )
     if as_json:
         print_json(study.to_dict())
@@ -86,7 +93,8 @@ def mjtf_command(
     from rich.console import Console
     from rich.table import Table
 
-    table = Table("zeta0", "E (m g l0)", "MJTF", "std", "95% CI", "capped", "failures", title=f"psi0 {psi0:g}°")
+    where = "" if study.world is None else f", in {study.world} from foot height {foot_y:g} l0"
+    table = Table("zeta0", "E (m g l0)", "MJTF", "std", "95% CI", "capped", "failures", title=f"psi0 {psi0:g}°{where}")
     for level in study.levels:
         outcomes = level.histogram()
         capped = outcomes.pop(CAPPED)
@@ -101,3 +109,15 @@ def mjtf_command(
             ", ".join(f"{code} {count}" for code, count in outcomes.items() if count),
         )
     Console().print(table)
+
+
+def _in_world(world: str | None, foot_y: float, setup: ModelSetup) -> dict:
+    """The study's world options: none without ``--world`` (``--foot-y`` then means nothing)."""
+    if world is None:
+        if foot_y != 0.0:
+            raise ParameterError("--foot-y", "needs --world: on the map's parallel walls trials have no height")
+        return {}
+    from sim_core.world.named import resolve_world
+
+    chosen, _description = resolve_world(world, setup.model.d_hat, setup.robot.scales.length)
+    return {"world": chosen, "foot_y": foot_y}

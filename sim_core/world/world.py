@@ -53,6 +53,12 @@ class World:
     right: Side
     name: str = ""
 
+    @property
+    def top(self) -> float:
+        """Where the chute as drawn ends [l0]: the lower of the two sides' last vertices (above
+        it both sides only go on as vertical walls)."""
+        return float(min(self.left.points[-1, 1], self.right.points[-1, 1]))
+
     def side(self, name: str) -> Side:
         return self.left if name == "left" else self.right
 
