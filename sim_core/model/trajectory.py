@@ -124,12 +124,12 @@ def simulate_trajectory(
             xdot, ydot, leg.psi0, leg.zeta0, next_leg.psi0, next_leg.zeta0, parameters, record
         )
         if rows >= 2:
-            pieces.append(_stance_piece(record[:rows], clock, sample_rate, side, half_width, foot_height, k))
+            pieces.append(stance_piece(record[:rows], clock, sample_rate, side, -half_width, foot_height, k))
         if status != OK:
             failure = Failure(status)
             break
         pieces.append(
-            _flight_piece(record[rows - 1], clock, flight_time, sample_rate, side, half_width, foot_height, next_leg, k)
+            flight_piece(record[rows - 1], clock, flight_time, sample_rate, side, -half_width, foot_height, next_leg, k)
         )
         clock += stance_time + flight_time
         foot_height += rise
@@ -158,19 +158,21 @@ def _sample_times(start: float, duration: float, rate: float) -> np.ndarray:
     return np.arange(first, last) / rate
 
 
-def _stance_piece(nodes, clock, rate, side, half_width, foot_height, jump_index):
+def stance_piece(nodes, clock, rate, side, foot_x, foot_height, jump_index):
+    """Samples of one stance from its integrator ``nodes`` (rows of the state), its foot at
+    ``(foot_x, foot_height)`` in the flipped frame (``-d_hat/2`` on parallel walls) and ``side``
+    the flipped frame's sign (+1: the stance is on the left wall), from time ``clock``."""
     from scipy.interpolate import CubicHermiteSpline  # half a second to import: loaded when first sampled
 
     times = _sample_times(clock, nodes[-1, TIME], rate)
     local = np.clip(times - clock, 0.0, nodes[-1, TIME])
     zeta = CubicHermiteSpline(nodes[:, TIME], nodes[:, ZETA], nodes[:, ZETA_DOT])(local)
     psi = CubicHermiteSpline(nodes[:, TIME], nodes[:, PSI], nodes[:, PSI_DOT])(local)
-    foot_x = -side * half_width
     return _piece(
         times,
-        x=side * (-half_width + zeta * np.cos(psi)),
+        x=side * (foot_x + zeta * np.cos(psi)),
         y=foot_height + zeta * np.sin(psi),
-        foot_x=np.full_like(times, foot_x),
+        foot_x=np.full_like(times, side * foot_x),
         foot_y=np.full_like(times, foot_height),
         psi=psi,
         zeta=zeta,
@@ -179,13 +181,15 @@ def _stance_piece(nodes, clock, rate, side, half_width, foot_height, jump_index)
     )
 
 
-def _flight_piece(liftoff, clock, flight_time, rate, side, half_width, foot_height, next_leg, jump_index):
+def flight_piece(liftoff, clock, flight_time, rate, side, foot_x, foot_height, next_leg, jump_index):
+    """Samples of the flight after the stance whose last node is ``liftoff`` (foot, side and clock
+    as :func:`stance_piece`), ``flight_time`` long, the next leg held at its controls."""
     psi, zeta_dot, psi_dot = liftoff[PSI], liftoff[ZETA_DOT], liftoff[PSI_DOT]
     start = clock + liftoff[TIME]
     times = _sample_times(start, flight_time, rate)
     local = times - start
     xdot, ydot = stride.liftoff_velocity(psi, zeta_dot, psi_dot)
-    x_flipped = -half_width + math.cos(psi) + xdot * local
+    x_flipped = foot_x + math.cos(psi) + xdot * local
     y = foot_height + math.sin(psi) + ydot * local - 0.5 * local**2
     x = side * x_flipped
     return _piece(
