@@ -54,6 +54,10 @@ def robot_sim_command(
     ] = 1,
     *,
     setup: ModelSetup,
+    world: Annotated[
+        str | None,
+        typer.Option("--world", help="The chute it climbs: a world file or a named world (docs/worlds.md)."),
+    ] = None,
 ) -> None:
     """Run the virtual robot until Ctrl-C; connect with the pyserial URL socket://HOST:PORT.
 
@@ -72,6 +76,10 @@ def robot_sim_command(
     if not tracker_host or not tracker_port.isdigit():
         raise ParameterError("tracker", f"must be HOST:PORT, got {tracker!r}")
     natnet = {"natnet_version": natnet_version, "natnet_rigid_body_id": natnet_rigid_body_id}
+    if world is not None:
+        from sim_core.world.named import resolve_world
+
+        imperfections["world"] = resolve_world(world, setup.model.d_hat, setup.robot.scales.length)[0]
     robot = VirtualRobot(host, port, tracker_to=(tracker_host, int(tracker_port)), seed=seed,
                          tracker_protocol=tracker_protocol, robot=setup.robot, leg_offsets=offsets,
                          **natnet, **imperfections).start()  # fmt: skip

@@ -37,6 +37,7 @@ from sim_core.model.noise_rules import NoiseSampler
 from sim_core.model.presets import START_GUESS
 from sim_core.model.validation import check_range
 from sim_core.model.walls import Wall
+from sim_core.world.world import World
 
 FRAME_RATE = 100.0  # [Hz] the FLEX V100's
 
@@ -59,8 +60,10 @@ class Climber:
         tracker_protocol: str = "pkt1",
         natnet_version: str = "3.1",
         natnet_rigid_body_id: int = 1,
+        world: World | None = None,
     ):
         self.legs, self.running, self.fell = legs, running, fell
+        self.world = world  # the chute it climbs (docs/model.md §8); None: parallel walls
         self.tracker_to = tracker_to
         self.robot = robot or get_preset("paper")
         self.model = self.robot.to_model()
@@ -96,7 +99,7 @@ class Climber:
         """One jump simulated and thrown away, before the robot can be started: a real robot is
         ready when it is switched on, and its first launch must not wait for the kernels to load
         (it did, 0.47 s, which a live run's tracker watch rightly reads as a silent tracker)."""
-        setup = ClimbSetup(self.robot, sample_rate=FRAME_RATE * self.robot.scales.time)
+        setup = ClimbSetup(self.robot, sample_rate=FRAME_RATE * self.robot.scales.time, world=self.world)
         sampler = NoiseSampler(self.noise, np.random.default_rng(0))
         start = self._launch(setup, sampler)
         climb.stance(setup, start)
@@ -130,7 +133,7 @@ class Climber:
         """One climb from launch until stopped, failed or at the floor."""
         self._seed_climb()
         self.climbs += 1
-        setup = ClimbSetup(self.robot, sample_rate=FRAME_RATE * self.robot.scales.time)
+        setup = ClimbSetup(self.robot, sample_rate=FRAME_RATE * self.robot.scales.time, world=self.world)
         sampler = NoiseSampler(self.noise, self._climb_rng)
         start = self._launch(setup, sampler)
         started = time.monotonic()

@@ -14,6 +14,7 @@ MJTF's outcome histogram lists every one of them.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from enum import Enum
 
@@ -23,6 +24,7 @@ from sim_core.model.controls import LegControl
 from sim_core.model.failures import Failure
 from sim_core.model.params import PhysicalParams
 from sim_core.model.walls import Wall
+from sim_core.world.world import World
 
 FLOOR = 0.0  # [m] the chute's floor: the height of the first foot's touchdown
 # [m] the top of the lab's chute, its air table's length up the slope (the paper's climbs end there,
@@ -63,6 +65,7 @@ class ClimbSetup:
     sample_rate: float = SAMPLE_RATE  # per sqrt(l0/g)
     floor: float = FLOOR  # [m]
     top: float | None = None  # [m]
+    world: World | None = None  # the chute (docs/model.md §8); None: parallel walls the robot's d apart
 
 
 @dataclass(frozen=True)
@@ -74,6 +77,8 @@ class JumpStart:
         time: [s]; body_height: [m] above the floor.
         state: ``(xdot, ydot)`` section state, nondimensional, flipped (docs/model.md §4).
         leg: the stance leg's controls as realised (noise included); pitch: body pitch [rad].
+        body_x: [m] the body's x at touchdown in a world (NaN on parallel walls, where the legs
+            set it); segment: the foot's segment of the stance side (docs/model.md §8).
     """
 
     jump: int
@@ -83,6 +88,8 @@ class JumpStart:
     state: tuple[float, float]
     leg: LegControl
     pitch: float = 0.0
+    body_x: float = math.nan
+    segment: int = 0
 
 
 @dataclass(frozen=True)
@@ -138,6 +145,7 @@ class Jump:
         end: why the climb ended in this jump (a jump failure or the floor), or None.
         rise: [m] foot height gained; duration: [s] to the next touchdown (NaN after an end).
         arrival: section state at the next touchdown, before process noise; None after an end.
+        landing: in a world, the next touchdown's body x [m] and segment; None otherwise.
     """
 
     start: JumpStart
@@ -148,6 +156,7 @@ class Jump:
     rise: float
     duration: float
     arrival: tuple[float, float] | None
+    landing: tuple[float, int] | None = None
 
     @property
     def wall(self) -> Wall:

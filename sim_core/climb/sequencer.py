@@ -33,16 +33,20 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import replace
+from typing import NamedTuple
 
 import numpy as np
 
 from sim_core.climb.records import FLOOR, ClimbEnd, ClimbSetup, Jump, JumpStart, NextLeg, Samples, Stance
 from sim_core.model.controls import ControlSchedule, LegControl
-from sim_core.model.failures import Failure
+from sim_core.model.failures import OK, Failure
+from sim_core.model.integrate import STATE_SIZE
 from sim_core.model.noise_rules import NoiseSampler
 from sim_core.model.params import PhysicalParams
-from sim_core.model.trajectory import FLIGHT, STANCE, simulate_trajectory
+from sim_core.model.trajectory import FLIGHT, MAX_STANCE_NODES, STANCE, Trajectory, simulate_trajectory
 from sim_core.model.walls import Wall, wall_of
+from sim_core.world.geometry import LEFT, RIGHT, pack, segment_at, side_x
+from sim_core.world.trajectory import jump_path
 
 
 def start_height(leg: LegControl, robot: PhysicalParams, floor: float = FLOOR) -> float:
@@ -62,6 +66,11 @@ def launch(setup: ClimbSetup, commanded: LegControl, state, sampler: NoiseSample
     """
     wall = wall_of(0)
     leg = commanded if sampler is None else sampler.controls(commanded, wall, 0.0)
+    body_x, segment = math.nan, 0
+    if setup.world is not None:  # the foot on the left side at the floor's height
+        sides, floor = pack(setup.world, setup.robot.to_model().mu), setup.floor / setup.robot.leg_length
+        body_x = (side_x(sides, LEFT, floor) + leg.zeta0 * math.cos(leg.psi0)) * setup.robot.leg_length
+        segment = int(segment_at(sides, LEFT, floor))
     return JumpStart(
         jump=0,
         wall=wall,
@@ -69,6 +78,8 @@ def launch(setup: ClimbSetup, commanded: LegControl, state, sampler: NoiseSample
         body_height=start_height(leg, setup.robot, setup.floor),
         state=(float(state[0]), float(state[1])),
         leg=leg,
+        body_x=body_x,
+        segment=segment,
     )
 
 
@@ -86,7 +97,7 @@ def stance(setup: ClimbSetup, start: JumpStart) -> Stance:
     The stance does not depend on the next leg; a lift-off without flight (``no_flight``) is
     judged by :func:`jump`, once the next leg is known.
     """
-    samples, failure, _, _ = _simulate(setup, start, start.leg)
+    samples, failure, _ = _simulate(setup, start, start.leg)
     in_stance = samples.take(samples.phase == STANCE)
     in_stance, floor = _above_floor(in_stance, setup.floor)
     end = ClimbEnd.FLOOR if floor else (None if failure in (None, Failure.NO_FLIGHT) else failure)
@@ -95,10 +106,10 @@ def stance(setup: ClimbSetup, start: JumpStart) -> Stance:
 
 def jump(setup: ClimbSetup, start: JumpStart, next_leg: NextLeg) -> Jump:
     """Jump ``start`` with ``next_leg`` flying to the other wall: samples, and how it ends."""
-    samples, failure, path, si = _simulate(setup, start, next_leg.leg)
+    samples, failure, outcome = _simulate(setup, start, next_leg.leg)
     samples, floor = _above_floor(samples, setup.floor)
     completed = failure is None and not floor
-    rise = float(si.rises[0]) if completed else math.nan
+    rise = outcome.rise if completed else math.nan
     robot = setup.robot
     landing = _next_body_height(start, next_leg, rise, robot) if completed else math.nan
     if landing < setup.floor:
@@ -113,8 +124,9 @@ def jump(setup: ClimbSetup, start: JumpStart, next_leg: NextLeg) -> Jump:
         liftoff=int(flight[0]) if flight.size else len(samples),
         end=ClimbEnd.FLOOR if floor else (ClimbEnd.TOP if top else failure),
         rise=rise if completed else math.nan,
-        duration=float(si.touchdown_times[-1]) if completed else math.nan,
-        arrival=(float(path.section_states[-1, 0]), float(path.section_states[-1, 1])) if completed else None,
+        duration=outcome.duration if completed else math.nan,
+        arrival=outcome.arrival if completed else None,
+        landing=outcome.landing if completed else None,
     )
 
 
@@ -132,6 +144,7 @@ def touchdown_after(setup: ClimbSetup, done: Jump, sampler: NoiseSampler | None 
         state=state,
         leg=done.next.leg,
         pitch=done.next.pitch,
+        **({} if done.landing is None else {"body_x": done.landing[0], "segment": done.landing[1]}),
     )
 
 
@@ -179,9 +192,20 @@ def _next_body_height(start: JumpStart, next_leg: NextLeg, rise: float, robot: P
     return foot_height(start, robot) + rise + leg.zeta0 * robot.leg_length * math.sin(leg.psi0)
 
 
+class _Outcome(NamedTuple):
+    """Where a completed jump leads: ``rise`` [m], ``duration`` [s], the ``arrival`` section state
+    and, in a world, the ``landing`` (body x [m], segment); NaNs after a failure."""
+
+    rise: float
+    duration: float
+    arrival: tuple[float, float]
+    landing: tuple[float, int] | None
+
+
 def _simulate(setup: ClimbSetup, start: JumpStart, next_leg: LegControl):
-    """One jump by ``sim_core.simulate_trajectory``: ``(samples, failure, path, si)``; the samples in SI
-    wall coordinates, ``path`` nondimensional (its section states exact), ``si`` the same in SI."""
+    """One jump, sampled: ``(samples, failure, outcome)``, the samples in SI wall coordinates."""
+    if setup.world is not None:
+        return _simulate_in_world(setup, start, next_leg)
     robot = setup.robot
     path = simulate_trajectory(
         robot.to_model(),
@@ -192,8 +216,47 @@ def _simulate(setup: ClimbSetup, start: JumpStart, next_leg: LegControl):
         start_height=start.body_height / robot.leg_length,
     )
     si = path.to_si(robot)
-    mirror = -float(start.wall)  # the simulator puts the stance on the left wall (x < 0)
-    samples = Samples(
+    arrival = (float(path.section_states[-1, 0]), float(path.section_states[-1, 1]))
+    completed = path.failure is None
+    outcome = _Outcome(float(si.rises[0]) if completed else math.nan,
+                       float(si.touchdown_times[-1]) if completed else math.nan, arrival, None)  # fmt: skip
+    return _samples(si, start), path.failure, outcome
+
+
+def _simulate_in_world(setup: ClimbSetup, start: JumpStart, next_leg: LegControl):
+    """:func:`_simulate` in ``setup.world`` (docs/model.md §8): the jump from the body at ``start``."""
+    robot = setup.robot
+    model, scales = robot.to_model(), robot.scales
+    side = LEFT if start.wall is Wall.LEFT else RIGHT
+    mirror = -float(start.wall)
+    touchdown = (start.body_x / scales.length, start.body_height / scales.length,
+                 mirror * start.state[0], start.state[1])  # fmt: skip
+    record = np.empty((MAX_STANCE_NODES, STATE_SIZE))
+    pieces, status, landing, next_side, segment, duration = jump_path(
+        model.record(), pack(setup.world, model.mu), touchdown, side, start.segment, start.leg, next_leg,
+        0.0, setup.sample_rate, start.jump, record,
+    )  # fmt: skip
+    columns = {  # none: a touchdown that slipped at once
+        name: np.concatenate([piece[name] for piece in pieces]) if pieces else np.empty(0)
+        for name in Trajectory.COLUMNS
+    }
+    path = Trajectory(**columns, touchdown_times=np.zeros(1), section_states=np.zeros((1, 2)), rises=np.zeros(0),
+                      failure=None, failed_jump=None)  # fmt: skip
+    if status != OK:
+        return _samples(path.to_si(robot), start), Failure(status), _Outcome(math.nan, math.nan, (math.nan,) * 2, None)
+    next_mirror = 1.0 if next_side == LEFT else -1.0
+    foot = start.body_height - start.leg.zeta0 * scales.length * math.sin(start.leg.psi0)
+    next_foot = (landing[1] - next_leg.zeta0 * math.sin(next_leg.psi0)) * scales.length
+    outcome = _Outcome(next_foot - foot, duration * scales.time, (next_mirror * landing[2], float(landing[3])),
+                       (float(landing[0]) * scales.length, int(segment)))  # fmt: skip
+    return _samples(path.to_si(robot), start), None, outcome
+
+
+def _samples(si: Trajectory, start: JumpStart) -> Samples:
+    """A sampled jump in SI from the jump's start time on; a map's path is mirrored onto its wall
+    (the simulator puts the stance on the left wall, x < 0), a world's is in wall coordinates."""
+    mirror = -float(start.wall) if math.isnan(start.body_x) else 1.0
+    return Samples(
         time=start.time + si.time,
         x=mirror * si.x,
         y=si.y,
@@ -202,7 +265,6 @@ def _simulate(setup: ClimbSetup, start: JumpStart, next_leg: LegControl):
         zeta=si.zeta,
         phase=si.phase.astype(int),
     )
-    return samples, path.failure, path, si
 
 
 def _above_floor(samples: Samples, floor: float) -> tuple[Samples, bool]:

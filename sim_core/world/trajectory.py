@@ -46,23 +46,16 @@ def simulate_world_trajectory(
     states, on_side, on_segment = [start], [LEFT], [segment]
     pieces, touchdown_times, clock, failure = [], [0.0], 0.0, None
     for k in range(jumps):
-        leg, next_leg = schedule[k], schedule[k + 1]
-        x, y, xdot, ydot = states[-1]
-        side = on_side[-1]
-        mirror = 1.0 if side == LEFT else -1.0
-        foot = (mirror * x - leg.zeta0 * math.cos(leg.psi0), y - leg.zeta0 * math.sin(leg.psi0))  # stance frame
-        status, *touchdown, next_side, next_segment, stance_time, flight_time, rows = world_jump(
-            x, y, xdot, ydot, side, on_segment[-1], leg.psi0, leg.zeta0, next_leg.psi0, next_leg.zeta0,
-            parameters, sides, record,
+        pieces_k, status, touchdown, next_side, next_segment, duration = jump_path(
+            parameters, sides, states[-1], on_side[-1], on_segment[-1], schedule[k], schedule[k + 1],
+            clock, sample_rate, k, record,
         )  # fmt: skip
-        if rows >= 2:
-            pieces.append(stance_piece(record[:rows], clock, sample_rate, mirror, foot[0], foot[1], k))
+        pieces.extend(pieces_k)
         if status != OK:
             failure = Failure(status)
             break
-        pieces.append(flight_piece(record[rows - 1], clock, flight_time, sample_rate, mirror, *foot, next_leg, k))
-        clock += stance_time + flight_time
-        states.append(np.array(touchdown))
+        clock += duration
+        states.append(touchdown)
         on_side.append(next_side)
         on_segment.append(next_segment)
         touchdown_times.append(clock)
@@ -85,3 +78,24 @@ def simulate_world_trajectory(
         failed_jump=climb.failed_jump,
     )
     return trajectory, climb
+
+
+def jump_path(model, sides, touchdown, side, segment, leg, next_leg, clock, sample_rate, k, record):
+    """One jump of a world climb, sampled: from ``touchdown`` (the body's ``x, y, xdot, ydot`` in
+    wall coordinates [l0]) on ``side``'s ``segment`` at time ``clock``, with ``leg`` in stance and
+    ``next_leg`` flying. Returns ``(pieces, status, next touchdown, next side, next segment,
+    duration)``: the :class:`~sim_core.model.trajectory.Trajectory` columns of its stance and flight
+    (``k``: its jump index), and where and when the next touchdown is (NaNs after a failure)."""
+    x, y, xdot, ydot = touchdown
+    mirror = 1.0 if side == LEFT else -1.0
+    foot = (mirror * x - leg.zeta0 * math.cos(leg.psi0), y - leg.zeta0 * math.sin(leg.psi0))  # stance frame
+    status, *landing, next_side, next_segment, stance_time, flight_time, rows = world_jump(
+        x, y, xdot, ydot, side, segment, leg.psi0, leg.zeta0, next_leg.psi0, next_leg.zeta0, model, sides, record
+    )
+    pieces = []
+    if rows >= 2:
+        pieces.append(stance_piece(record[:rows], clock, sample_rate, mirror, foot[0], foot[1], k))
+    if status != OK:
+        return pieces, status, np.array(landing), side, segment, math.nan
+    pieces.append(flight_piece(record[rows - 1], clock, flight_time, sample_rate, mirror, *foot, next_leg, k))
+    return pieces, status, np.array(landing), next_side, next_segment, stance_time + flight_time

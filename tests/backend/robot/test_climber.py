@@ -21,8 +21,10 @@ from sim_core import ClimbEnd, ControlSchedule, LegControl, PhysicalParams, get_
 from sim_core.climb.records import FLOOR
 from sim_core.model.controls import LegOffsets
 from sim_core.model.errors import ParameterError
+from sim_core.model.failures import Failure
 from sim_core.model.noise import NO_NOISE, NoiseModel
 from sim_core.model.walls import Wall, wall_of
+from sim_core.world.world import Side, World
 from tests.robot_rig import climb_open_loop
 
 LEGS = {Leg.LEFT: (30.0, 0.87), Leg.RIGHT: (30.0, 0.9)}
@@ -172,3 +174,15 @@ def test_a_descending_robot_stops_at_the_floor():
     assert state == LinkState.DISARMED and link.telemetry.faults & Fault.FELL
     assert robot.climber.jumps < 200 and robot.climber.end is ClimbEnd.FLOOR
     assert tracker.as_arrays()["y"].min() > FLOOR - 0.01, "nothing is tracked below the floor (1 mm noise)"
+
+
+def test_in_a_world_it_climbs_the_worlds_sides_and_slips_where_they_give_no_grip():
+    """A chute with no grip above 0.2 m (parkour robot-sim --world FILE): the robot climbs to it,
+    slips there, and says so; every tracked pose stays inside the sides."""
+    grip = np.array([[-1.21, 0.0], [-1.21, 0.2 / ROBOT.leg_length], [-1.21, 9.0]])
+    greasy = World(Side(grip, np.array([np.nan, 0.0])), Side(grip * [-1, 1], np.array([np.nan, 0.0])), "greasy")
+    tracker, robot, link, state = _run(NO_NOISE, jumps=40, speed=20.0, world=greasy, tracker_noise=0.0)
+    assert state == LinkState.DISARMED and link.telemetry.faults & Fault.FELL
+    assert robot.climber.end is Failure.SLIP and robot.climber.jumps < 10
+    poses = tracker.as_arrays()
+    assert np.abs(poses["x"]).max() < 1.21 * ROBOT.leg_length, "inside the chute"
