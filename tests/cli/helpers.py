@@ -18,3 +18,11 @@ def json_of(*args: str):
     result = invoke(*args, "--json")
     assert result.exit_code == 0, result.output
     return json.loads(result.stdout)
+
+
+def one_line_error(*args: str) -> str:
+    """The command's refusal, after checking it is one line on stderr and exit code 2."""
+    result = invoke(*args)
+    assert result.exit_code == 2, result.output
+    assert result.stderr.startswith("error: ") and len(result.stderr.strip().splitlines()) == 1, result.stderr
+    return result.stderr.strip()

@@ -9,16 +9,9 @@ import numpy as np
 import pytest
 
 from sim_core.world.named import NAMED_WORLDS
-from tests.cli.helpers import invoke, json_of
+from tests.cli.helpers import invoke, json_of, one_line_error
 
 TOUCHDOWN_KEYS = {"jump", "side", "segment", "x", "y", "xdot", "ydot"}
-
-
-def _one_line_error(*args: str) -> str:
-    result = invoke(*args)
-    assert result.exit_code == 2, result.output
-    assert result.stderr.startswith("error: ") and len(result.stderr.strip().splitlines()) == 1, result.stderr
-    return result.stderr.strip()
 
 
 def test_the_json_contract_and_parallel_walls_as_parkour_map():
@@ -61,9 +54,9 @@ def test_mistakes_are_one_line_naming_the_field(tmp_path):
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps({"units": "l0", "left": {"points": [[-1, 0], [-1, 2], [-1, 1]]},
                                "right": {"points": [[1, 0], [1, 2]]}}))  # fmt: skip
-    assert "left.points[2]" in _one_line_error("climb", "--world", str(bad), "--state", "-1", "0.5")
-    assert "world" in _one_line_error("climb", "--world", "moon", "--state", "-1", "0.5")
-    assert "xdot" in _one_line_error("climb", "--world", "parallel", "--state", "1", "0.5")
-    assert "foot_y" in _one_line_error("climb", "--world", "parallel", "--state", "-1", "0.5", "--foot-y", "nan")
-    missing = _one_line_error("climb", "--world", str(tmp_path / "none.json"), "--state", "-1", "0.5")
+    assert "left.points[2]" in one_line_error("climb", "--world", str(bad), "--state", "-1", "0.5")
+    assert "world" in one_line_error("climb", "--world", "moon", "--state", "-1", "0.5")
+    assert "xdot" in one_line_error("climb", "--world", "parallel", "--state", "1", "0.5")
+    assert "foot_y" in one_line_error("climb", "--world", "parallel", "--state", "-1", "0.5", "--foot-y", "nan")
+    missing = one_line_error("climb", "--world", str(tmp_path / "none.json"), "--state", "-1", "0.5")
     assert "none.json" in missing

@@ -12,14 +12,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 from sim_core.world.files import load_world, save_world
 from sim_core.world.named import NAMED_WORLDS, named_world
 from sim_core.world.world import parallel
-from tests.cli.helpers import invoke, json_of
-
-
-def _one_line_error(*args: str) -> str:
-    result = invoke(*args)
-    assert result.exit_code == 2, result.output
-    assert result.stderr.startswith("error: ") and len(result.stderr.strip().splitlines()) == 1, result.stderr
-    return result.stderr.strip()
+from tests.cli.helpers import invoke, json_of, one_line_error
 
 
 def test_list_names_every_world_with_its_description():
@@ -102,7 +95,7 @@ def test_random_defaults_fill_the_lab_chute(tmp_path):
 )
 def test_mistakes_are_one_line_naming_the_field(args, said, tmp_path):
     extra = ("--out", str(tmp_path / "x.json")) if args[0] == "random" else ()
-    assert _one_line_error("world", *args, *extra).startswith(said)
+    assert one_line_error("world", *args, *extra).startswith(said)
     assert not (tmp_path / "x.json").exists(), "nothing written"
 
 
@@ -110,8 +103,8 @@ def test_a_bad_world_file_is_one_line_naming_the_point(tmp_path):
     path = tmp_path / "bad.json"
     bad = {"units": "l0", "left": {"points": [[-1, 0], [-1, 0.9], [-1, 0.8]]}, "right": {"points": [[1, 0], [1, 1]]}}
     path.write_text(json.dumps(bad))
-    said = _one_line_error("world", "show", str(path))
+    said = one_line_error("world", "show", str(path))
     assert said == "error: left.points[2]: y must increase strictly bottom to top: 0.8 after 0.9"
     path.write_text("{")
-    assert _one_line_error("world", "show", str(path)).startswith(f"error: {path}: is not JSON: ")
-    assert "No such file" in _one_line_error("world", "show", str(tmp_path / "absent.json"))
+    assert one_line_error("world", "show", str(path)).startswith(f"error: {path}: is not JSON: ")
+    assert "No such file" in one_line_error("world", "show", str(tmp_path / "absent.json"))
