@@ -15,7 +15,9 @@ from tests.helpers import free_port
 os.environ["PARKOUR_ALLOWED_HOSTS"] = "testserver"
 
 
-PATIENT_ESTOP_S = 5.0  # [s] an e-stop's budget where a test checks that it gets through: a hang guard
+# [s] an e-stop's budget where a test checks that it gets through: a hang guard (5 s ran out on a
+# machine loaded 4x)
+PATIENT_ESTOP_S = 15.0
 
 
 @pytest.fixture

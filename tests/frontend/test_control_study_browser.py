@@ -67,7 +67,8 @@ def test_a_control_study_is_scheduled_and_shown_as_its_table_and_plots(page, ser
     page.fill("input[name=steps]", "4")
     page.fill("input[name=basin_grid]", "0")
     page.click("#submit-job")
-    until(page, f"{NEWEST.format(cell='td:nth-child(2)')} === 'sweep' && {NEWEST.format(cell='.state')} === 'done'")
+    sweep_done = f"{NEWEST.format(cell='td:nth-child(2)')} === 'sweep' && {NEWEST.format(cell='.state')} === 'done'"
+    until(page, sweep_done, timeout=90_000)  # 30 s ran out on a machine loaded 4x: a hang guard
     page.click("#job-table tbody tr:first-child .show")
     until(page, "document.querySelector('#job-study').hidden && document.querySelector('#job-plot-climbs').hidden")
 
