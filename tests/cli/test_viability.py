@@ -31,3 +31,13 @@ def test_what_it_cannot_take_is_one_line_naming_the_option(args, message):
     result = invoke("viability", *args)
     assert result.exit_code == 2, result.output
     assert message in result.output
+
+
+def test_in_a_world_the_states_are_at_the_centre_line_with_height():
+    payload = json_of("viability", "--world", "narrowing", "--heights", "3", "--states", "6", "--actions", "3")
+    assert payload["world"] == "narrowing" and set(payload["state_axes"]) == {"y", "xdot", "ydot"}
+    assert payload["state_axes"]["y"][0] == 0.0 and len(payload["state_axes"]["y"]) == 3
+    assert payload["cells"] == 3 * 6 * 6 and isinstance(payload["kernel_heights"], list)
+    for args, named in ((("--pitch-nodes", "3"), "--pitch-nodes"), (("--heights", "1"), "--heights")):
+        result = invoke("viability", "--world", "narrowing", *args)
+        assert result.exit_code == 2 and named in result.stderr, result.output
