@@ -28,8 +28,9 @@ from sim_core.world.world import World
 DEFAULT_XDOT = (-2.5, 2.5)  # [sqrt(g l0)]: both directions; the centre bins never reach a side
 DEFAULT_YDOT = (-3.0, 3.0)
 # A kernel needs a fine velocity grid under the engine's conservative rule: at 24-32 nodes per
-# velocity axis parallel walls' kernel is empty, at 48 it holds 57% of the states (2026-12-06).
-DEFAULT_HEIGHTS, DEFAULT_STATES, DEFAULT_ACTIONS = 12, 48, 12
+# velocity axis parallel walls' kernel is empty, at 48 it holds 57% of the states, with 24 heights;
+# with 12 heights it was empty again (2026-12-06): a kernel here is a resolution study.
+DEFAULT_HEIGHTS, DEFAULT_STATES, DEFAULT_ACTIONS = 24, 48, 12
 
 
 def world_step_map(model: ModelParams, world: World) -> StepMap:
