@@ -110,6 +110,9 @@ def _posted_job(page, action) -> tuple[dict, int]:
 UNDECIDED = "document.querySelector('{plot}').data.find((t) => t.type === 'heatmap' && t.name.startsWith('undecided'))"
 
 
+JOB_DONE_WITHIN_MS = 180_000
+
+
 def test_basin_and_sweep_are_jobs_drawn_in_simulate(page):
     """The basin is not cut short unsaid: its jump limit is sent, and the cells still undecided at
     it have a colour of their own, named in the legend, their count in the title (issue 28)."""
@@ -121,7 +124,8 @@ def test_basin_and_sweep_are_jobs_drawn_in_simulate(page):
     until(page, "document.querySelector('#basin_jump_limit-error')?.textContent.includes('at least jumps')")
     page.fill("input[name=basin_jump_limit]", "240")
     assert _posted_job(page, lambda: page.click("#run-basin"))[0]["jump_limit"] == 240
-    page.wait_for_selector("#basin-plot .heatmaplayer image", timeout=60_000)
+    # jobs on the job worker: hang guards, widened where a loaded machine (load 6 on 2 cores) ran 60 s out
+    page.wait_for_selector("#basin-plot .heatmaplayer image", timeout=JOB_DONE_WITHIN_MS)
     assert "% converge" in page.inner_text("#basin-plot")
     title = page.text_content("#basin-plot .gtitle")
     assert "cap 60, limit 240 jumps;" in title and re.search(r"\d+ cells undecided", title), title
@@ -139,9 +143,9 @@ def test_basin_and_sweep_are_jobs_drawn_in_simulate(page):
     body, job = _posted_job(page, lambda: page.click("#run-basin"))
     assert "jump_limit" not in body, "empty: the API's default"
     status = "document.querySelector('#analysis-status').textContent"
-    until(page, f"{status}.startsWith('basin job {job}: done')", timeout=60_000)
+    until(page, f"{status}.startsWith('basin job {job}: done')", timeout=JOB_DONE_WITHIN_MS)
     page.click("#run-sweep")
-    page.wait_for_selector("#sweep-plot .scatterlayer .trace", timeout=60_000)
+    page.wait_for_selector("#sweep-plot .scatterlayer .trace", timeout=JOB_DONE_WITHIN_MS)
     assert page.inner_text("#analysis-status").startswith("sweep job") and "done" in page.inner_text("#analysis-status")
     page.locator("#sweep-plot").scroll_into_view_if_needed()
     screenshot(page, "simulate_analyses")
