@@ -10,11 +10,14 @@ from cli.options import (
     ControlsOption,
     JsonOption,
     ModelSetup,
+    SeedOption,
     handles_errors,
     parse_controls,
     print_json,
     with_model,
+    with_noise,
 )
+from sim_core.model.noise import NoiseModel
 
 app = typer.Typer(rich_markup_mode=None)
 
@@ -30,6 +33,7 @@ WorldOption = Annotated[
 @app.command("climb")
 @handles_errors
 @with_model
+@with_noise
 def climb_command(
     world: WorldOption,
     state: Annotated[
@@ -40,21 +44,29 @@ def climb_command(
         ),
     ],
     setup: ModelSetup,
+    noise: NoiseModel,
     controls: ControlsOption = "30:0.9",
     foot_y: Annotated[
         float, typer.Option("--foot-y", help="Height of touchdown 0's foot on the left side [l0].")
     ] = 0.0,
     jumps: Annotated[int, typer.Option("--jumps", help="Number of jumps.", min=0, max=1_000_000)] = 10,
+    noisy: Annotated[
+        bool, typer.Option("--noise", help="Apply the noise options (docs/model.md §5.1, pitch included); off: none.")
+    ] = False,
+    seed: SeedOption = 0,
+    floor: Annotated[bool, typer.Option("--floor", help="End the climb at a touchdown below the floor.")] = False,
     as_json: JsonOption = False,
 ) -> None:
     """Climb a world: the body at every touchdown in wall coordinates [l0], and how the climb ended.
 
-    No noise, pitch or floor (docs/model.md §8)."""
+    No noise, pitch or floor unless asked: --noise (with the noise options, drawn from --seed),
+    --floor (docs/model.md §8)."""
     from sim_core.world.climb import climb_world
     from sim_core.world.named import resolve_world
 
     chosen, _description = resolve_world(world, setup.model.d_hat, setup.robot.scales.length)
-    climb = climb_world(setup.model, chosen, parse_controls(controls), state, jumps, foot_y=foot_y)
+    climb = climb_world(setup.model, chosen, parse_controls(controls), state, jumps, foot_y=foot_y,
+                        noise=noise if noisy else None, seed=seed, floor=floor)  # fmt: skip
     result = climb.to_dict()
     if as_json:
         print_json(result)

@@ -2,7 +2,7 @@
 
 Touchdown 0 is on the left side with the foot on its polyline at height ``foot_y`` and the body
 arriving with velocity ``(xdot, ydot)`` (``xdot < 0``), as ``parkour map --state`` takes it. Jump
-``k`` uses schedule row ``k % m`` while the sides alternate. No noise, pitch or floor here.
+``k`` uses schedule row ``k % m`` while the sides alternate. No noise, pitch or floor unless asked.
 
 >>> from sim_core import ControlSchedule, get_preset
 >>> from sim_core.world.world import parallel
@@ -20,12 +20,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim_core.model.controls import ControlSchedule
-from sim_core.model.failures import OK, Failure
+from sim_core.model.failures import FLOOR_HEIGHT, OK, Failure
+from sim_core.model.integrate import STATE_SIZE
+from sim_core.model.noise import NoiseModel
+from sim_core.model.noise_rules import NoiseSampler
 from sim_core.model.params import ModelParams
 from sim_core.model.poincare import check_jumps, check_section_state
 from sim_core.model.validation import check_range
+from sim_core.model.walls import Wall, wall_of
 from sim_core.world.geometry import LEFT, SIDE_NAMES, pack, segment_at, side_x
-from sim_core.world.stride import TOUCHDOWN_SIZE, world_orbit
+from sim_core.world.stride import TOUCHDOWN_SIZE, world_jump, world_orbit
 from sim_core.world.world import World
 
 
@@ -78,21 +82,79 @@ def first_touchdown(model: ModelParams, world: World, schedule: ControlSchedule,
 
 
 def climb_world(
-    model: ModelParams, world: World, schedule: ControlSchedule, state, jumps: int, *, foot_y: float = 0.0
+    model: ModelParams,
+    world: World,
+    schedule: ControlSchedule,
+    state,
+    jumps: int,
+    *,
+    foot_y: float = 0.0,
+    noise: NoiseModel | None = None,
+    seed: int = 0,
+    floor: bool = False,
 ) -> WorldClimb:
     """Climb ``jumps`` jumps in ``world`` from touchdown 0 (see the module). A failing jump ends
-    the climb; the result says which and why."""
+    the climb; the result says which and why. Asked for: ``noise`` (docs/model.md §5.1, pitch
+    included, drawn in its rules' order from ``seed``) and the ``floor`` (a touchdown with the body
+    below ``y = 0`` ends the climb there, code ``floor``, docs/model.md §7.2)."""
     jumps = check_jumps(jumps)
-    start, segment = first_touchdown(model, world, schedule, state, foot_y)
-    states = np.empty((jumps + 1, TOUCHDOWN_SIZE))
-    states[0] = start
-    sides = np.zeros(jumps + 1, dtype=np.int64)
-    segments = np.zeros(jumps + 1, dtype=np.int64)
-    sides[0], segments[0] = LEFT, segment
-    status, completed = world_orbit(
-        schedule.as_array(), 0, model.record(), pack(world, model.mu), states, sides, segments
-    )
+    if noise is not None:
+        climb = _noisy_climb(model, world, schedule, state, jumps, foot_y, noise, seed)
+    else:
+        start, segment = first_touchdown(model, world, schedule, state, foot_y)
+        states = np.empty((jumps + 1, TOUCHDOWN_SIZE))
+        states[0] = start
+        sides = np.zeros(jumps + 1, dtype=np.int64)
+        segments = np.zeros(jumps + 1, dtype=np.int64)
+        sides[0], segments[0] = LEFT, segment
+        status, completed = world_orbit(
+            schedule.as_array(), 0, model.record(), pack(world, model.mu), states, sides, segments
+        )
+        climb = _ended(states, sides, segments, status, completed)
+    return _cut_at_floor(climb) if floor else climb
+
+
+def _ended(states, sides, segments, status, completed) -> WorldClimb:
     if status == OK:
         return WorldClimb(states, sides, segments, None, None)
     kept = completed + 1
     return WorldClimb(states[:kept].copy(), sides[:kept].copy(), segments[:kept].copy(), Failure(status), completed + 1)
+
+
+def _cut_at_floor(climb: WorldClimb) -> WorldClimb:
+    """``climb`` ended at its first touchdown (after touchdown 0) with the body below the floor."""
+    below = np.flatnonzero(climb.states[1:, 1] < FLOOR_HEIGHT)
+    if below.size == 0:
+        return climb
+    k = int(below[0]) + 1  # jump k (1-based) ended below the floor: touchdowns 0 .. k - 1 stand
+    return WorldClimb(climb.states[:k].copy(), climb.sides[:k].copy(), climb.segments[:k].copy(), Failure.FLOOR, k)
+
+
+def _noisy_climb(model, world, schedule, state, jumps, foot_y, noise, seed) -> WorldClimb:
+    """The climb with the legs, pitch and velocity drawn as docs/model.md §5.1 says, jump by jump."""
+    sampler = NoiseSampler(noise, np.random.default_rng(seed))
+    pitch = 0.0
+    leg = sampler.controls(schedule[0], Wall.LEFT, pitch)
+    start, segment = first_touchdown(model, world, ControlSchedule.of(leg), state, foot_y)
+    sides_arrays, record, no_record = pack(world, model.mu), model.record(), np.empty((0, STATE_SIZE))
+    states, sides, segments = [start], [LEFT], [segment]
+    status = OK
+    for k in range(jumps):
+        next_pitch = sampler.pitch_step(pitch)
+        next_leg = sampler.controls(schedule[k + 1], wall_of(k + 1), next_pitch)
+        x, y, xdot, ydot = states[-1]
+        status, *landing, side, segment, _, _, _ = world_jump(
+            x, y, xdot, ydot, sides[-1], segments[-1], leg.psi0, leg.zeta0, next_leg.psi0, next_leg.zeta0,
+            record, sides_arrays, no_record,
+        )  # fmt: skip
+        if status != OK:
+            break
+        mirror = 1.0 if side == LEFT else -1.0  # the velocity's noise in the coming stance's frame
+        flipped_xdot, landing[3] = sampler.state((mirror * landing[2], landing[3]))
+        landing[2] = mirror * flipped_xdot
+        states.append(np.array(landing))
+        sides.append(side)
+        segments.append(segment)
+        pitch, leg = next_pitch, next_leg
+    completed = len(states) - 1
+    return _ended(np.array(states), np.array(sides), np.array(segments), status, completed)

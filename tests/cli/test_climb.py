@@ -60,3 +60,15 @@ def test_mistakes_are_one_line_naming_the_field(tmp_path):
     assert "foot_y" in one_line_error("climb", "--world", "parallel", "--state", "-1", "0.5", "--foot-y", "nan")
     missing = one_line_error("climb", "--world", str(tmp_path / "none.json"), "--state", "-1", "0.5")
     assert "none.json" in missing
+
+
+def test_noise_and_the_floor_only_when_asked():
+    args = ("climb", "--world", "narrowing", "--state", "-1.0", "0.5", "--jumps", "10")
+    assert json_of(*args) == json_of(*args, "--noise-psi0", "2.0"), "noise options alone apply no noise"
+    noisy = json_of(*args, "--noise", "--seed", "4")
+    assert noisy != json_of(*args) and noisy == json_of(*args, "--noise", "--seed", "4")
+    descending = ("climb", "--world", "parallel", "--controls", "30:0.97", "--state", "-1.0", "0.0", "--jumps", "30")
+    free = json_of(*descending)
+    assert min(row["y"] for row in free["touchdowns"]) < 0.0, "without --floor it goes below it"
+    cut = json_of(*descending, "--floor")
+    assert cut["failure"] == {"code": "floor", "jump": 2} and all(row["y"] >= 0.0 for row in cut["touchdowns"])
