@@ -50,8 +50,8 @@ def test_without_a_command_it_shows_the_list():
 
 
 def test_an_unknown_command_is_named():
-    result = invoke("climb")
-    assert result.exit_code == 2 and "No such command 'climb'" in result.output
+    result = invoke("leap")
+    assert result.exit_code == 2 and "No such command 'leap'" in result.output
 
 
 def test_main_runs_the_command_line(monkeypatch, capsys):
