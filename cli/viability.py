@@ -45,7 +45,7 @@ def viability_command(
         str | None,
         typer.Option("--world", help="In this world (a file or a named world): centre-line states, with height."),
     ] = None,
-    heights: Annotated[int, typer.Option("--heights", help="With --world: nodes of the height axis.")] = 24,
+    heights: Annotated[int, typer.Option("--heights", help="With --world: nodes of the height axis.")] = 12,
     as_json: JsonOption = False,
 ) -> None:
     """The states from which some leg command keeps the robot jumping forever, and how many do.

@@ -5,9 +5,12 @@ A *step map* is passed in, so the engine works for any model: the ParkourBot's o
 mid-chute section (:mod:`sim_core.viability.step_map`), a calibrated preset's, or vibly's SLIP
 hopper (:mod:`sim_core.viability.slip_hopper`, the cross-check). Its shape::
 
-    step_map(states (N, ds) float64, actions (N, da) float64) -> (next_states (N, ds), failed (N,) bool)
+    step_map(states (N, ds) float64, actions (N, da) float64)
+        -> (next_states (N, ds), failed (N,) bool[, done (N,) bool])
 
-one step for each row. Over a :class:`ViabilityGrid` of state and action axes the engine
+one step for each row; ``done`` (optional) marks a step that reached the map's goal — a world's
+top, where the chute is climbed — viable whatever follows (its bins are :data:`DONE`). Over a
+:class:`ViabilityGrid` of state and action axes the engine
 
 1. maps every (state, action) grid pair once (the *transition map*): failed, or the bin of the
    state reached, ``np.digitize(next, axis)`` per dimension (``0 .. n``: below the first node,
@@ -44,8 +47,9 @@ from sim_core.viability.kernels import pair_measures, shrink
 __all__ = ["FAILED", "StepMap", "Viability", "ViabilityGrid", "compute_viability", "transition_map"]
 __all__ += ["viability_of_map"]
 
-StepMap = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
+StepMap = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, ...]]
 FAILED = -1  # the bin of a failed pair
+DONE = -2  # the bin of a pair that reached the step map's goal (a world's top): viable, whatever follows
 DEFAULT_CHUNK_PAIRS = 200_000  # ~0.5 s of the paper model's stances on two cores: steady progress
 
 
@@ -55,7 +59,8 @@ class Viability:
 
     Attributes:
         failed: bool, where the step itself fails.
-        bins: int, shape + (ds,), the bin each pair reaches per state dimension; -1 where failed.
+        bins: int, shape + (ds,), the bin each pair reaches per state dimension; -1 where failed,
+            -2 (DONE) where it reached the step map's goal.
         viable_pairs: bool, the viable state-action pairs (vibly's ``Q_V``).
         kernel: bool, state shape: the viability kernel (``S_V``).
         measure: float, state shape: the fraction of a state's actions that are viable (``S_M``).
@@ -131,12 +136,15 @@ def transition_map(
     slices = chunk_slices(count, chunk_pairs)
     for done, part in enumerate(slices, start=1):
         pair = np.arange(part.start, part.stop)  # state-major: pair = state * actions + action
-        reached, part_failed = step_map(states[pair // actions.shape[0]], actions[pair % actions.shape[0]])
-        reached = np.asarray(reached, dtype=np.float64).reshape(-1, dimensions)
-        part_failed = np.asarray(part_failed, dtype=bool) | ~np.all(np.isfinite(reached), axis=1)
+        stepped = step_map(states[pair // actions.shape[0]], actions[pair % actions.shape[0]])
+        reached = np.asarray(stepped[0], dtype=np.float64).reshape(-1, dimensions)
+        part_failed = np.asarray(stepped[1], dtype=bool) | ~np.all(np.isfinite(reached), axis=1)
+        part_done = np.zeros(part_failed.shape, dtype=bool) if len(stepped) < 3 else np.asarray(stepped[2], dtype=bool)
+        part_done &= ~part_failed
         failed[part] = part_failed
         for d, axis in enumerate(grid.state_axes):
-            bins[part, d] = np.where(part_failed, FAILED, closed_bins(np.nan_to_num(reached[:, d]), axis))
+            found = closed_bins(np.nan_to_num(reached[:, d]), axis)
+            bins[part, d] = np.where(part_failed, FAILED, np.where(part_done, DONE, found))
         if progress is not None:
             progress(done, len(slices))
     return failed.reshape(grid.shape), bins.reshape((*grid.shape, dimensions))
@@ -160,16 +168,18 @@ def viability_of_map(
     actions = int(np.prod(grid.action_shape))
     flat_bins = np.ascontiguousarray(bins.reshape(states * actions, -1))
     viable = ~failed.reshape(states * actions)
+    done = flat_bins[:, 0] == DONE  # no corner of a DONE bin is a node: the shrink never drops it
     if edges_extend:
         viable &= np.any(flat_bins != 0, axis=1)
     else:
-        viable &= np.all((flat_bins >= 1) & (flat_bins <= state_shape - 1), axis=1)
+        viable &= np.all((flat_bins >= 1) & (flat_bins <= state_shape - 1), axis=1) | done
     viable = np.ascontiguousarray(viable)
     kernel_mask = np.empty(states, dtype=bool)
     sweeps = shrink(flat_bins, viable, kernel_mask, state_shape, actions)
     measure = viable.reshape(states, actions).mean(axis=1)
     pair_measure = np.zeros(states * actions)
     pair_measures(flat_bins, viable, measure, state_shape, pair_measure)
+    pair_measure[done] = 1.0  # the goal leaves all the room there is
     shape = grid.shape
     return Viability(
         grid=grid,

@@ -151,3 +151,18 @@ def test_the_result_reads_as_numbers_and_answers_for_one_state():
     assert np.array_equal(result.viable_actions(centre)[:, 0], grid.action_axes[0][result.viable_pairs[15]])
     with pytest.raises(ParameterError, match="state: must have 1 components"):
         result.nearest_node([0.0, 1.0])
+
+
+def test_a_step_that_reaches_the_maps_goal_is_viable_whatever_follows():
+    """A climber that rises one node a step leaves any grid: nothing is viable, unless reaching the
+    top is the goal (a world's chute climbed); then every state is, with all the room there is."""
+    grid = ViabilityGrid((np.arange(6.0), np.array([-1.0, 1.0])), (np.array([0.0, 1.0]),))
+
+    def rising(states, actions, goal=None):
+        reached = states + np.array([1.0, 0.0])
+        failed = np.zeros(len(states), dtype=bool)
+        return (reached, failed) if goal is None else (reached, failed, reached[:, 0] >= goal)
+
+    assert not compute_viability(rising, grid).kernel.any()
+    climbed = compute_viability(lambda s, a: rising(s, a, goal=5.0), grid)
+    assert climbed.kernel.all() and (climbed.pair_measure[climbed.bins[..., 0] == -2] == 1.0).all()

@@ -1,7 +1,6 @@
 """Viability in a world: the centre-line step map on the engine — grip taken away only adds
 failures (so never grows the kernel), a world whose centre line leaves the chute is refused, the
-grid spans floor to top. (A kernel needs a fine grid here: 24 heights x 48 x 48 velocities x
-12 x 12 controls found 57% of parallel walls' states viable in a minute; too slow for the suite.)"""
+grid spans floor to top, and a step to the top is the chute climbed."""
 
 import numpy as np
 import pytest
@@ -42,3 +41,14 @@ def test_the_grid_spans_the_floor_to_the_top_and_a_world_off_centre_is_refused(p
         world_step_map(paper, off_centre)
     with pytest.raises(ParameterError, match="heights"):
         world_grid(off_centre, heights=1)
+
+
+def test_a_step_to_the_top_is_the_chute_climbed(paper):
+    walls = parallel(paper.d_hat, height=3.0)
+    grid = world_grid(walls, heights=4, states=10, actions=4, xdot_range=(-2.5, 2.5), ydot_range=(-3.0, 3.0))
+    states, actions = grid.states(), grid.actions()
+    pairs = np.array([(s, a) for s in range(len(states)) for a in range(len(actions))])
+    reached, failed, done = world_step_map(paper, walls)(states[pairs[:, 0]], actions[pairs[:, 1]])
+    assert done.any() and not (done & failed).any()
+    assert np.array_equal(done, ~failed & (reached[:, 0] >= 3.0))
+    assert compute_viability(world_step_map(paper, walls), grid).kernel.any(), "climbing it is viable"
