@@ -134,7 +134,10 @@ def first_crossing(sides, side, mirror, x0, y0, vx, vy):
     points = sides.points[side]
     n = sides.counts[side]
     best_t, best_segment = math.inf, -2
+    apex = y0 + 0.5 * vy * vy if vy > 0.0 else y0  # the foot never rises above it
     for segment in range(-1, n):
+        if segment >= 0 and points[segment, 1] > apex:
+            break  # this segment and every one above start higher than the foot ever gets
         if segment == -1:  # x = x_0 below y_0
             xa, ya, slope = mirror * points[0, 0], points[0, 1], 0.0
             y_low, y_high = -math.inf, points[0, 1]
