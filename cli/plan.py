@@ -1,0 +1,69 @@
+"""``parkour plan``: the most robust way up a world, foothold by foothold (docs/worlds.md)."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+
+from cli.options import JsonOption, ModelSetup, SeedOption, handles_errors, note, print_json, with_model, with_noise
+from sim_core.model.errors import ParameterError
+from sim_core.model.noise import NoiseModel
+
+app = typer.Typer(rich_markup_mode=None)
+
+
+@app.command("plan")
+@handles_errors
+@with_model
+@with_noise
+def plan_command(
+    world: Annotated[str, typer.Option("--world", help="A world file (.json) or a named world (parkour world list).")],
+    goal_height: Annotated[float, typer.Option("--goal-height", help="The height the feet must reach [m].")],
+    setup: ModelSetup,
+    noise: NoiseModel,
+    state: Annotated[
+        tuple[float, float] | None,
+        typer.Option("--state", help="The body's velocity XDOT YDOT at touchdown 0; default: the 30:0.9 gait's."),
+    ] = None,
+    foot_y: Annotated[float, typer.Option("--foot-y", help="Touchdown 0's foot height on the left side [l0].")] = 0.0,
+    seed: SeedOption = 0,
+    as_json: JsonOption = False,
+) -> None:
+    """A sequence of footholds and leg commands from touchdown 0 to --goal-height, the most robust
+    under the noise options (each jump's share of noisy draws that land and hold, multiplied)."""
+    from sim_core.planning.planner import plan_climb
+    from sim_core.world.named import resolve_world
+
+    chosen, _description = resolve_world(world, setup.model.d_hat, setup.robot.scales.length)
+    metres = setup.robot.scales.length
+    start_m, top_m = foot_y * metres, chosen.top * metres
+    if not start_m < goal_height <= top_m:  # said in metres, as asked (the library speaks l0)
+        raise ParameterError("--goal-height", f"must be above the start's foot ({start_m:.3f} m) and at most "
+                             f"{chosen.name}'s top ({top_m:.3f} m), got {goal_height:g} m")  # fmt: skip
+    if state is None:
+        from cli.options import parse_controls
+        from sim_core.section.gait_search import gait_of
+
+        state = tuple(gait_of(setup.model, parse_controls("30:0.9")).state.tolist())
+        note(f"touchdown 0 at the 30:0.9 gait's velocity {[round(v, 4) for v in state]}")
+    plan = plan_climb(setup.model, chosen, goal_height / metres, state, foot_y=foot_y, noise=noise, seed=seed)
+    if not plan.reaches_goal:
+        raise ParameterError(
+            "goal_height", f"no plan reaches {goal_height:g} m in {chosen.name}: the highest reachable is "
+            f"{plan.highest * metres:.3f} m"
+        )  # fmt: skip
+    document = {"reaches_goal": True, "plan": [step.to_dict() for step in plan.steps], "seconds": plan.seconds,
+                "highest_m": plan.highest * metres, "chance": plan.chance}  # fmt: skip
+    if as_json:
+        print_json(document)
+        return
+    from rich.console import Console
+    from rich.table import Table
+
+    title = f"plan up {chosen.name} to {goal_height:g} m: estimated chance {plan.chance:.0%} ({plan.seconds:.2f} s)"
+    table = Table("jump", "side", "segment", "foot x [l0]", "foot y [l0]", "psi0 [deg]", "zeta0", title=title)
+    for row in document["plan"]:
+        table.add_row(str(row["jump"]), row["side"], str(row["segment"]), f"{row['target'][0]:.3f}",
+                      f"{row['target'][1]:.3f}", f"{row['psi0_deg']:.1f}", f"{row['zeta0']:.3f}")  # fmt: skip
+    Console().print(table)
