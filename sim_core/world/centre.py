@@ -19,9 +19,10 @@ import numpy as np
 
 from sim_core._jit import kernel
 from sim_core.model.failures import FLOOR, FLOOR_HEIGHT, INVALID_STATE, NO_FLIGHT, NO_TOUCHDOWN, OK
-from sim_core.model.integrate import PSI, PSI_DOT, STATE_SIZE, ZETA_DOT, stance_in_cone
-from sim_core.model.stride import liftoff_velocity, touchdown_polar_state
+from sim_core.model.integrate import PSI, PSI_DOT, STATE_SIZE, ZETA_DOT
+from sim_core.model.stride import liftoff_velocity
 from sim_core.world.geometry import FLIGHT_TIME_CAP, first_crossing
+from sim_core.world.stride import foothold_stance
 
 
 @kernel
@@ -45,14 +46,8 @@ def centre_step(y, xdot, ydot, psi0, zeta0, model, sides, no_record):
         return FLOOR, nan, nan, nan
     foot_x_stance = -(foot_x + -mirror * xdot * flight)  # the stance frame's x of the foot
     foot_y_stance = touchdown_y - zeta0 * math.sin(psi0)
-    beta = sides.beta[side, segment + 1]
-    half_angle = math.atan(sides.friction[side, segment + 1])
-    zeta_dot, psi_dot = touchdown_polar_state(vx, vy, psi0, zeta0)
     final = np.empty(STATE_SIZE)
-    status, _ = stance_in_cone(
-        zeta0, psi0, zeta_dot, psi_dot, model.alpha, model.c_zeta, model.c_psi,
-        beta - half_angle, beta + half_angle, final, no_record,
-    )  # fmt: skip
+    status, _ = foothold_stance(vx, vy, psi0, zeta0, model, sides, side, segment, final, no_record)
     if status != OK:
         return status, nan, nan, nan
     psi = final[PSI]

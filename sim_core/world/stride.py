@@ -57,15 +57,8 @@ def world_jump(x, y, xdot, ydot, side, segment, psi0, zeta0, next_psi0, next_zet
         return INVALID_STATE, nan, nan, nan, nan, side, segment, nan, nan, 0
     foot_x = body_x - zeta0 * math.cos(psi0)
     foot_y = y - zeta0 * math.sin(psi0)
-    # The foothold's friction cone, about its inward normal (docs/model.md §8)
-    beta = sides.beta[side, segment + 1]
-    half_angle = math.atan(sides.friction[side, segment + 1])
-    zeta_dot, psi_dot = touchdown_polar_state(body_vx, ydot, psi0, zeta0)
     final = np.empty(STATE_SIZE)
-    status, rows = stance_in_cone(
-        zeta0, psi0, zeta_dot, psi_dot, model.alpha, model.c_zeta, model.c_psi,
-        beta - half_angle, beta + half_angle, final, record,
-    )  # fmt: skip
+    status, rows = foothold_stance(body_vx, ydot, psi0, zeta0, model, sides, side, segment, final, record)
     stance_time = final[TIME]
     if status != OK:
         return status, nan, nan, nan, nan, side, segment, stance_time, nan, rows
@@ -84,6 +77,20 @@ def world_jump(x, y, xdot, ydot, side, segment, psi0, zeta0, next_psi0, next_zet
     touch_y = next_y + (vy - 0.5 * flight_time) * flight_time + next_zeta0 * math.sin(next_psi0)
     return (OK, mirror * touch_x, touch_y, mirror * vx, vy - flight_time, other, landing,
             stance_time, flight_time, rows)  # fmt: skip
+
+
+@kernel
+def foothold_stance(vx, vy, psi0, zeta0, model, sides, side, segment, final, record):
+    """The stance on ``side``'s ``segment`` from a touchdown with body velocity ``(vx, vy)`` in the
+    side's stance frame, the leg at ``(psi0, zeta0)``, in the foothold's friction cone about its
+    inward normal (docs/model.md §8): ``(status, rows)`` as :func:`sim_core.model.integrate.stance`."""
+    beta = sides.beta[side, segment + 1]
+    half_angle = math.atan(sides.friction[side, segment + 1])
+    zeta_dot, psi_dot = touchdown_polar_state(vx, vy, psi0, zeta0)
+    return stance_in_cone(
+        zeta0, psi0, zeta_dot, psi_dot, model.alpha, model.c_zeta, model.c_psi,
+        beta - half_angle, beta + half_angle, final, record,
+    )  # fmt: skip
 
 
 @kernel
