@@ -164,7 +164,7 @@ def _expand(model, sides, legs, draws, nodes) -> list[_Node]:
     for i, node in enumerate(nodes):
         block = slice(i * per_node, (i + 1) * per_node)
         start = np.tile(node.row, (per_node, 1))
-        start[:, 2:] += np.tile(draws[:, 2:], (len(legs), 1)) * [1.0, 1.0]
+        start[:, 2:] += np.tile(draws[:, 2:], (len(legs), 1))  # the velocity noise at this touchdown
         states[block, 0], on_side[block, 0], on_segment[block, 0] = start, node.side, node.segment
         schedules[block, 0] = legs[node.leg]
         coming = np.repeat(legs, per_leg, axis=0) + np.tile(draws[:, :2], (len(legs), 1))
