@@ -591,6 +591,9 @@ ARM_AND_LAUNCH = "The robot is disarmed. Starting the run arms it and launches i
 ROBOT_STATE = "document.querySelector('#robot-state').textContent"
 
 
+RUN_ENDS_WITHIN_S = 30.0  # a hang guard: a stopped run's journal closes in well under a second
+
+
 @pytest.fixture
 def robot(page, service):
     """A virtual robot the panel (page, with the token) is connected to; disconnected afterwards."""
@@ -615,6 +618,14 @@ def robot(page, service):
         until(page, f"{ROBOT_STATE} === 'disarmed'", timeout=10_000)
         yield virtual
     finally:
+        # A run the test stopped may still be ending (its journal closing) after the robot reads
+        # 'disarmed'; a disconnect meanwhile is refused and the next test's connect too (a CI run
+        # saw "live run 11 ... is in progress: stop it before you connect").
+        deadline = time.monotonic() + RUN_ENDS_WITHIN_S
+        while (httpx.get(f"{_base}/api/v1/robot").json().get("run") or {}).get("active"):
+            if time.monotonic() > deadline:
+                break
+            time.sleep(0.05)
         httpx.post(f"{_base}/api/v1/robot/disconnect", headers={"Authorization": f"Bearer {token}"})
         virtual.stop()
 
