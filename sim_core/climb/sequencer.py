@@ -43,7 +43,14 @@ from sim_core.model.failures import OK, Failure
 from sim_core.model.integrate import STATE_SIZE
 from sim_core.model.noise_rules import NoiseSampler
 from sim_core.model.params import PhysicalParams
-from sim_core.model.trajectory import FLIGHT, MAX_STANCE_NODES, STANCE, Trajectory, simulate_trajectory
+from sim_core.model.trajectory import (
+    FLIGHT,
+    MAX_STANCE_NODES,
+    STANCE,
+    Trajectory,
+    joined_columns,
+    simulate_trajectory,
+)
 from sim_core.model.walls import Wall, wall_of
 from sim_core.world.geometry import LEFT, RIGHT, pack, segment_at, side_x
 from sim_core.world.trajectory import jump_path
@@ -236,12 +243,8 @@ def _simulate_in_world(setup: ClimbSetup, start: JumpStart, next_leg: LegControl
         model.record(), pack(setup.world, model.mu), touchdown, side, start.segment, start.leg, next_leg,
         0.0, setup.sample_rate, start.jump, record,
     )  # fmt: skip
-    columns = {  # none: a touchdown that slipped at once
-        name: np.concatenate([piece[name] for piece in pieces]) if pieces else np.empty(0)
-        for name in Trajectory.COLUMNS
-    }
-    path = Trajectory(**columns, touchdown_times=np.zeros(1), section_states=np.zeros((1, 2)), rises=np.zeros(0),
-                      failure=None, failed_jump=None)  # fmt: skip
+    path = Trajectory(**joined_columns(pieces), touchdown_times=np.zeros(1), section_states=np.zeros((1, 2)),
+                      rises=np.zeros(0), failure=None, failed_jump=None)  # fmt: skip
     if status != OK:
         return _samples(path.to_si(robot), start), Failure(status), _Outcome(math.nan, math.nan, (math.nan,) * 2, None)
     next_mirror = 1.0 if next_side == LEFT else -1.0

@@ -137,10 +137,7 @@ def simulate_trajectory(
         sections.append(np.array([xdot, ydot]))
         rises.append(rise)
         touchdown_times.append(clock)
-    columns = {
-        name: np.concatenate([piece[name] for piece in pieces]) if pieces else np.empty(0)
-        for name in Trajectory.COLUMNS
-    }
+    columns = joined_columns(pieces)
     return Trajectory(
         **columns,
         touchdown_times=np.array(touchdown_times),
@@ -149,6 +146,15 @@ def simulate_trajectory(
         failure=failure,
         failed_jump=len(rises) + 1 if failure is not None else None,
     )
+
+
+def joined_columns(pieces: list[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
+    """The :attr:`Trajectory.COLUMNS` of sampled pieces (stances and flights) one after another;
+    empty columns for none (a touchdown that slipped at once)."""
+    return {
+        name: np.concatenate([piece[name] for piece in pieces]) if pieces else np.empty(0)
+        for name in Trajectory.COLUMNS
+    }
 
 
 def _sample_times(start: float, duration: float, rate: float) -> np.ndarray:

@@ -17,7 +17,14 @@ from sim_core.model.failures import OK, Failure
 from sim_core.model.integrate import STATE_SIZE
 from sim_core.model.params import ModelParams
 from sim_core.model.poincare import check_jumps
-from sim_core.model.trajectory import DEFAULT_SAMPLE_RATE, MAX_STANCE_NODES, Trajectory, flight_piece, stance_piece
+from sim_core.model.trajectory import (
+    DEFAULT_SAMPLE_RATE,
+    MAX_STANCE_NODES,
+    Trajectory,
+    flight_piece,
+    joined_columns,
+    stance_piece,
+)
 from sim_core.model.validation import check_range
 from sim_core.world.climb import WorldClimb, first_touchdown
 from sim_core.world.geometry import LEFT, pack
@@ -65,10 +72,7 @@ def simulate_world_trajectory(
     legs = schedule.as_array()[np.arange(len(states)) % len(schedule)]
     feet = touchdowns[:, 1] - legs[:, 1] * np.sin(legs[:, 0])
     flip = np.where(climb.sides == LEFT, 1.0, -1.0)
-    columns = {
-        name: np.concatenate([piece[name] for piece in pieces]) if pieces else np.empty(0)
-        for name in Trajectory.COLUMNS
-    }
+    columns = joined_columns(pieces)
     trajectory = Trajectory(
         **columns,
         touchdown_times=np.array(touchdown_times),
