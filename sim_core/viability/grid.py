@@ -102,9 +102,7 @@ def section_grid(
     """A grid of ``states`` nodes per velocity axis and ``actions`` per control axis; with
     ``pitch_nodes`` > 0 a third state axis over ``[-pitch_deg, pitch_deg]`` (an odd count puts
     a node at zero; the axis is symmetric, so a pitch's sign change lands on a node)."""
-    for field, count in (("states", states), ("actions", actions)):
-        if isinstance(count, bool) or int(count) != count or count < 2:
-            raise ParameterError(field, f"must be an integer >= 2 nodes per axis, got {count!r}")
+    check_node_counts(states=states, actions=actions)
     x_low, x_high = check_interval("xdot_range", xdot_range, 0.0, 20.0)
     y_low, y_high = check_interval("ydot_range", ydot_range, -20.0, 20.0)
     p_low, p_high = check_interval("psi0_range", psi0_deg_range, 1.0, 89.0)
@@ -119,6 +117,13 @@ def section_grid(
         state_axes.append(np.radians(np.linspace(-limit, limit, int(pitch_nodes))))
     action_axes = (np.radians(np.linspace(p_low, p_high, int(actions))), np.linspace(z_low, z_high, int(actions)))
     return ViabilityGrid(tuple(state_axes), action_axes)
+
+
+def check_node_counts(**counts: int) -> None:
+    """Each named count of nodes per axis an integer >= 2, or a ParameterError naming it."""
+    for field, count in counts.items():
+        if isinstance(count, bool) or int(count) != count or count < 2:
+            raise ParameterError(field, f"must be an integer >= 2 nodes per axis, got {count!r}")
 
 
 def degrees_of(actions: np.ndarray) -> np.ndarray:

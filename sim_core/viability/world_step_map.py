@@ -21,7 +21,7 @@ from sim_core.model.integrate import STATE_SIZE
 from sim_core.model.params import ModelParams
 from sim_core.model.validation import ParameterError, check_interval
 from sim_core.viability.engine import StepMap
-from sim_core.viability.grid import DEFAULT_PSI0_DEG, DEFAULT_ZETA0, ViabilityGrid
+from sim_core.viability.grid import DEFAULT_PSI0_DEG, DEFAULT_ZETA0, ViabilityGrid, check_node_counts
 from sim_core.world.centre import centre_step
 from sim_core.world.geometry import pack
 from sim_core.world.world import World
@@ -41,9 +41,7 @@ def world_step_map(model: ModelParams, world: World) -> StepMap:
     if not ((world.left.points[:, 0] < 0).all() and (world.right.points[:, 0] > 0).all()):
         raise ParameterError("world", f"{world.name or 'the world'} must have its centre line x = 0 between its sides "
                              f"at every height (heights {heights.min():g} to {heights.max():g} l0)")  # fmt: skip
-    parameters, sides = model.record(), pack(world, model.mu)
-
-    top = world.top
+    parameters, sides, top = model.record(), pack(world, model.mu), world.top
 
     def step(states: np.ndarray, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         states = np.ascontiguousarray(states, dtype=np.float64)
@@ -70,9 +68,7 @@ def world_grid(
 ) -> ViabilityGrid:
     """``heights`` nodes from the floor to the world's top, ``states`` per velocity axis and
     ``actions`` per control axis."""
-    for field, count in (("heights", heights), ("states", states), ("actions", actions)):
-        if isinstance(count, bool) or int(count) != count or count < 2:
-            raise ParameterError(field, f"must be an integer >= 2 nodes per axis, got {count!r}")
+    check_node_counts(heights=heights, states=states, actions=actions)
     x_low, x_high = check_interval("xdot_range", xdot_range, -20.0, 20.0)
     y_low, y_high = check_interval("ydot_range", ydot_range, -20.0, 20.0)
     p_low, p_high = check_interval("psi0_range", psi0_deg_range, 1.0, 89.0)
