@@ -52,7 +52,8 @@ from sim_core.model.trajectory import (
     simulate_trajectory,
 )
 from sim_core.model.walls import Wall, wall_of
-from sim_core.world.geometry import LEFT, RIGHT, pack, segment_at, side_x
+from sim_core.world.climb import start_foot
+from sim_core.world.geometry import LEFT, RIGHT, pack
 from sim_core.world.trajectory import jump_path
 
 
@@ -75,9 +76,9 @@ def launch(setup: ClimbSetup, commanded: LegControl, state, sampler: NoiseSample
     leg = commanded if sampler is None else sampler.controls(commanded, wall, 0.0)
     body_x, segment = math.nan, 0
     if setup.world is not None:  # the foot on the left side at the floor's height
-        sides, floor = pack(setup.world, setup.robot.to_model().mu), setup.floor / setup.robot.leg_length
-        body_x = (side_x(sides, LEFT, floor) + leg.zeta0 * math.cos(leg.psi0)) * setup.robot.leg_length
-        segment = int(segment_at(sides, LEFT, floor))
+        sides = pack(setup.world, setup.robot.to_model().mu)
+        foot_x, segment = start_foot(sides, setup.floor / setup.robot.leg_length)
+        body_x = (foot_x + leg.zeta0 * math.cos(leg.psi0)) * setup.robot.leg_length
     return JumpStart(
         jump=0,
         wall=wall,

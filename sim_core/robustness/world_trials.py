@@ -23,7 +23,8 @@ from sim_core.model.noise_rules import disturbed_state, perturbed_controls, pitc
 from sim_core.model.params import ModelParams
 from sim_core.model.poincare import check_section_state
 from sim_core.model.validation import check_range
-from sim_core.world.geometry import pack, segment_at, side_x
+from sim_core.world.climb import start_foot
+from sim_core.world.geometry import pack
 from sim_core.world.stride import world_jump
 from sim_core.world.world import World
 
@@ -43,10 +44,10 @@ def run_world_trials(
     velocity = check_section_state(start)
     foot_y = check_range("foot_y", foot_y)
     sides = pack(world, model.mu)
-    foot = np.array([side_x(sides, 0, foot_y), foot_y])
+    foot_x, segment = start_foot(sides, foot_y)
     jumps = np.empty(seeds.size, dtype=np.int64)
     status = np.empty(seeds.size, dtype=np.int64)
-    world_trials_batch(foot, velocity, int(segment_at(sides, 0, foot_y)), schedule, seeds, cap, noise.record(),
+    world_trials_batch(np.array([foot_x, foot_y]), velocity, segment, schedule, seeds, cap, noise.record(),
                        model.record(), sides, jumps, status)  # fmt: skip
     return jumps, status
 

@@ -74,11 +74,16 @@ def first_touchdown(model: ModelParams, world: World, schedule: ControlSchedule,
     foot on the left side at ``foot_y`` [l0] under schedule row 0, and the foot's segment."""
     velocity = check_section_state(state)
     foot_y = check_range("foot_y", foot_y)
-    sides = pack(world, model.mu)
+    foot_x, segment = start_foot(pack(world, model.mu), foot_y)
     leg = schedule[0]
-    foot_x = side_x(sides, LEFT, foot_y)
     body = (foot_x + leg.zeta0 * math.cos(leg.psi0), foot_y + leg.zeta0 * math.sin(leg.psi0))
-    return np.array([*body, *velocity]), int(segment_at(sides, LEFT, foot_y))
+    return np.array([*body, *velocity]), segment
+
+
+def start_foot(sides, foot_y: float) -> tuple[float, int]:
+    """Touchdown 0's foot on the left side (the kernels' record ``sides``) at height ``foot_y``
+    [l0]: its ``x`` [l0] and its segment."""
+    return float(side_x(sides, LEFT, foot_y)), int(segment_at(sides, LEFT, foot_y))
 
 
 def climb_world(
