@@ -105,8 +105,6 @@ def section_grid(
     check_node_counts(states=states, actions=actions)
     x_low, x_high = check_interval("xdot_range", xdot_range, 0.0, 20.0)
     y_low, y_high = check_interval("ydot_range", ydot_range, -20.0, 20.0)
-    p_low, p_high = check_interval("psi0_range", psi0_deg_range, 1.0, 89.0)
-    z_low, z_high = check_interval("zeta0_range", zeta0_range, 0.05, 0.999)
     state_axes = [np.linspace(x_low, x_high, int(states)), np.linspace(y_low, y_high, int(states))]
     if pitch_nodes:
         if isinstance(pitch_nodes, bool) or int(pitch_nodes) != pitch_nodes or pitch_nodes < 2:
@@ -115,8 +113,15 @@ def section_grid(
         if limit == 0.0:
             raise ParameterError("pitch_deg", f"must be in (0, {MAX_PITCH_DEG:g}] with a pitch axis, got 0")
         state_axes.append(np.radians(np.linspace(-limit, limit, int(pitch_nodes))))
-    action_axes = (np.radians(np.linspace(p_low, p_high, int(actions))), np.linspace(z_low, z_high, int(actions)))
-    return ViabilityGrid(tuple(state_axes), action_axes)
+    return ViabilityGrid(tuple(state_axes), control_axes(actions, psi0_deg_range, zeta0_range))
+
+
+def control_axes(actions: int, psi0_deg_range, zeta0_range) -> tuple[np.ndarray, np.ndarray]:
+    """The action axes: ``actions`` leg angles [rad] over ``psi0_deg_range`` [deg] and as many
+    leg lengths over ``zeta0_range`` [l0], each range checked by name."""
+    p_low, p_high = check_interval("psi0_range", psi0_deg_range, 1.0, 89.0)
+    z_low, z_high = check_interval("zeta0_range", zeta0_range, 0.05, 0.999)
+    return np.radians(np.linspace(p_low, p_high, int(actions))), np.linspace(z_low, z_high, int(actions))
 
 
 def check_node_counts(**counts: int) -> None:

@@ -21,7 +21,7 @@ from sim_core.model.integrate import STATE_SIZE
 from sim_core.model.params import ModelParams
 from sim_core.model.validation import ParameterError, check_interval
 from sim_core.viability.engine import StepMap
-from sim_core.viability.grid import DEFAULT_PSI0_DEG, DEFAULT_ZETA0, ViabilityGrid, check_node_counts
+from sim_core.viability.grid import DEFAULT_PSI0_DEG, DEFAULT_ZETA0, ViabilityGrid, check_node_counts, control_axes
 from sim_core.world.centre import centre_step
 from sim_core.world.geometry import pack
 from sim_core.world.world import World
@@ -71,12 +71,9 @@ def world_grid(
     check_node_counts(heights=heights, states=states, actions=actions)
     x_low, x_high = check_interval("xdot_range", xdot_range, -20.0, 20.0)
     y_low, y_high = check_interval("ydot_range", ydot_range, -20.0, 20.0)
-    p_low, p_high = check_interval("psi0_range", psi0_deg_range, 1.0, 89.0)
-    z_low, z_high = check_interval("zeta0_range", zeta0_range, 0.05, 0.999)
     state_axes = (np.linspace(0.0, world.top, int(heights)), np.linspace(x_low, x_high, int(states)),
                   np.linspace(y_low, y_high, int(states)))  # fmt: skip
-    action_axes = (np.radians(np.linspace(p_low, p_high, int(actions))), np.linspace(z_low, z_high, int(actions)))
-    return ViabilityGrid(state_axes, action_axes)
+    return ViabilityGrid(state_axes, control_axes(actions, psi0_deg_range, zeta0_range))
 
 
 @parallel_kernel
