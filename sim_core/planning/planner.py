@@ -1,19 +1,28 @@
 """A plan from touchdown 0 to a goal height in a world: which leg commands, jump by jump, put the
-feet on footholds most robustly under the robot's noise (docs/model.md §5.1, §8).
+feet on footholds most robustly under the robot's noise (docs/model.md §5.1, §8), in a form the
+foot-placement law can follow (:mod:`sim_core.planning.follow`).
 
 The search is a beam over the next leg's commands (a grid of ``psi0`` x ``zeta0``: the next leg may
 be chosen up to lift-off, docs/model.md §2.1). Each candidate jump is run nominally and under
 ``samples`` draws of the noise — the coming leg's ``psi0`` (its pitch drift folded in) and
-``zeta0``, and the velocity at this touchdown — the same draws for every candidate (common random
-numbers, so candidates are compared on equal terms). A draw succeeds if the jump completes, the
-foot lands where its touchdown does not slip at once (inside its foothold's cone) and the body
-stays above the floor. **The robustness measure** is the product over the plan's jumps of each
-jump's success share (a plan's estimated chance to get through, each jump judged from the nominal
-state): the search keeps the ``beam`` best partial plans by that score (ties: the higher foot),
-one per (foot height to 1 cm of l0, side, velocity to 0.1), and ends at the first jump whose
-nominal foot reaches the goal, with the best-scored plan there. A search that finds none is run
-once more with a beam of :data:`WIDEST_BEAM` (on ten default random worlds a beam of 24 found 9
-ways to 1.5 m, 64 found 10).
+``zeta0``, the velocity at this touchdown, and the length of the leg stood on (the angle then the
+one that keeps its foot on the wall below the body: what the law cannot see,
+:func:`sim_core.control.placement.leg_on_wall`) — the same draws for every candidate (common random
+numbers, so candidates are compared on equal terms). A candidate is kept only if its nominal foot
+lands with the placement law's margins (from the foothold's ends and inside its cone,
+:class:`sim_core.control.laws.placement.PlacementSettings`), so that the law, on the plan, sends the
+plan's own legs. A draw succeeds if the jump completes, the foot lands on the nominal's foothold
+inside its cone and the body stays above the floor. **The robustness measure** is the product over
+the plan's jumps of each jump's success share (a plan's estimated chance to get through, each jump
+judged from the nominal state): the search keeps the ``beam`` best partial plans by that score
+(ties: the higher foot), one per (foot height to 1 cm of l0, side, velocity to 0.1), and ends at
+the first jump whose nominal foot reaches the goal, with the best-scored plan there. A search that
+finds none is run once more with a beam of :data:`WIDEST_BEAM`. :func:`replan` plans the same way
+from a touchdown under way.
+
+What the measure misses (docs/analyses.md, "Foot placement"): each jump is judged from the plan's
+own state, so a plan whose every jump is sure can still fail once noise has moved the robot off
+it; measured, the chance overstates how often the law gets through.
 """
 
 from __future__ import annotations
@@ -24,6 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sim_core.control.laws.placement import PlacementSettings
+from sim_core.control.placement import leg_on_wall
 from sim_core.model.controls import ControlSchedule, LegControl
 from sim_core.model.errors import ParameterError
 from sim_core.model.failures import FLOOR_HEIGHT, OK
@@ -40,6 +51,7 @@ ZETA0 = np.arange(0.80, 0.961, 0.02)  # and lengths [l0]
 SAMPLES, BEAM, MAX_JUMPS = 8, 24, 80
 WIDEST_BEAM = 96  # the second search's, when the first finds no way to the goal
 FLOOR_OF_CHANCE = 1e-3  # a jump no draw survives still scores, far below any that one does
+LEGS = np.array([(math.radians(p), z) for p in PSI0_DEG for z in ZETA0])  # the next legs tried
 
 
 @dataclass(frozen=True)
@@ -52,6 +64,7 @@ class PlanStep:
     segment: int
     target: tuple[float, float]
     leg: LegControl
+    velocity: tuple[float, float]  # the body's (xdot, ydot) at this touchdown [sqrt(g l0)], wall coordinates
 
     def to_dict(self) -> dict:
         return {"jump": self.jump, "side": SIDES[self.side], "segment": self.segment,
@@ -98,36 +111,56 @@ def plan_climb(
         raise ParameterError("goal_height", f"must be above the start's foot ({foot_y:g} l0), got {goal:g} l0")
     if goal > world.top:
         raise ParameterError("goal_height", f"must be at most the world's top ({world.top:g} l0), got {goal:g} l0")
+    nodes = []
+    for leg in LEGS:
+        row, segment = first_touchdown(model, world, ControlSchedule.of(LegControl(*leg)), state, foot_y)
+        nodes.append(_Node(row, 0, segment, tuple(leg), 0.0, ((row, 0, segment, tuple(leg)),)))
+    return _best_plan(model, world, goal, nodes, foot_y, noise, samples, beam, max_jumps, seed, started)
+
+
+def replan(model: ModelParams, world: World, goal: float, touchdown, *, noise: NoiseModel | None = None,
+           samples: int = SAMPLES, beam: int = BEAM, max_jumps: int = MAX_JUMPS, seed: int = 0) -> Plan:  # fmt: skip
+    """The most robust plan from a touchdown under way to a foot at ``goal`` [l0]: ``touchdown`` is
+    ``(row, side, segment, leg)``, the body's ``x, y, xdot, ydot`` there (wall coordinates), its
+    side and segment, and the leg ``(psi0, zeta0)`` [rad, l0] it stands on. The plan's row 0 is
+    this touchdown (its ``jump`` 0)."""
+    started = time.perf_counter()
+    row, side, segment, leg = touchdown
+    row, leg = np.asarray(row, dtype=float), (float(leg[0]), float(leg[1]))
+    node = _Node(row, int(side), int(segment), leg, 0.0, ((row, int(side), int(segment), leg),))
+    foot = node.foot()
+    if goal <= foot:
+        return _plan(node.path, True, 0.0, foot, started)
+    return _best_plan(model, world, goal, [node], foot, noise, samples, beam, max_jumps, seed, started)
+
+
+def _best_plan(model, world, goal, nodes, foot_y, noise, samples, beam, max_jumps, seed, started) -> Plan:
     noise = NoiseModel() if noise is None else noise
-    plan = _search(model, world, goal, state, foot_y, noise, samples, beam, max_jumps, seed, started)
+    plan = _search(model, world, goal, nodes, foot_y, noise, samples, beam, max_jumps, seed, started)
     if not plan.reaches_goal and beam < WIDEST_BEAM:  # a narrow beam can lose the only way up
-        plan = _search(model, world, goal, state, foot_y, noise, samples, WIDEST_BEAM, max_jumps, seed, started)
+        plan = _search(model, world, goal, nodes, foot_y, noise, samples, WIDEST_BEAM, max_jumps, seed, started)
     return plan
 
 
-def _search(model, world, goal, state, foot_y, noise, samples, beam, max_jumps, seed, started) -> Plan:
-    """One beam search (see the module)."""
-    legs = np.array([(math.radians(p), z) for p in PSI0_DEG for z in ZETA0])
+def _search(model, world, goal, nodes, foot_y, noise, samples, beam, max_jumps, seed, started) -> Plan:
+    """One beam search (see the module) from ``nodes``, the touchdowns it may start from."""
+    legs = LEGS
     draws = _draws(noise, samples, seed)
     sides = pack(world, model.mu)
-    nodes = []
-    for index, leg in enumerate(legs):
-        row, segment = first_touchdown(model, world, ControlSchedule.of(LegControl(*leg)), state, foot_y)
-        nodes.append(_Node(row, 0, segment, index, 0.0, ((row, 0, segment, index),)))
     highest, best_path = foot_y, nodes[0].path
     for _ in range(max_jumps):
-        children = _expand(model, sides, legs, draws, nodes)
+        children = _expand(model, sides, legs, draws, nodes, PlacementSettings())
         if not children:
             break
-        top = max(children, key=lambda child: child.foot(legs))
-        if top.foot(legs) > highest:
-            highest, best_path = top.foot(legs), top.path
-        arrived = [child for child in children if child.foot(legs) >= goal]
+        top = max(children, key=_Node.foot)
+        if top.foot() > highest:
+            highest, best_path = top.foot(), top.path
+        arrived = [child for child in children if child.foot() >= goal]
         if arrived:
-            chosen = max(arrived, key=lambda child: (child.score, child.foot(legs)))
-            return _plan(chosen.path, legs, True, chosen.score, max(highest, chosen.foot(legs)), started)
-        nodes = _keep(children, legs, beam)
-    return _plan(best_path, legs, False, -math.inf, highest, started)
+            chosen = max(arrived, key=lambda child: (child.score, child.foot()))
+            return _plan(chosen.path, True, chosen.score, max(highest, chosen.foot()), started)
+        nodes = _keep(children, beam)
+    return _plan(best_path, False, -math.inf, highest, started)
 
 
 @dataclass(frozen=True)
@@ -135,25 +168,39 @@ class _Node:
     row: np.ndarray  # the body at this touchdown: x, y, xdot, ydot [l0, sqrt(g l0)]
     side: int
     segment: int
-    leg: int  # index of the leg that set it down
+    leg: tuple[float, float]  # (psi0, zeta0) of the leg that set it down [rad, l0]
     score: float  # sum of log chances so far
     path: tuple  # (row, side, segment, leg) of every touchdown so far
 
-    def foot(self, legs) -> float:
-        psi0, zeta0 = legs[self.leg]
+    def foot(self) -> float:
+        psi0, zeta0 = self.leg
         return float(self.row[1] - zeta0 * math.sin(psi0))
 
 
 def _draws(noise: NoiseModel, samples: int, seed: int) -> np.ndarray:
-    """(samples + 1, 4) draws of (psi0, zeta0, xdot, ydot) noise; row 0 the nominal (zeros)."""
+    """(samples + 1, 5) draws of noise — the coming leg's (psi0, zeta0), the velocity (xdot, ydot)
+    at this touchdown and the zeta0 this leg stands on — row 0 the nominal (zeros)."""
     record = noise.record()
     sigma_psi0 = math.hypot(record.sigma_psi0, record.sigma_pitch)  # the pitch's step turns the leg too
-    scale = np.array([sigma_psi0, record.sigma_zeta0, record.sigma_velocity, record.sigma_velocity])
-    normal = np.random.default_rng(seed).standard_normal((samples, 4))
-    return np.vstack([np.zeros(4), normal * scale])
+    scale = np.array([sigma_psi0, record.sigma_zeta0, record.sigma_velocity, record.sigma_velocity,
+                      record.sigma_zeta0])  # fmt: skip
+    normal = np.random.default_rng(seed).standard_normal((samples, 5))
+    return np.vstack([np.zeros(5), normal * scale])
 
 
-def _expand(model, sides, legs, draws, nodes) -> list[_Node]:
+def _standing_legs(sides, node, draws) -> np.ndarray:
+    """The leg ``node`` stands on under each draw: its length as drawn, its angle the one that keeps
+    the foot on the wall below the body (the law sees the body, not the leg's noise:
+    :func:`sim_core.control.placement.leg_on_wall`)."""
+    x, y = node.row[0], node.row[1]
+    legs = np.empty((len(draws), 2))
+    for d, draw in enumerate(draws):
+        zeta0 = node.leg[1] + draw[4]
+        legs[d] = leg_on_wall(sides, node.side, x, y, node.leg[0], zeta0), zeta0
+    return legs
+
+
+def _expand(model, sides, legs, draws, nodes, settings) -> list[_Node]:
     """Every node's jump with every next leg, under every draw: the children that land nominally."""
     per_node, per_leg = len(legs) * len(draws), len(draws)
     count = len(nodes) * per_node
@@ -164,9 +211,9 @@ def _expand(model, sides, legs, draws, nodes) -> list[_Node]:
     for i, node in enumerate(nodes):
         block = slice(i * per_node, (i + 1) * per_node)
         start = np.tile(node.row, (per_node, 1))
-        start[:, 2:] += np.tile(draws[:, 2:], (len(legs), 1))  # the velocity noise at this touchdown
+        start[:, 2:] += np.tile(draws[:, 2:4], (len(legs), 1))  # the velocity noise at this touchdown
         states[block, 0], on_side[block, 0], on_segment[block, 0] = start, node.side, node.segment
-        schedules[block, 0] = legs[node.leg]
+        schedules[block, 0] = np.tile(_standing_legs(sides, node, draws), (len(legs), 1))
         coming = np.repeat(legs, per_leg, axis=0) + np.tile(draws[:, :2], (len(legs), 1))
         schedules[block, 1] = np.clip(coming, [1e-3, 1e-3], [0.5 * math.pi - 1e-3, 1.0 - 1e-3])
     status, completed = np.empty(count, dtype=np.int64), np.empty(count, dtype=np.int64)
@@ -175,15 +222,46 @@ def _expand(model, sides, legs, draws, nodes) -> list[_Node]:
     held = (status == OK) & (landed[:, 1] >= FLOOR_HEIGHT) & _in_cone(sides, on_side[:, 1], on_segment[:, 1],
                                                                      schedules[:, 1, 0])  # fmt: skip
     held = held.reshape(len(nodes), len(legs), len(draws))
+    nominal = np.arange(0, count, len(draws))
+    placeable = _with_margins(sides, on_side[nominal, 1], on_segment[nominal, 1],
+                              landed[nominal, 1] - schedules[nominal, 1, 1] * np.sin(schedules[nominal, 1, 0]),
+                              schedules[nominal, 1, 0], settings).reshape(len(nodes), len(legs))  # fmt: skip
+    landed_on = on_segment[:, 1].reshape(len(nodes), len(legs), len(draws))
+    held[:, :, 1:] &= landed_on[:, :, 1:] == landed_on[:, :, :1]  # a draw counts on the nominal's foothold only
     chance = held[:, :, 1:].mean(axis=2) if len(draws) > 1 else held[:, :, 0].astype(float)
     children = []
     for i, node in enumerate(nodes):
-        for leg in np.flatnonzero(held[i, :, 0]):  # the nominal jump lands
+        for leg in np.flatnonzero(held[i, :, 0] & placeable[i]):  # the nominal jump lands, with margins
             k = i * per_node + leg * per_leg
             score = node.score + math.log(max(float(chance[i, leg]), FLOOR_OF_CHANCE))
-            step = (landed[k].copy(), int(on_side[k, 1]), int(on_segment[k, 1]), int(leg))
+            step = (
+                landed[k].copy(),
+                int(on_side[k, 1]),
+                int(on_segment[k, 1]),
+                (float(legs[leg, 0]), float(legs[leg, 1])),
+            )
             children.append(_Node(*step, score, (*node.path, step)))
     return children
+
+
+def _with_margins(sides, side, segment, foot_y, psi0, settings: PlacementSettings) -> np.ndarray:
+    """Whether feet at ``foot_y`` [l0] set down at ``psi0`` [rad] on ``side``'s ``segment`` keep the
+    placement law's margins (:mod:`sim_core.control.placement`: from the foothold's ends, a quarter
+    of its length at most, and inside its cone, half of it at most), so the law can follow."""
+    last = sides.counts[side] - 1
+    inner = np.clip(segment, 0, np.maximum(last - 1, 0))
+    low, high = sides.points[side, inner], sides.points[side, inner + 1]
+    length = np.hypot(*(high - low).T)
+    share = (foot_y - low[:, 1]) / np.maximum(high[:, 1] - low[:, 1], 1e-300)
+    along = np.minimum(share, 1.0 - share) * length
+    along = np.where(segment < 0, sides.points[side, 0, 1] - foot_y, along)
+    along = np.where(segment >= last, foot_y - sides.points[side, last, 1], along)
+    asked = np.where((segment < 0) | (segment >= last), settings.end_margin, np.minimum(settings.end_margin,
+                                                                                        0.25 * length))  # fmt: skip
+    column = np.clip(segment + 1, 0, sides.beta.shape[1] - 1)
+    half = np.arctan(sides.friction[side, column])
+    cone = half - np.abs(psi0 - sides.beta[side, column])
+    return (along >= asked) & (cone >= np.minimum(math.radians(settings.cone_margin_deg), 0.5 * half))
 
 
 def _in_cone(sides, side, segment, psi0) -> np.ndarray:
@@ -193,11 +271,11 @@ def _in_cone(sides, side, segment, psi0) -> np.ndarray:
     return np.abs(psi0 - beta) < np.arctan(mu)
 
 
-def _keep(children, legs, beam: int) -> list[_Node]:
+def _keep(children, beam: int) -> list[_Node]:
     """The ``beam`` best-scored children, one per (foot to 0.01 l0, side, velocity to 0.1)."""
     kept, seen = [], set()
-    for child in sorted(children, key=lambda c: (c.score, c.foot(legs)), reverse=True):
-        key = (round(child.foot(legs), 2), child.side, round(float(child.row[2]), 1), round(float(child.row[3]), 1))
+    for child in sorted(children, key=lambda c: (c.score, c.foot()), reverse=True):
+        key = (round(child.foot(), 2), child.side, round(float(child.row[2]), 1), round(float(child.row[3]), 1))
         if key not in seen:
             seen.add(key)
             kept.append(child)
@@ -206,15 +284,15 @@ def _keep(children, legs, beam: int) -> list[_Node]:
     return kept
 
 
-def _plan(path, legs, reaches, score, highest, started) -> Plan:
+def _plan(path, reaches, score, highest, started) -> Plan:
     steps = []
     for jump, (row, side, segment, leg) in enumerate(path):
-        control = LegControl(*legs[leg])
+        control = LegControl(*leg)
         mirror = 1.0 if side == 0 else -1.0
         target = (
             row[0] - mirror * control.zeta0 * math.cos(control.psi0),
             row[1] - control.zeta0 * math.sin(control.psi0),
         )
-        steps.append(PlanStep(jump, side, segment, target, control))
+        steps.append(PlanStep(jump, side, segment, target, control, (float(row[2]), float(row[3]))))
     chance = math.exp(score) if reaches else 0.0
     return Plan(tuple(steps), reaches, chance, highest, time.perf_counter() - started)

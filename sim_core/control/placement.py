@@ -1,0 +1,298 @@
+"""The foot-placement law: the next leg's ``psi0`` and ``zeta0`` chosen so that its foot lands on
+the foothold a plan names, with a margin from the foothold's ends and inside its friction cone
+(docs/model.md §8; docs/analyses.md, "Foot placement").
+
+At touchdown ``k`` the robot knows its body (tracked: ``x, y, xdot, ydot`` in wall coordinates),
+the foothold it stands on and the leg it sent. The foot is on the wall, so the body's place tells
+the leg's angle as the noise made it (:func:`leg_on_wall`, for the length sent); the model then
+fixes the stance under way and its lift-off, and the flight after it is a parabola: where the
+coming foot first meets the other side is a quadratic per segment
+(:func:`sim_core.world.geometry.first_crossing`). The law tries a grid of next legs — the angles
+inside the target foothold's cone, the lengths over the leg's range — and the plan's own leg. A
+candidate is *good* if its foot lands on the target segment at least ``end_margin`` [l0] along it
+from either end (a quarter of a short foothold at most), its angle at least ``cone_margin``
+[rad] inside the cone (half the cone at most), the body above the floor, and (``stance_spread``
+> 0) it lands on the target from either end of the stance length's spread too. Good candidates
+are costed by
+
+    ((y_foot - y_aim) / position_scale)² + |v - v_aim|² / velocity_scale²
+        + ((psi0 - psi0_aim) / psi0_scale)² + ((zeta0 - zeta0_aim) / zeta0_scale)²
+
+against the plan's touchdown ``k + 1`` (its foot, the body's velocity there, its leg); the
+:data:`AHEAD` cheapest are looked at one jump further — the jump each sets off with the plan's
+following leg must complete above the floor (the guard), and its touchdown is costed the same
+way against the plan's ``k + 2`` — and the least total wins (``found`` :data:`PLACED`). With no
+good candidate the guard passes, the plan's own leg if it lands on the target and goes on, else
+the widest margin that lands there (:data:`TIGHT`); with none that lands there, the plan's leg
+(:data:`OFF_PLAN`). A caller replans on anything but PLACED (:mod:`sim_core.planning.follow`).
+
+The time is bounded: at most three stances, ``PSI0_GRID x ZETA0_GRID + 1`` crossings (three times
+that with the spread) and :data:`AHEAD` jumps; about 60-70 µs a jump on one core
+(docs/analyses.md).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from sim_core._jit import kernel
+from sim_core.model.failures import FLOOR_HEIGHT, OK
+from sim_core.model.integrate import PSI, PSI_DOT, STATE_SIZE, ZETA_DOT
+from sim_core.model.stride import liftoff_velocity
+from sim_core.world.geometry import FLIGHT_TIME_CAP, first_crossing, side_x
+from sim_core.world.stride import foothold_stance, world_jump
+
+# The aim (what the plan says of touchdown k + 1): its segment on the other side, its foot [l0],
+# the body's velocity there [sqrt(g l0)] and its leg; then of touchdown k + 2: the leg that sets it
+# down, its foot's height and the body's velocity (NaN: the plan ends at k + 1)
+AIM_SEGMENT, AIM_X, AIM_Y, AIM_XDOT, AIM_YDOT, AIM_PSI0, AIM_ZETA0 = range(7)
+THEN_PSI0, THEN_ZETA0, THEN_Y, THEN_XDOT, THEN_YDOT = range(7, 12)
+AIM_SIZE = 12
+# The settings: the leg's range [rad, l0], the margins [l0, rad] and the cost's scales
+PSI0_LOW, PSI0_HIGH, ZETA0_LOW, ZETA0_HIGH, END_MARGIN, CONE_MARGIN = range(6)
+POSITION_SCALE, VELOCITY_SCALE, PSI0_SCALE, ZETA0_SCALE, STANCE_SPREAD = range(6, 11)
+SETTINGS_SIZE = 11
+PSI0_GRID, ZETA0_GRID = 13, 9
+AHEAD = 12  # the best landings looked at one jump further
+NEWTON_STEPS, MAX_TURN = 6, 0.2  # the leg angle found from the tracked body: its steps, and how far [rad] it may be
+OFF_PLAN, TIGHT, PLACED = 0, 1, 2  # what `found` says
+
+
+@kernel
+def place_leg(model, sides, x, y, xdot, ydot, side, segment, psi0, zeta0, aim, settings):
+    """The next leg for the foothold ``aim`` names, from touchdown ``k``: the body ``x, y, xdot,
+    ydot`` (wall coordinates) on ``side``'s ``segment``, touched down with ``(psi0, zeta0)`` as
+    the robot expects it realised (its command turned by the pitch it knew). Returns ``(found,
+    psi0, zeta0)``: ``found`` as :data:`PLACED`, :data:`TIGHT` or :data:`OFF_PLAN` (the module);
+    the angle in the landing side's stance frame, before any pitch correction."""
+    record = np.empty((0, STATE_SIZE))
+    mirror = 1.0 if side == 0 else -1.0
+    psi0 = leg_on_wall(sides, side, x, y, psi0, zeta0)
+    final = np.empty(STATE_SIZE)
+    status, _ = foothold_stance(mirror * xdot, ydot, psi0, zeta0, model, sides, side, segment, final, record)
+    if status != OK:  # the stance under way fails: nothing chosen now changes that
+        return OFF_PLAN, aim[AIM_PSI0], aim[AIM_ZETA0]
+    psi = final[PSI]
+    vx, vy = liftoff_velocity(psi, final[ZETA_DOT], final[PSI_DOT])
+    hip_x = mirror * x - zeta0 * math.cos(psi0) + math.cos(psi)  # the hip at lift-off, stance frame
+    hip_y = y - zeta0 * math.sin(psi0) + math.sin(psi)
+    # The stance's length is the robot's guess (its noise unseen): lift-offs from either end of its spread
+    spread = np.empty((2, 4))
+    spread_count = 0
+    for sign in (-1.0, 1.0):
+        length = zeta0 + sign * settings[STANCE_SPREAD]
+        if settings[STANCE_SPREAD] > 0.0 and 0.0 < length < 1.0:
+            angle = leg_on_wall(sides, side, x, y, psi0, length)
+            status, _ = foothold_stance(mirror * xdot, ydot, angle, length, model, sides, side, segment, final, record)
+            if status == OK:
+                spread[spread_count, 2], spread[spread_count, 3] = liftoff_velocity(final[PSI], final[ZETA_DOT],
+                                                                                    final[PSI_DOT])  # fmt: skip
+                spread[spread_count, 0] = mirror * x - length * math.cos(angle) + math.cos(final[PSI])
+                spread[spread_count, 1] = y - length * math.sin(angle) + math.sin(final[PSI])
+                spread_count += 1
+    other, target = 1 - side, int(aim[AIM_SEGMENT])
+    beta = sides.beta[other, target + 1]
+    half = math.atan(sides.friction[other, target + 1])
+    cone_margin = min(settings[CONE_MARGIN], 0.5 * half)
+    psi0_low = max(settings[PSI0_LOW], beta - half + cone_margin)
+    psi0_high = min(settings[PSI0_HIGH], beta + half - cone_margin)
+    if psi0_low > psi0_high:  # the leg's range misses the cone's core: try the whole cone in range
+        psi0_low, psi0_high = max(settings[PSI0_LOW], beta - half), min(settings[PSI0_HIGH], beta + half)
+        if psi0_low > psi0_high:
+            return OFF_PLAN, aim[AIM_PSI0], aim[AIM_ZETA0]
+    zeta0_low, zeta0_high = settings[ZETA0_LOW], settings[ZETA0_HIGH]
+    psi0_step = (psi0_high - psi0_low) / (PSI0_GRID - 1)
+    zeta0_step = (zeta0_high - zeta0_low) / (ZETA0_GRID - 1)
+    grid = PSI0_GRID * ZETA0_GRID + 1
+    legs = np.empty((grid, 2))
+    costs = np.full(grid, math.inf)
+    for i in range(grid - 1):
+        legs[i, 0] = psi0_low + (i // ZETA0_GRID) * psi0_step
+        legs[i, 1] = zeta0_low + (i % ZETA0_GRID) * zeta0_step
+    legs[grid - 1, 0], legs[grid - 1, 1] = aim[AIM_PSI0], aim[AIM_ZETA0]  # the plan's own leg, where it lands
+    _score(
+        legs,
+        costs,
+        sides,
+        other,
+        target,
+        mirror,
+        hip_x,
+        hip_y,
+        vx,
+        vy,
+        beta,
+        half,
+        cone_margin,
+        aim,
+        settings,
+        spread[:spread_count],
+    )
+    # The best by the landing alone, looked at one jump further: the jump each sets off, with the
+    # plan's following leg, must complete (the guard), and where it lands is costed too
+    best, best_cost = -1, math.inf
+    for _ in range(AHEAD):
+        candidate = int(np.argmin(costs))
+        if not math.isfinite(costs[candidate]):
+            break
+        ahead = _ahead_cost(model, sides, side, mirror, hip_x, hip_y, vx, vy, legs[candidate, 0], legs[candidate, 1],
+                            aim, settings, record)  # fmt: skip
+        if costs[candidate] + ahead < best_cost:
+            best, best_cost = candidate, costs[candidate] + ahead
+        costs[candidate] = math.inf
+    if best >= 0:
+        return PLACED, legs[best, 0], legs[best, 1]
+    # No good leg the guard passes: the plan's own if it lands on the target and goes on, else the
+    # widest margin that lands there
+    plan_psi0, plan_zeta0 = aim[AIM_PSI0], aim[AIM_ZETA0]
+    on_target = _margin(sides, other, target, mirror, hip_x, hip_y, vx, vy, plan_psi0, plan_zeta0, beta, half,
+                        cone_margin, settings) > 0.0  # fmt: skip
+    if on_target and math.isfinite(
+        _ahead_cost(model, sides, side, mirror, hip_x, hip_y, vx, vy, plan_psi0, plan_zeta0, aim, settings, record)
+    ):
+        return TIGHT, plan_psi0, plan_zeta0
+    best_margin, widest = -math.inf, -1
+    for i in range(grid):
+        margin = _margin(sides, other, target, mirror, hip_x, hip_y, vx, vy, legs[i, 0], legs[i, 1], beta, half,
+                         cone_margin, settings)  # fmt: skip
+        if margin > best_margin:
+            best_margin, widest = margin, i
+    if widest < 0:
+        return OFF_PLAN, plan_psi0, plan_zeta0
+    return TIGHT, legs[widest, 0], legs[widest, 1]
+
+
+@kernel
+def leg_on_wall(sides, side, x, y, psi0, zeta0):
+    """The leg angle [rad] that puts the foot of a body at ``(x, y)`` (tracked) on ``side``'s
+    polyline with the leg at ``zeta0``, found from ``psi0`` (the angle as sent, turned by the pitch):
+    the foot is on the wall, so the body's place tells the angle the noise gave the leg. Newton's
+    steps; ``psi0`` itself where they do not settle."""
+    mirror = 1.0 if side == 0 else -1.0
+    step, angle = 1e-7, psi0
+    for _ in range(NEWTON_STEPS):
+        gap = _off_wall(sides, side, mirror, x, y, angle, zeta0)
+        if abs(gap) < 1e-12:
+            return angle
+        slope = (_off_wall(sides, side, mirror, x, y, angle + step, zeta0) - gap) / step
+        if slope == 0.0 or not math.isfinite(slope):
+            return psi0
+        angle -= gap / slope
+    if abs(_off_wall(sides, side, mirror, x, y, angle, zeta0)) < 1e-9 and abs(angle - psi0) < MAX_TURN:
+        return angle
+    return psi0
+
+
+@kernel
+def _off_wall(sides, side, mirror, x, y, psi0, zeta0):
+    """How far [l0] the foot of a body at ``(x, y)`` with the leg ``(psi0, zeta0)`` lies off the wall,
+    along x in the side's stance frame."""
+    return mirror * x - zeta0 * math.cos(psi0) - mirror * side_x(sides, side, y - zeta0 * math.sin(psi0))
+
+
+@kernel
+def _landing(sides, other, mirror, hip_x, hip_y, vx, vy, psi0, zeta0):
+    """Where the coming leg ``(psi0, zeta0)`` lands from lift-off (the hip at ``hip_x, hip_y`` in
+    the stance frame, velocity ``vx, vy``): ``(segment, foot_y, body_y, xdot, ydot, t)``, the
+    velocity in the stance frame; segment ``-2`` if it lands nowhere."""
+    next_x = hip_x + zeta0 * math.cos(psi0)  # the coming foot, held at its angle toward the other side
+    next_y = hip_y - zeta0 * math.sin(psi0)
+    if vx <= 0.0 or next_x >= mirror * side_x(sides, other, next_y):
+        return -2, math.nan, math.nan, math.nan, math.nan, math.nan
+    t, landing = first_crossing(sides, other, mirror, next_x, next_y, vx, vy)
+    if not t <= FLIGHT_TIME_CAP:
+        return -2, math.nan, math.nan, math.nan, math.nan, math.nan
+    landed_y = next_y + (vy - 0.5 * t) * t
+    return landing, landed_y, landed_y + zeta0 * math.sin(psi0), vx, vy - t, t
+
+
+@kernel
+def _end_margin(sides, other, segment, foot_y):
+    """How far along ``segment`` [l0] ``foot_y`` lies from its nearer end, and the most that can
+    be asked on it (a quarter of its length); the continuations are open on their far side."""
+    points, last = sides.points[other], sides.counts[other] - 1
+    if segment < 0:
+        return points[0, 1] - foot_y, math.inf
+    if segment >= last:
+        return foot_y - points[last, 1], math.inf
+    xa, ya, xb, yb = points[segment, 0], points[segment, 1], points[segment + 1, 0], points[segment + 1, 1]
+    length = math.hypot(xb - xa, yb - ya)
+    share = (foot_y - ya) / (yb - ya)
+    return min(share, 1.0 - share) * length, 0.25 * length
+
+
+@kernel
+def _margin(sides, other, target, mirror, hip_x, hip_y, vx, vy, psi0, zeta0, beta, half, cone_margin, settings):
+    """A landing's margin on the target in units of what is asked (>= 1: good); -inf off it."""
+    segment, landed_y, body_y, _, _, _ = _landing(sides, other, mirror, hip_x, hip_y, vx, vy, psi0, zeta0)
+    if segment != target or body_y < FLOOR_HEIGHT:
+        return -math.inf
+    along, most = _end_margin(sides, other, segment, landed_y)
+    end_margin = min(settings[END_MARGIN], most)
+    return min(along / end_margin, (half - abs(psi0 - beta)) / cone_margin)
+
+
+@kernel
+def _score(legs, costs, sides, other, target, mirror, hip_x, hip_y, vx, vy, beta, half, cone_margin, aim, settings,
+           spread):  # fmt: skip
+    """Each good leg's cost by its landing into ``costs`` (inf for the others); from the ``spread``
+    lift-offs (rows ``hip_x, hip_y, vx, vy``) a good leg lands on the target too."""
+    for i in range(legs.shape[0]):
+        psi0, zeta0 = legs[i, 0], legs[i, 1]
+        segment, landed_y, body_y, land_vx, land_vy, _ = _landing(sides, other, mirror, hip_x, hip_y, vx, vy,
+                                                                   psi0, zeta0)  # fmt: skip
+        if segment != target or body_y < FLOOR_HEIGHT:
+            continue
+        along, most = _end_margin(sides, other, segment, landed_y)
+        if along < min(settings[END_MARGIN], most) or half - abs(psi0 - beta) < cone_margin:
+            continue
+        if not _lands_from_all(sides, other, target, mirror, spread, psi0, zeta0):
+            continue
+        costs[i] = (
+            _miss(settings, landed_y, mirror * land_vx, land_vy, aim[AIM_Y], aim[AIM_XDOT], aim[AIM_YDOT])
+            + ((psi0 - aim[AIM_PSI0]) / settings[PSI0_SCALE]) ** 2
+            + ((zeta0 - aim[AIM_ZETA0]) / settings[ZETA0_SCALE]) ** 2
+        )
+
+
+@kernel
+def _lands_from_all(sides, other, target, mirror, spread, psi0, zeta0):
+    """Whether the leg lands on ``target`` above the floor from every lift-off of ``spread``."""
+    for row in range(spread.shape[0]):
+        segment, _, body_y, _, _, _ = _landing(sides, other, mirror, spread[row, 0], spread[row, 1], spread[row, 2],
+                                               spread[row, 3], psi0, zeta0)  # fmt: skip
+        if segment != target or body_y < FLOOR_HEIGHT:
+            return False
+    return True
+
+
+@kernel
+def _miss(settings, foot_y, xdot, ydot, aim_y, aim_xdot, aim_ydot):
+    """How far a touchdown (its foot's height [l0], the body's velocity) is from its aim, in the
+    cost's scales; an aim of NaN height costs nothing."""
+    if math.isnan(aim_y):
+        return 0.0
+    velocity = ((xdot - aim_xdot) ** 2 + (ydot - aim_ydot) ** 2) / settings[VELOCITY_SCALE] ** 2
+    return ((foot_y - aim_y) / settings[POSITION_SCALE]) ** 2 + velocity
+
+
+@kernel
+def _ahead_cost(model, sides, side, mirror, hip_x, hip_y, vx, vy, psi0, zeta0, aim, settings, record):
+    """The jump after a landing with ``(psi0, zeta0)``, with the plan's following leg, on the
+    model: how far its touchdown is from the plan's (:func:`_miss`); inf if it fails (the guard);
+    0 where the plan ends at the landing (a NaN following leg)."""
+    segment, _, body_y, _, land_vy, t = _landing(sides, 1 - side, mirror, hip_x, hip_y, vx, vy, psi0, zeta0)
+    then_psi0, then_zeta0 = aim[THEN_PSI0], aim[THEN_ZETA0]
+    if math.isnan(then_psi0):  # the plan ends at this touchdown: nothing after it to guard
+        return 0.0
+    status, _, y, xdot, ydot, _, _, _, _, _ = world_jump(
+        mirror * (hip_x + vx * t), body_y, mirror * vx, land_vy, 1 - side, segment, psi0, zeta0,
+        then_psi0, then_zeta0, model, sides, record,
+    )  # fmt: skip
+    if status != OK or y < FLOOR_HEIGHT:
+        return math.inf
+    return _miss(
+        settings, y - then_zeta0 * math.sin(then_psi0), xdot, ydot, aim[THEN_Y], aim[THEN_XDOT], aim[THEN_YDOT]
+    )

@@ -1,0 +1,183 @@
+"""A plan followed under noise: the foot-placement law aiming each touchdown at the plan's
+foothold, replanning from where the robot is when it is off its plan (docs/analyses.md, "Foot
+placement").
+
+A trial starts as MJTF's world trials do (:mod:`sim_core.robustness.world_trials`): touchdown 0
+on the left side at the plan's first foot, numba's generator seeded by the trial's seed, the noise
+drawn in the same order (at each lift-off a pitch step and the next leg's controls, after each
+jump the velocity) — so the same seed gives the same draws to a fixed schedule and to this law.
+At touchdown ``k`` the law (:func:`sim_core.control.placement.place_leg`) sees the tracked body,
+its foothold, the pitch and the leg it sent (turned by the pitch it knew: the draws it cannot
+know), and sets leg ``k + 1`` for the plan's touchdown ``k + 1``; the leg is sent turned back by
+the tracked pitch and clipped to the leg's range.
+
+Off plan — the law finds no leg that lands on the plan's next foothold with its margins and goes
+on, or the plan ends below the goal — the compiled loop stops *before* that lift-off's draws,
+the planner (:func:`sim_core.planning.planner.replan`) plans again from that touchdown, and the
+loop goes on with the draws where they were. A trial ends at the goal (a foot at or above it),
+at a failure (the floor included), or at ``cap`` jumps.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim_core._jit import kernel
+from sim_core.control.laws.placement import PlacementSettings
+from sim_core.control.placement import AIM_SIZE, OFF_PLAN, PLACED, PSI0_HIGH, PSI0_LOW, place_leg
+from sim_core.model.failures import FLOOR, FLOOR_HEIGHT, OK
+from sim_core.model.integrate import STATE_SIZE
+from sim_core.model.noise import NoiseModel
+from sim_core.model.noise_rules import commanded_controls, disturbed_state, pitch_step, seed_trial
+from sim_core.model.params import ModelParams
+from sim_core.planning.planner import Plan, replan
+from sim_core.world.geometry import SideArrays, pack
+from sim_core.world.stride import world_jump
+from sim_core.world.world import World
+
+# A trial's state at a touchdown (one float array, in and out of the compiled loop): the body, its
+# side and segment, the leg as realised (the physics') and as sent (the law's), the pitch, the jump
+X, Y, XDOT, YDOT, SIDE, SEGMENT, PSI0, ZETA0, SENT_PSI0, SENT_ZETA0, PITCH, JUMP = range(12)
+TRIAL_SIZE = 12
+REACHED, CAPPED, REPLAN = -1, -2, -3  # how the loop stops, beside a failure's code
+MAX_REPLANS = 3  # a trial's replans at most; then the law's best leg goes out, on plan or not
+
+
+def plan_aims(plan: Plan) -> np.ndarray:
+    """The law's aims (:mod:`sim_core.control.placement`'s layout), row ``k`` for touchdown ``k``
+    (row 0 unused): each touchdown's segment, foot, velocity and leg, and the next one's (NaN after
+    the last)."""
+    steps = plan.steps
+    aims = np.full((len(steps), AIM_SIZE), math.nan)
+    for k, step in enumerate(steps):
+        aims[k, :7] = (step.segment, *step.target, *step.velocity, step.leg.psi0, step.leg.zeta0)
+        if k + 1 < len(steps):
+            after = steps[k + 1]
+            aims[k, 7:] = (after.leg.psi0, after.leg.zeta0, after.target[1], *after.velocity)
+    return aims
+
+
+@kernel
+def start_trial(trial, aims, foot_x, foot_y, segment, xdot, ydot, seed, noise):
+    """Seed the generator and fill ``trial`` with touchdown 0: the foot at ``(foot_x, foot_y)`` on the
+    left side's ``segment``, the plan's first leg sent and realised with fresh draws."""
+    seed_trial(seed)
+    sent_psi0, sent_zeta0 = aims[0, 5], aims[0, 6]
+    psi0, zeta0 = commanded_controls(0, 0.0, sent_psi0, sent_zeta0, noise)
+    trial[X], trial[Y] = foot_x + zeta0 * math.cos(psi0), foot_y + zeta0 * math.sin(psi0)
+    trial[XDOT], trial[YDOT], trial[SIDE], trial[SEGMENT] = xdot, ydot, 0.0, segment
+    trial[PSI0], trial[ZETA0], trial[SENT_PSI0], trial[SENT_ZETA0] = psi0, zeta0, sent_psi0, sent_zeta0
+    trial[PITCH], trial[JUMP] = 0.0, 0.0
+
+
+@kernel
+def expected_leg(trial):
+    """The leg of this touchdown as the robot expects it realised: as sent, turned by the pitch."""
+    turn = trial[PITCH] if trial[SIDE] == 0.0 else -trial[PITCH]
+    return trial[SENT_PSI0] + turn, trial[SENT_ZETA0]
+
+
+@kernel
+def follow(trial, aims, row, goal, cap, may_replan, noise, model, sides, settings):
+    """Advance ``trial`` from its touchdown, which is the plan's ``row``, until the goal
+    (:data:`REACHED`), a failure (its code), ``cap`` jumps in all (:data:`CAPPED`) or, where
+    ``may_replan``, the robot off its plan (:data:`REPLAN`, before the lift-off's draws).
+    Returns ``(outcome, row)``, the plan's row of the touchdown ``trial`` holds."""
+    no_record = np.empty((0, STATE_SIZE))
+    while True:
+        if trial[Y] - trial[ZETA0] * math.sin(trial[PSI0]) >= goal:
+            return REACHED, row
+        if trial[JUMP] >= cap:
+            return CAPPED, row
+        side, segment = int(trial[SIDE]), int(trial[SEGMENT])
+        if row + 1 >= aims.shape[0]:  # the plan ends below the goal
+            if may_replan:
+                return REPLAN, row
+            found, psi0, zeta0 = OFF_PLAN, aims[row, 5], aims[row, 6]
+        else:
+            psi0_now, zeta0_now = expected_leg(trial)
+            found, psi0, zeta0 = place_leg(model, sides, trial[X], trial[Y], trial[XDOT], trial[YDOT], side, segment,
+                                           psi0_now, zeta0_now, aims[row + 1], settings)  # fmt: skip
+            if found != PLACED and may_replan:
+                return REPLAN, row
+        next_on_left = side == 1
+        turned = psi0 - (trial[PITCH] if next_on_left else -trial[PITCH])
+        sent_psi0 = min(max(turned, settings[PSI0_LOW]), settings[PSI0_HIGH])
+        k = int(trial[JUMP])
+        next_pitch = pitch_step(trial[PITCH], noise)
+        next_psi0, next_zeta0 = commanded_controls(k + 1, next_pitch, sent_psi0, zeta0, noise)
+        status, x, y, xdot, ydot, side, segment, _, _, _ = world_jump(
+            trial[X], trial[Y], trial[XDOT], trial[YDOT], side, segment, trial[PSI0], trial[ZETA0],
+            next_psi0, next_zeta0, model, sides, no_record,
+        )  # fmt: skip
+        if status != OK:
+            return status, row
+        if y < FLOOR_HEIGHT:
+            return FLOOR, row
+        mirror = 1.0 if side == 0 else -1.0  # the disturbance in the coming stance's frame, as MJTF's
+        flipped_xdot, ydot = disturbed_state(mirror * xdot, ydot, noise)
+        trial[X], trial[Y], trial[XDOT], trial[YDOT] = x, y, mirror * flipped_xdot, ydot
+        trial[SIDE], trial[SEGMENT], trial[PSI0], trial[ZETA0] = side, segment, next_psi0, next_zeta0
+        trial[SENT_PSI0], trial[SENT_ZETA0], trial[PITCH], trial[JUMP] = sent_psi0, zeta0, next_pitch, k + 1
+        row = min(row + 1, aims.shape[0] - 1)
+
+
+@dataclass(frozen=True)
+class FollowOutcome:
+    """One trial: ``reached`` the goal, else ``status`` (a failure's code, or 0 at the cap); the
+    jumps done, the replans made and the planner's seconds on them."""
+
+    reached: bool
+    status: int
+    jumps: int
+    replans: int
+    replan_seconds: float
+
+
+def follow_plan(
+    model: ModelParams,
+    world: World,
+    plan: Plan,
+    goal: float,
+    noise: NoiseModel,
+    seed: int,
+    *,
+    cap: int = 200,
+    settings: PlacementSettings | None = None,
+    sides: SideArrays | None = None,
+    max_replans: int = MAX_REPLANS,
+) -> FollowOutcome:
+    """One noisy trial of ``plan`` (from its touchdown 0 to a foot at ``goal`` [l0]) in ``world``,
+    the law's ``settings`` (defaults :class:`PlacementSettings`), replanning at most ``max_replans``
+    times."""
+    sides = pack(world, model.mu) if sides is None else sides
+    settings_array = (settings or PlacementSettings()).array()
+    record, noise_record = model.record(), noise.record()
+    first = plan.steps[0]
+    foot_x, foot_y = first.target
+    trial = np.empty(TRIAL_SIZE)
+    aims = plan_aims(plan)
+    start_trial(trial, aims, foot_x, foot_y, first.segment, *first.velocity, seed, noise_record)
+    row, replans, seconds = 0, 0, 0.0
+    while True:
+        outcome, row = follow(trial, aims, row, goal, cap, replans < max_replans, noise_record, record, sides,
+                              settings_array)  # fmt: skip
+        if outcome != REPLAN:
+            break
+        replans += 1
+        started = time.perf_counter()
+        touchdown = (trial[X:SIDE].copy(), int(trial[SIDE]), int(trial[SEGMENT]), expected_leg(trial))
+        fresh = replan(model, world, goal, touchdown, noise=noise, seed=seed)
+        seconds += time.perf_counter() - started
+        if fresh.reaches_goal and len(fresh.steps) > 1:
+            aims, row = plan_aims(fresh), 0
+        else:  # no way on from here: the law aims at what it had, without replanning again
+            replans = max_replans
+    jumps = int(trial[JUMP])
+    if outcome == REACHED:
+        return FollowOutcome(True, OK, jumps, replans, seconds)
+    return FollowOutcome(False, OK if outcome == CAPPED else int(outcome), jumps, replans, seconds)
