@@ -12,43 +12,21 @@ Usage: PYTHONPATH=. python scripts/placement_study.py [--worlds 10] [--trials 20
 from __future__ import annotations
 
 import argparse
-import math
-import time
 from collections import Counter
 
 import numpy as np
 
 from sim_core.control.laws.placement import PlacementSettings
-from sim_core.control.placement import place_leg
 from sim_core.model.failures import Failure
 from sim_core.model.noise import NoiseModel
 from sim_core.model.presets import get_preset
-from sim_core.planning.follow import follow_plan, plan_aims
+from sim_core.planning.follow import follow_plan, law_us_per_jump
 from sim_core.planning.planner import plan_climb
 from sim_core.robustness.world_trials import run_world_trials
 from sim_core.world.geometry import pack
 from sim_core.world.random_world import random_world
 
 START = (-1.0, 0.5)
-
-
-def law_us_per_jump(model, sides, plan, settings) -> float:
-    """The compiled law's CPU time per call [µs] on the plan's own touchdowns (best of 3)."""
-    aims, calls = plan_aims(plan), []
-    for k, step in enumerate(plan.steps[:-1]):
-        inward = 1.0 if step.side == 0 else -1.0
-        body = (step.target[0] + inward * step.leg.zeta0 * math.cos(step.leg.psi0),
-                step.target[1] + step.leg.zeta0 * math.sin(step.leg.psi0))  # fmt: skip
-        calls.append((*body, *step.velocity, step.side, step.segment, step.leg.psi0, step.leg.zeta0, aims[k + 1]))
-    record, best = model.record(), math.inf
-    for _ in range(3):
-        started, count = time.thread_time(), 0
-        while time.thread_time() - started < 0.05:
-            for call in calls:
-                place_leg(record, sides, *call, settings)
-                count += 1
-        best = min(best, (time.thread_time() - started) / count * 1e6)
-    return best
 
 
 def main() -> None:

@@ -28,6 +28,8 @@ from sim_core.world.geometry import pack
 from sim_core.world.stride import world_jump
 from sim_core.world.world import World
 
+REACHED = -1  # a trial's status when its foot reached the goal (beside OK at the cap and the failures)
+
 
 def run_world_trials(
     model: ModelParams,
@@ -38,24 +40,27 @@ def run_world_trials(
     cap: int,
     world: World,
     foot_y: float,
+    goal: float = math.inf,
 ) -> tuple[np.ndarray, np.ndarray]:
     """One trial per seed in ``world`` on all cores, touchdown 0 with velocity ``start`` and the
-    foot at ``foot_y`` [l0] under schedule row 0: ``(jumps completed, status)`` arrays."""
+    foot at ``foot_y`` [l0] under schedule row 0: ``(jumps completed, status)`` arrays; a trial
+    whose foot reaches ``goal`` [l0] ends there with status :data:`REACHED`."""
     velocity = check_section_state(start)
     foot_y = check_range("foot_y", foot_y)
     sides = pack(world, model.mu)
     foot_x, segment = start_foot(sides, foot_y)
     jumps = np.empty(seeds.size, dtype=np.int64)
     status = np.empty(seeds.size, dtype=np.int64)
-    world_trials_batch(np.array([foot_x, foot_y]), velocity, segment, schedule, seeds, cap, noise.record(),
-                       model.record(), sides, jumps, status)  # fmt: skip
+    world_trials_batch(np.array([foot_x, foot_y]), velocity, segment, schedule, seeds, cap, float(goal),
+                       noise.record(), model.record(), sides, jumps, status)  # fmt: skip
     return jumps, status
 
 
 @kernel
-def world_trial(foot, velocity, segment, schedule, seed, cap, noise, model, sides):
+def world_trial(foot, velocity, segment, schedule, seed, cap, goal, noise, model, sides):
     """One noisy climb from the foot of touchdown 0 (on the left side, ``segment``) and the body's
-    ``velocity`` there: ``(jumps completed, status of the failing jump or OK at the cap)``."""
+    ``velocity`` there: ``(jumps completed, status of the failing jump, OK at the cap or REACHED
+    at a foot at ``goal`` [l0] or higher)``."""
     seed_trial(seed)
     no_record = np.empty((0, STATE_SIZE))
     side = 0
@@ -65,6 +70,8 @@ def world_trial(foot, velocity, segment, schedule, seed, cap, noise, model, side
     x, y = foot[0] + zeta0 * math.cos(psi0), foot[1] + zeta0 * math.sin(psi0)
     xdot, ydot = velocity[0], velocity[1]
     for k in range(cap):
+        if y - zeta0 * math.sin(psi0) >= goal:
+            return k, REACHED
         next_pitch = pitch_step(pitch, noise)
         next_psi0, next_zeta0 = perturbed_controls(schedule, k + 1, next_pitch, math.nan, noise)
         status, x, y, xdot, ydot, side, segment, _, _, _ = world_jump(
@@ -82,7 +89,7 @@ def world_trial(foot, velocity, segment, schedule, seed, cap, noise, model, side
 
 
 @parallel_kernel
-def world_trials_batch(foot, velocity, segment, schedule, seeds, cap, noise, model, sides, jumps, status):
+def world_trials_batch(foot, velocity, segment, schedule, seeds, cap, goal, noise, model, sides, jumps, status):
     """:func:`world_trial` for each seed on all cores."""
     for i in prange(seeds.size):
-        jumps[i], status[i] = world_trial(foot, velocity, segment, schedule, seeds[i], cap, noise, model, sides)
+        jumps[i], status[i] = world_trial(foot, velocity, segment, schedule, seeds[i], cap, goal, noise, model, sides)
