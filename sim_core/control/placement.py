@@ -41,19 +41,19 @@ from sim_core._jit import kernel
 from sim_core.model.failures import FLOOR_HEIGHT, OK
 from sim_core.model.integrate import PSI, PSI_DOT, STATE_SIZE, ZETA_DOT
 from sim_core.model.stride import liftoff_velocity
-from sim_core.world.geometry import FLIGHT_TIME_CAP, first_crossing, side_x
-from sim_core.world.stride import foothold_stance, world_jump
+from sim_core.world.geometry import side_x
+from sim_core.world.stride import foothold_stance, world_flight, world_jump
 
 # The aim (what the plan says of touchdown k + 1): its segment on the other side, its foot [l0],
 # the body's velocity there [sqrt(g l0)] and its leg; then of touchdown k + 2: the leg that sets it
 # down, its foot's height and the body's velocity (NaN: the plan ends at k + 1)
 AIM_SEGMENT, AIM_X, AIM_Y, AIM_XDOT, AIM_YDOT, AIM_PSI0, AIM_ZETA0 = range(7)
-THEN_PSI0, THEN_ZETA0, THEN_Y, THEN_XDOT, THEN_YDOT = range(7, 12)
-AIM_SIZE = 12
+THEN_PSI0, THEN_ZETA0, THEN_Y, THEN_XDOT, THEN_YDOT, THEN_SEGMENT = range(7, 13)
+AIM_SIZE = 13
 # The settings: the leg's range [rad, l0], the margins [l0, rad] and the cost's scales
 PSI0_LOW, PSI0_HIGH, ZETA0_LOW, ZETA0_HIGH, END_MARGIN, CONE_MARGIN = range(6)
-POSITION_SCALE, VELOCITY_SCALE, PSI0_SCALE, ZETA0_SCALE, STANCE_SPREAD = range(6, 11)
-SETTINGS_SIZE = 11
+POSITION_SCALE, VELOCITY_SCALE, PSI0_SCALE, ZETA0_SCALE = range(6, 10)
+SETTINGS_SIZE = 10
 PSI0_GRID, ZETA0_GRID = 13, 9
 AHEAD = 12  # the best landings looked at one jump further
 NEWTON_STEPS, MAX_TURN = 6, 0.2  # the leg angle found from the tracked body: its steps, and how far [rad] it may be
@@ -62,11 +62,10 @@ OFF_PLAN, TIGHT, PLACED = 0, 1, 2  # what `found` says
 
 @kernel
 def place_leg(model, sides, x, y, xdot, ydot, side, segment, psi0, zeta0, aim, settings):
-    """The next leg for the foothold ``aim`` names, from touchdown ``k``: the body ``x, y, xdot,
-    ydot`` (wall coordinates) on ``side``'s ``segment``, touched down with ``(psi0, zeta0)`` as
-    the robot expects it realised (its command turned by the pitch it knew). Returns ``(found,
-    psi0, zeta0)``: ``found`` as :data:`PLACED`, :data:`TIGHT` or :data:`OFF_PLAN` (the module);
-    the angle in the landing side's stance frame, before any pitch correction."""
+    """The next leg for the foothold ``aim`` names, decided at touchdown ``k``: the body ``x, y,
+    xdot, ydot`` (wall coordinates) on ``side``'s ``segment``, touched down with ``(psi0, zeta0)``
+    as sent (the angle turned by the pitch it knew); the lift-off predicted on the model
+    (:func:`place_from_liftoff` takes it as tracked). Returns ``(found, psi0, zeta0)`` as there."""
     record = np.empty((0, STATE_SIZE))
     mirror = 1.0 if side == 0 else -1.0
     psi0 = leg_on_wall(sides, side, x, y, psi0, zeta0)
@@ -74,24 +73,19 @@ def place_leg(model, sides, x, y, xdot, ydot, side, segment, psi0, zeta0, aim, s
     status, _ = foothold_stance(mirror * xdot, ydot, psi0, zeta0, model, sides, side, segment, final, record)
     if status != OK:  # the stance under way fails: nothing chosen now changes that
         return OFF_PLAN, aim[AIM_PSI0], aim[AIM_ZETA0]
-    psi = final[PSI]
-    vx, vy = liftoff_velocity(psi, final[ZETA_DOT], final[PSI_DOT])
-    hip_x = mirror * x - zeta0 * math.cos(psi0) + math.cos(psi)  # the hip at lift-off, stance frame
-    hip_y = y - zeta0 * math.sin(psi0) + math.sin(psi)
-    # The stance's length is the robot's guess (its noise unseen): lift-offs from either end of its spread
-    spread = np.empty((2, 4))
-    spread_count = 0
-    for sign in (-1.0, 1.0):
-        length = zeta0 + sign * settings[STANCE_SPREAD]
-        if settings[STANCE_SPREAD] > 0.0 and 0.0 < length < 1.0:
-            angle = leg_on_wall(sides, side, x, y, psi0, length)
-            status, _ = foothold_stance(mirror * xdot, ydot, angle, length, model, sides, side, segment, final, record)
-            if status == OK:
-                spread[spread_count, 2], spread[spread_count, 3] = liftoff_velocity(final[PSI], final[ZETA_DOT],
-                                                                                    final[PSI_DOT])  # fmt: skip
-                spread[spread_count, 0] = mirror * x - length * math.cos(angle) + math.cos(final[PSI])
-                spread[spread_count, 1] = y - length * math.sin(angle) + math.sin(final[PSI])
-                spread_count += 1
+    vx, vy = liftoff_velocity(final[PSI], final[ZETA_DOT], final[PSI_DOT])
+    hip_x = x - mirror * zeta0 * math.cos(psi0) + mirror * math.cos(final[PSI])
+    hip_y = y - zeta0 * math.sin(psi0) + math.sin(final[PSI])
+    return place_from_liftoff(model, sides, side, hip_x, hip_y, mirror * vx, vy, aim, settings)
+
+
+@kernel
+def place_from_liftoff(model, sides, side, x, y, xdot, ydot, aim, settings):
+    """The next leg for the foothold ``aim`` names, decided at lift-off off ``side``: the body at
+    ``x, y`` with velocity ``xdot, ydot`` (wall coordinates, tracked). Returns ``(found, psi0,
+    zeta0)``: ``found`` as :data:`PLACED`, :data:`TIGHT` or :data:`OFF_PLAN` (the module); the
+    angle in the landing side's stance frame, before any pitch correction."""
+    record = np.empty((0, STATE_SIZE))
     other, target = 1 - side, int(aim[AIM_SEGMENT])
     beta = sides.beta[other, target + 1]
     half = math.atan(sides.friction[other, target + 1])
@@ -112,33 +106,20 @@ def place_leg(model, sides, x, y, xdot, ydot, side, segment, psi0, zeta0, aim, s
         legs[i, 0] = psi0_low + (i // ZETA0_GRID) * psi0_step
         legs[i, 1] = zeta0_low + (i % ZETA0_GRID) * zeta0_step
     legs[grid - 1, 0], legs[grid - 1, 1] = aim[AIM_PSI0], aim[AIM_ZETA0]  # the plan's own leg, where it lands
-    _score(
-        legs,
-        costs,
-        sides,
-        other,
-        target,
-        mirror,
-        hip_x,
-        hip_y,
-        vx,
-        vy,
-        beta,
-        half,
-        cone_margin,
-        aim,
-        settings,
-        spread[:spread_count],
-    )
+    liftoff = (x, y, xdot, ydot)
+    for i in range(grid):
+        if _margin(sides, side, liftoff, target, legs[i, 0], legs[i, 1], beta, half, cone_margin, settings) >= 1.0:
+            costs[i] = _landing_cost(sides, side, liftoff, legs[i, 0], legs[i, 1], aim, settings)
     # The best by the landing alone, looked at one jump further: the jump each sets off, with the
-    # plan's following leg, must complete (the guard), and where it lands is costed too
+    # plan's following leg, must reach the plan's next foothold with the margins (the guard), and
+    # where it lands is costed too
     best, best_cost = -1, math.inf
     for _ in range(AHEAD):
         candidate = int(np.argmin(costs))
         if not math.isfinite(costs[candidate]):
             break
-        ahead = _ahead_cost(model, sides, side, mirror, hip_x, hip_y, vx, vy, legs[candidate, 0], legs[candidate, 1],
-                            aim, settings, record)  # fmt: skip
+        ahead = _ahead_cost(model, sides, side, liftoff, legs[candidate, 0], legs[candidate, 1], aim, settings,
+                            record)  # fmt: skip
         if costs[candidate] + ahead < best_cost:
             best, best_cost = candidate, costs[candidate] + ahead
         costs[candidate] = math.inf
@@ -147,19 +128,17 @@ def place_leg(model, sides, x, y, xdot, ydot, side, segment, psi0, zeta0, aim, s
     # No good leg the guard passes: the plan's own if it lands on the target and goes on, else the
     # widest margin that lands there
     plan_psi0, plan_zeta0 = aim[AIM_PSI0], aim[AIM_ZETA0]
-    on_target = _margin(sides, other, target, mirror, hip_x, hip_y, vx, vy, plan_psi0, plan_zeta0, beta, half,
-                        cone_margin, settings) > 0.0  # fmt: skip
+    on_target = _margin(sides, side, liftoff, target, plan_psi0, plan_zeta0, beta, half, cone_margin, settings) > 0.0
     if on_target and math.isfinite(
-        _ahead_cost(model, sides, side, mirror, hip_x, hip_y, vx, vy, plan_psi0, plan_zeta0, aim, settings, record)
+        _ahead_cost(model, sides, side, liftoff, plan_psi0, plan_zeta0, aim, settings, record)
     ):
         return TIGHT, plan_psi0, plan_zeta0
     best_margin, widest = -math.inf, -1
     for i in range(grid):
-        margin = _margin(sides, other, target, mirror, hip_x, hip_y, vx, vy, legs[i, 0], legs[i, 1], beta, half,
-                         cone_margin, settings)  # fmt: skip
+        margin = _margin(sides, side, liftoff, target, legs[i, 0], legs[i, 1], beta, half, cone_margin, settings)
         if margin > best_margin:
             best_margin, widest = margin, i
-    if widest < 0:
+    if widest < 0 or best_margin == -math.inf:
         return OFF_PLAN, plan_psi0, plan_zeta0
     return TIGHT, legs[widest, 0], legs[widest, 1]
 
@@ -167,9 +146,10 @@ def place_leg(model, sides, x, y, xdot, ydot, side, segment, psi0, zeta0, aim, s
 @kernel
 def leg_on_wall(sides, side, x, y, psi0, zeta0):
     """The leg angle [rad] that puts the foot of a body at ``(x, y)`` (tracked) on ``side``'s
-    polyline with the leg at ``zeta0``, found from ``psi0`` (the angle as sent, turned by the pitch):
-    the foot is on the wall, so the body's place tells the angle the noise gave the leg. Newton's
-    steps; ``psi0`` itself where they do not settle."""
+    polyline with the leg at ``zeta0``, found from ``psi0`` (the angle as sent, turned by the pitch)
+    by Newton's steps — the root nearest it, where a kinked side has two; ``psi0`` itself where
+    they do not settle within ``MAX_TURN``. The foot is on the wall, so the body's place tells the
+    angle the noise gave the leg (for the length sent: its own noise stays unseen)."""
     mirror = 1.0 if side == 0 else -1.0
     step, angle = 1e-7, psi0
     for _ in range(NEWTON_STEPS):
@@ -193,22 +173,6 @@ def _off_wall(sides, side, mirror, x, y, psi0, zeta0):
 
 
 @kernel
-def _landing(sides, other, mirror, hip_x, hip_y, vx, vy, psi0, zeta0):
-    """Where the coming leg ``(psi0, zeta0)`` lands from lift-off (the hip at ``hip_x, hip_y`` in
-    the stance frame, velocity ``vx, vy``): ``(segment, foot_y, body_y, xdot, ydot, t)``, the
-    velocity in the stance frame; segment ``-2`` if it lands nowhere."""
-    next_x = hip_x + zeta0 * math.cos(psi0)  # the coming foot, held at its angle toward the other side
-    next_y = hip_y - zeta0 * math.sin(psi0)
-    if vx <= 0.0 or next_x >= mirror * side_x(sides, other, next_y):
-        return -2, math.nan, math.nan, math.nan, math.nan, math.nan
-    t, landing = first_crossing(sides, other, mirror, next_x, next_y, vx, vy)
-    if not t <= FLIGHT_TIME_CAP:
-        return -2, math.nan, math.nan, math.nan, math.nan, math.nan
-    landed_y = next_y + (vy - 0.5 * t) * t
-    return landing, landed_y, landed_y + zeta0 * math.sin(psi0), vx, vy - t, t
-
-
-@kernel
 def _end_margin(sides, other, segment, foot_y):
     """How far along ``segment`` [l0] ``foot_y`` lies from its nearer end, and the most that can
     be asked on it (a quarter of its length); the continuations are open on their far side."""
@@ -224,48 +188,25 @@ def _end_margin(sides, other, segment, foot_y):
 
 
 @kernel
-def _margin(sides, other, target, mirror, hip_x, hip_y, vx, vy, psi0, zeta0, beta, half, cone_margin, settings):
-    """A landing's margin on the target in units of what is asked (>= 1: good); -inf off it."""
-    segment, landed_y, body_y, _, _, _ = _landing(sides, other, mirror, hip_x, hip_y, vx, vy, psi0, zeta0)
-    if segment != target or body_y < FLOOR_HEIGHT:
+def _margin(sides, side, liftoff, target, psi0, zeta0, beta, half, cone_margin, settings):
+    """A landing's margin on the target in units of what is asked (>= 1: good); -inf off it or
+    below the floor."""
+    status, _, body_y, _, _, segment, _ = world_flight(*liftoff, side, psi0, zeta0, sides)
+    if status != OK or segment != target or body_y < FLOOR_HEIGHT:
         return -math.inf
-    along, most = _end_margin(sides, other, segment, landed_y)
-    end_margin = min(settings[END_MARGIN], most)
-    return min(along / end_margin, (half - abs(psi0 - beta)) / cone_margin)
+    along, most = _end_margin(sides, 1 - side, segment, body_y - zeta0 * math.sin(psi0))
+    return min(along / min(settings[END_MARGIN], most), (half - abs(psi0 - beta)) / cone_margin)
 
 
 @kernel
-def _score(legs, costs, sides, other, target, mirror, hip_x, hip_y, vx, vy, beta, half, cone_margin, aim, settings,
-           spread):  # fmt: skip
-    """Each good leg's cost by its landing into ``costs`` (inf for the others); from the ``spread``
-    lift-offs (rows ``hip_x, hip_y, vx, vy``) a good leg lands on the target too."""
-    for i in range(legs.shape[0]):
-        psi0, zeta0 = legs[i, 0], legs[i, 1]
-        segment, landed_y, body_y, land_vx, land_vy, _ = _landing(sides, other, mirror, hip_x, hip_y, vx, vy,
-                                                                   psi0, zeta0)  # fmt: skip
-        if segment != target or body_y < FLOOR_HEIGHT:
-            continue
-        along, most = _end_margin(sides, other, segment, landed_y)
-        if along < min(settings[END_MARGIN], most) or half - abs(psi0 - beta) < cone_margin:
-            continue
-        if not _lands_from_all(sides, other, target, mirror, spread, psi0, zeta0):
-            continue
-        costs[i] = (
-            _miss(settings, landed_y, mirror * land_vx, land_vy, aim[AIM_Y], aim[AIM_XDOT], aim[AIM_YDOT])
-            + ((psi0 - aim[AIM_PSI0]) / settings[PSI0_SCALE]) ** 2
-            + ((zeta0 - aim[AIM_ZETA0]) / settings[ZETA0_SCALE]) ** 2
-        )
-
-
-@kernel
-def _lands_from_all(sides, other, target, mirror, spread, psi0, zeta0):
-    """Whether the leg lands on ``target`` above the floor from every lift-off of ``spread``."""
-    for row in range(spread.shape[0]):
-        segment, _, body_y, _, _, _ = _landing(sides, other, mirror, spread[row, 0], spread[row, 1], spread[row, 2],
-                                               spread[row, 3], psi0, zeta0)  # fmt: skip
-        if segment != target or body_y < FLOOR_HEIGHT:
-            return False
-    return True
+def _landing_cost(sides, side, liftoff, psi0, zeta0, aim, settings):
+    """A landing's cost against the plan's touchdown ``k + 1`` (its foot, velocity and leg)."""
+    _, _, body_y, xdot, ydot, _, _ = world_flight(*liftoff, side, psi0, zeta0, sides)
+    return (
+        _miss(settings, body_y - zeta0 * math.sin(psi0), xdot, ydot, aim[AIM_Y], aim[AIM_XDOT], aim[AIM_YDOT])
+        + ((psi0 - aim[AIM_PSI0]) / settings[PSI0_SCALE]) ** 2
+        + ((zeta0 - aim[AIM_ZETA0]) / settings[ZETA0_SCALE]) ** 2
+    )
 
 
 @kernel
@@ -279,20 +220,24 @@ def _miss(settings, foot_y, xdot, ydot, aim_y, aim_xdot, aim_ydot):
 
 
 @kernel
-def _ahead_cost(model, sides, side, mirror, hip_x, hip_y, vx, vy, psi0, zeta0, aim, settings, record):
+def _ahead_cost(model, sides, side, liftoff, psi0, zeta0, aim, settings, record):
     """The jump after a landing with ``(psi0, zeta0)``, with the plan's following leg, on the
-    model: how far its touchdown is from the plan's (:func:`_miss`); inf if it fails (the guard);
-    0 where the plan ends at the landing (a NaN following leg)."""
-    segment, _, body_y, _, land_vy, t = _landing(sides, 1 - side, mirror, hip_x, hip_y, vx, vy, psi0, zeta0)
+    model: how far its touchdown is from the plan's (:func:`_miss`); inf if it fails, misses the
+    plan's next foothold or lands there without the margins (the guard); 0 where the plan ends at
+    the landing (a NaN following leg)."""
     then_psi0, then_zeta0 = aim[THEN_PSI0], aim[THEN_ZETA0]
     if math.isnan(then_psi0):  # the plan ends at this touchdown: nothing after it to guard
         return 0.0
-    status, _, y, xdot, ydot, _, _, _, _, _ = world_jump(
-        mirror * (hip_x + vx * t), body_y, mirror * vx, land_vy, 1 - side, segment, psi0, zeta0,
-        then_psi0, then_zeta0, model, sides, record,
-    )  # fmt: skip
-    if status != OK or y < FLOOR_HEIGHT:
-        return math.inf
-    return _miss(
-        settings, y - then_zeta0 * math.sin(then_psi0), xdot, ydot, aim[THEN_Y], aim[THEN_XDOT], aim[THEN_YDOT]
+    _, x, y, xdot, ydot, segment, _ = world_flight(*liftoff, side, psi0, zeta0, sides)
+    status, _, y, xdot, ydot, _, landing, _, _, _ = world_jump(
+        x, y, xdot, ydot, 1 - side, segment, psi0, zeta0, then_psi0, then_zeta0, model, sides, record
     )
+    if status != OK or y < FLOOR_HEIGHT or landing != aim[THEN_SEGMENT]:
+        return math.inf
+    foot_y = y - then_zeta0 * math.sin(then_psi0)
+    along, most = _end_margin(sides, side, landing, foot_y)
+    half = math.atan(sides.friction[side, landing + 1])
+    cone = half - abs(then_psi0 - sides.beta[side, landing + 1])
+    if along < min(settings[END_MARGIN], most) or cone < min(settings[CONE_MARGIN], 0.5 * half):
+        return math.inf  # the plan's next foothold reached, but without the margins the law keeps
+    return _miss(settings, foot_y, xdot, ydot, aim[THEN_Y], aim[THEN_XDOT], aim[THEN_YDOT])

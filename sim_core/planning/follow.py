@@ -28,21 +28,24 @@ import numpy as np
 
 from sim_core._jit import kernel
 from sim_core.control.laws.placement import PlacementSettings
-from sim_core.control.placement import AIM_SIZE, OFF_PLAN, PLACED, PSI0_HIGH, PSI0_LOW, place_leg
+from sim_core.control.placement import AIM_SIZE, OFF_PLAN, PLACED, PSI0_HIGH, PSI0_LOW, place_from_liftoff, place_leg
 from sim_core.model.failures import FLOOR, FLOOR_HEIGHT, OK
-from sim_core.model.integrate import STATE_SIZE
+from sim_core.model.integrate import PSI, PSI_DOT, STATE_SIZE, ZETA_DOT
 from sim_core.model.noise import NoiseModel
 from sim_core.model.noise_rules import commanded_controls, disturbed_state, pitch_step, seed_trial
 from sim_core.model.params import ModelParams
+from sim_core.model.stride import liftoff_velocity
 from sim_core.planning.planner import Plan, replan
 from sim_core.world.geometry import SideArrays, pack
-from sim_core.world.stride import world_jump
+from sim_core.world.stride import foothold_stance, world_flight
 from sim_core.world.world import World
 
 # A trial's state at a touchdown (one float array, in and out of the compiled loop): the body, its
-# side and segment, the leg as realised (the physics') and as sent (the law's), the pitch, the jump
+# side and segment, the leg as realised (the physics') and as sent (the law's), the pitch, the jump,
+# and the lift-off that follows once the stance has run
 X, Y, XDOT, YDOT, SIDE, SEGMENT, PSI0, ZETA0, SENT_PSI0, SENT_ZETA0, PITCH, JUMP = range(12)
-TRIAL_SIZE = 12
+LIFT_X, LIFT_Y, LIFT_XDOT, LIFT_YDOT = range(12, 16)  # the lift-off under way, tracked (wall coordinates)
+TRIAL_SIZE = 16
 REACHED, CAPPED, REPLAN = -1, -2, -3  # how the loop stops, beside a failure's code
 MAX_REPLANS = 3  # a trial's replans at most; then the law's best leg goes out, on plan or not
 
@@ -57,7 +60,7 @@ def plan_aims(plan: Plan) -> np.ndarray:
         aims[k, :7] = (step.segment, *step.target, *step.velocity, step.leg.psi0, step.leg.zeta0)
         if k + 1 < len(steps):
             after = steps[k + 1]
-            aims[k, 7:] = (after.leg.psi0, after.leg.zeta0, after.target[1], *after.velocity)
+            aims[k, 7:] = (after.leg.psi0, after.leg.zeta0, after.target[1], *after.velocity, after.segment)
     return aims
 
 
@@ -85,23 +88,33 @@ def expected_leg(trial):
 def follow(trial, aims, row, goal, cap, may_replan, noise, model, sides, settings):
     """Advance ``trial`` from its touchdown, which is the plan's ``row``, until the goal
     (:data:`REACHED`), a failure (its code), ``cap`` jumps in all (:data:`CAPPED`) or, where
-    ``may_replan``, the robot off its plan (:data:`REPLAN`, before the lift-off's draws).
-    Returns ``(outcome, row)``, the plan's row of the touchdown ``trial`` holds."""
+    ``may_replan``, the robot off its plan at a lift-off (:data:`REPLAN`, before that lift-off's
+    draws; the lift-off in ``trial``). Returns ``(outcome, row)``, the plan's row of the touchdown
+    ``trial`` holds."""
     no_record = np.empty((0, STATE_SIZE))
+    final = np.empty(STATE_SIZE)
     while True:
         if trial[Y] - trial[ZETA0] * math.sin(trial[PSI0]) >= goal:
             return REACHED, row
         if trial[JUMP] >= cap:
             return CAPPED, row
         side, segment = int(trial[SIDE]), int(trial[SEGMENT])
+        mirror = 1.0 if side == 0 else -1.0
+        status, _ = foothold_stance(mirror * trial[XDOT], trial[YDOT], trial[PSI0], trial[ZETA0], model, sides, side,
+                                    segment, final, no_record)  # fmt: skip
+        if status != OK:
+            return status, row
+        vx, vy = liftoff_velocity(final[PSI], final[ZETA_DOT], final[PSI_DOT])
+        trial[LIFT_X] = trial[X] - mirror * (trial[ZETA0] * math.cos(trial[PSI0]) - math.cos(final[PSI]))
+        trial[LIFT_Y] = trial[Y] - trial[ZETA0] * math.sin(trial[PSI0]) + math.sin(final[PSI])
+        trial[LIFT_XDOT], trial[LIFT_YDOT] = mirror * vx, vy
         if row + 1 >= aims.shape[0]:  # the plan ends below the goal
             if may_replan:
                 return REPLAN, row
             found, psi0, zeta0 = OFF_PLAN, aims[row, 5], aims[row, 6]
         else:
-            psi0_now, zeta0_now = expected_leg(trial)
-            found, psi0, zeta0 = place_leg(model, sides, trial[X], trial[Y], trial[XDOT], trial[YDOT], side, segment,
-                                           psi0_now, zeta0_now, aims[row + 1], settings)  # fmt: skip
+            liftoff = trial[LIFT_X], trial[LIFT_Y], trial[LIFT_XDOT], trial[LIFT_YDOT]
+            found, psi0, zeta0 = place_from_liftoff(model, sides, side, *liftoff, aims[row + 1], settings)
             if found != PLACED and may_replan:
                 return REPLAN, row
         next_on_left = side == 1
@@ -110,14 +123,14 @@ def follow(trial, aims, row, goal, cap, may_replan, noise, model, sides, setting
         k = int(trial[JUMP])
         next_pitch = pitch_step(trial[PITCH], noise)
         next_psi0, next_zeta0 = commanded_controls(k + 1, next_pitch, sent_psi0, zeta0, noise)
-        status, x, y, xdot, ydot, side, segment, _, _, _ = world_jump(
-            trial[X], trial[Y], trial[XDOT], trial[YDOT], side, segment, trial[PSI0], trial[ZETA0],
-            next_psi0, next_zeta0, model, sides, no_record,
-        )  # fmt: skip
+        status, x, y, xdot, ydot, segment, _ = world_flight(
+            trial[LIFT_X], trial[LIFT_Y], trial[LIFT_XDOT], trial[LIFT_YDOT], side, next_psi0, next_zeta0, sides
+        )
         if status != OK:
             return status, row
         if y < FLOOR_HEIGHT:
             return FLOOR, row
+        side = 1 - side
         mirror = 1.0 if side == 0 else -1.0  # the disturbance in the coming stance's frame, as MJTF's
         flipped_xdot, ydot = disturbed_state(mirror * xdot, ydot, noise)
         trial[X], trial[Y], trial[XDOT], trial[YDOT] = x, y, mirror * flipped_xdot, ydot
@@ -171,7 +184,8 @@ def follow_plan(
         replans += 1
         started = time.perf_counter()
         touchdown = (trial[X:SIDE].copy(), int(trial[SIDE]), int(trial[SEGMENT]), expected_leg(trial))
-        fresh = replan(model, world, goal, touchdown, noise=noise, seed=seed)
+        fresh = replan(model, world, goal, touchdown, liftoff=tuple(trial[LIFT_X:LIFT_YDOT + 1]), noise=noise,
+                       seed=seed)  # fmt: skip
         seconds += time.perf_counter() - started
         if fresh.reaches_goal and len(fresh.steps) > 1:
             aims, row = plan_aims(fresh), 0

@@ -43,7 +43,7 @@ from sim_core.model.params import ModelParams
 from sim_core.model.validation import check_range
 from sim_core.world.climb import first_touchdown
 from sim_core.world.geometry import pack
-from sim_core.world.stride import world_orbit_batch
+from sim_core.world.stride import world_flight, world_orbit_batch
 from sim_core.world.world import SIDES, World
 
 PSI0_DEG = np.arange(15.0, 45.01, 2.5)  # the next leg's angles tried [deg]
@@ -143,20 +143,56 @@ def check_goal(world: World, goal: float, foot_y: float, *, name: str | None = N
     return goal, foot_y
 
 
-def replan(model: ModelParams, world: World, goal: float, touchdown, *, noise: NoiseModel | None = None,
+def replan(model: ModelParams, world: World, goal: float, touchdown, *, liftoff=None, noise: NoiseModel | None = None,
            samples: int = SAMPLES, beam: int = BEAM, max_jumps: int = MAX_JUMPS, seed: int = 0) -> Plan:  # fmt: skip
     """The most robust plan from a touchdown under way to a foot at ``goal`` [l0]: ``touchdown`` is
     ``(row, side, segment, leg)``, the body's ``x, y, xdot, ydot`` there (wall coordinates), its
-    side and segment, and the leg ``(psi0, zeta0)`` [rad, l0] it stands on. The plan's row 0 is
-    this touchdown (its ``jump`` 0)."""
+    side and segment, and the leg ``(psi0, zeta0)`` [rad, l0] it stands on; ``liftoff``: the
+    lift-off that stance ends in, tracked (``x, y, xdot, ydot``), where known — then the first
+    jump is planned from it. The plan's row 0 is this touchdown (its ``jump`` 0)."""
     started = time.perf_counter()
+    noise = NoiseModel() if noise is None else noise
     row, side, segment, leg = touchdown
     row, leg = np.asarray(row, dtype=float), (float(leg[0]), float(leg[1]))
     node = _Node(row, int(side), int(segment), leg, 0.0, ((row, int(side), int(segment), leg),))
     foot = node.foot()
     if goal <= foot:
         return _plan(node.path, True, 0.0, foot, started)
-    return _best_plan(model, world, goal, [node], foot, noise, samples, beam, max_jumps, seed, started)
+    if liftoff is None:
+        return _best_plan(model, world, goal, [node], foot, noise, samples, beam, max_jumps, seed, started)
+    sides = pack(world, model.mu)
+    children = _flights(sides, node, tuple(float(v) for v in liftoff), _draws(noise, samples, seed),
+                        PlacementSettings())  # fmt: skip
+    if not children:
+        return _plan(node.path, False, -math.inf, foot, started)
+    return _best_plan(model, world, goal, _keep(children, beam), foot, noise, samples, beam, max_jumps - 1, seed,
+                      started)  # fmt: skip
+
+
+def _flights(sides, node, liftoff, draws, settings) -> list[_Node]:
+    """``node``'s children from its lift-off, tracked: each leg's flight, nominal and under the
+    draws of the coming leg's noise (the stance is over: its noise is seen)."""
+    children = []
+    for leg in LEGS:
+        landings = []
+        for draw in draws:
+            coming = np.clip(leg + draw[:2], [1e-3, 1e-3], [0.5 * math.pi - 1e-3, 1.0 - 1e-3])
+            status, x, y, xdot, ydot, segment, _ = world_flight(*liftoff, node.side, coming[0], coming[1], sides)
+            landings.append((status, np.array([x, y, xdot, ydot]), segment, coming))
+        status, landed, segment, _ = landings[0]
+        other = 1 - node.side
+        if status != OK or landed[1] < FLOOR_HEIGHT or not _in_cone(sides, other, segment, leg[0]):
+            continue
+        foot = landed[1] - leg[1] * math.sin(leg[0])
+        if not _with_margins(sides, np.array([other]), np.array([segment]), np.array([foot]), np.array([leg[0]]),
+                             settings)[0]:  # fmt: skip
+            continue
+        held = [s == OK and row[1] >= FLOOR_HEIGHT and seg == segment and _in_cone(sides, other, seg, c[0])
+                for s, row, seg, c in landings[1:]]  # fmt: skip
+        chance = float(np.mean(held)) if held else 1.0
+        step = (landed, other, int(segment), (float(leg[0]), float(leg[1])))
+        children.append(_Node(*step, node.score + math.log(max(chance, FLOOR_OF_CHANCE)), (*node.path, step)))
+    return children
 
 
 def _best_plan(model, world, goal, nodes, foot_y, noise, samples, beam, max_jumps, seed, started) -> Plan:
@@ -172,7 +208,11 @@ def _search(model, world, goal, nodes, foot_y, noise, samples, beam, max_jumps, 
     legs = LEGS
     draws = _draws(noise, samples, seed)
     sides = pack(world, model.mu)
-    highest, best_path = foot_y, nodes[0].path
+    highest, best_path = max(foot_y, max(node.foot() for node in nodes)), max(nodes, key=_Node.foot).path
+    arrived = [node for node in nodes if len(node.path) > 1 and node.foot() >= goal]  # a replan's first flights
+    if arrived:
+        chosen = max(arrived, key=lambda node: (node.score, node.foot()))
+        return _plan(chosen.path, True, chosen.score, highest, started)
     for _ in range(max_jumps):
         children = _expand(model, sides, legs, draws, nodes, PlacementSettings())
         if not children:

@@ -64,19 +64,36 @@ def world_jump(x, y, xdot, ydot, side, segment, psi0, zeta0, next_psi0, next_zet
         return status, nan, nan, nan, nan, side, segment, stance_time, nan, rows
     psi = final[PSI]
     vx, vy = liftoff_velocity(psi, final[ZETA_DOT], final[PSI_DOT])
-    # The next leg's foot at lift-off, held at its touchdown angle toward the other side
-    next_x = foot_x + math.cos(psi) + next_zeta0 * math.cos(next_psi0)
-    next_y = foot_y + math.sin(psi) - next_zeta0 * math.sin(next_psi0)
+    hip_x, hip_y = mirror * (foot_x + math.cos(psi)), foot_y + math.sin(psi)
+    status, x, y, xdot, ydot, landing, flight_time = world_flight(
+        hip_x, hip_y, mirror * vx, vy, side, next_psi0, next_zeta0, sides
+    )
+    if status != OK:
+        return status, nan, nan, nan, nan, side, segment, stance_time, nan, rows
+    return OK, x, y, xdot, ydot, 1 - side, landing, stance_time, flight_time, rows
+
+
+@kernel
+def world_flight(x, y, xdot, ydot, side, next_psi0, next_zeta0, sides):
+    """The flight from a lift-off off ``side`` (the body at ``x, y`` with velocity ``xdot, ydot``,
+    wall coordinates) until the next leg's foot, held at ``(next_psi0, next_zeta0)`` toward the other
+    side, first reaches it: ``(status, x, y, xdot, ydot, segment, flight_time)`` of that touchdown
+    (:data:`NO_FLIGHT`: the foot starts past the other side or the body flies back;
+    :data:`NO_TOUCHDOWN`: no side within the flight's cap; NaNs then)."""
+    nan = math.nan
+    mirror = 1.0 if side == 0 else -1.0
+    vx = mirror * xdot
+    next_x = mirror * x + next_zeta0 * math.cos(next_psi0)  # the next leg's foot, in the stance frame
+    next_y = y - next_zeta0 * math.sin(next_psi0)
     other = 1 - side
     if vx <= 0.0 or next_x >= mirror * side_x(sides, other, next_y):
-        return NO_FLIGHT, nan, nan, nan, nan, side, segment, stance_time, nan, rows
-    flight_time, landing = first_crossing(sides, other, mirror, next_x, next_y, vx, vy)
+        return NO_FLIGHT, nan, nan, nan, nan, -2, nan
+    flight_time, landing = first_crossing(sides, other, mirror, next_x, next_y, vx, ydot)
     if not flight_time <= FLIGHT_TIME_CAP:
-        return NO_TOUCHDOWN, nan, nan, nan, nan, side, segment, stance_time, nan, rows
+        return NO_TOUCHDOWN, nan, nan, nan, nan, -2, nan
     touch_x = next_x + vx * flight_time - next_zeta0 * math.cos(next_psi0)
-    touch_y = next_y + (vy - 0.5 * flight_time) * flight_time + next_zeta0 * math.sin(next_psi0)
-    return (OK, mirror * touch_x, touch_y, mirror * vx, vy - flight_time, other, landing,
-            stance_time, flight_time, rows)  # fmt: skip
+    touch_y = next_y + (ydot - 0.5 * flight_time) * flight_time + next_zeta0 * math.sin(next_psi0)
+    return OK, mirror * touch_x, touch_y, xdot, ydot - flight_time, landing, flight_time
 
 
 @kernel

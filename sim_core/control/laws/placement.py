@@ -20,9 +20,7 @@ class PlacementSettings:
     body, the margins a landing keeps — ``end_margin`` [l0] along the foothold from either end (a
     quarter of a shorter foothold), ``cone_margin_deg`` inside its friction cone (half the cone's
     at most) — and the cost's scales: how far from the aimed foot [l0], velocity [sqrt(g l0)],
-    angle [deg] and length [l0] weigh alike. ``stance_spread`` [l0]: how far the length of the leg
-    stood on may be from the one sent (its noise, which the tracker cannot see): a good landing
-    holds from either end of it."""
+    angle [deg] and length [l0] weigh alike."""
 
     zeta0_range: tuple[float, float] = (HeightController.zeta0_min, 0.96)
     psi0_range_deg: tuple[float, float] = PSI0_RANGE_DEG
@@ -32,7 +30,6 @@ class PlacementSettings:
     velocity_scale: float = 0.1
     psi0_scale_deg: float = 10.0
     zeta0_scale: float = 0.1
-    stance_spread: float = 0.0  # [l0]: two of the default noise's zeta0 sigmas
 
     def __post_init__(self) -> None:
         check_interval("zeta0_range", self.zeta0_range, 1.0)
@@ -41,12 +38,11 @@ class PlacementSettings:
         check_range("cone_margin_deg", self.cone_margin_deg, 0.0, 45.0)
         for field in ("position_scale", "velocity_scale", "psi0_scale_deg", "zeta0_scale"):
             check_range(field, getattr(self, field), 0.0, 1e3)
-        check_range("stance_spread", self.stance_spread, 0.0, 0.2, low_open=False)
 
     def array(self) -> np.ndarray:
         """The kernel's settings (:mod:`sim_core.control.placement`'s layout), angles in rad."""
         return np.array([
             *(math.radians(value) for value in self.psi0_range_deg), *self.zeta0_range, self.end_margin,
             math.radians(self.cone_margin_deg), self.position_scale, self.velocity_scale,
-            math.radians(self.psi0_scale_deg), self.zeta0_scale, self.stance_spread,
+            math.radians(self.psi0_scale_deg), self.zeta0_scale,
         ])  # fmt: skip
