@@ -1,34 +1,34 @@
 """The foot-placement law: the next leg's ``psi0`` and ``zeta0`` chosen so that its foot lands on
 the foothold a plan names, with a margin from the foothold's ends and inside its friction cone
-(docs/model.md §8; docs/analyses.md, "Foot placement").
+(docs/model.md §8; docs/worlds.md, "Following a plan").
 
-At touchdown ``k`` the robot knows its body (tracked: ``x, y, xdot, ydot`` in wall coordinates),
-the foothold it stands on and the leg it sent. The foot is on the wall, so the body's place tells
-the leg's angle as the noise made it (:func:`leg_on_wall`, for the length sent); the model then
-fixes the stance under way and its lift-off, and the flight after it is a parabola: where the
-coming foot first meets the other side is a quadratic per segment
-(:func:`sim_core.world.geometry.first_crossing`). The law tries a grid of next legs — the angles
-inside the target foothold's cone, the lengths over the leg's range — and the plan's own leg. A
-candidate is *good* if its foot lands on the target segment at least ``end_margin`` [l0] along it
-from either end (a quarter of a short foothold at most), its angle at least ``cone_margin``
-[rad] inside the cone (half the cone at most), the body above the floor, and (``stance_spread``
-> 0) it lands on the target from either end of the stance length's spread too. Good candidates
-are costed by
+The legs may be chosen up to lift-off (docs/model.md §2.1), and the law decides there
+(:func:`place_from_liftoff`): the tracker sees the body leave the wall, so what the stance made of
+the leg's noise is known, and the flight after it is a parabola — where the coming foot first
+meets the other side is a quadratic per segment (:func:`sim_core.world.stride.world_flight`).
+(:func:`place_leg` decides at touchdown instead: it reads the leg's angle off the tracked body —
+the foot is on the wall, :func:`leg_on_wall` — and predicts the stance on the model; the length's
+noise stays unseen there, and measured, that alone halves how often a plan is followed to its
+goal.) The law tries a grid of next legs — the angles inside the target foothold's cone, the
+lengths over the leg's range — and the plan's own leg. A candidate is *good* if its foot lands on
+the target segment at least ``end_margin`` [l0] along it from either end (a quarter of a short
+foothold at most), its angle at least ``cone_margin`` [rad] inside the cone (half the cone at
+most) and the body above the floor. Good candidates are costed by
 
     ((y_foot - y_aim) / position_scale)² + |v - v_aim|² / velocity_scale²
         + ((psi0 - psi0_aim) / psi0_scale)² + ((zeta0 - zeta0_aim) / zeta0_scale)²
 
 against the plan's touchdown ``k + 1`` (its foot, the body's velocity there, its leg); the
 :data:`AHEAD` cheapest are looked at one jump further — the jump each sets off with the plan's
-following leg must complete above the floor (the guard), and its touchdown is costed the same
-way against the plan's ``k + 2`` — and the least total wins (``found`` :data:`PLACED`). With no
-good candidate the guard passes, the plan's own leg if it lands on the target and goes on, else
-the widest margin that lands there (:data:`TIGHT`); with none that lands there, the plan's leg
-(:data:`OFF_PLAN`). A caller replans on anything but PLACED (:mod:`sim_core.planning.follow`).
+following leg must land on the plan's next foothold with the same margins, above the floor (the
+guard), and its touchdown is costed the same way against the plan's ``k + 2`` — and the least
+total wins (``found`` :data:`PLACED`). With no good candidate the guard passes, the plan's own
+leg if it lands on the target and goes on, else the widest margin that lands there
+(:data:`TIGHT`); with none that lands there, the plan's leg (:data:`OFF_PLAN`). A caller replans
+on anything but PLACED (:mod:`sim_core.planning.follow`).
 
-The time is bounded: at most three stances, ``PSI0_GRID x ZETA0_GRID + 1`` crossings (three times
-that with the spread) and :data:`AHEAD` jumps; about 60-70 µs a jump on one core
-(docs/analyses.md).
+The time is bounded: ``PSI0_GRID x ZETA0_GRID + 1`` flights and at most :data:`AHEAD` jumps (one
+stance more from a touchdown); about 50-60 µs a jump on one core (docs/worlds.md).
 """
 
 from __future__ import annotations

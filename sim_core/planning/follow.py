@@ -1,19 +1,18 @@
 """A plan followed under noise: the foot-placement law aiming each touchdown at the plan's
-foothold, replanning from where the robot is when it is off its plan (docs/analyses.md, "Foot
-placement").
+foothold, replanning from where the robot is when it is off its plan (docs/worlds.md,
+"Following a plan").
 
 A trial starts as MJTF's world trials do (:mod:`sim_core.robustness.world_trials`): touchdown 0
 on the left side at the plan's first foot, numba's generator seeded by the trial's seed, the noise
 drawn in the same order (at each lift-off a pitch step and the next leg's controls, after each
 jump the velocity) — so the same seed gives the same draws to a fixed schedule and to this law.
-At touchdown ``k`` the law (:func:`sim_core.control.placement.place_leg`) sees the tracked body,
-its foothold, the pitch and the leg it sent (turned by the pitch it knew: the draws it cannot
-know), and sets leg ``k + 1`` for the plan's touchdown ``k + 1``; the leg is sent turned back by
-the tracked pitch and clipped to the leg's range.
+At each lift-off the law (:func:`sim_core.control.placement.place_from_liftoff`) sees the body
+leave the wall (tracked) and sets the coming leg for the plan's next foothold; the leg is sent
+turned back by the tracked pitch and clipped to the leg's range, then drawn with its noise.
 
 Off plan — the law finds no leg that lands on the plan's next foothold with its margins and goes
 on, or the plan ends below the goal — the compiled loop stops *before* that lift-off's draws,
-the planner (:func:`sim_core.planning.planner.replan`) plans again from that touchdown, and the
+the planner (:func:`sim_core.planning.planner.replan`) plans again from that lift-off, and the
 loop goes on with the draws where they were. A trial ends at the goal (a foot at or above it),
 at a failure (the floor included), or at ``cap`` jumps.
 """
@@ -28,7 +27,7 @@ import numpy as np
 
 from sim_core._jit import kernel
 from sim_core.control.laws.placement import PlacementSettings
-from sim_core.control.placement import AIM_SIZE, OFF_PLAN, PLACED, PSI0_HIGH, PSI0_LOW, place_from_liftoff, place_leg
+from sim_core.control.placement import AIM_SIZE, OFF_PLAN, PLACED, PSI0_HIGH, PSI0_LOW, place_from_liftoff
 from sim_core.model.failures import FLOOR, FLOOR_HEIGHT, OK
 from sim_core.model.integrate import PSI, PSI_DOT, STATE_SIZE, ZETA_DOT
 from sim_core.model.noise import NoiseModel
@@ -198,22 +197,29 @@ def follow_plan(
 
 
 def law_us_per_jump(model: ModelParams, sides: SideArrays, plan: Plan, settings: np.ndarray) -> float:
-    """The compiled law's CPU time per call [µs] on the plan's own touchdowns: the best of three
-    runs of about 50 ms each, by the thread's clock (a busy machine does not inflate it)."""
-    aims, calls = plan_aims(plan), []
+    """The compiled law's CPU time per call [µs] at the plan's own lift-offs (as a trial calls it):
+    the best of three runs of about 50 ms each, by the thread's clock (a busy machine does not
+    inflate it)."""
+    aims, calls, record = plan_aims(plan), [], model.record()
+    final, no_record = np.empty(STATE_SIZE), np.empty((0, STATE_SIZE))
     for k, step in enumerate(plan.steps[:-1]):
         inward = 1.0 if step.side == 0 else -1.0
-        body = (step.target[0] + inward * step.leg.zeta0 * math.cos(step.leg.psi0),
-                step.target[1] + step.leg.zeta0 * math.sin(step.leg.psi0))  # fmt: skip
-        calls.append((*body, *step.velocity, step.side, step.segment, step.leg.psi0, step.leg.zeta0, aims[k + 1]))
+        status, _ = foothold_stance(inward * step.velocity[0], step.velocity[1], step.leg.psi0, step.leg.zeta0,
+                                    record, sides, step.side, step.segment, final, no_record)  # fmt: skip
+        if status != OK:
+            continue
+        vx, vy = liftoff_velocity(final[PSI], final[ZETA_DOT], final[PSI_DOT])
+        liftoff = (step.target[0] + inward * math.cos(final[PSI]), step.target[1] + math.sin(final[PSI]),
+                   inward * vx, vy)  # fmt: skip
+        calls.append((step.side, *liftoff, aims[k + 1]))
     if not calls:
         return 0.0
-    record, best = model.record(), math.inf
+    best = math.inf
     for _ in range(3):
         started, count = time.thread_time(), 0
         while time.thread_time() - started < 0.05:
             for call in calls:
-                place_leg(record, sides, *call, settings)
+                place_from_liftoff(record, sides, *call, settings)
                 count += 1
         best = min(best, (time.thread_time() - started) / count * 1e6)
     return best

@@ -107,3 +107,43 @@ def test_bad_settings_are_refused_naming_the_field():
         PlacementSettings(end_margin=-0.1)
     with pytest.raises(ParameterError, match="zeta0_range"):
         PlacementSettings(zeta0_range=(0.9, 0.8))
+
+
+def test_from_a_tracked_lift_off_the_chosen_leg_lands_on_the_aimed_foothold(paper):
+    from sim_core.control.placement import place_from_liftoff
+    from sim_core.world.stride import world_flight
+
+    world = random_world(9)
+    sides = pack(world, paper.mu)
+    plan = plan_climb(paper, world, 5.0, START)
+    aims = plan_aims(plan)
+    rng = np.random.default_rng(9)
+    for k, step in enumerate(plan.steps[:-1]):
+        x, y = _body(step)
+        # the true stance, its leg a little off what was sent: the lift-off the tracker sees
+        status, lift_x, lift_y, lift_xdot, lift_ydot, *_ = _lift_off(paper, sides, x, y, step, rng)
+        if status != 0:
+            continue
+        found, psi0, zeta0 = place_from_liftoff(paper.record(), sides, step.side, lift_x, lift_y, lift_xdot, lift_ydot,
+                                                aims[k + 1], PlacementSettings().array())  # fmt: skip
+        if found == PLACED:
+            landed = world_flight(lift_x, lift_y, lift_xdot, lift_ydot, step.side, psi0, zeta0, sides)
+            assert landed[0] == 0 and landed[5] == int(aims[k + 1, 0])
+
+
+def _lift_off(model, sides, x, y, step, rng):
+    """The lift-off of ``step``'s stance with its leg's length drawn (the angle then the wall's)."""
+    from sim_core.model.integrate import PSI, PSI_DOT, ZETA_DOT
+    from sim_core.model.stride import liftoff_velocity
+    from sim_core.world.stride import foothold_stance
+
+    zeta0 = step.leg.zeta0 + rng.normal(0.0, 0.003)
+    psi0 = leg_on_wall(sides, step.side, x, y, step.leg.psi0, zeta0)
+    mirror = 1.0 if step.side == 0 else -1.0
+    final = np.empty(STATE_SIZE)
+    status, _ = foothold_stance(mirror * step.velocity[0], step.velocity[1], psi0, zeta0, model.record(), sides,
+                                step.side, step.segment, final, NO_RECORD)  # fmt: skip
+    vx, vy = liftoff_velocity(final[PSI], final[ZETA_DOT], final[PSI_DOT])
+    lift_x = x - mirror * (zeta0 * math.cos(psi0) - math.cos(final[PSI]))
+    lift_y = y - zeta0 * math.sin(psi0) + math.sin(final[PSI])
+    return status, lift_x, lift_y, mirror * vx, vy

@@ -46,3 +46,38 @@ def test_a_replan_starts_at_the_touchdown_it_is_given(paper):
     done = replan(paper, world, middle.target[1] - 0.1, (row, middle.side, middle.segment,
                                                         (middle.leg.psi0, middle.leg.zeta0)))  # fmt: skip
     assert done.reaches_goal and len(done.steps) == 1, "a goal at or below this foot is reached already"
+
+
+def test_a_replan_from_a_tracked_lift_off_lands_its_first_jump_from_there(paper):
+    import numpy as np
+
+    from sim_core.model.integrate import PSI, PSI_DOT, STATE_SIZE, ZETA_DOT
+    from sim_core.model.stride import liftoff_velocity
+    from sim_core.world.geometry import pack
+    from sim_core.world.stride import foothold_stance, world_flight
+
+    world = random_world(12)
+    sides = pack(world, paper.mu)
+    plan = plan_climb(paper, world, 5.0, START)
+    first = plan.steps[0]
+    x, y = _body_of(first)
+    final = np.empty(STATE_SIZE)
+    status, _ = foothold_stance(first.velocity[0], first.velocity[1], first.leg.psi0, first.leg.zeta0, paper.record(),
+                                sides, 0, first.segment, final, np.empty((0, STATE_SIZE)))  # fmt: skip
+    assert status == 0
+    vx, vy = liftoff_velocity(final[PSI], final[ZETA_DOT], final[PSI_DOT])
+    liftoff = (x - first.leg.zeta0 * math.cos(first.leg.psi0) + math.cos(final[PSI]),
+               y - first.leg.zeta0 * math.sin(first.leg.psi0) + math.sin(final[PSI]), vx, vy)  # fmt: skip
+    touchdown = ((x, y, *first.velocity), 0, first.segment, (first.leg.psi0, first.leg.zeta0))
+    fresh = replan(paper, world, 5.0, touchdown, liftoff=liftoff)
+    assert fresh.reaches_goal and fresh.steps[-1].target[1] >= 5.0, "the plan it was on is one way up"
+    second = fresh.steps[1]
+    landed = world_flight(*liftoff, 0, second.leg.psi0, second.leg.zeta0, sides)
+    assert landed[0] == 0 and (1, landed[5]) == (second.side, second.segment)
+    assert np.array(landed[1:5]) == pytest.approx(np.array([*_body_of(second), *second.velocity]), abs=1e-12)
+
+
+def _body_of(step):
+    inward = 1.0 if step.side == 0 else -1.0
+    return (step.target[0] + inward * step.leg.zeta0 * math.cos(step.leg.psi0),
+            step.target[1] + step.leg.zeta0 * math.sin(step.leg.psi0))  # fmt: skip
