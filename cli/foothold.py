@@ -74,7 +74,7 @@ def foothold_study_command(
     """Foot placement following a plan against the best fixed schedule a reach search finds, on
     the worlds named or on random-foothold worlds, every method on the same noise draws: how many
     trials reach --goal-height, how the others fail, the planning's time and the law's."""
-    from sim_core.planning.planner import check_goal
+    from sim_core.planning.goals import check_goal
     from sim_core.planning.study import foothold_study
     from sim_core.world.named import resolve_world
     from sim_core.world.random_world import random_world

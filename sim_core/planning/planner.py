@@ -34,13 +34,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim_core.control.laws.placement import PlacementSettings
-from sim_core.control.placement import leg_on_wall
 from sim_core.model.controls import ControlSchedule, LegControl
-from sim_core.model.errors import ParameterError
 from sim_core.model.failures import FLOOR_HEIGHT, OK
 from sim_core.model.noise import NoiseModel
 from sim_core.model.params import ModelParams
-from sim_core.model.validation import check_range
+from sim_core.planning.goals import check_goal
+from sim_core.planning.landings import in_cone, noise_draws, standing_legs, with_margins
 from sim_core.world.climb import first_touchdown
 from sim_core.world.geometry import pack
 from sim_core.world.stride import world_flight, world_orbit_batch
@@ -114,35 +113,6 @@ def plan_climb(
     return _best_plan(model, world, goal, nodes, foot_y, noise, samples, beam, max_jumps, seed, started)
 
 
-def check_goal(world: World, goal: float, foot_y: float, *, name: str | None = None, metres: float | None = None,
-               footholds: bool = True):  # fmt: skip
-    """``(goal, foot_y)`` [l0] if a foot can stand at ``goal`` in ``world`` from a start at
-    ``foot_y``: above the start, at most the world's top and, with ``footholds``, a world with a
-    foothold (a segment with grip) whose top is at ``goal`` or higher; a ParameterError naming the
-    field otherwise, in metres where ``metres`` (l0 [m]) is given. ``name``: the world as the
-    caller knows it. (The planner asks without ``footholds``: it says how high it got instead.)"""
-    goal, foot_y = check_range("goal_height", goal), check_range("foot_y", foot_y)
-    name = name or world.name or "the world"
-    unit = 1.0 if metres is None else metres
-
-    def said(value: float) -> str:
-        return f"{value * unit:.3f} m" if metres is not None else f"{value:g} l0"
-
-    highest = [side.points[1:, 1][~(side.mu == 0.0)] for side in (world.left, world.right)]
-    if footholds and not any(tops.size for tops in highest):
-        raise ParameterError("world", f"{name} has no foothold: every segment of both sides is without grip")
-    if goal <= foot_y:
-        raise ParameterError("goal_height", f"must be above the start's foot ({said(foot_y)}), got {said(goal)}")
-    if goal > world.top:
-        raise ParameterError("goal_height", f"must be at most {name}'s top ({said(world.top)}), got {said(goal)}")
-    best = max((float(tops.max()) for tops in highest if tops.size), default=-math.inf)
-    if footholds and goal > best:
-        raise ParameterError(
-            "goal_height", f"must be at most the top of {name}'s highest foothold ({said(best)}), got {said(goal)}"
-        )
-    return goal, foot_y
-
-
 def replan(model: ModelParams, world: World, goal: float, touchdown, *, liftoff=None, noise: NoiseModel | None = None,
            samples: int = SAMPLES, beam: int = BEAM, max_jumps: int = MAX_JUMPS, seed: int = 0) -> Plan:  # fmt: skip
     """The most robust plan from a touchdown under way to a foot at ``goal`` [l0]: ``touchdown`` is
@@ -161,7 +131,7 @@ def replan(model: ModelParams, world: World, goal: float, touchdown, *, liftoff=
     if liftoff is None:
         return _best_plan(model, world, goal, [node], foot, noise, samples, beam, max_jumps, seed, started)
     sides = pack(world, model.mu)
-    children = _flights(sides, node, tuple(float(v) for v in liftoff), _draws(noise, samples, seed),
+    children = _flights(sides, node, tuple(float(v) for v in liftoff), noise_draws(noise, samples, seed),
                         PlacementSettings())  # fmt: skip
     if not children:
         return _plan(node.path, False, -math.inf, foot, started)
@@ -181,13 +151,13 @@ def _flights(sides, node, liftoff, draws, settings) -> list[_Node]:
             landings.append((status, np.array([x, y, xdot, ydot]), segment, coming))
         status, landed, segment, _ = landings[0]
         other = 1 - node.side
-        if status != OK or landed[1] < FLOOR_HEIGHT or not _in_cone(sides, other, segment, leg[0]):
+        if status != OK or landed[1] < FLOOR_HEIGHT or not in_cone(sides, other, segment, leg[0]):
             continue
         foot = landed[1] - leg[1] * math.sin(leg[0])
-        if not _with_margins(sides, np.array([other]), np.array([segment]), np.array([foot]), np.array([leg[0]]),
+        if not with_margins(sides, np.array([other]), np.array([segment]), np.array([foot]), np.array([leg[0]]),
                              settings)[0]:  # fmt: skip
             continue
-        held = [s == OK and row[1] >= FLOOR_HEIGHT and seg == segment and _in_cone(sides, other, seg, c[0])
+        held = [s == OK and row[1] >= FLOOR_HEIGHT and seg == segment and in_cone(sides, other, seg, c[0])
                 for s, row, seg, c in landings[1:]]  # fmt: skip
         chance = float(np.mean(held)) if held else 1.0
         step = (landed, other, int(segment), (float(leg[0]), float(leg[1])))
@@ -206,7 +176,7 @@ def _best_plan(model, world, goal, nodes, foot_y, noise, samples, beam, max_jump
 def _search(model, world, goal, nodes, foot_y, noise, samples, beam, max_jumps, seed, started) -> Plan:
     """One beam search (see the module) from ``nodes``, the touchdowns it may start from."""
     legs = LEGS
-    draws = _draws(noise, samples, seed)
+    draws = noise_draws(noise, samples, seed)
     sides = pack(world, model.mu)
     highest, best_path = max(foot_y, max(node.foot() for node in nodes)), max(nodes, key=_Node.foot).path
     arrived = [node for node in nodes if len(node.path) > 1 and node.foot() >= goal]  # a replan's first flights
@@ -242,29 +212,6 @@ class _Node:
         return float(self.row[1] - zeta0 * math.sin(psi0))
 
 
-def _draws(noise: NoiseModel, samples: int, seed: int) -> np.ndarray:
-    """(samples + 1, 5) draws of noise — the coming leg's (psi0, zeta0), the velocity (xdot, ydot)
-    at this touchdown and the zeta0 this leg stands on — row 0 the nominal (zeros)."""
-    record = noise.record()
-    sigma_psi0 = math.hypot(record.sigma_psi0, record.sigma_pitch)  # the pitch's step turns the leg too
-    scale = np.array([sigma_psi0, record.sigma_zeta0, record.sigma_velocity, record.sigma_velocity,
-                      record.sigma_zeta0])  # fmt: skip
-    normal = np.random.default_rng(seed).standard_normal((samples, 5))
-    return np.vstack([np.zeros(5), normal * scale])
-
-
-def _standing_legs(sides, node, draws) -> np.ndarray:
-    """The leg ``node`` stands on under each draw: its length as drawn, its angle the one that keeps
-    the foot on the wall below the body (the law sees the body, not the leg's noise:
-    :func:`sim_core.control.placement.leg_on_wall`)."""
-    x, y = node.row[0], node.row[1]
-    legs = np.empty((len(draws), 2))
-    for d, draw in enumerate(draws):
-        zeta0 = node.leg[1] + draw[4]
-        legs[d] = leg_on_wall(sides, node.side, x, y, node.leg[0], zeta0), zeta0
-    return legs
-
-
 def _expand(model, sides, legs, draws, nodes, settings) -> list[_Node]:
     """Every node's jump with every next leg, under every draw: the children that land nominally."""
     per_node, per_leg = len(legs) * len(draws), len(draws)
@@ -278,17 +225,17 @@ def _expand(model, sides, legs, draws, nodes, settings) -> list[_Node]:
         start = np.tile(node.row, (per_node, 1))
         start[:, 2:] += np.tile(draws[:, 2:4], (len(legs), 1))  # the velocity noise at this touchdown
         states[block, 0], on_side[block, 0], on_segment[block, 0] = start, node.side, node.segment
-        schedules[block, 0] = np.tile(_standing_legs(sides, node, draws), (len(legs), 1))
+        schedules[block, 0] = np.tile(standing_legs(sides, node, draws), (len(legs), 1))
         coming = np.repeat(legs, per_leg, axis=0) + np.tile(draws[:, :2], (len(legs), 1))
         schedules[block, 1] = np.clip(coming, [1e-3, 1e-3], [0.5 * math.pi - 1e-3, 1.0 - 1e-3])
     status, completed = np.empty(count, dtype=np.int64), np.empty(count, dtype=np.int64)
     world_orbit_batch(schedules, 0, model.record(), sides, states, on_side, on_segment, status, completed)
     landed = states[:, 1]
-    held = (status == OK) & (landed[:, 1] >= FLOOR_HEIGHT) & _in_cone(sides, on_side[:, 1], on_segment[:, 1],
+    held = (status == OK) & (landed[:, 1] >= FLOOR_HEIGHT) & in_cone(sides, on_side[:, 1], on_segment[:, 1],
                                                                      schedules[:, 1, 0])  # fmt: skip
     held = held.reshape(len(nodes), len(legs), len(draws))
     nominal = np.arange(0, count, len(draws))
-    placeable = _with_margins(sides, on_side[nominal, 1], on_segment[nominal, 1],
+    placeable = with_margins(sides, on_side[nominal, 1], on_segment[nominal, 1],
                               landed[nominal, 1] - schedules[nominal, 1, 1] * np.sin(schedules[nominal, 1, 0]),
                               schedules[nominal, 1, 0], settings).reshape(len(nodes), len(legs))  # fmt: skip
     landed_on = on_segment[:, 1].reshape(len(nodes), len(legs), len(draws))
@@ -307,33 +254,6 @@ def _expand(model, sides, legs, draws, nodes, settings) -> list[_Node]:
             )
             children.append(_Node(*step, score, (*node.path, step)))
     return children
-
-
-def _with_margins(sides, side, segment, foot_y, psi0, settings: PlacementSettings) -> np.ndarray:
-    """Whether feet at ``foot_y`` [l0] set down at ``psi0`` [rad] on ``side``'s ``segment`` keep the
-    placement law's margins (:mod:`sim_core.control.placement`: from the foothold's ends, a quarter
-    of its length at most, and inside its cone, half of it at most), so the law can follow."""
-    last = sides.counts[side] - 1
-    inner = np.clip(segment, 0, np.maximum(last - 1, 0))
-    low, high = sides.points[side, inner], sides.points[side, inner + 1]
-    length = np.hypot(*(high - low).T)
-    share = (foot_y - low[:, 1]) / np.maximum(high[:, 1] - low[:, 1], 1e-300)
-    along = np.minimum(share, 1.0 - share) * length
-    along = np.where(segment < 0, sides.points[side, 0, 1] - foot_y, along)
-    along = np.where(segment >= last, foot_y - sides.points[side, last, 1], along)
-    asked = np.where((segment < 0) | (segment >= last), settings.end_margin, np.minimum(settings.end_margin,
-                                                                                        0.25 * length))  # fmt: skip
-    column = np.clip(segment + 1, 0, sides.beta.shape[1] - 1)
-    half = np.arctan(sides.friction[side, column])
-    cone = half - np.abs(psi0 - sides.beta[side, column])
-    return (along >= asked) & (cone >= np.minimum(math.radians(settings.cone_margin_deg), 0.5 * half))
-
-
-def _in_cone(sides, side, segment, psi0) -> np.ndarray:
-    """Whether a touchdown at ``psi0`` [rad] on ``side``'s ``segment`` holds at once (docs/model.md §8)."""
-    column = np.clip(segment + 1, 0, sides.beta.shape[1] - 1)
-    beta, mu = sides.beta[side, column], sides.friction[side, column]
-    return np.abs(psi0 - beta) < np.arctan(mu)
 
 
 def _keep(children, beam: int) -> list[_Node]:
