@@ -20,6 +20,7 @@ from cli.options import (
     with_noise,
 )
 from cli.studies import run_study
+from cli.world import OPTION_OF_FIELD as WORLD_OPTIONS
 from sim_core.model.errors import ParameterError
 from sim_core.model.noise import NoiseModel
 from sim_core.world.named import CHUTE_HEIGHT
@@ -27,9 +28,10 @@ from sim_core.world.random_world import GAP, HOLD_LENGTH, INCLINE_DEG, MU
 
 app = typer.Typer(rich_markup_mode=None)
 Interval = tuple[float, float]
-# random_world's arguments as the options that give them here.
-OPTION_OF_FIELD = {"seed": "--seed0", "holds": "--holds", "incline_deg": "--incline-deg", "mu": "--hold-mu",
-                   "gap": "--gap", "hold_length": "--hold-length", "height": "--height"}  # fmt: skip
+# random_world's arguments as the options that give them here: parkour world random's, but the seeds
+# are --seed0 (--seed is the trials') and the friction --hold-mu (--mu is the model's); the width is the model's
+OPTION_OF_FIELD = {field: option for field, option in WORLD_OPTIONS.items() if field != "width"} | {
+    "seed": "--seed0", "mu": "--hold-mu"}  # fmt: skip
 MAX_RANDOM = 1000
 
 

@@ -32,7 +32,7 @@ def plan_command(
 ) -> None:
     """A sequence of footholds and leg commands from touchdown 0 to --goal-height, the most robust
     under the noise options (each jump's share of noisy draws that land and hold, multiplied)."""
-    from sim_core.planning.planner import plan_climb
+    from sim_core.planning.planner import plan_climb, start_velocity
     from sim_core.world.named import resolve_world
 
     chosen, _description = resolve_world(world, setup.model.d_hat, setup.robot.scales.length)
@@ -42,10 +42,7 @@ def plan_command(
         raise ParameterError("--goal-height", f"must be above the start's foot ({start_m:.3f} m) and at most "
                              f"{chosen.name}'s top ({top_m:.3f} m), got {goal_height:g} m")  # fmt: skip
     if state is None:
-        from cli.options import parse_controls
-        from sim_core.section.gait_search import gait_of
-
-        state = tuple(gait_of(setup.model, parse_controls("30:0.9")).state.tolist())
+        state = start_velocity(setup.model)
         note(f"touchdown 0 at the 30:0.9 gait's velocity {[round(v, 4) for v in state]}")
     plan = plan_climb(setup.model, chosen, goal_height / metres, state, foot_y=foot_y, noise=noise, seed=seed)
     if not plan.reaches_goal:

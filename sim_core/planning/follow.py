@@ -31,10 +31,11 @@ from sim_core.control.placement import AIM_SIZE, OFF_PLAN, PLACED, PSI0_HIGH, PS
 from sim_core.model.failures import FLOOR, FLOOR_HEIGHT, OK
 from sim_core.model.integrate import PSI, PSI_DOT, STATE_SIZE, ZETA_DOT
 from sim_core.model.noise import NoiseModel
-from sim_core.model.noise_rules import commanded_controls, disturbed_state, pitch_step, seed_trial
+from sim_core.model.noise_rules import commanded_controls, pitch_step, seed_trial
 from sim_core.model.params import ModelParams
 from sim_core.model.stride import liftoff_velocity
 from sim_core.planning.planner import Plan, replan
+from sim_core.robustness.world_trials import disturbed_on_side
 from sim_core.world.geometry import SideArrays, pack
 from sim_core.world.stride import foothold_stance, world_flight
 from sim_core.world.world import World
@@ -130,9 +131,8 @@ def follow(trial, aims, row, goal, cap, may_replan, noise, model, sides, setting
         if y < FLOOR_HEIGHT:
             return FLOOR, row
         side = 1 - side
-        mirror = 1.0 if side == 0 else -1.0  # the disturbance in the coming stance's frame, as MJTF's
-        flipped_xdot, ydot = disturbed_state(mirror * xdot, ydot, noise)
-        trial[X], trial[Y], trial[XDOT], trial[YDOT] = x, y, mirror * flipped_xdot, ydot
+        xdot, ydot = disturbed_on_side(side, xdot, ydot, noise)  # as MJTF's world trials
+        trial[X], trial[Y], trial[XDOT], trial[YDOT] = x, y, xdot, ydot
         trial[SIDE], trial[SEGMENT], trial[PSI0], trial[ZETA0] = side, segment, next_psi0, next_zeta0
         trial[SENT_PSI0], trial[SENT_ZETA0], trial[PITCH], trial[JUMP] = sent_psi0, zeta0, next_pitch, k + 1
         row = min(row + 1, aims.shape[0] - 1)

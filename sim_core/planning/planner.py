@@ -88,6 +88,14 @@ class Plan:
         return ControlSchedule.of(*(step.leg for step in self.steps))
 
 
+def start_velocity(model: ModelParams) -> tuple[float, float]:
+    """The body's velocity at touchdown 0 when none is given: the 30:0.9 gait's (docs/worlds.md)."""
+    from sim_core.section.gait_search import gait_of
+
+    state = gait_of(model, ControlSchedule.from_degrees([(30.0, 0.9)])).state
+    return float(state[0]), float(state[1])
+
+
 def plan_climb(
     model: ModelParams,
     world: World,

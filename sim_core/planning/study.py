@@ -37,7 +37,7 @@ from sim_core.model.poincare import check_section_state
 from sim_core.model.validation import check_range
 from sim_core.planning.follow import follow_plan, law_us_per_jump
 from sim_core.planning.goals import check_goal
-from sim_core.planning.planner import PSI0_DEG, ZETA0, plan_climb
+from sim_core.planning.planner import PSI0_DEG, ZETA0, plan_climb, start_velocity
 from sim_core.robustness.world_trials import REACHED, run_world_trials
 from sim_core.world.geometry import pack
 from sim_core.world.reach import reach_rows
@@ -179,11 +179,7 @@ def foothold_study(
     cap = int(check_range("cap", cap, 1, 100_000, low_open=False, high_open=False))
     for label, world in worlds:
         check_goal(world, goal, foot_y, name=label)
-    if state is None:  # the 30:0.9 gait's velocity, as parkour plan's
-        from sim_core.model.controls import ControlSchedule
-        from sim_core.section.gait_search import gait_of
-
-        state = gait_of(model, ControlSchedule.from_degrees([(30.0, 0.9)])).state
+    state = start_velocity(model) if state is None else state
     velocity = tuple(float(v) for v in check_section_state(state))
     noise = NoiseModel() if noise is None else noise
     arguments = [(model, label, world, goal, velocity, foot_y, trials, seed, noise, cap) for label, world in worlds]

@@ -81,11 +81,18 @@ def world_trial(foot, velocity, segment, schedule, seed, cap, goal, noise, model
             return k, status
         if y < FLOOR_HEIGHT:
             return k, FLOOR
-        mirror = 1.0 if side == 0 else -1.0  # the disturbance in the coming stance's frame, as the map's
-        flipped_xdot, ydot = disturbed_state(mirror * xdot, ydot, noise)
-        xdot = mirror * flipped_xdot
+        xdot, ydot = disturbed_on_side(side, xdot, ydot, noise)
         pitch, psi0, zeta0 = next_pitch, next_psi0, next_zeta0
     return cap, OK
+
+
+@kernel
+def disturbed_on_side(side, xdot, ydot, noise):
+    """The body's velocity at a touchdown on ``side`` (wall coordinates) with the velocity noise
+    drawn in that side's stance frame, as the map's section state is disturbed."""
+    mirror = 1.0 if side == 0 else -1.0
+    flipped_xdot, ydot = disturbed_state(mirror * xdot, ydot, noise)
+    return mirror * flipped_xdot, ydot
 
 
 @parallel_kernel
