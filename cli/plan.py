@@ -28,10 +28,33 @@ def plan_command(
     ] = None,
     foot_y: Annotated[float, typer.Option("--foot-y", help="Touchdown 0's foot height on the left side [l0].")] = 0.0,
     seed: SeedOption = 0,
+    mfpt: Annotated[
+        bool,
+        typer.Option(
+            "--mfpt",
+            help="Also the chance that a climb of the plan fails and its mean jumps to failure, "
+            "the placement law following it under the noise options, by splitting.",
+        ),
+    ] = False,
+    replicas: Annotated[
+        int | None, typer.Option("--replicas", help="With --mfpt: attempts a run (default 40).")
+    ] = None,
+    runs: Annotated[int | None, typer.Option("--runs", help="With --mfpt: independent runs (default 64).")] = None,
+    replans: Annotated[
+        int | None, typer.Option("--replans", help="With --mfpt: replans an attempt may make (default 3).")
+    ] = None,
+    monte_carlo: Annotated[
+        int | None,
+        typer.Option("--monte-carlo", help="With --mfpt: as many plain attempts beside it, to check it (1-100000)."),
+    ] = None,
     as_json: JsonOption = False,
 ) -> None:
     """A sequence of footholds and leg commands from touchdown 0 to --goal-height, the most robust
-    under the noise options (each jump's share of noisy draws that land and hold, multiplied)."""
+    under the noise options (each jump's share of noisy draws that land and hold, multiplied);
+    with --mfpt, how often the placement law's climbs of it fail (docs/worlds.md)."""
+    from cli.plan_mfpt import check_mfpt_options
+
+    splitting = check_mfpt_options(mfpt, replicas, runs, replans, monte_carlo, seed)
     from sim_core.planning.planner import plan_climb, start_velocity
     from sim_core.world.named import resolve_world
 
@@ -52,6 +75,11 @@ def plan_command(
         )  # fmt: skip
     document = {"reaches_goal": True, "plan": [step.to_dict() for step in plan.steps], "seconds": plan.seconds,
                 "highest_m": plan.highest * metres, "chance": plan.chance}  # fmt: skip
+    if splitting is not None:
+        from cli.plan_mfpt import plan_mfpt_document
+
+        document["mfpt"] = plan_mfpt_document(setup.model, chosen, plan, goal_height / metres, noise, splitting,
+                                              monte_carlo)  # fmt: skip
     if as_json:
         print_json(document)
         return
@@ -64,3 +92,7 @@ def plan_command(
         table.add_row(str(row["jump"]), row["side"], str(row["segment"]), f"{row['target'][0]:.3f}",
                       f"{row['target'][1]:.3f}", f"{row['psi0_deg']:.1f}", f"{row['zeta0']:.3f}")  # fmt: skip
     Console().print(table)
+    if splitting is not None:
+        from cli.plan_mfpt import print_mfpt
+
+        print_mfpt(document["mfpt"])

@@ -94,7 +94,7 @@ class RobotConnect(Strict):
 class ClosedLoopIn(Strict):
     """A closed loop: ``controller`` holds ``target_m`` from each touchdown to the next leg
     (docs/analyses.md, "Controllers"); the PIDs take the gains, every law the zeta0 range, the
-    deadbeat its climb per jump. The LQR and the deadbeat are designed on ``preset`` (a stored
+    deadbeat and the placement law their climb per jump. The model-based laws are designed on ``preset`` (a stored
     calibration gives its own controller, its leg offsets taken off each command), else on the
     service's robot."""
 
@@ -108,7 +108,7 @@ class ClosedLoopIn(Strict):
     zeta0_min: Zeta0 = 0.80
     zeta0_max: Zeta0 = 0.98
     climb_per_jump: Annotated[
-        float, Field(gt=0.0, le=1.0, description="deadbeat: the most it climbs toward the target a jump [l0]")
+        float, Field(gt=0.0, le=1.0, description="deadbeat, placement: the most it climbs to the target a jump [l0]")
     ] = DEADBEAT_CLIMB_PER_JUMP
     preset: Annotated[
         str | None,

@@ -23,6 +23,9 @@ Kinds so far:
 - ``deadbeat``: zeta0 chosen two jumps ahead on the design model's own map from the section state
   (:mod:`sim_core.control.deadbeat`), climbing at most ``climb_per_jump`` a jump, behind a guard that
   never sends a command the model predicts fails; the leg angle nominal, pitch fed back.
+- ``placement``: the foot-placement law between parallel walls — the deadbeat's horizon over both
+  legs (the angle a step either side of the gait's too), the feet's heights weighed above the
+  state; pitch fed back.
 """
 
 from __future__ import annotations
@@ -33,8 +36,8 @@ import numpy as np
 
 from sim_core._jit import kernel
 from sim_core.control.closed_loop import pid_step
-from sim_core.control.deadbeat import PITCH_GAIN, PSI0_HIGH, PSI0_LOW, PSI0_STAR, deadbeat_zeta0
-from sim_core.control.laws import DEADBEAT, LQR, MEMORY_SIZE, PID_PITCH
+from sim_core.control.deadbeat import PITCH_GAIN, PSI0_HIGH, PSI0_LOW, deadbeat_leg
+from sim_core.control.laws import DEADBEAT, LQR, MEMORY_SIZE, PID_PITCH, PLACEMENT
 
 
 def new_memory(kind: int, first_psi0: float, first_zeta0: float) -> np.ndarray:
@@ -46,7 +49,7 @@ def new_memory(kind: int, first_psi0: float, first_zeta0: float) -> np.ndarray:
 @kernel
 def start_memory(kind, first_psi0, first_zeta0):
     memory = np.empty(MEMORY_SIZE)
-    if kind in (LQR, DEADBEAT):  # the controls of the touchdown before the first command
+    if kind in (LQR, DEADBEAT, PLACEMENT):  # the controls of the touchdown before the first command
         memory[0], memory[1] = first_psi0, first_zeta0
     else:  # the PID: no integral, no error before
         memory[0], memory[1] = 0.0, math.nan
@@ -61,7 +64,7 @@ def control_step(kind, parameters, memory, height, pitch, xdot, ydot, next_on_le
     (:func:`new_memory`) is updated in place."""
     if kind == LQR:
         return _lqr_step(parameters, memory, height, pitch, xdot, ydot, next_on_left)
-    if kind == DEADBEAT:
+    if kind in (DEADBEAT, PLACEMENT):
         return _deadbeat_step(parameters, memory, height, pitch, xdot, ydot, next_on_left)
     zeta0_min, zeta0_max, psi0 = parameters[5], parameters[6], parameters[7]
     error = parameters[0] - height
@@ -111,10 +114,9 @@ def _turned_back(psi0, pitch, next_on_left, pitch_gain, psi0_min, psi0_max):
 
 @kernel
 def _deadbeat_step(parameters, memory, height, pitch, xdot, ydot, next_on_left):
-    """zeta0 by :func:`sim_core.control.deadbeat.deadbeat_zeta0` from the controls last touched down with
-    (the memory), the leg angle the gait's turned back by the pitch."""
-    zeta0, guarded = deadbeat_zeta0(parameters, memory[0], memory[1], height, xdot, ydot)
-    psi0 = parameters[PSI0_STAR]
+    """The leg by :func:`sim_core.control.deadbeat.deadbeat_leg` from the controls last touched down
+    with (the memory; the angle before its pitch turn), the angle turned back by the pitch."""
+    psi0, zeta0, guarded = deadbeat_leg(parameters, memory[0], memory[1], height, xdot, ydot)
     memory[0], memory[1] = psi0, zeta0
     psi0, clipped = _turned_back(
         psi0, pitch, next_on_left, parameters[PITCH_GAIN], parameters[PSI0_LOW], parameters[PSI0_HIGH]

@@ -108,7 +108,7 @@ def place_from_liftoff(model, sides, side, x, y, xdot, ydot, aim, settings):
     legs[grid - 1, 0], legs[grid - 1, 1] = aim[AIM_PSI0], aim[AIM_ZETA0]  # the plan's own leg, where it lands
     liftoff = (x, y, xdot, ydot)
     for i in range(grid):
-        if _margin(sides, side, liftoff, target, legs[i, 0], legs[i, 1], beta, half, cone_margin, settings) >= 1.0:
+        if _margin(sides, side, liftoff, target, legs[i, 0], legs[i, 1], settings) >= 1.0:
             costs[i] = _landing_cost(sides, side, liftoff, legs[i, 0], legs[i, 1], aim, settings)
     # The best by the landing alone, looked at one jump further: the jump each sets off, with the
     # plan's following leg, must reach the plan's next foothold with the margins (the guard), and
@@ -128,14 +128,14 @@ def place_from_liftoff(model, sides, side, x, y, xdot, ydot, aim, settings):
     # No good leg the guard passes: the plan's own if it lands on the target and goes on, else the
     # widest margin that lands there
     plan_psi0, plan_zeta0 = aim[AIM_PSI0], aim[AIM_ZETA0]
-    on_target = _margin(sides, side, liftoff, target, plan_psi0, plan_zeta0, beta, half, cone_margin, settings) > 0.0
+    on_target = _margin(sides, side, liftoff, target, plan_psi0, plan_zeta0, settings) > 0.0
     if on_target and math.isfinite(
         _ahead_cost(model, sides, side, liftoff, plan_psi0, plan_zeta0, aim, settings, record)
     ):
         return TIGHT, plan_psi0, plan_zeta0
     best_margin, widest = -math.inf, -1
     for i in range(grid):
-        margin = _margin(sides, side, liftoff, target, legs[i, 0], legs[i, 1], beta, half, cone_margin, settings)
+        margin = _margin(sides, side, liftoff, target, legs[i, 0], legs[i, 1], settings)
         if margin > best_margin:
             best_margin, widest = margin, i
     if widest < 0 or best_margin == -math.inf:
@@ -188,14 +188,25 @@ def _end_margin(sides, other, segment, foot_y):
 
 
 @kernel
-def _margin(sides, side, liftoff, target, psi0, zeta0, beta, half, cone_margin, settings):
+def _margin(sides, side, liftoff, target, psi0, zeta0, settings):
     """A landing's margin on the target in units of what is asked (>= 1: good); -inf off it or
     below the floor."""
     status, _, body_y, _, _, segment, _ = world_flight(*liftoff, side, psi0, zeta0, sides)
     if status != OK or segment != target or body_y < FLOOR_HEIGHT:
         return -math.inf
-    along, most = _end_margin(sides, 1 - side, segment, body_y - zeta0 * math.sin(psi0))
-    return min(along / min(settings[END_MARGIN], most), (half - abs(psi0 - beta)) / cone_margin)
+    return landing_margin(sides, 1 - side, segment, body_y - zeta0 * math.sin(psi0), psi0, settings)
+
+
+@kernel
+def landing_margin(sides, side, segment, foot_y, psi0, settings):
+    """A foot's margin on ``side``'s ``segment`` at height ``foot_y`` [l0] with the leg at ``psi0``
+    [rad], in units of what the law asks (>= 1: good): the smaller of its distance from the nearer
+    end over ``END_MARGIN`` (a quarter of a shorter foothold) and its angle inside the friction cone
+    over ``CONE_MARGIN`` (half the cone at most)."""
+    along, most = _end_margin(sides, side, segment, foot_y)
+    half = math.atan(sides.friction[side, segment + 1])
+    cone = half - abs(psi0 - sides.beta[side, segment + 1])
+    return min(along / min(settings[END_MARGIN], most), cone / min(settings[CONE_MARGIN], 0.5 * half))
 
 
 @kernel
@@ -203,14 +214,14 @@ def _landing_cost(sides, side, liftoff, psi0, zeta0, aim, settings):
     """A landing's cost against the plan's touchdown ``k + 1`` (its foot, velocity and leg)."""
     _, _, body_y, xdot, ydot, _, _ = world_flight(*liftoff, side, psi0, zeta0, sides)
     return (
-        _miss(settings, body_y - zeta0 * math.sin(psi0), xdot, ydot, aim[AIM_Y], aim[AIM_XDOT], aim[AIM_YDOT])
+        miss_cost(settings, body_y - zeta0 * math.sin(psi0), xdot, ydot, aim[AIM_Y], aim[AIM_XDOT], aim[AIM_YDOT])
         + ((psi0 - aim[AIM_PSI0]) / settings[PSI0_SCALE]) ** 2
         + ((zeta0 - aim[AIM_ZETA0]) / settings[ZETA0_SCALE]) ** 2
     )
 
 
 @kernel
-def _miss(settings, foot_y, xdot, ydot, aim_y, aim_xdot, aim_ydot):
+def miss_cost(settings, foot_y, xdot, ydot, aim_y, aim_xdot, aim_ydot):
     """How far a touchdown (its foot's height [l0], the body's velocity) is from its aim, in the
     cost's scales; an aim of NaN height costs nothing."""
     if math.isnan(aim_y):
@@ -222,7 +233,7 @@ def _miss(settings, foot_y, xdot, ydot, aim_y, aim_xdot, aim_ydot):
 @kernel
 def _ahead_cost(model, sides, side, liftoff, psi0, zeta0, aim, settings, record):
     """The jump after a landing with ``(psi0, zeta0)``, with the plan's following leg, on the
-    model: how far its touchdown is from the plan's (:func:`_miss`); inf if it fails, misses the
+    model: how far its touchdown is from the plan's (:func:`miss_cost`); inf if it fails, misses the
     plan's next foothold or lands there without the margins (the guard); 0 where the plan ends at
     the landing (a NaN following leg)."""
     then_psi0, then_zeta0 = aim[THEN_PSI0], aim[THEN_ZETA0]
@@ -240,4 +251,4 @@ def _ahead_cost(model, sides, side, liftoff, psi0, zeta0, aim, settings, record)
     cone = half - abs(then_psi0 - sides.beta[side, landing + 1])
     if along < min(settings[END_MARGIN], most) or cone < min(settings[CONE_MARGIN], 0.5 * half):
         return math.inf  # the plan's next foothold reached, but without the margins the law keeps
-    return _miss(settings, foot_y, xdot, ydot, aim[THEN_Y], aim[THEN_XDOT], aim[THEN_YDOT])
+    return miss_cost(settings, foot_y, xdot, ydot, aim[THEN_Y], aim[THEN_XDOT], aim[THEN_YDOT])

@@ -15,7 +15,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 
-from sim_core.control.laws import Controller, DesignRequest, deadbeat, lqr, pid
+from sim_core.control.laws import Controller, Deadbeat, DesignRequest, Placement, deadbeat, lqr, pid
 from sim_core.control.laws.pid import Pid
 from sim_core.model.validation import ParameterError
 
@@ -52,13 +52,16 @@ def _lqr(request: DesignRequest) -> Controller:
     return replace(law, psi0_range_deg=request.psi0_range_deg)
 
 
-def _deadbeat(request: DesignRequest) -> Controller:
-    from sim_core.control.deadbeat import design_deadbeat  # the compiled predictions, only when asked
+def _horizon(law: type[Deadbeat]) -> Callable[[DesignRequest], Controller]:
+    def design(request: DesignRequest) -> Controller:
+        from sim_core.control.deadbeat import design_deadbeat  # the compiled predictions, only when asked
 
-    height = request.height
-    return design_deadbeat(request.model, height.target, request.psi0_deg, height.zeta0_hover,
-                           zeta0_range=request.zeta0_range, climb_per_jump=request.climb_per_jump,
-                           psi0_range_deg=request.psi0_range_deg)  # fmt: skip
+        height = request.height
+        return design_deadbeat(request.model, height.target, request.psi0_deg, height.zeta0_hover,
+                               zeta0_range=request.zeta0_range, climb_per_jump=request.climb_per_jump,
+                               psi0_range_deg=request.psi0_range_deg, law=law)  # fmt: skip
+
+    return design
 
 
 LAWS: dict[str, LawKind] = {
@@ -67,7 +70,13 @@ LAWS: dict[str, LawKind] = {
         LawKind("pid", pid.NUMBER, "PID on the touchdown height", _pid(False), sets_leg_angle=False),
         LawKind("pid-pitch", pid.PITCH_NUMBER, "PID, the tracked pitch fed to the leg angle", _pid(True)),
         LawKind("lqr", lqr.NUMBER, "LQR on the model's return map", _lqr),
-        LawKind("deadbeat", deadbeat.NUMBER, "two jumps ahead on the model, guarded", _deadbeat),
+        LawKind("deadbeat", deadbeat.NUMBER, "two jumps ahead on the model, guarded", _horizon(Deadbeat)),
+        LawKind(
+            "placement",
+            deadbeat.PLACEMENT_NUMBER,
+            "each foot placed two jumps ahead, angle and length",
+            _horizon(Placement),
+        ),
     )
 }
 NAMES: tuple[str, ...] = tuple(LAWS)

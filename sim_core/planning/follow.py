@@ -27,7 +27,15 @@ import numpy as np
 
 from sim_core._jit import kernel
 from sim_core.control.laws.placement import PlacementSettings
-from sim_core.control.placement import AIM_SIZE, OFF_PLAN, PLACED, PSI0_HIGH, PSI0_LOW, place_from_liftoff
+from sim_core.control.placement import (
+    AIM_SIZE,
+    OFF_PLAN,
+    PLACED,
+    PSI0_HIGH,
+    PSI0_LOW,
+    landing_margin,
+    place_from_liftoff,
+)
 from sim_core.model.failures import FLOOR, FLOOR_HEIGHT, OK
 from sim_core.model.integrate import PSI, PSI_DOT, STATE_SIZE, ZETA_DOT
 from sim_core.model.noise import NoiseModel
@@ -98,16 +106,10 @@ def follow(trial, aims, row, goal, cap, may_replan, noise, model, sides, setting
             return REACHED, row
         if trial[JUMP] >= cap:
             return CAPPED, row
-        side, segment = int(trial[SIDE]), int(trial[SEGMENT])
-        mirror = 1.0 if side == 0 else -1.0
-        status, _ = foothold_stance(mirror * trial[XDOT], trial[YDOT], trial[PSI0], trial[ZETA0], model, sides, side,
-                                    segment, final, no_record)  # fmt: skip
+        side = int(trial[SIDE])
+        status = lift_off_from(trial, model, sides, final, no_record)
         if status != OK:
             return status, row
-        vx, vy = liftoff_velocity(final[PSI], final[ZETA_DOT], final[PSI_DOT])
-        trial[LIFT_X] = trial[X] - mirror * (trial[ZETA0] * math.cos(trial[PSI0]) - math.cos(final[PSI]))
-        trial[LIFT_Y] = trial[Y] - trial[ZETA0] * math.sin(trial[PSI0]) + math.sin(final[PSI])
-        trial[LIFT_XDOT], trial[LIFT_YDOT] = mirror * vx, vy
         if row + 1 >= aims.shape[0]:  # the plan ends below the goal
             if may_replan:
                 return REPLAN, row
@@ -136,6 +138,43 @@ def follow(trial, aims, row, goal, cap, may_replan, noise, model, sides, setting
         trial[SIDE], trial[SEGMENT], trial[PSI0], trial[ZETA0] = side, segment, next_psi0, next_zeta0
         trial[SENT_PSI0], trial[SENT_ZETA0], trial[PITCH], trial[JUMP] = sent_psi0, zeta0, next_pitch, k + 1
         row = min(row + 1, aims.shape[0] - 1)
+
+
+@kernel
+def lift_off_from(trial, model, sides, final, no_record):
+    """Run the stance of ``trial``'s touchdown and put its lift-off (wall coordinates) in ``trial``;
+    returns the stance's status (``final``: scratch for its last state)."""
+    side, segment = int(trial[SIDE]), int(trial[SEGMENT])
+    mirror = 1.0 if side == 0 else -1.0
+    status, _ = foothold_stance(mirror * trial[XDOT], trial[YDOT], trial[PSI0], trial[ZETA0], model, sides, side,
+                                segment, final, no_record)  # fmt: skip
+    if status != OK:
+        return status
+    vx, vy = liftoff_velocity(final[PSI], final[ZETA_DOT], final[PSI_DOT])
+    trial[LIFT_X] = trial[X] - mirror * (trial[ZETA0] * math.cos(trial[PSI0]) - math.cos(final[PSI]))
+    trial[LIFT_Y] = trial[Y] - trial[ZETA0] * math.sin(trial[PSI0]) + math.sin(final[PSI])
+    trial[LIFT_XDOT], trial[LIFT_YDOT] = mirror * vx, vy
+    return OK
+
+
+@kernel
+def planned_margin(trial, aims, row, model, sides, settings):
+    """The margin (:func:`sim_core.control.placement.landing_margin`) of the landing the law aims at
+    from ``trial``'s touchdown (the plan's ``row``), on the model without noise: the stance, the law's
+    leg at its lift-off, that leg's flight. -inf where the stance or the flight fails or the body
+    comes down below the floor; +inf where the plan has no touchdown after this one."""
+    if row + 1 >= aims.shape[0]:
+        return math.inf
+    work = trial.copy()
+    if lift_off_from(work, model, sides, np.empty(STATE_SIZE), np.empty((0, STATE_SIZE))) != OK:
+        return -math.inf
+    side = int(work[SIDE])
+    liftoff = work[LIFT_X], work[LIFT_Y], work[LIFT_XDOT], work[LIFT_YDOT]
+    _, psi0, zeta0 = place_from_liftoff(model, sides, side, *liftoff, aims[row + 1], settings)
+    status, _, body_y, _, _, segment, _ = world_flight(*liftoff, side, psi0, zeta0, sides)
+    if status != OK or body_y < FLOOR_HEIGHT:
+        return -math.inf
+    return landing_margin(sides, 1 - side, segment, body_y - zeta0 * math.sin(psi0), psi0, settings)
 
 
 @dataclass(frozen=True)
@@ -182,18 +221,24 @@ def follow_plan(
             break
         replans += 1
         started = time.perf_counter()
-        touchdown = (trial[X:SIDE].copy(), int(trial[SIDE]), int(trial[SEGMENT]), expected_leg(trial))
-        fresh = replan(model, world, goal, touchdown, liftoff=tuple(trial[LIFT_X:LIFT_YDOT + 1]), noise=noise,
-                       seed=seed)  # fmt: skip
+        fresh = replanned(model, world, goal, trial, noise, seed)
         seconds += time.perf_counter() - started
-        if fresh.reaches_goal and len(fresh.steps) > 1:
-            aims, row = plan_aims(fresh), 0
+        if fresh is not None:
+            aims, row = fresh, 0
         else:  # no way on from here: the law aims at what it had, without replanning again
             replans = max_replans
     jumps = int(trial[JUMP])
     if outcome == REACHED:
         return FollowOutcome(True, OK, jumps, replans, seconds)
     return FollowOutcome(False, OK if outcome == CAPPED else int(outcome), jumps, replans, seconds)
+
+
+def replanned(model: ModelParams, world: World, goal: float, trial: np.ndarray, noise: NoiseModel, seed: int):
+    """The aims of a plan from the lift-off ``trial`` stopped at (:data:`REPLAN`) to ``goal`` [l0], the
+    planner's noisy draws from ``seed``; None where none reaches the goal."""
+    touchdown = (trial[X:SIDE].copy(), int(trial[SIDE]), int(trial[SEGMENT]), expected_leg(trial))
+    fresh = replan(model, world, goal, touchdown, liftoff=tuple(trial[LIFT_X : LIFT_YDOT + 1]), noise=noise, seed=seed)
+    return plan_aims(fresh) if fresh.reaches_goal and len(fresh.steps) > 1 else None
 
 
 def law_us_per_jump(model: ModelParams, sides: SideArrays, plan: Plan, settings: np.ndarray) -> float:

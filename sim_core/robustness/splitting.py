@@ -38,6 +38,7 @@ from sim_core.control.laws import Controller
 from sim_core.model.noise import NoiseModel
 from sim_core.model.params import ModelParams
 from sim_core.model.validation import ParameterError, check_range
+from sim_core.robustness.ams import ams_chance
 from sim_core.robustness.splitting_holding import Holding, Loop, measure_holding
 
 
@@ -211,28 +212,21 @@ def failure_probability(loop: Loop, holding: Holding, replicas: int, rng: np.ran
     every replica came home at the same highest level, which no copy can pass)."""
     picks = rng.integers(holding.exit_states.shape[0], size=replicas)
     paths = [loop.excursion(holding.exit_states[i], int(holding.exit_touchdowns[i]), holding, rng) for i in picks]
-    levels = np.array([level for *_, level in paths])
-    log_p = 0.0
-    while not math.isinf(floor := levels.min()):
-        dropped = np.flatnonzero(levels <= floor)
-        if dropped.size == replicas:
-            return 0.0
-        log_p += math.log1p(-dropped.size / replicas)
-        survivors = np.flatnonzero(levels > floor)
-        for i in dropped:
-            parent = paths[rng.choice(survivors)]
-            states, touchdowns, scores, _ = parent
-            above = scores > floor
-            if not above.any():  # the survivor crossed the level by failing: the copy fails with it
-                paths[i], levels[i] = parent, parent[3]
-                continue
-            cut = int(np.argmax(above))  # the survivor's first touchdown past the level
-            on_states, on_touchdowns, on_scores, level = loop.excursion(states[cut], int(touchdowns[cut]), holding, rng)
-            paths[i] = (
-                np.concatenate([states[:cut], on_states]),
-                np.concatenate([touchdowns[:cut], on_touchdowns]),
-                np.concatenate([scores[:cut], on_scores]),
-                level,  # the prefix stays at or below the floor, and the continuation starts above it
-            )
-            levels[i] = paths[i][3]
-    return math.exp(log_p)
+
+    def branch(parent, floor):
+        states, touchdowns, scores, level = parent
+        above = scores > floor
+        if not above.any():  # the survivor crossed the level by failing: the copy fails with it
+            return parent, level
+        cut = int(np.argmax(above))  # the survivor's first touchdown past the level
+        on_states, on_touchdowns, on_scores, level = loop.excursion(states[cut], int(touchdowns[cut]), holding, rng)
+        path = (
+            np.concatenate([states[:cut], on_states]),
+            np.concatenate([touchdowns[:cut], on_touchdowns]),
+            np.concatenate([scores[:cut], on_scores]),
+            level,  # the prefix stays at or below the floor, and the continuation starts above it
+        )
+        return path, level
+
+    chance, _ = ams_chance(paths, [level for *_, level in paths], branch, rng)
+    return chance

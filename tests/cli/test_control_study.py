@@ -25,7 +25,7 @@ def test_control_study_json_contract():
 @pytest.mark.parametrize(
     ("args", "says"),
     [
-        (("--controllers", "mpc"), "controllers: must be among pid, pid-pitch, lqr, deadbeat, got 'mpc'"),
+        (("--controllers", "mpc"), "controllers: must be among pid, pid-pitch, lqr, deadbeat, placement, got 'mpc'"),
         (("--controllers", "pid,pid"), "controllers: names a controller twice"),
         (("--controllers", " , "), "controllers: must name at least one"),
         (("--seeds", "0"), "seeds"),

@@ -25,7 +25,10 @@ def test_the_words_say_an_interval_open_above():
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (("--controller", "pd", "--pitch-drift", "0"), "--controller: must be one of pid, pid-pitch, lqr, deadbeat"),
+        (
+            ("--controller", "pd", "--pitch-drift", "0"),
+            "--controller: must be one of pid, pid-pitch, lqr, deadbeat, placement",
+        ),
         (("--controller", "lqr"), "--pitch-drift: must be 0 for a controller's MFPT"),
         (("--controller", "lqr", "--pitch-drift", "0", "--target", "9"), "--target: must be in (0, 2]"),
         (("--controller", "lqr", "--pitch-drift", "0", "--runs", "1"), "--runs: must be in [2, 1000], got 1"),

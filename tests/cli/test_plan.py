@@ -23,3 +23,26 @@ def test_no_way_up_and_goals_out_of_the_world_are_one_line(tmp_path):
     said = one_line_error("plan", "--world", str(greasy), "--state", "-1.0", "0.5", "--goal-height", "1.5")
     assert "no plan reaches 1.5 m" in said and "highest reachable is 0.2" in said
     assert "--goal-height" in one_line_error(*ARGS, "--goal-height", "5")
+
+
+def test_the_mfpt_of_a_plan_by_splitting_with_monte_carlo_beside_it():
+    plan = json_of(*ARGS, "--goal-height", "1.0", "--mfpt", "--replicas", "10", "--runs", "3", "--replans", "0",
+                   "--monte-carlo", "200")  # fmt: skip
+    mfpt = plan["mfpt"]
+    assert mfpt["method"] == "splitting" and set(mfpt) >= {
+        "failure_chance", "failure_chance_ci95", "mean_attempt_jumps", "mfpt_jumps", "ci95", "splitting", "seconds",
+        "monte_carlo"}  # fmt: skip
+    assert mfpt["splitting"]["runs"] == 3 and len(mfpt["splitting"]["runs_failure_chance"]) == 3
+    check = mfpt["monte_carlo"]
+    assert check["trials"] == 200 and 0 <= check["failures"] <= 200
+    low, high = check["failure_chance_ci95"]
+    assert low <= check["failure_chance"] <= high
+    if mfpt["failure_chance"] > 0:
+        assert mfpt["mfpt_jumps"] == mfpt["mean_attempt_jumps"] / mfpt["failure_chance"]
+
+
+def test_mfpt_options_are_checked_naming_the_option():
+    assert "--replicas: needs --mfpt" in one_line_error(*ARGS, "--goal-height", "1.0", "--replicas", "10")
+    assert "--replicas" in one_line_error(*ARGS, "--goal-height", "1.0", "--mfpt", "--replicas", "1")
+    assert "--monte-carlo" in one_line_error(*ARGS, "--goal-height", "1.0", "--mfpt", "--monte-carlo", "0")
+    assert "--replans" in one_line_error(*ARGS, "--goal-height", "1.0", "--mfpt", "--replans", "-1")

@@ -9,12 +9,13 @@ from __future__ import annotations
 
 from sim_core.control.laws import deadbeat, lqr, pid
 from sim_core.control.laws.common import DEADBEAT_CLIMB_PER_JUMP, MEMORY_SIZE, PSI0_RANGE_DEG, DesignRequest
-from sim_core.control.laws.deadbeat import Deadbeat
+from sim_core.control.laws.deadbeat import Deadbeat, Placement
 from sim_core.control.laws.lqr import Lqr
 from sim_core.control.laws.pid import Pid
 
-Controller = Pid | Lqr | Deadbeat  # what every front end hands the compiled loop
+Controller = Pid | Lqr | Deadbeat | Placement  # what every front end hands the compiled loop
 PID, PID_PITCH, LQR, DEADBEAT = pid.NUMBER, pid.PITCH_NUMBER, lqr.NUMBER, deadbeat.NUMBER  # the compiled branches
+PLACEMENT = deadbeat.PLACEMENT_NUMBER
 
 __all__ = [
     "DEADBEAT",
@@ -23,10 +24,12 @@ __all__ = [
     "MEMORY_SIZE",
     "PID",
     "PID_PITCH",
+    "PLACEMENT",
     "PSI0_RANGE_DEG",
     "Controller",
     "Deadbeat",
     "DesignRequest",
     "Lqr",
     "Pid",
+    "Placement",
 ]

@@ -39,6 +39,8 @@ class Deadbeat:
     guard: tuple[float, ...] = ()  # the viability kernel it never leaves (sim_core.viability.guard); () for none
 
     name = "deadbeat"
+    number = NUMBER
+    angle_step_deg = 0.0  # [deg] the angle is held (the placement law steps it: :class:`Placement`)
 
     def __post_init__(self) -> None:
         check_range("target", self.target, 0.0, 1e4)
@@ -59,5 +61,29 @@ class Deadbeat:
         :mod:`sim_core.control.deadbeat`'s layout."""
         psi0_low, psi0_high = (math.radians(value) for value in self.psi0_range_deg)
         parameters = [self.target, math.radians(self.psi0_deg), self.zeta0, *self.zeta0_range, psi0_low, psi0_high,
-                      self.climb_per_jump, 1.0, *self.model, *self.state, self.q_state, *self.guard]  # fmt: skip
-        return NUMBER, np.array(parameters)
+                      self.climb_per_jump, 1.0, *self.model, *self.state, self.q_state,
+                      math.radians(self.angle_step_deg), *self.guard]  # fmt: skip
+        return self.number, np.array(parameters)
+
+
+PLACEMENT_NUMBER = 4  # the placement law's branch in the compiled dispatch
+
+
+@dataclass(frozen=True)
+class Placement(Deadbeat):
+    """The foot-placement law between parallel walls (``placement``): as :class:`Deadbeat`, the
+    next foot placed two jumps ahead on the design model, but over both legs — the leg angle at the
+    gait's and ``angle_step_deg`` either side of it, each with zeta0 over its range — and a lighter
+    weight on the state (``q_state``) so that the feet's heights lead. Between parallel walls every
+    foothold is the other wall, so placing the next foot is placing it at a height; on footholds
+    the same law's world form follows a plan (:mod:`sim_core.control.placement`)."""
+
+    q_state: float = 0.3  # per (sqrt(g l0))², against l0² of height (docs/analyses.md: 0.1 falls, 1 holds looser)
+    angle_step_deg: float = 3.0
+
+    name = "placement"
+    number = PLACEMENT_NUMBER
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_range("angle_step_deg", self.angle_step_deg, 0.0, 15.0, low_open=False)

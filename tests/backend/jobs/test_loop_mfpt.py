@@ -43,7 +43,7 @@ def test_pitch_drift_is_refused_at_its_field_in_sim_cores_words():
 @pytest.mark.parametrize(
     ("change", "where", "says"),
     [
-        ({"controller": "mpc"}, ("controller",), "'pid', 'pid-pitch', 'lqr' or 'deadbeat'"),
+        ({"controller": "mpc"}, ("controller",), "'pid', 'pid-pitch', 'lqr', 'deadbeat' or 'placement'"),
         ({"target_m": 0.0}, ("target_m",), "greater than 0"),
         ({"target_m": 2.5}, ("target_m",), "less than or equal to 2"),
         ({"psi0_deg": 70}, ("psi0_deg",), "less than or equal to 60"),

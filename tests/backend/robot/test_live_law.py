@@ -52,7 +52,7 @@ def test_the_pid_is_todays_loop_and_each_leg_keeps_its_angle():
         assert journal["state"] == pytest.approx([integral, error], rel=1e-12, abs=1e-15)
 
 
-@pytest.mark.parametrize("name", ["pid-pitch", "lqr", "deadbeat"])
+@pytest.mark.parametrize("name", ["pid-pitch", "lqr", "deadbeat", "placement"])
 def test_a_model_based_law_is_the_simulators_on_what_the_touchdown_shows(name):
     """The same compiled law, stepped on the touchdown's height [l0], pitch and section state,
     for the climb's next touchdown's wall; its memory starts at the right leg's controls."""

@@ -107,3 +107,18 @@ def test_the_lqr_on_the_return_map_holds_the_height_closest_and_rises_fastest(lo
     assert law.name == "lqr" and law.failures <= 1
     assert entry["height_rms_m"] < 0.0085 and entry["height_rms_m"] < reference["height_rms_m"]
     assert entry["rise_jumps"] <= 8 < reference["rise_jumps"]
+
+
+def test_the_placement_law_holds_the_height_no_worse_than_the_lqr(loop):
+    """Issue 42's parallel-walls target at a reduced size, on seeds neither law was tuned on (40 x
+    200, default noise): no failure, a height error no larger than the LQR's, as fast a rise."""
+    from sim_core.control.deadbeat import design_deadbeat
+    from sim_core.control.laws import Placement
+
+    lqr = design_lqr(loop.model, loop.controller.target, 35.0, loop.hover)
+    placement = design_deadbeat(loop.model, loop.controller.target, 35.0, loop.hover, law=Placement)
+    reference, law = control_study(loop.model, [lqr, placement], loop.start, 0.9, 200, 5000, 40, NoiseModel())
+    entry, lqr_entry = law.to_dict(ROBOT.leg_length), reference.to_dict(ROBOT.leg_length)
+    assert law.name == "placement" and law.failures == 0
+    assert entry["height_rms_m"] <= lqr_entry["height_rms_m"]
+    assert entry["rise_jumps"] <= lqr_entry["rise_jumps"]

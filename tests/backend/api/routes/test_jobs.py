@@ -286,7 +286,7 @@ def test_a_controllers_mfpt_job_gives_the_splittings_numbers_for_its_seed(client
 @pytest.mark.parametrize(
     ("change", "field", "says"),
     [
-        ({"controller": "mpc"}, "controller", "'pid', 'pid-pitch', 'lqr' or 'deadbeat'"),
+        ({"controller": "mpc"}, "controller", "'pid', 'pid-pitch', 'lqr', 'deadbeat' or 'placement'"),
         ({"noise": {"velocity": 0.05, "pitch_drift_deg": 0.5}}, "pitch_drift_deg", "must be 0 for a controller's MFPT"),
         ({"replicas": 1000, "runs": 64}, "loop-mfpt", "replicas x runs must be at most"),
     ],

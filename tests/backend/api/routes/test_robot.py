@@ -259,7 +259,11 @@ def test_closed_loop_live_run_holds_a_height(client, auth, connected, controller
 @pytest.mark.parametrize(
     ("change", "loc", "says"),
     [
-        ({"controller": "mpc"}, ["body", "closed_loop", "controller"], "must be one of pid, pid-pitch, lqr, deadbeat"),
+        (
+            {"controller": "mpc"},
+            ["body", "closed_loop", "controller"],
+            "must be one of pid, pid-pitch, lqr, deadbeat, placement",
+        ),
         ({"target_m": 2.5}, ["body", "closed_loop", "target_m"], "less than or equal to 2"),
         ({"target_m": 0.0}, ["body", "closed_loop", "target_m"], "greater than 0"),
         ({"zeta0_min": 0.7}, ["body", "closed_loop.zeta0_min"], "must be in [0.75, 0.98]"),

@@ -96,7 +96,7 @@ def test_simulate_mode_stops_a_descending_climb_at_the_floor_and_says_so(browser
     assert "height** 0.000 m" in readout, readout
 
 
-@pytest.mark.parametrize("name", ["lqr", "deadbeat"])
+@pytest.mark.parametrize("name", ["lqr", "deadbeat", "placement"])
 def test_a_controller_holds_the_height_a_browser_chose_and_the_readout_shows_its_command(browsers, name):
     browser, session = browsers()
     other = browsers()[1].modes["simulate"]  # a second browser's view keeps its own open loop

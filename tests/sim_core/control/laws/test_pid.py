@@ -26,4 +26,4 @@ def test_a_law_out_of_range_names_the_field(changes, field):
 
 def test_each_law_is_named_by_its_kind():
     assert Pid(HEIGHT, 35.0).name == "pid" and Pid(HEIGHT, 35.0, pitch_feedback=True).name == "pid-pitch"
-    assert KINDS == {"pid": 0, "pid-pitch": 1, "lqr": 2, "deadbeat": 3}
+    assert KINDS == {"pid": 0, "pid-pitch": 1, "lqr": 2, "deadbeat": 3, "placement": 4}
