@@ -77,6 +77,9 @@ def test_a_live_run_is_stored_with_the_models_prediction(connected, session):
     assert set(frames) == {"time", "x", "y", "pitch"} and frames["time"].size == results["tracker"]["frames"] > 0
 
 
+# Real time: how many poses arrive between two scans is the tracker's rate times how long the loop
+# waited for the interpreter; beside other work (two busy loops: 352 of 2,618) that passes the bound.
+@pytest.mark.realtime
 def test_a_long_live_run_scans_only_the_poses_of_its_last_flight(connected, session, monkeypatch):
     """Each new tracker pose costs the control loop the same at the 40th jump as at the first: it
     scans only the poses since its last scan (it rescanned the whole run at every pose, which at a
