@@ -29,6 +29,7 @@ from parkourlab.bodies import Leg, State, legs, mapping, present, state
 from parkourlab.jobs import JobCalls
 from parkourlab.types import RUN_FILTERS, Experiment, Page, Run, RunDetail, RunFilters
 from parkourlab.waiting import POLL_TIMEOUT, wait_until_ready
+from parkourlab.worlds import WorldCalls
 
 RunSort = Literal[
     "-id", "id", "-created_at", "created_at", "-climb", "climb", "-zeta0", "zeta0", "-duration_s", "duration_s"
@@ -36,7 +37,7 @@ RunSort = Literal[
 DEFAULT_PAGE_SIZE = 200  # runs fetched per request by the generators; the API allows 1..500
 
 
-class Client(JobCalls):
+class Client(JobCalls, WorldCalls):
     """A connection to one ParkourLab service.
 
     Parameters
@@ -121,6 +122,7 @@ class Client(JobCalls):
         experiment_id: int | None = None,
         trajectory_rate: float | None = None,
         fixed_point: bool = False,
+        world_id: int | None = None,
     ) -> RunDetail:
         """Simulate a run on the service and store it; returns it with its results.
 
@@ -129,7 +131,9 @@ class Client(JobCalls):
         xdot < 0. ``jumps``: how many (None: the service's default). ``model``: ``{"preset":
         "paper"}`` and nondimensional overrides (``alpha``, ``d_hat``, ``c_zeta``, ``c_psi``,
         ``mu``; docs/model.md §1). ``trajectory_rate``: also store the path, samples per
-        sqrt(l0/g). ``fixed_point``: also find the gait near ``start``."""
+        sqrt(l0/g). ``fixed_point``: also find the gait near ``start``. ``world_id``: climb that
+        stored world (:meth:`create_world`; its results are ``parkour climb``'s touchdowns) instead
+        of parallel walls."""
         body = {
             "controls": legs(controls),
             "start": state(start),
@@ -139,6 +143,7 @@ class Client(JobCalls):
             "experiment_id": experiment_id,
             "trajectory_rate": trajectory_rate,
             "fixed_point": fixed_point,
+            "world_id": world_id,
         }
         return self._http.call("POST", "/api/v1/runs", body=present(body))
 

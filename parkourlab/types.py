@@ -36,6 +36,7 @@ class Run(TypedDict):
 
     id: int
     experiment_id: int | None
+    world_id: int | None
     kind: RunKind
     status: RunStatus
     created_at: str
@@ -79,6 +80,20 @@ class Experiment(TypedDict):
     runs: int
 
 
+class World(TypedDict):
+    """A stored world: ``world`` is its §8 JSON as posted; ``source`` "posted", "named:NAME" or
+    "random:SEED"; ``runs`` and ``jobs`` count those that use it."""
+
+    id: int
+    name: str
+    world: dict[str, Any]
+    source: str
+    created_at: str
+    created_by: str | None
+    runs: int
+    jobs: int
+
+
 class Job(TypedDict):
     """A batch job. ``completed`` of ``total`` units (trials for MJTF) are done; ``progress`` is
     their ratio in [0, 1]; ``spec`` is the job's body with the service's defaults filled in.
@@ -89,6 +104,7 @@ class Job(TypedDict):
 
     id: int
     experiment_id: int | None
+    world_id: int | None
     kind: str
     state: JobState
     total: int
@@ -136,6 +152,7 @@ class RunFilters(TypedDict, total=False):
     notes or a tag (any case, 3 characters or more); ``ids``: these runs only (up to 1,000)."""
 
     experiment_id: int
+    world_id: int
     kind: RunKind
     status: RunStatus
     tag: str

@@ -23,7 +23,7 @@ from fastapi.staticfiles import StaticFiles
 from backend.api import errors, security, statuses
 from backend.api.deps import Database
 from backend.api.identity import Identities
-from backend.api.routes import calibrations, catalog, experiments, jobs, robot, runs, sim, site, view
+from backend.api.routes import calibrations, catalog, experiments, jobs, robot, runs, sim, site, view, worlds
 from backend.api.token_file import api_token
 from backend.services import exports, quick_calls, studies
 from backend.services import runs as run_service
@@ -41,7 +41,7 @@ log = logging.getLogger("parkourlab.api")
 # The control panel's static files (frontend/panel): located, not imported — the frontend sits above
 # the backend in the layers, and the backend only serves its files.
 PANEL_DIR = Path(__file__).resolve().parents[2] / "frontend" / "panel"
-ROUTERS = (site, catalog, experiments, runs, calibrations, jobs, robot, view, sim)
+ROUTERS = (site, catalog, experiments, runs, calibrations, worlds, jobs, robot, view, sim)
 # Threads that run the sync routes (database work; compute is awaited in worker processes, the
 # e-stop is async). anyio's default is 40: under load 40 threads ping-pong the GIL once per row
 # SQLite steps, and on this 2-core machine 20 clients got 116 pages/s, p95 378 ms; with 4, 143

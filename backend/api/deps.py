@@ -71,6 +71,7 @@ async def database(request: Request) -> Database:
 
 async def run_filter(
     experiment_id: Annotated[int | None, Query(ge=1, le=schemas.MAX_ID)] = None,
+    world_id: Annotated[int | None, Query(ge=1, le=schemas.MAX_ID, description="runs in this stored world")] = None,
     kind: schemas.RunKind | None = None,
     status_: Annotated[schemas.RunStatus | None, Query(alias="status")] = None,
     tag: Annotated[str | None, Query(max_length=64)] = None,
@@ -109,6 +110,7 @@ async def run_filter(
         raise RequestValidationError([{"loc": ("query", "q"), "msg": message, "type": "string_too_short", "input": q}])
     return RunFilter(
         experiment_id=experiment_id,
+        world_id=world_id,
         kind=kind,
         status=status_,
         tag=tag,

@@ -31,6 +31,7 @@ class RunFilter:
     trigrams finds; a shorter one is a ValueError); ``ids`` keeps only the runs named (a basket)."""
 
     experiment_id: int | None = None
+    world_id: int | None = None
     kind: str | None = None
     status: str | None = None
     tag: str | None = None
@@ -139,6 +140,7 @@ def _among_tagged_since(since):
 # criterion reads an index.
 _CONDITIONS = {
     "experiment_id": lambda v: Run.experiment_id == v,
+    "world_id": lambda v: Run.world_id == v,
     "kind": lambda v: Run.kind == v,
     "status": lambda v: Run.status == v,
     "failure_code": lambda v: Run.failure_code == v,

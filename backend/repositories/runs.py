@@ -28,9 +28,9 @@ from backend.store.run_record import RunRecord
 # The columns of a listed run (the API's RunOut less its tags), read as plain rows; its JSON
 # columns come as text (LISTED_JSON) and a page decodes them in one call (listed_page).
 LISTED_JSON = ("model", "controls", "start_state")
-LISTED = (Run.id, Run.experiment_id, Run.kind, Run.status, Run.created_at, Run.duration_s, Run.code_version,
-          Run.jumps, Run.jumps_completed, Run.failure_code, Run.climb, Run.notes, Run.end_reason, Run.loop,
-          Run.controller, Run.target, Run.touchdowns, Run.created_by, Run.notes_by,
+LISTED = (Run.id, Run.experiment_id, Run.world_id, Run.kind, Run.status, Run.created_at, Run.duration_s,
+          Run.code_version, Run.jumps, Run.jumps_completed, Run.failure_code, Run.climb, Run.notes, Run.end_reason,
+          Run.loop, Run.controller, Run.target, Run.touchdowns, Run.created_by, Run.notes_by,
           Run.trajectory.is_not(None).label("has_trajectory"),
           *(cast(getattr(Run, name), Text).label(name) for name in LISTED_JSON))  # fmt: skip
 # A run's tags as one text (group_concat on SQLite, string_agg on PostgreSQL), split by a character
@@ -41,9 +41,9 @@ _TAG_LIST = (
 ).label("tag_list")
 # What an export reads of each run: the record's own columns, then its JSON columns as text.
 JSON_COLUMNS = ("model", "controls", "start_state")
-EXPORTED = (Run.id, Run.experiment_id, Run.kind, Run.status, Run.created_at, Run.duration_s, Run.code_version,
-            Run.notes, Run.jumps, Run.jumps_completed, Run.failure_code, Run.climb, Run.end_reason, Run.loop,
-            Run.controller, Run.target, Run.touchdowns, Run.created_by, Run.notes_by,
+EXPORTED = (Run.id, Run.experiment_id, Run.world_id, Run.kind, Run.status, Run.created_at, Run.duration_s,
+            Run.code_version, Run.notes, Run.jumps, Run.jumps_completed, Run.failure_code, Run.climb, Run.end_reason,
+            Run.loop, Run.controller, Run.target, Run.touchdowns, Run.created_by, Run.notes_by,
             *(cast(getattr(Run, name), Text).label(name) for name in JSON_COLUMNS))  # fmt: skip
 # What a list sorts by: each an indexed column (id, then the column's order; -name: descending).
 SORTED_BY = ("id", "created_at", "climb", "zeta0", "psi0_deg", "duration_s", "jumps_completed", "kind", "status",

@@ -66,6 +66,7 @@ from backend.schemas.runs import (
 )
 from backend.schemas.sim import FixedPointIn, FixedPointOut, MapIn, MapOut, TrajectoryIn, TrajectoryOut
 from backend.schemas.view import VIEWER_ID_PATTERN, ViewerId, ViewOut, ViewReplay
+from backend.schemas.worlds import RandomWorldIn, WorldCreate, WorldOut, WorldPage, WorldRename
 
 __all__ = [
     "CLIENT_PATTERN",
@@ -111,6 +112,7 @@ __all__ = [
     "NoiseIn",
     "Page",
     "Psi0Deg",
+    "RandomWorldIn",
     "RecordRef",
     "RobotConnect",
     "RobotEstopOut",
@@ -139,6 +141,10 @@ __all__ = [
     "ViewOut",
     "ViewReplay",
     "ViewerId",
+    "WorldCreate",
+    "WorldOut",
+    "WorldPage",
+    "WorldRename",
     "Zeta0",
     "finite_or_none",
 ]  # fmt: skip

@@ -27,6 +27,7 @@ class JobState(enum.StrEnum):
 class JobOut(BaseModel):
     id: int
     experiment_id: int | None
+    world_id: int | None = Field(None, description="the stored world it works in; null: parallel walls")
     kind: str
     state: JobState
     total: int

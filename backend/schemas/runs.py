@@ -48,6 +48,9 @@ class RunBase(BaseModel):
     """What a run is asked for with and keeps: its experiment, length and labels."""
 
     experiment_id: RecordRef | None = None
+    world_id: RecordRef | None = Field(
+        None, description="the stored world it climbs (GET /api/v1/worlds); none: parallel walls"
+    )
     jumps: Jumps = 20
     tags: Tags = []
 

@@ -139,6 +139,7 @@ def public(job: Job, standing: Standing | None = None) -> JobOut:
     return JobOut(
         id=job.id,
         experiment_id=job.experiment_id,
+        world_id=job.world_id,
         kind=job.kind,
         state=job.state,
         total=job.total,

@@ -9,6 +9,8 @@ them in each worker at start-up. Hence the imports inside the functions below.
 
 from __future__ import annotations
 
+import itertools
+import math
 import threading
 import time
 from collections.abc import Callable
@@ -107,8 +109,9 @@ def _gait_of(model: ModelParams, schedule: ControlSchedule, period: int | None, 
         return gait_of(model, schedule, period, None if guess is None else (guess.xdot, guess.ydot))
 
 
-def simulate_run(body: RunCreate) -> RunRecord:
-    """Run the map (and the sampled path if asked): the run to store (its tags are the caller's)."""
+def simulate_run(body: RunCreate, world: dict | None = None) -> RunRecord:
+    """Run the map (and the sampled path if asked): the run to store (its tags are the caller's);
+    in ``world`` (its §8 JSON in ``l0``) where given, the climb of ``parkour climb``."""
     from sim_core.model.poincare import iterate_map
     from sim_core.model.trajectory import simulate_trajectory
 
@@ -116,12 +119,17 @@ def simulate_run(body: RunCreate) -> RunRecord:
     start = (body.start.xdot, body.start.ydot)
     began = time.perf_counter()
     trajectory = None
-    with KERNEL_LOCK:
-        orbit = iterate_map(model, schedule, start, body.jumps)
-        if body.trajectory_rate is not None:
-            path = simulate_trajectory(model, schedule, start, body.jumps, sample_rate=body.trajectory_rate)
-            trajectory = pack_trajectory(path.columns())
-    results = orbit.to_dict()
+    if world is not None:
+        results, failure_code, jumps_completed, climb, trajectory = _world_climb(body, model, schedule, start, world)
+    else:
+        with KERNEL_LOCK:
+            orbit = iterate_map(model, schedule, start, body.jumps)
+            if body.trajectory_rate is not None:
+                path = simulate_trajectory(model, schedule, start, body.jumps, sample_rate=body.trajectory_rate)
+                trajectory = pack_trajectory(path.columns())
+        results = orbit.to_dict()
+        failure_code = None if orbit.failure is None else orbit.failure.code
+        jumps_completed, climb = orbit.jumps_completed, float(np.sum(orbit.rises))
     if body.fixed_point:
         results["fixed_point"] = _gait_near(model, schedule, start)
     return RunRecord(
@@ -133,12 +141,40 @@ def simulate_run(body: RunCreate) -> RunRecord:
         controls=[[leg.psi0_deg, leg.zeta0] for leg in body.controls],
         start_state=list(start),
         jumps=body.jumps,
-        failure_code=None if orbit.failure is None else orbit.failure.code,
-        jumps_completed=orbit.jumps_completed,
-        climb=float(np.sum(orbit.rises)),
+        failure_code=failure_code,
+        jumps_completed=jumps_completed,
+        climb=climb,
         results=json_safe(results),
         trajectory=trajectory,
     )
+
+
+def _world_climb(body: RunCreate, model, schedule, start, document: dict):
+    """A run in a world: ``(results, failure code, jumps completed, climb [l0], path or None)``; the
+    results are ``parkour climb``'s touchdowns and failure, with each jump's rise of the foot."""
+    from sim_core.world.climb import climb_world
+    from sim_core.world.files import world_from_document
+    from sim_core.world.trajectory import simulate_world_trajectory
+
+    world, trajectory = world_from_document(document), None
+    with KERNEL_LOCK:
+        if body.trajectory_rate is None:
+            climb = climb_world(model, world, schedule, start, body.jumps)
+        else:
+            path, climb = simulate_world_trajectory(model, world, schedule, start, body.jumps,
+                                                    sample_rate=body.trajectory_rate)  # fmt: skip
+            trajectory = pack_trajectory(path.columns())
+    results = climb.to_dict()
+    touchdowns = results["touchdowns"]
+    feet = [td["y"] - height for td, height in zip(touchdowns, _leg_heights(schedule, len(touchdowns)), strict=True)]
+    results["rises"] = [after - before for before, after in itertools.pairwise(feet)]
+    failure_code = None if climb.failure is None else climb.failure.code
+    return results, failure_code, len(touchdowns) - 1, float(sum(results["rises"])), trajectory
+
+
+def _leg_heights(schedule, touchdowns: int) -> list[float]:
+    """How far each touchdown's body is above its foot [l0]: its leg's ``zeta0 sin psi0``."""
+    return [schedule[k].zeta0 * math.sin(schedule[k].psi0) for k in range(touchdowns)]
 
 
 def _gait_near(model, schedule, start) -> dict:

@@ -22,12 +22,14 @@ from sqlalchemy.orm import Session
 from backend.errors import NotFound
 from backend.repositories import experiments as stored_experiments
 from backend.repositories import runs as stored_runs
+from backend.repositories import worlds as stored_worlds
 from backend.repositories.runs import RunFilter
 from backend.schemas import RunAggregate, RunComparison, RunCreate, RunDetail, RunOut, RunTrajectory
 from backend.services.exports import flat_record
 from backend.services.presets import InSession, preset_resolved
 from backend.services.quick_calls import simulate_run
 from backend.services.run_stats import stats
+from backend.services.worlds import world_in_l0
 from backend.store.database import freeing_space
 from backend.store.models import Run
 from backend.store.run_record import RunRecord
@@ -53,33 +55,40 @@ async def create(in_session: InSession, compute, body: RunCreate, *, person: str
     simulation is paid for, the simulation awaited (no request thread waits for it), the run stored
     in a request thread."""
     body = await preset_resolved(in_session, body)
-    if body.experiment_id is not None:
-        await in_session(check_run_request, body)
-    record = await compute.call(simulate_run, body)
+    world = None
+    if body.experiment_id is not None or body.world_id is not None:
+        world = await in_session(check_run_request, body)
+    record = await compute.call(simulate_run, body, world)
     return await in_session(store_run, body, record, person=person)
 
 
 def create_run(session: Session, body: RunCreate, compute=None, *, person: str | None = None) -> RunDetail:
     """:func:`create` without an event loop: simulated in ``compute``'s workers or, without one, here."""
-    check_run_request(session, body)
+    world = check_run_request(session, body)
     # Simulated before the lock is taken: it takes a while.
-    record = simulate_run(body) if compute is None else compute.run(simulate_run, body)
+    record = simulate_run(body, world) if compute is None else compute.run(simulate_run, body, world)
     return store_run(session, body, record, person=person)
 
 
-def check_run_request(session: Session, body: RunCreate) -> None:
-    """What a run request names exists (its experiment): checked before the simulation is paid for."""
+def check_run_request(session: Session, body: RunCreate) -> dict | None:
+    """What a run request names exists (its experiment, its world): checked before the simulation is
+    paid for. Returns the world's §8 JSON in ``l0`` (metres read with the model preset's leg length),
+    or None for parallel walls."""
     if body.experiment_id is not None:
         stored_experiments.get(session, body.experiment_id)
+    if body.world_id is None:
+        return None
+    return world_in_l0(session, body.world_id, body.model.preset)
 
 
 def store_run(session: Session, body: RunCreate, record: RunRecord, *, person: str | None = None) -> RunDetail:
     """Store ``record``, simulated for ``body`` asked by ``person``, with the request's experiment and tags."""
     if body.experiment_id is not None:  # still there (a concurrent delete waits for this commit)
         stored_experiments.locked_experiment(session, body.experiment_id)
-    run = stored_runs.add_run(
-        session, dataclasses.replace(record, tags=tuple(body.tags)), experiment_id=body.experiment_id, created_by=person
-    )
+    if body.world_id is not None:  # the same for its world
+        stored_worlds.locked(session, body.world_id)
+    record = dataclasses.replace(record, tags=tuple(body.tags), world_id=body.world_id)
+    run = stored_runs.add_run(session, record, experiment_id=body.experiment_id, created_by=person)
     session.commit()
     stored_runs.stored_has_trajectory(run, record.trajectory is not None)
     return run_detail(run)
@@ -202,6 +211,7 @@ def _fields(run: Run) -> dict:
     return {
         "id": run.id,
         "experiment_id": run.experiment_id,
+        "world_id": run.world_id,
         "kind": run.kind,
         "status": run.status,
         "created_at": run.created_at,

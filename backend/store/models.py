@@ -67,6 +67,21 @@ class Experiment(Base):
     runs: Mapped[list[Run]] = relationship(back_populates="experiment")
 
 
+class World(Base):
+    """A world (docs/model.md §8) the lab stored by name: the §8 JSON as it was posted (coordinates
+    exact), where it came from (``source``: "posted", "named:staircase", "random:7"), who stored it
+    and when. Runs, robot runs and jobs in it refer to it (``world_id``); none: parallel walls."""
+
+    __tablename__ = "worlds"
+
+    id: Mapped[int] = mapped_column(primary_key=True)
+    name: Mapped[str] = mapped_column(String(200), unique=True)
+    document: Mapped[dict]
+    source: Mapped[str] = mapped_column(String(200))
+    created_at: Mapped[datetime.datetime] = mapped_column(default=utcnow, index=True)
+    created_by: Mapped[str | None] = mapped_column(String(64))
+
+
 class Run(Base):
     __tablename__ = "runs"
 
@@ -106,6 +121,8 @@ class Run(Base):
     touchdowns: Mapped[int | None]  # robot and replay runs: touchdowns recorded (what their jumps count)
     created_by: Mapped[str | None] = mapped_column(String(64))  # the person (null: stored before people had names)
     notes_by: Mapped[str | None] = mapped_column(String(64))  # who last wrote its notes or tags
+    # The world it ran in (migration 0013); None: parallel walls, as every run before worlds.
+    world_id: Mapped[int | None] = mapped_column(ForeignKey("worlds.id"), index=True)
 
     experiment: Mapped[Experiment | None] = relationship(back_populates="runs")
     run_tags: Mapped[list[RunTag]] = relationship(cascade="all, delete-orphan", lazy="selectin")
@@ -182,6 +199,7 @@ class Job(Base):
     finished_at: Mapped[datetime.datetime | None]
     submitted_by: Mapped[str | None] = mapped_column(String(64))  # the person: the queue's shares are per person
     submitted_via: Mapped[str | None] = mapped_column(String(64))  # the tool (X-Parkour-Client), a label only
+    world_id: Mapped[int | None] = mapped_column(ForeignKey("worlds.id"), index=True)
 
     trials: Mapped[list[Trial]] = relationship(back_populates="job", cascade="all, delete-orphan")
 

@@ -26,4 +26,5 @@ class RunRecord:
     failure_code: str | None = None
     duration_s: float = 0.0  # [s] wall-clock time it took
     trajectory: bytes | None = None  # the sampled path (backend.store.trajectory_blob.pack_trajectory)
+    world_id: int | None = None  # the stored world it ran in (None: parallel walls)
     tags: tuple[str, ...] = field(default=())

@@ -3,7 +3,7 @@ SQLite and on PostgreSQL."""
 
 from alembic.autogenerate import compare_metadata
 from alembic.migration import MigrationContext
-from sqlalchemy import inspect
+from sqlalchemy import inspect, text
 
 from backend.store.database import make_engine, migrate, sqlite_url
 from backend.store.models import Base, modelled
@@ -141,3 +141,27 @@ def test_the_search_index_is_built_and_kept(empty_database_url):
             assert "Bitmap Index Scan on ix_runs_notes_trgm" in plan, plan  # the notes: never every run's
             assert connection.execute(query).scalars().all() == [7]
     engine.dispose()
+
+
+def test_runs_and_jobs_stored_before_worlds_are_on_parallel_walls(empty_database_url):
+    """Migration 0013: the worlds table, and ``world_id`` null on every run and job stored before."""
+    run = RUN_COLUMNS + OLD_RUN.format(id=1, kind="sim", status="done", results="{}")
+    assert _row_after_upgrade(empty_database_url, "0012", run, "SELECT id, world_id FROM runs") == (1, None)
+
+
+def test_the_search_index_still_follows_notes_after_worlds(empty_database_url):
+    """0013 adds ``runs.world_id`` in place: the triggers that keep History's search (0012) stay."""
+    engine = make_engine(empty_database_url)
+    migrate(engine)
+    try:
+        with engine.begin() as connection:
+            connection.exec_driver_sql(RUN_COLUMNS + OLD_RUN.format(id=7, kind="sim", status="done", results="{}"))
+            connection.exec_driver_sql("UPDATE runs SET notes = 'slipped on the third foothold' WHERE id = 7")
+        with engine.connect() as connection:
+            if engine.dialect.name == "sqlite":
+                found = connection.execute(text("SELECT rowid FROM run_search WHERE notes LIKE '%third%'")).all()
+            else:
+                found = connection.execute(text("SELECT id FROM runs WHERE notes ILIKE '%third%'")).all()
+    finally:
+        engine.dispose()
+    assert [tuple(row) for row in found] == [(7,)]

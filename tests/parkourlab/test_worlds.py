@@ -1,0 +1,48 @@
+"""Worlds through the client (parkourlab/worlds.py), against the real service: a world file stored
+and read back as written, a random one from its seed, renamed, deleted; mistakes as the client's
+own exceptions, naming the field."""
+
+import pytest
+
+from parkourlab import Conflict, InvalidRequest
+from sim_core.model.presets import get_preset
+from sim_core.world.files import world_to_document
+from sim_core.world.named import named_world
+
+WALL = {
+    "units": "m",
+    "left": {"points": [[-0.27, 0.0], [-0.25, 0.3333333333333333], [-0.27, 0.9]], "mu": [0.6, None]},
+    "right": {"points": [[0.27, 0.0], [0.27, 0.9]], "mu": ["inf"]},
+}
+
+
+def test_a_world_file_goes_in_and_comes_back_as_written(client):
+    stored = client.create_world("client wall", world=WALL)
+    assert stored["world"] == WALL and stored["source"] == "posted"
+    assert client.world(stored["id"])["world"] == WALL
+    assert client.rename_world(stored["id"], "client wall 2")["name"] == "client wall 2"
+    assert "client wall 2" in [world["name"] for world in client.worlds(page_size=1)]
+    client.delete_world(stored["id"])
+    assert "client wall 2" not in [world["name"] for world in client.worlds()]
+
+
+def test_named_and_random_worlds_and_mistakes(client):
+    stairs = client.create_world("client stairs", named="staircase")
+    expected = world_to_document(named_world("staircase", get_preset("paper").to_model().d_hat))
+    assert stairs["world"]["left"]["points"] == expected["left"]["points"]
+    assert client.create_world("client random", random={"seed": 11})["source"] == "random:11"
+    with pytest.raises(Conflict):
+        client.create_world("client stairs", named="staircase")
+    with pytest.raises(InvalidRequest) as caught:
+        client.create_world("broken", world=WALL | {"right": {"points": [[0.27, 0.0]]}})
+    assert "world.right.points" in str(caught.value)
+
+
+def test_a_run_in_a_stored_world_and_the_runs_of_a_world(client):
+    world = client.create_world("client climb", named="narrowing")
+    run = client.create_run([(30, 0.9)], (-1.0, 0.5), jumps=5, world_id=world["id"])
+    assert run["world_id"] == world["id"] and len(run["results"]["touchdowns"]) >= 2
+    assert [listed["id"] for listed in client.runs(world_id=world["id"])] == [run["id"]]
+    with pytest.raises(Conflict) as caught:
+        client.delete_world(world["id"])
+    assert f"run {run['id']}" in str(caught.value)
