@@ -8,7 +8,7 @@ import enum
 import math
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, Field, ValidationInfo, field_validator
+from pydantic import BaseModel, Field, ValidationInfo, field_validator, model_validator
 
 from backend.schemas.common import (
     MAX_JUMPS,
@@ -67,6 +67,12 @@ class RunCreate(RunBase, Strict):
         json_schema_extra={"x-max-rate-times-jumps": MAX_PATH_SAMPLES},  # the panel thins a long run's path by it
     )
     fixed_point: bool = Field(False, description="also find the gait near the start state and store its eigenvalues")
+
+    @model_validator(mode="after")
+    def _gaits_are_parallel_walls(self) -> RunCreate:
+        if self.fixed_point and self.world_id is not None:  # a gait is a fixed point of parallel walls' map
+            raise ValueError("fixed_point: gaits are found between parallel walls, not in a world (world_id)")
+        return self
 
     @field_validator("trajectory_rate")
     @classmethod

@@ -133,3 +133,5 @@ def test_a_run_in_a_world_is_parkour_climbs_climb_and_is_listed_by_world(client,
     listed = client.get("/api/v1/runs", params={"world_id": world["id"]}).json()
     assert [item["id"] for item in listed["items"]] == [run["id"]] and listed["items"][0]["world_id"] == world["id"]
     assert client.post("/api/v1/runs", json=RUN | {"world_id": 999}, headers=auth).status_code == 404
+    gait = client.post("/api/v1/runs", json=RUN | {"world_id": world["id"], "fixed_point": True}, headers=auth)
+    assert gait.status_code == 422 and "gaits are found between parallel walls" in gait.text
