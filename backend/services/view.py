@@ -107,9 +107,12 @@ class StoredPath:
 
 def stored_path(sessions: Callable, run_id: int) -> StoredPath:
     """Stored run ``run_id`` as the view replays it. Raises NotFound when there is no such run,
-    Conflict when a robot or replay run has no tracker frames."""
+    Conflict when a robot or replay run has no tracker frames or the run climbed a stored world."""
     with sessions() as session:
         run = run_rows.get_run(session, run_id)
+        if run.world_id is not None:  # drawn between parallel walls it would show walls it never met
+            raise Conflict(f"run {run_id} climbed world {run.world_id}, and the 3D view draws parallel walls only "
+                           "(worlds in the view are the next slice of issue 43)")  # fmt: skip
         source = run
         if run.kind == "replay":
             source = run_rows.get_run(session, int(run.results.get("source_run_id", 0)) or run_id)

@@ -3,8 +3,10 @@ shared file both take it (touchdowns passed, the trail of the jump under way), a
 loaded through the service. (Robot and replay runs are loaded in test_share.py's fixture.)"""
 
 import numpy as np
+import pytest
 from numpy.testing import assert_array_equal
 
+from backend.errors import Conflict
 from frontend.viewer.motion import PathClip
 from frontend.viewer.recordings import MAX_TRAIL_SECONDS, Recording, load_recording
 from sim_core import get_preset
@@ -48,6 +50,17 @@ def test_recordings_put_sim_runs_between_the_walls(service):
     stance_feet = recording.clip.foot_x[recording.clip.phase == 0]
     assert np.allclose(np.abs(stance_feet), half), "stance feet are on the walls"
     assert np.all(np.abs(recording.clip.x) < half)
+
+
+def test_a_run_in_a_world_is_not_replayed_between_parallel_walls(service):
+    """Its stored path (or one simulated again from its controls) drawn between the view's walls
+    would show walls it never met: refused, said why."""
+    client, auth, view = service
+    world = client.post("/api/v1/worlds", json={"name": "replayed", "named": "staircase"}, headers=auth).json()
+    body = RUN | {"world_id": world["id"], "start": {"xdot": -1.0, "ydot": 0.5}, "trajectory_rate": 50}
+    run = client.post("/api/v1/runs", json=body, headers=auth).json()
+    with pytest.raises(Conflict, match=f"climbed world {world['id']}"):
+        load_recording(view.context.sessions, run["id"])
 
 
 def _stored(**changes):
