@@ -244,6 +244,8 @@ def test_closed_loop_live_run_holds_a_height(client, auth, connected, controller
     run = client.get(f"/api/v1/runs/{status['run']['stored_run_id']}").json()
     results = run["results"]
     heights = [td["body_height"] for td in results["touchdowns"]]
+    # Once (a CI run, 2026-12-06) pid's run ended after one touchdown, why unrecorded: say it if again.
+    assert results.get("end_reason") == "jumps done" and len(heights) == 25, (results.get("end_reason"), heights)
     # The robot answers in real time, so when each command lands differs from run to run (by up to
     # 0.035 m in a jump of a loaded CI machine): the loop must close the gap, not trace one path.
     errors = [abs(h - 0.4) for h in heights]
