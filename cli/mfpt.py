@@ -17,6 +17,7 @@ from cli.options import (
     parse_controls,
     print_json,
     progress_bar,
+    refuse_given,
     with_model,
     with_noise,
 )
@@ -86,7 +87,7 @@ def mfpt_command(
     (xdot, ydot, pitch), or of a controller holding a height (--controller) by splitting."""
     if controller is not None:
         given = {"--grid": grid, "--pitch-spacing": pitch_spacing, "--start": start, "--guess": guess}
-        _refuse_given(
+        refuse_given(
             given | {"--no-cache": no_cache or None}, "applies to the chain of fixed controls, not with --controller"
         )
         from cli.mfpt_loop import controller_mfpt
@@ -94,14 +95,8 @@ def mfpt_command(
         splitting = {"replicas": replicas, "runs": runs, "seed": seed}
         controller_mfpt(setup, noise, controller, controls or CLIMB_CONTROLS, target, splitting, as_json)
         return
-    _refuse_given({"--target": target, "--replicas": replicas, "--runs": runs, "--seed": seed}, "needs --controller")
+    refuse_given({"--target": target, "--replicas": replicas, "--runs": runs, "--seed": seed}, "needs --controller")
     _chain_mfpt(setup, noise, controls or GAIT_CONTROLS, grid, pitch_spacing, start, guess, no_cache, as_json)
-
-
-def _refuse_given(options: dict, why: str) -> None:
-    for option, value in options.items():
-        if value is not None:
-            raise ParameterError(option, why)
 
 
 def _chain_mfpt(setup, noise, controls, grid, pitch_spacing, start, guess, no_cache, as_json) -> None:

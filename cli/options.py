@@ -269,6 +269,13 @@ def progress_bar(description: str) -> Iterator[Callable[..., None]]:
         yield update
 
 
+def refuse_given(options: dict, why: str) -> None:
+    """A ParameterError naming the first of ``options`` (option -> value) given (not None), saying ``why``."""
+    for option, value in options.items():
+        if value is not None:
+            raise ParameterError(option, why)
+
+
 def note(message: str) -> None:
     """Progress and side information for people: stderr, so stdout stays parseable."""
     print(message, file=sys.stderr)

@@ -3,7 +3,7 @@ the mean jumps to failure of climbs made again and again (:mod:`sim_core.plannin
 
 from __future__ import annotations
 
-from cli.options import option_named, progress_bar
+from cli.options import option_named, progress_bar, refuse_given
 from sim_core.model.errors import ParameterError
 
 MAX_MONTE_CARLO = 100_000
@@ -12,11 +12,9 @@ MAX_MONTE_CARLO = 100_000
 def check_mfpt_options(mfpt: bool, replicas, runs, replans, monte_carlo, seed: int):
     """The splitting's options (None without --mfpt); an option given without --mfpt, or out of
     range, is an error naming it."""
-    given = {"--replicas": replicas, "--runs": runs, "--replans": replans, "--monte-carlo": monte_carlo}
     if not mfpt:
-        for option, value in given.items():
-            if value is not None:
-                raise ParameterError(option, "needs --mfpt")
+        refuse_given({"--replicas": replicas, "--runs": runs, "--replans": replans, "--monte-carlo": monte_carlo},
+                     "needs --mfpt")  # fmt: skip
         return None
     from sim_core.planning.plan_splitting import PlanSplitting
 

@@ -53,6 +53,12 @@ class Attempt:
     failed: bool = False
 
     @property
+    def jumps(self) -> int:
+        """The jumps it completed (to its last touchdown: a failing jump is not counted, as in
+        :class:`sim_core.planning.follow.FollowOutcome`)."""
+        return int(self.states[-1][0][JUMP])
+
+    @property
     def level(self) -> float:
         return math.inf if self.failed else self.scores[-1]
 

@@ -38,7 +38,7 @@ from sim_core.model.noise import NoiseModel
 from sim_core.model.params import ModelParams
 from sim_core.model.validation import check_range
 from sim_core.planning.attempts import Attempt, Attempts
-from sim_core.planning.follow import JUMP, MAX_REPLANS
+from sim_core.planning.follow import MAX_REPLANS
 from sim_core.planning.planner import Plan
 from sim_core.robustness.ams import ams_chance
 from sim_core.world.world import World
@@ -109,7 +109,7 @@ def _splitting_run(follower: Attempts, options: PlanSplitting, run: int) -> tupl
     rng = np.random.default_rng((options.seed, run))
     first_seed = options.seed + run * options.replicas
     attempts = [follower.start(first_seed + i) for i in range(options.replicas)]
-    jumps = [int(attempt.states[-1][0][JUMP]) for attempt in attempts]
+    jumps = [attempt.jumps for attempt in attempts]
 
     def branch(parent: Attempt, floor: float) -> tuple[Attempt, float]:
         cut = parent.cut(floor)
@@ -211,7 +211,7 @@ def plan_monte_carlo(
     for i in range(trials):
         attempt = follower.start(first_seed + i)
         failures += attempt.failed
-        jumps += int(attempt.states[-1][0][JUMP])
+        jumps += attempt.jumps
         if progress is not None and (i + 1) % 100 == 0:
             progress(i + 1, trials)
     low = float(beta.ppf(0.025, failures, trials - failures + 1)) if failures else 0.0

@@ -7,7 +7,7 @@ import pytest
 from sim_core.model.noise import NO_NOISE, NoiseModel
 from sim_core.model.validation import ParameterError
 from sim_core.planning.attempts import Attempts
-from sim_core.planning.follow import JUMP, follow_plan
+from sim_core.planning.follow import follow_plan
 from sim_core.planning.plan_splitting import PlanSplitting, plan_mfpt, plan_monte_carlo
 from sim_core.planning.planner import plan_climb, start_velocity
 from sim_core.world.random_world import random_world
@@ -32,7 +32,7 @@ def test_an_attempt_is_the_foothold_studys_trial_of_its_seed(paper, climb, repla
         attempt = follower.start(seed)
         trial = follow_plan(paper, world, plan, GOAL, noise, seed, max_replans=replans)
         assert attempt.failed == (not trial.reached)
-        assert int(attempt.states[-1][0][JUMP]) == trial.jumps
+        assert attempt.jumps == trial.jumps
         assert attempt.states[-1][3] == trial.replans
 
 
