@@ -73,8 +73,7 @@ def plan_command(
             "goal_height", f"no plan reaches {goal_height:g} m in {chosen.name}: the highest reachable is "
             f"{plan.highest * metres:.3f} m"
         )  # fmt: skip
-    document = {"reaches_goal": True, "plan": [step.to_dict() for step in plan.steps], "seconds": plan.seconds,
-                "highest_m": plan.highest * metres, "chance": plan.chance}  # fmt: skip
+    document = plan.to_dict(metres)
     if splitting is not None:
         from cli.plan_mfpt import plan_mfpt_document
 

@@ -1,14 +1,16 @@
 """Worlds through the client: store one (the §8 JSON, a named world, or random footholds from a
-seed), list, read back as posted, rename, delete. The part of :class:`parkourlab.Client` that deals
-with ``/api/v1/worlds`` (docs/worlds.md, "Worlds in the service")."""
+seed), list, read back as posted, rename, delete; and the jobs that work in worlds (a foothold
+study, a plan, Mean Jumps To Failure in a world), followed as any job (:mod:`parkourlab.jobs`).
+The part of :class:`parkourlab.Client` that deals with ``/api/v1/worlds`` (docs/worlds.md,
+"Worlds in the service")."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-from parkourlab.bodies import mapping, present
-from parkourlab.types import World
+from parkourlab.bodies import Leg, State, legs, mapping, present, state
+from parkourlab.types import Job, World
 
 if TYPE_CHECKING:
     from parkourlab._http import Http
@@ -52,3 +54,71 @@ class WorldCalls:
     def delete_world(self, world_id: int) -> None:
         """Delete a world; :class:`~parkourlab.Conflict` (naming one) while a run or job uses it."""
         self._http.call("DELETE", f"/api/v1/worlds/{world_id}")
+
+    def submit_foothold_study(
+        self,
+        goal_height_m: float,
+        *,
+        world_id: int | None = None,
+        random_worlds: Mapping[str, int] | None = None,
+        trials: int | None = None,
+        cap: int | None = None,
+        seed: int | None = None,
+        noise: Mapping[str, float] | None = None,
+        start: State | None = None,
+        model: Mapping[str, Any] | None = None,
+        experiment_id: int | None = None,
+    ) -> Job:
+        """The foothold study (``parkour foothold-study``) on the stored world ``world_id`` or on
+        ``random_worlds`` (``{"count", "seed0"}``): foot placement following a plan against the best
+        fixed schedule, ``trials`` noisy climbs a world and method to a foot at ``goal_height_m``
+        [m]. Its result is the command's ``--json``; each world is stored as it finishes (a
+        restarted service goes on from there)."""
+        spec = {"world_id": world_id, "random_worlds": mapping(random_worlds), "goal_height_m": goal_height_m}
+        spec |= {"trials": trials, "cap": cap, "seed": seed, "noise": mapping(noise), "state": state(start)}
+        return self._job("foothold-study", spec, model, experiment_id)
+
+    def submit_plan(
+        self,
+        world_id: int,
+        goal_height_m: float,
+        *,
+        attempts: int | None = None,
+        replans: int | None = None,
+        cap: int | None = None,
+        seed: int | None = None,
+        noise: Mapping[str, float] | None = None,
+        start: State | None = None,
+        model: Mapping[str, Any] | None = None,
+        experiment_id: int | None = None,
+    ) -> Job:
+        """The most robust plan up the stored world ``world_id`` to ``goal_height_m`` [m] (``parkour
+        plan``); with ``attempts``, that many noisy climbs of it by the placement law, counted."""
+        spec = {"world_id": world_id, "goal_height_m": goal_height_m, "attempts": attempts, "replans": replans}
+        spec |= {"cap": cap, "seed": seed, "noise": mapping(noise), "state": state(start)}
+        return self._job("plan", spec, model, experiment_id)
+
+    def submit_world_mjtf(
+        self,
+        world_id: int,
+        controls: Sequence[Leg],
+        *,
+        goal_height_m: float | None = None,
+        trials: int | None = None,
+        cap: int | None = None,
+        seed: int | None = None,
+        noise: Mapping[str, float] | None = None,
+        start: State | None = None,
+        model: Mapping[str, Any] | None = None,
+        experiment_id: int | None = None,
+    ) -> Job:
+        """Mean Jumps To Failure in the stored world ``world_id``: ``trials`` noisy climbs of
+        ``controls`` (legs ``(psi0_deg, zeta0)`` in turn), each to a failure, ``cap`` jumps or a
+        foot at ``goal_height_m`` [m]."""
+        spec = {"world_id": world_id, "controls": legs(controls), "goal_height_m": goal_height_m, "trials": trials}
+        spec |= {"cap": cap, "seed": seed, "noise": mapping(noise), "state": state(start)}
+        return self._job("world-mjtf", spec, model, experiment_id)
+
+    def _job(self, kind: str, spec: dict, model: Mapping[str, Any] | None, experiment_id: int | None) -> Job:
+        body = {"kind": kind} | present(spec | {"model": mapping(model), "experiment_id": experiment_id})
+        return self._http.call("POST", "/api/v1/jobs", body=body)

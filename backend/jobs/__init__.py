@@ -19,12 +19,26 @@ from typing import Annotated, Union
 from pydantic import Discriminator
 from pydantic import Tag as KindTag
 
-from backend.jobs import atlas, basin, control_study, gaits, loop_mfpt, mfpt, mjtf, sweep, viability
+from backend.jobs import (
+    atlas,
+    basin,
+    control_study,
+    foothold_study,
+    gaits,
+    loop_mfpt,
+    mfpt,
+    mjtf,
+    plan,
+    sweep,
+    viability,
+    world_mjtf,
+)
 from backend.jobs.base import JobContext, JobKind, WorstCase
 from backend.jobs.specs import UnreadableSpec, encode, read_fields
 
 KINDS: tuple[JobKind, ...] = (mjtf.KIND, sweep.KIND, basin.KIND, gaits.KIND, control_study.KIND, mfpt.KIND,
-                              loop_mfpt.KIND, viability.KIND, atlas.KIND)  # fmt: skip
+                              loop_mfpt.KIND, viability.KIND, atlas.KIND, foothold_study.KIND,
+                              plan.KIND, world_mjtf.KIND)  # fmt: skip
 BY_NAME: dict[str, JobKind] = {kind.name: kind for kind in KINDS}
 JOB_KINDS: dict[str, type] = {kind.name: kind.request for kind in KINDS}  # the request body of each
 DEFAULT_KIND = "mjtf"  # a request without a kind (the first kind, which clients may leave out)

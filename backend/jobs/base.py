@@ -34,6 +34,20 @@ def one_chunk(spec: Any) -> int:
 
 
 @dataclass(frozen=True)
+class Chunked:
+    """A kind whose work is independent chunks, each stored as it finishes, so that a restart (after a
+    kill -9 too) computes only those missing and ends with the result an uninterrupted job gives
+    (:meth:`backend.services.job_runner.JobRunner.run`). ``arguments(spec, context)``: each chunk's
+    arguments, in order; ``chunk(*arguments)``: one chunk's JSON result (module-level: it runs in the
+    job worker, or on a Dask worker); ``combine(spec, context, results)``: the job's result from every
+    chunk's (as stored: JSON), in order. All three run in the job worker, never in the service."""
+
+    arguments: Callable[[Any, JobContext], list[tuple]]
+    chunk: Callable[..., dict]
+    combine: Callable[[Any, JobContext, list[dict]], dict]
+
+
+@dataclass(frozen=True)
 class JobKind:
     """A registered job kind (:mod:`backend.jobs`): its ``name`` (the request's ``kind``), a
     ``title`` for choosers, its ``request`` body (a strict pydantic model, checked against the
@@ -45,7 +59,10 @@ class JobKind:
     one (measured by scripts/bench_job_estimates.py; the service learns its own from finished jobs,
     :mod:`backend.services.job_estimates`). ``warm``: a small request body (its fields but ``kind``)
     whose run loads the kind's kernels: the job worker runs each at start, so that a first job does
-    not wait for them (an MFPT took 11 s cold, 5.6 s warm)."""
+    not wait for them (an MFPT took 11 s cold, 5.6 s warm). ``chunked``: for a kind run chunk by
+    chunk, each stored (:class:`Chunked`; its ``run`` is None). ``check(spec, robot)``: what the
+    request's schema cannot check alone, once its stored world is in the spec (a goal within the
+    world): a ParameterError naming the field."""
 
     name: str
     title: str
@@ -56,6 +73,8 @@ class JobKind:
     total: Callable[[Any], int] = one_chunk
     typical_fraction: float = 1.0
     warm: dict | None = None
+    chunked: Chunked | None = None
+    check: Callable[[Any, PhysicalParams], None] | None = None
 
 
 @contextmanager

@@ -12,7 +12,10 @@ request schema at all. Here: the parts every kind's spec shares.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, fields
+import functools
+import types
+import typing
+from dataclasses import asdict, dataclass, fields, is_dataclass
 
 from experiments.manifest import json_safe
 from sim_core.model.noise import NoiseModel
@@ -74,13 +77,21 @@ class NoiseSpec:
         return NoiseModel(**asdict(self))
 
 
-_PARTS = {"model": ModelSpec, "noise": NoiseSpec, "guess": StateSpec, "start": StateSpec}
+_PARTS = {"model": ModelSpec, "noise": NoiseSpec, "guess": StateSpec, "start": StateSpec, "state": StateSpec}
 _TUPLES = ("zeta0s", "controllers")  # lists stored, tuples in the frozen spec
 
 
 def encode(spec) -> dict:
     """The spec as the store's JSON (plain lists and dicts)."""
     return {"version": SPEC_VERSION, **json_safe(asdict(spec))}
+
+
+@functools.cache
+def _part_of(cls: type, name: str) -> type | None:
+    """The dataclass a kind's own field holds (``RandomWorldsSpec | None``: RandomWorldsSpec), if any."""
+    hint = typing.get_type_hints(cls).get(name)
+    options = typing.get_args(hint) if isinstance(hint, types.UnionType) else (hint,)  # not tuple[LegSpec, ...]
+    return next((option for option in options if is_dataclass(option)), None)
 
 
 def read_fields(cls: type, stored: dict):
@@ -91,8 +102,9 @@ def read_fields(cls: type, stored: dict):
         if spec_field.name not in stored:
             continue
         value = stored[spec_field.name]
-        if spec_field.name in _PARTS and value is not None:
-            value = _PARTS[spec_field.name](**value)
+        part = _PARTS.get(spec_field.name) or _part_of(cls, spec_field.name)
+        if part is not None and value is not None:
+            value = part(**value)
         elif spec_field.name == "controls":
             value = tuple(LegSpec(**leg) for leg in value)
         elif spec_field.name in _TUPLES:

@@ -1,4 +1,4 @@
-"""The jobs and their trials in the store: SQL and only SQL (the services commit).
+"""The jobs, their trials and their chunks in the store: SQL and only SQL (the services commit).
 
 A job's state changes with conditional UPDATEs (:func:`change_state`, :func:`claim`): the job
 runner and a cancel request may write the same row at once, and reading the state first and then
@@ -16,7 +16,7 @@ from sqlalchemy.orm import Session
 
 from backend.repositories.common import fetch, newest_first, page
 from backend.schemas.jobs import JobState
-from backend.store.models import Job, Trial, utcnow
+from backend.store.models import Job, JobChunk, Trial, utcnow
 
 _UNSYNCHRONIZED = {"synchronize_session": False}  # a conditional UPDATE: the session's copy is refreshed after
 
@@ -130,6 +130,21 @@ def add_trials(session: Session, job_id: int, trials: Iterable[Trial]) -> None:
     session.add_all(trials)
     session.flush()
     completed = session.scalar(select(func.count()).select_from(Trial).where(Trial.job_id == job_id))
+    session.execute(update(Job).where(Job.id == job_id).values(completed=completed, updated_at=utcnow()))
+
+
+def stored_chunks(session: Session, job_id: int) -> dict[int, dict]:
+    """The chunked job's finished chunks: ``{chunk index: its JSON result}``."""
+    rows = session.execute(select(JobChunk.index, JobChunk.result).where(JobChunk.job_id == job_id))
+    return {index: result for index, result in rows}
+
+
+def add_chunk(session: Session, job_id: int, index: int, result: dict) -> None:
+    """Store one finished chunk and count it into the job's ``completed`` (one transaction with the
+    caller's commit); a chunk stored already is an IntegrityError (the key refuses a second copy)."""
+    session.add(JobChunk(job_id=job_id, index=index, result=result))
+    session.flush()
+    completed = session.scalar(select(func.count()).select_from(JobChunk).where(JobChunk.job_id == job_id))
     session.execute(update(Job).where(Job.id == job_id).values(completed=completed, updated_at=utcnow()))
 
 

@@ -1,23 +1,25 @@
 """The job runner: one background thread that takes the stored jobs to their end, one at a time.
 
-An MJTF job survives crashes trial by trial. The runner takes the study's one plan from sim_core
-— the levels' starts (:func:`sim_core.robustness.mjtf.level_starts`, in the job worker), then the trials in
-chunks (:func:`sim_core.robustness.mjtf_plan.plan_trials`) leaving out the trials already stored — runs the
-chunks in the service's job worker process (:mod:`backend.workers.pools`; never in the service's
-own, where they would hold up the API) or on the Dask cluster named by ``PARKOUR_DASK_ADDRESS``,
-and commits each chunk's trials and the progress in one transaction as it finishes. Killed
-mid-job, the service finds the job at the next start, recomputes only the missing trials — their
-seeds depend on ``(seed, level, index)`` alone — and ends with exactly the trials asked for, none
-lost and none duplicated (the unique key refuses a second copy). Sweeps, basins and gait searches
-are deterministic: they run whole through the chunk map, report progress per chunk, and store
-their result on the job when done; a restart recomputes them. Cancelling marks the job; the runner
-sees it within ``CANCEL_POLL`` and stops the worker at once (a chunk under way is dropped: its
-trials are not committed, and nothing else depends on it). A service stopping is seen as soon: the
-job stays running, for the next start to resume, and no queued job starts. On a full disk a job
-pauses: what it computed waits in memory and is committed when there is room again
-(:mod:`backend.services.storage_waits`);
-stopped meanwhile, it stays running and the next start resumes it. The jobs a crash left unfinished
-are settled on the runner's thread too, so a full disk never holds up the service's start.
+Its work runs in the service's job worker process (:mod:`backend.workers.pools`; never in the
+service's own, where it would hold up the API) or on the Dask cluster named by
+``PARKOUR_DASK_ADDRESS``. Three ways, by kind (:mod:`backend.jobs`):
+
+- MJTF survives crashes trial by trial: sim_core's one plan of the study (the levels' starts, then
+  the trials in chunks, :func:`sim_core.robustness.mjtf_plan.plan_trials`) less the trials stored;
+  each chunk's trials and the progress committed in one transaction. Their seeds depend on
+  ``(seed, level, index)`` alone, so a restart after kill -9 ends with exactly the trials asked for
+  (the unique key refuses a second copy).
+- A chunked kind (a foothold study, trials in a world: :class:`backend.jobs.base.Chunked`) stores
+  each chunk's JSON result as it finishes; a restart computes the chunks missing, and the result is
+  made from all of them as stored — the uninterrupted job's.
+- The other kinds are deterministic: run whole through the chunk map, progress per chunk, the
+  result stored when done; a restart recomputes them.
+
+Cancelling marks the job; the runner sees it within ``CANCEL_POLL`` and stops the worker at once
+(a chunk under way is dropped). A service stopping is seen as soon: the job stays running, for the
+next start to resume, and no queued job starts. On a full disk a job pauses, what it computed
+waiting in memory (:mod:`backend.services.storage_waits`). The jobs a crash left unfinished are
+settled on the runner's thread too, so a full disk never holds up the service's start.
 """
 
 from __future__ import annotations
@@ -35,19 +37,17 @@ import numpy as np
 from sqlalchemy.orm import Session, sessionmaker
 
 from backend.jobs import decode, job_kind
-from backend.jobs.mjtf import MJTFSpec
 from backend.repositories import jobs as stored_jobs
 from backend.schemas.jobs import JobState
+from backend.services.job_runs import RunsByKind
 from backend.services.storage_waits import Stopped, Waiting, when_room
 from backend.services.studies import run_study, run_study_here
 from backend.store.database import StorageFull
-from backend.store.models import Trial, utcnow
+from backend.store.models import utcnow
 from backend.workers.pools import ComputePool
 from experiments.cluster import as_completed_results, chunk_map_for, dask_client
 from experiments.manifest import json_safe
 from sim_core.chunks import Cancelled
-from sim_core.model.failures import OK, Failure
-from sim_core.robustness.mjtf_plan import TrialChunk, plan_trials
 
 log = logging.getLogger("parkourlab.jobs")
 T = TypeVar("T")
@@ -57,7 +57,7 @@ CANCEL_POLL = 0.2  # [s] how often the runner looks for a cancel while a worker 
 IN_FLIGHT = 4  # chunks handed to the worker ahead of the one awaited: it never idles between chunks
 
 
-class JobRunner:
+class JobRunner(RunsByKind):
     """Runs jobs one at a time on a background thread, resuming unfinished ones at start."""
 
     def __init__(
@@ -139,49 +139,12 @@ class JobRunner:
                 return
             job = stored_jobs.get(session, job_id)
             kind, spec = job.kind, decode(job.spec)
-        if job_kind(kind).run is None:  # MJTF: trials stored chunk by chunk, a restart resumes them
+        if job_kind(kind).chunked is not None:  # chunks stored as they finish, a restart computes the rest
+            self._run_chunked(job_id, spec)
+        elif job_kind(kind).run is None:  # MJTF: trials stored chunk by chunk, a restart resumes them
             self._run_mjtf(job_id, spec)
         else:
             self._run_study(job_id, spec)
-
-    def _run_mjtf(self, job_id: int, spec: MJTFSpec) -> None:
-        """The study's trials not stored yet, chunk by chunk as sim_core plans them."""
-        from sim_core.robustness.mjtf import level_starts  # the kernels load with the first job (simulation.py)
-        from sim_core.robustness.mjtf_trials import run_trials
-
-        model, noise = spec.model.params(), spec.noise.model()
-        guess = None if spec.guess is None else (spec.guess.xdot, spec.guess.ydot)
-        try:
-            starts = self.pool.submit(functools.partial(level_starts, guess=guess), model, np.radians(spec.psi0_deg),
-                                      spec.zeta0s)  # fmt: skip
-            levels = self._await(job_id, starts)
-        except Cancelled:
-            self._cancelled(job_id)  # marks it cancelled
-            return
-        with self.sessions() as session:
-            stored = stored_jobs.stored_indices(session, job_id)
-        done = [stored.get(level, set()) for level in range(len(levels))]
-        chunks = plan_trials(len(levels), spec.trials, spec.seed, self.chunk_trials, done)
-        if self._cancelled(job_id):
-            return
-        arguments = [chunk.arguments(model, levels, noise, spec.cap) for chunk in chunks]
-        results = self._execute(job_id, run_trials, arguments)
-        try:
-            for index, (jumps, status) in results:
-                chunk = chunks[index]
-                zeta0 = levels[chunk.level].zeta0
-                self._stored(f"storing job {job_id}'s trials", self._commit_chunk, job_id, chunk, zeta0, jumps, status)
-                if self._cancelled(job_id):
-                    return
-        except Cancelled:
-            self._cancelled(job_id)  # marks it cancelled
-            return
-        finally:
-            results.close()  # on a Dask cluster, cancels the chunks not yet finished
-        with self.sessions() as session:
-            job = stored_jobs.get(session, job_id)
-            job.state, job.finished_at = JobState.DONE, utcnow()
-            session.commit()
 
     def _run_study(self, job_id: int, spec) -> None:
         """Sweeps, basins and gait searches: computed whole (a restart recomputes them — they are
@@ -276,23 +239,3 @@ class JobRunner:
                 session.commit()
                 return True
             return job.state != JobState.RUNNING
-
-    def _commit_chunk(self, job_id: int, chunk: TrialChunk, zeta0: float, jumps, status) -> None:
-        with self.sessions() as session:
-            stored_jobs.add_trials(
-                session,
-                job_id,
-                (
-                    Trial(
-                        job_id=job_id,
-                        level=chunk.level,
-                        index=int(i),
-                        zeta0=float(zeta0),
-                        seed=int(seed),
-                        jumps=int(n),
-                        failure_code=None if code == OK else Failure(int(code)).code,
-                    )
-                    for i, seed, n, code in zip(chunk.indices, chunk.seeds, jumps, status, strict=True)
-                ),
-            )
-            session.commit()

@@ -9,6 +9,7 @@ each call one unit of work that returns what the API answers (``schemas.JobOut``
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from sqlalchemy.orm import Session
@@ -19,8 +20,9 @@ from backend.repositories.common import locked
 from backend.schemas.jobs import JobOut, JobPage, JobResults, JobState, MJTFLevelOut
 from backend.services import job_estimates
 from backend.services.job_queue import Standing, check_room, standings, standings_of
-from backend.services.presets import with_preset_resolved
+from backend.services.presets import resolve_model, with_preset_resolved
 from backend.services.provenance import current_code_version
+from backend.services.worlds import world_in_l0
 from backend.store.database import lock_for_write
 from backend.store.models import Experiment, Job, utcnow
 from sim_core.robustness.mjtf_plan import CAPPED, jump_statistics, no_outcomes
@@ -45,7 +47,7 @@ def create_job(
     ahead = check_room(session, body, person or "unknown")
     if body.experiment_id is not None:
         locked(session, Experiment, body.experiment_id, "experiment")
-    spec = spec_of(body)  # stored as its own versioned record: backend/jobs/specs.py says why
+    spec = in_its_world(session, spec_of(body))  # stored as its own versioned record: backend/jobs/specs.py says why
     job = stored_jobs.add(
         session,
         Job(
@@ -57,6 +59,7 @@ def create_job(
             code_version=current_code_version(),
             submitted_by=person,
             submitted_via=via,
+            world_id=getattr(spec, "world_id", None),
         ),
     )
     session.commit()
@@ -64,6 +67,18 @@ def create_job(
         runner.submit(job.id)
     # Its standing among the jobs read under the write lock: the queue as it stood at its submission.
     return public(job, standings_of([*ahead, job], job_estimates.paces(session)).get(job.id))
+
+
+def in_its_world(session: Session, spec):
+    """``spec`` with its stored world copied in (its §8 JSON in ``l0``: the job reads no store; a
+    404 if there is no such world), checked by its kind where the schema cannot (a goal within the
+    world: a 422 naming the field)."""
+    kind = job_kind(spec.kind)
+    if getattr(spec, "world_id", None) is not None:
+        spec = replace(spec, world=world_in_l0(session, spec.world_id, spec.model.preset))
+    if kind.check is not None:
+        kind.check(spec, resolve_model(None, spec.model.preset).robot)  # a stored preset is resolved already
+    return spec
 
 
 def get_job(session: Session, job_id: int) -> JobOut:

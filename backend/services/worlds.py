@@ -69,10 +69,11 @@ def delete(session: Session, world_id: int) -> None:
 
 def world_in_l0(session: Session, world_id: int, preset: str) -> dict:
     """The stored world ``world_id`` as the §8 JSON in ``l0`` (a world posted in metres read with
-    ``preset``'s leg length): what a simulation in it is handed. :class:`NotFound` if there is none."""
+    ``preset``'s leg length), named as stored: what a simulation or job in it is handed.
+    :class:`NotFound` if there is none."""
     world = stored.get(session, world_id)
     robot = resolve_model(session, preset).robot
-    return world_to_document(world_from_document(world.document, robot.leg_length))
+    return world_to_document(world_from_document(world.document, robot.leg_length)) | {"name": world.name}
 
 
 def world_out(world: World, used: tuple[int, int]) -> WorldOut:

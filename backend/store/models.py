@@ -202,6 +202,7 @@ class Job(Base):
     world_id: Mapped[int | None] = mapped_column(ForeignKey("worlds.id"), index=True)
 
     trials: Mapped[list[Trial]] = relationship(back_populates="job", cascade="all, delete-orphan")
+    chunks: Mapped[list[JobChunk]] = relationship(back_populates="job", cascade="all, delete-orphan")
 
 
 class Trial(Base):
@@ -221,6 +222,20 @@ class Trial(Base):
     job: Mapped[Job] = relationship(back_populates="trials")
 
     __table_args__ = (UniqueConstraint("job_id", "level", "index", name="uq_trials_key"),)
+
+
+class JobChunk(Base):
+    """One finished chunk of a chunked job (a foothold study's world, a block of trials in a world):
+    its JSON result, stored as it finished, so that a restart computes only the chunks missing.
+    (job, index) is its idempotent key."""
+
+    __tablename__ = "job_chunks"
+
+    job_id: Mapped[int] = mapped_column(ForeignKey("jobs.id", ondelete="CASCADE"), primary_key=True)
+    index: Mapped[int] = mapped_column(primary_key=True)
+    result: Mapped[dict]
+
+    job: Mapped[Job] = relationship(back_populates="chunks")
 
 
 class ModelPreset(Base):

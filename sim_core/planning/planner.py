@@ -82,6 +82,11 @@ class Plan:
     highest: float
     seconds: float
 
+    def to_dict(self, metres: float) -> dict:
+        """``parkour plan --json`` (l0 = ``metres`` [m]; the targets in l0, as the world file's frame)."""
+        return {"reaches_goal": self.reaches_goal, "plan": [step.to_dict() for step in self.steps],
+                "seconds": self.seconds, "highest_m": self.highest * metres, "chance": self.chance}  # fmt: skip
+
     @property
     def schedule(self) -> ControlSchedule:
         """The plan's legs as a schedule: row k sets touchdown k down (climb_world replays it)."""

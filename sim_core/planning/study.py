@@ -67,6 +67,15 @@ class WorldOutcome:
     replans: int = 0
     schedule: tuple[float, float] = (math.nan, math.nan)  # open-loop's leg (psi0 [deg], zeta0)
 
+    def to_record(self) -> dict:
+        """Every field as JSON (a job stores each world's outcome as it finishes); :meth:`from_record`
+        reads it back to an equal outcome."""
+        return {name: (list(value) if isinstance(value, tuple) else value) for name, value in vars(self).items()}
+
+    @classmethod
+    def from_record(cls, record: dict) -> WorldOutcome:
+        return cls(**{**record, "schedule": tuple(record["schedule"])})
+
     def to_dict(self) -> dict:
         """The world's row of ``parkour foothold-study --json``."""
         return {"world": self.world, "plan_exists": self.plan_exists, "trials": self.trials,

@@ -69,6 +69,50 @@ def test_kill_nine_mid_job_resumes_exactly(tmp_path):
         np.testing.assert_array_equal(jumps[level], expected.jumps)
 
 
+STUDY = {"kind": "foothold-study", "random_worlds": {"count": 6, "seed0": 20}, "goal_height_m": 0.5, "trials": 8}
+
+
+def test_kill_nine_mid_foothold_study_resumes_exactly(tmp_path):
+    """Its worlds are stored as they finish: after kill -9 the restarted service computes the rest,
+    and the result is the command's on the same worlds (timings aside)."""
+    from tests.backend.jobs.test_foothold_study import without_timings
+    from tests.cli.helpers import json_of
+
+    data_dir = tmp_path / "data"
+    first = start_service(data_dir, 0, "--no-view")
+    base = f"http://127.0.0.1:{first.port}/api/v1"
+    try:
+        token = (data_dir / "api_token").read_text().strip()
+        job = httpx.post(f"{base}/jobs", json=STUDY, headers={"Authorization": f"Bearer {token}"}).json()
+        deadline = time.monotonic() + PROGRESS_WAIT_S
+        while (completed := httpx.get(f"{base}/jobs/{job['id']}").json()["completed"]) < 2:
+            assert time.monotonic() < deadline, "no progress"
+            time.sleep(0.05)
+    finally:
+        os.kill(first.pid, signal.SIGKILL)
+        first.wait()
+    assert 0 < completed < job["total"] == 6, f"the kill must land mid-job (completed {completed} of 6)"
+
+    second = start_service(data_dir, 0, "--no-view")
+    base = f"http://127.0.0.1:{second.port}/api/v1"
+    try:
+        deadline = time.monotonic() + PROGRESS_WAIT_S
+        while (state := httpx.get(f"{base}/jobs/{job['id']}").json())["state"] != "done":
+            assert state["state"] in ("queued", "running") and time.monotonic() < deadline, state
+            time.sleep(0.1)
+        result = httpx.get(f"{base}/jobs/{job['id']}/results").json()["result"]
+    finally:
+        second.terminate()
+        second.wait(30)
+    engine = create_engine(f"sqlite:///{data_dir / 'parkourlab.sqlite3'}")
+    with engine.connect() as connection:
+        chunks = connection.execute(text('SELECT "index" FROM job_chunks WHERE job_id = :job'), {"job": job["id"]})
+        assert sorted(index for (index,) in chunks) == list(range(6)), "each world once"
+    command = json_of("foothold-study", "--random", "6", "--seed0", "20", "--goal-height", "0.5", "--trials", "8")
+    assert without_timings(result) == without_timings(command)
+    print(f"SIGKILL with {completed} of 6 worlds stored; resumed to the command's result")
+
+
 @pytest.mark.realtime  # the journal keeps the run to within a second of the kill: a real-time bound
 def test_kill_nine_during_a_live_run_keeps_it_interrupted_to_the_last_second(tmp_path, virtual):
     """The run is stored as it starts and journaled while it runs: after kill -9 and a restart it

@@ -46,3 +46,30 @@ def test_a_run_in_a_stored_world_and_the_runs_of_a_world(client):
     with pytest.raises(Conflict) as caught:
         client.delete_world(world["id"])
     assert f"run {run['id']}" in str(caught.value)
+
+
+def test_a_world_created_and_a_foothold_study_run_in_it(client):
+    """The issue's "the client creating a world and running a foothold study"."""
+    world = client.create_world("client holds", random={"seed": 2})
+    job = client.submit_foothold_study(0.5, world_id=world["id"], trials=3, seed=4)
+    assert job["kind"] == "foothold-study" and job["world_id"] == world["id"] and job["total"] == 1
+    done = client.wait(job, timeout=600)
+    result = client.results(done)["result"]
+    assert [row["world"] for row in result["worlds"]] == ["client holds"]
+    assert result["methods"]["placement"]["trials"] == 3 and result["trials_per_world"] == 3
+    assert client.world(world["id"])["jobs"] == 1
+    with pytest.raises(Conflict) as caught:
+        client.delete_world(world["id"])
+    assert f"job {job['id']}" in str(caught.value)
+
+
+def test_a_plan_and_trials_in_a_world_through_the_client(client):
+    world = client.create_world("client plan stairs", named="staircase")
+    plan = client.results(client.wait(client.submit_plan(world["id"], 0.5), timeout=600))["result"]
+    assert plan["reaches_goal"] and plan["world"] == "client plan stairs"
+    trials = client.submit_world_mjtf(world["id"], [(30, 0.9)], trials=20, cap=50)
+    result = client.results(client.wait(trials, timeout=600))["result"]
+    assert result["trials"] == 20 and sum(result["outcomes"].values()) == 20
+    with pytest.raises(InvalidRequest) as caught:
+        client.submit_plan(world["id"], 99.0)
+    assert "goal_height_m" in str(caught.value)

@@ -30,7 +30,10 @@ CONTROL = {"kind": "control-study"}
 MFPT = {"kind": "mfpt"}
 VIABILITY = {"kind": "viability"}
 BODIES = {"mjtf": MJTF, "sweep": SWEEP, "basin": BASIN, "gaits": GAITS, "control-study": CONTROL, "mfpt": MFPT,
-          "loop-mfpt": {"kind": "loop-mfpt"}, "viability": VIABILITY, "atlas": {"kind": "atlas"}}  # fmt: skip
+          "loop-mfpt": {"kind": "loop-mfpt"}, "viability": VIABILITY, "atlas": {"kind": "atlas"},
+          "foothold-study": {"kind": "foothold-study", "random_worlds": {"count": 1}, "goal_height_m": 0.5},
+          "plan": {"kind": "plan", "world_id": 1, "goal_height_m": 0.5},
+          "world-mjtf": {"kind": "world-mjtf", "world_id": 1, "controls": [LEG]}}  # fmt: skip
 
 
 @pytest.mark.parametrize("kind", JOB_KINDS)

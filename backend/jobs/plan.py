@@ -1,0 +1,100 @@
+"""A plan as a job (``parkour plan``): the most robust way up a stored world to a goal height,
+foothold by foothold, and optionally how often the placement law following it (with replanning)
+gets there under the noise, by plain Monte-Carlo attempts (docs/worlds.md). Its result is ``parkour
+plan --json`` — with ``reaches_goal`` false and the highest foot where no plan reaches the goal
+(the command refuses instead) — and, with ``attempts``, ``"monte_carlo"`` as the command's
+``--mfpt --monte-carlo`` gives it. (The splitting estimate for rare failures stays the command's:
+docs/worlds.md says why it goes extinct where failures are rare.)"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Annotated, Literal
+
+from pydantic import Field, model_validator
+
+from backend.jobs.base import JobContext, JobKind, WorstCase
+from backend.jobs.budget import within_budget
+from backend.jobs.in_world import (
+    PLAN_SEARCH_JUMPS,
+    GoalHeightM,
+    WorldRef,
+    check_goal_in,
+    goal_in_l0,
+    label_of,
+    world_of,
+)
+from backend.jobs.specs import ModelSpec, NoiseSpec, StateSpec
+from backend.schemas.common import ModelIn, RecordRef, StateIn, Strict
+from backend.schemas.noise import NoiseIn
+
+MAX_ATTEMPTS = 100_000
+
+
+def worst_case(job) -> WorstCase:
+    return PLAN_SEARCH_JUMPS + job.attempts * job.cap, f"{PLAN_SEARCH_JUMPS} (the search) + attempts x cap"
+
+
+class PlanJobCreate(Strict):
+    """The most robust plan up the stored world ``world_id`` to a foot at ``goal_height_m``, from
+    touchdown 0 on the left side at the floor; with ``attempts``, that many noisy climbs of it by
+    the placement law (at most ``replans`` replans each, ``cap`` jumps), counted."""
+
+    kind: Literal["plan"]
+    experiment_id: RecordRef | None = None
+    model: ModelIn = ModelIn()
+    world_id: WorldRef
+    goal_height_m: GoalHeightM
+    seed: Annotated[int, Field(ge=0, lt=2**31, description="the search's draws; attempt i is seed + i")] = 0
+    noise: NoiseIn = NoiseIn()
+    state: StateIn | None = Field(None, description="the body's velocity at touchdown 0; none: the 30:0.9 gait's")
+    attempts: Annotated[int, Field(ge=0, le=MAX_ATTEMPTS, description="noisy climbs of the plan; 0: none")] = 0
+    replans: Annotated[int, Field(ge=0, le=10, description="replans an attempt may make")] = 3
+    cap: Annotated[int, Field(ge=1, le=10_000, description="most jumps an attempt")] = 200
+
+    @model_validator(mode="after")
+    def _within_budget(self) -> PlanJobCreate:
+        return within_budget(self, worst_case(self))
+
+
+@dataclass(frozen=True)
+class PlanSpec:
+    world_id: int
+    goal_height_m: float
+    world: dict | None = None  # the stored world's §8 JSON in l0, copied when the job was accepted
+    model: ModelSpec = field(default_factory=ModelSpec)
+    seed: int = 0
+    noise: NoiseSpec = field(default_factory=NoiseSpec)
+    state: StateSpec | None = None
+    attempts: int = 0
+    replans: int = 3
+    cap: int = 200
+    kind: str = "plan"
+
+
+def check(spec: PlanSpec, robot) -> None:
+    """The goal above the start and within the world (the planner says how high it got otherwise)."""
+    check_goal_in(world_of(spec), spec, robot, label=label_of(spec), footholds=False)
+
+
+def run(spec: PlanSpec, context: JobContext) -> dict:
+    from sim_core.planning.plan_splitting import PlanSplitting, plan_monte_carlo
+    from sim_core.planning.planner import plan_climb, start_velocity
+
+    world, goal, noise = world_of(spec), goal_in_l0(spec, context.robot), spec.noise.model()
+    state = start_velocity(context.model) if spec.state is None else (spec.state.xdot, spec.state.ydot)
+    plan = plan_climb(context.model, world, goal, state, noise=noise, seed=spec.seed)
+    context.progress(1, 2 if spec.attempts and plan.reaches_goal else 1)
+    document = plan.to_dict(context.robot.leg_length) | {"world": label_of(spec), "state": [float(v) for v in state]}
+    if spec.attempts and plan.reaches_goal:
+        options = PlanSplitting(seed=spec.seed, cap=spec.cap, max_replans=spec.replans)
+        checked = plan_monte_carlo(context.model, world, plan, goal, noise, options, spec.attempts, spec.seed)
+        document["monte_carlo"] = checked.to_dict()
+        context.progress(2, 2)
+    return document
+
+
+KIND = JobKind(
+    "plan", "plan a climb up a stored world", PlanJobCreate, PlanSpec, worst_case, run, typical_fraction=0.01,
+    warm={"world_id": 1, "goal_height_m": 0.3}, check=check,
+)  # fmt: skip
