@@ -40,7 +40,12 @@ class WorldCreate(Strict):
 
     name: WorldName
     world: dict[str, Any] | None = Field(None, description="the world file's JSON (docs/model.md §8)")
-    named: str | None = Field(None, max_length=64, description=f"one of {', '.join(NAMED_WORLDS)}")
+    named: str | None = Field(
+        None, max_length=64, description=f"one of {', '.join(NAMED_WORLDS)}",
+        # The panel's chooser of named worlds reads them here (one registry: sim_core's).
+        json_schema_extra={"x-named-worlds": [{"name": name, "description": named.description}
+                                              for name, named in NAMED_WORLDS.items()]},
+    )  # fmt: skip
     random: RandomWorldIn | None = None
     preset: Preset = "paper"
 

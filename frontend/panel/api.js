@@ -96,12 +96,12 @@ export async function call(method, path, body, fields) {
   } catch {  // not the service's JSON (a proxy's page, say): its text is the reason
     if (!response.ok) data = { detail: text.trim().slice(0, 300) || null };
   }
-  if (!response.ok && response.status === 422 && fields && data) {
+  if (!response.ok && response.status === 422 && fields?.form && data) {
     const { left, marked } = Fields.markApiErrors(fields.form, data.detail, fields.locations);
     const message = left.length ? left.join("; ") : "the service refused the marked field(s)";
     const also = marked ? "; fix the marked field(s) too" : "";
     say(left.length ? `${fields.action ?? `${method} ${path}`}: ${message}${also}` : "Fix the marked field(s): the service refused them.", "error");
-    throw new Error(message);
+    throw Object.assign(new Error(message), { status: 422, detail: data.detail });
   }
   if (!response.ok) {
     const message = response.status === 401
@@ -109,7 +109,8 @@ export async function call(method, path, body, fields) {
       : explain(data, response.status);
     if (response.status === 401) checkToken();
     say(`${fields?.action ?? `${method} ${path}`}: ${message}`, "error");
-    throw new Error(message);
+    // The status and the API's detail go with it: a caller may show them where they belong (a 422 at a world's segment).
+    throw Object.assign(new Error(message), { status: response.status, detail: data?.detail });
   }
   return data;
 }

@@ -11,7 +11,7 @@ import { FILTERS, COLUMNS, readView, showView } from "./history_view.js";
 import { addRun, removeRun, refreshRun, inBasket, basketIds, basketRuns, basketQuery, onBasketChange, restoreBasket } from "./basket.js";
 import { loadExperiments, onExperimentRuns, showExperiment, closeExperiment } from "./experiment.js";
 import { GROUP_BY, showAggregate, hideAggregate } from "./aggregate.js";
-import { cell, controlsText, endingBadge, jumpsCell, statusCell, targetText } from "./run_cells.js";
+import { cell, controlsText, endingBadge, jumpsCell, statusCell, targetText, worldCell } from "./run_cells.js";
 import "./compare.js";
 
 export { loadExperiments };
@@ -27,7 +27,7 @@ const SORTS = [["-id", "newest"], ["id", "oldest"], ["-climb", "best climb"], ["
   ["-created_at", "created ↓"], ["created_at", "created ↑"], ["kind", "kind"], ["status", "status"], ["end_reason", "ending"],
   ["loop", "loop"], ["controller", "controller"], ["-target", "target ↓"], ["target", "target ↑"], ["failure_code", "failure"]];
 const COLUMN_WORDS = { kind: "kind", status: "status", ending: "ending", loop: "loop", controller: "controller", target: "target",
-  controls: "controls", jumps: "jumps", climb: "climb", failure: "failure", tags: "tags", notes: "notes", created: "created" };
+  controls: "controls", world: "world", jumps: "jumps", climb: "climb", failure: "failure", tags: "tags", notes: "notes", created: "created" };
 const view = readView();  // what the tab shows; the form holds the filters, sort and page size
 const shownRuns = new Map();  // id -> the run as last listed: what the editor and the basket start from
 const form = () => $("#history-form");
@@ -77,7 +77,7 @@ function runRow(run) {
   { class: "actions" });
   const row = element("tr", null, element("td", null, tick), element("td", String(run.id)), cell("kind", run.kind), statusCell(run),
     cell("ending", null, endingBadge(run.end_reason)), cell("loop", run.loop), cell("controller", run.controller ?? "—"),
-    cell("target", targetText(run)), cell("controls", controlsText(run)), jumpsCell(run), cell("climb", run.climb.toFixed(3)),
+    cell("target", targetText(run)), cell("controls", controlsText(run)), worldCell(run), jumpsCell(run), cell("climb", run.climb.toFixed(3)),
     cell("failure", run.failure_code ?? ""), attributes(element("td", run.tags.join(" ")), { class: "tags col-tags" }), notes,
     created(run), actions);
   row.id = `run-${run.id}`;
@@ -155,7 +155,7 @@ function again(page = 1) {
 }
 
 on("#history-form", "submit", (event) => { event.preventDefault(); return again(); });
-for (const name of ["experiment_id", "kind", "status", "end_reason", "loop", "controller", "sort", "size"]) {
+for (const name of ["experiment_id", "kind", "status", "end_reason", "loop", "controller", "world_id", "sort", "size"]) {
   on(`#history-form select[name=${name}]`, "change", () => again());  // a choice applies at once
 }
 on("#runs-first", "click", () => again(1));

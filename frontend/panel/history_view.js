@@ -4,9 +4,9 @@
 // it rides in the fragment, which api.js takes out at once.
 
 // The run filters as the API names them (GET /api/v1/runs), each a field of #history-form.
-export const FILTERS = ["experiment_id", "kind", "status", "end_reason", "loop", "controller", "tag", "q"];
+export const FILTERS = ["experiment_id", "kind", "status", "end_reason", "loop", "controller", "world_id", "tag", "q"];
 export const PAGE_SIZES = [25, 50, 100, 200];
-export const COLUMNS = ["kind", "status", "ending", "loop", "controller", "target", "controls", "jumps", "climb",
+export const COLUMNS = ["kind", "status", "ending", "loop", "controller", "target", "controls", "world", "jumps", "climb",
   "failure", "tags", "notes", "created"];
 const DEFAULT = { sort: "-id", page: 1, size: 50 };
 

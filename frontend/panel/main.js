@@ -15,6 +15,8 @@ import "./simulate.js";
 import { showView } from "./view.js";
 import { fillChoosers } from "./catalog.js";
 import { watchWarming } from "./warming.js";
+import { loadWorldTab } from "./worlds.js";
+import { loadWorlds } from "./world_list.js";
 
 initTabs((name) => {
   if (name === "history") loadExperiments().then(loadRuns).then(loadCalibrations).catch(() => {});
@@ -22,7 +24,9 @@ initTabs((name) => {
   if (name === "robot") { refreshRobot().catch(() => {}); drawLive(true); }
   syncLive();  // the live websocket is open while the Robot tab is shown
   if (name === "view3d") showView();
+  if (name === "world") loadWorldTab().catch(() => {});
 });
 // The choosers are filled first: a link to a History view may choose a controller.
 fillChoosers().catch(() => {}).then(() => restoreView()).catch(() => {});  // a link to a History view (?tab=history&…) opens it
+loadWorlds().catch(() => {});  // the worlds fill the Simulate and History choosers
 watchWarming();  // "warming up" while the service's workers load after a start

@@ -2,6 +2,8 @@
 // ended (an e-stop, a fall, a lost link, an error stand out as badges), how it was driven, and
 // its jumps counted as its kind counts them.
 import { element, attributes } from "./dom.js";
+import { drawWorld, svgElement } from "./world_draw.js";
+import { cachedWorld, worldById } from "./world_list.js";
 
 // End reasons a robot run records (backend/robot/live_run.py) that need a look: a badge each.
 const ALARMS = [
@@ -54,4 +56,22 @@ export const targetText = (run) => (run.target === null || run.target === undefi
 // A cell of column ``name`` (the class that shows or hides it: ``col-NAME``) holding ``text``.
 export function cell(name, text, ...children) {
   return attributes(element("td", text, ...children), { class: `col-${name}` });
+}
+
+// The run's world: a thumbnail of it (world_draw.js; the worlds fetched once, world_list.js) and
+// its name; "parallel walls" for none.
+export function worldCell(run) {
+  if (!run.world_id) return attributes(cell("world", "parallel"), { title: "parallel walls (no stored world)" });
+  const thumb = svgElement("svg", { "aria-hidden": "true", class: "world-thumb" });
+  const name = attributes(element("span", `#${run.world_id}`), { class: "world-name" });
+  const td = attributes(cell("world", null, thumb, name), { "data-world": run.world_id });
+  const show = (world) => {
+    drawWorld(thumb, world.world, { thumbnail: true, width: 28, height: 44 });
+    name.textContent = world.name;
+    td.title = `world #${world.id}: ${world.name} (${world.source})`;
+  };
+  const known = cachedWorld(run.world_id);
+  if (known) show(known);
+  else worldById(run.world_id).then(show).catch(() => {});
+  return td;
 }

@@ -46,9 +46,11 @@ on("#save-run", "click", async () => {
   const spec = await simControls("RunCreate.jumps");
   if (!spec) return;
   const { rate, note } = await pathRate(spec.jumps);
-  const body = { ...spec, trajectory_rate: rate, tags: ["panel"], ...filedUnder($("#sim-form")) };
+  const world = $("#sim-world").value ? { world_id: Number($("#sim-world").value) } : {};  // none: parallel walls
+  const body = { ...spec, trajectory_rate: rate, tags: ["panel"], ...filedUnder($("#sim-form")), ...world };
   const run = await call("POST", "/runs", body, simFields("Save run"));
-  say(`Run ${run.id} stored: ${run.jumps_completed}/${run.jumps} jumps, climb ${run.climb.toFixed(3)} l0${note}. It is in History (tag "panel").`);
+  const where = run.world_id ? ` in world #${run.world_id}` : "";
+  say(`Run ${run.id} stored${where}: ${run.jumps_completed}/${run.jumps} jumps, climb ${run.climb.toFixed(3)} l0${note}. It is in History (tag "panel").`);
 });
 
 on("#find-gait", "click", async () => {

@@ -11,6 +11,7 @@ from sim_core.model.controls import ControlSchedule
 from sim_core.model.presets import get_preset
 from sim_core.world.climb import climb_world
 from sim_core.world.files import world_from_document, world_to_document
+from sim_core.world.named import NAMED_WORLDS
 from sim_core.world.random_world import random_world
 from tests.backend.api.bodies import RUN
 
@@ -135,3 +136,11 @@ def test_a_run_in_a_world_is_parkour_climbs_climb_and_is_listed_by_world(client,
     assert client.post("/api/v1/runs", json=RUN | {"world_id": 999}, headers=auth).status_code == 404
     gait = client.post("/api/v1/runs", json=RUN | {"world_id": world["id"], "fixed_point": True}, headers=auth)
     assert gait.status_code == 422 and "gaits are found between parallel walls" in gait.text
+
+
+def test_the_named_worlds_are_listed_in_the_openapi_document(client):
+    """The panel's chooser of named worlds reads them there: sim_core's registry, one source."""
+    named = client.get("/openapi.json").json()["components"]["schemas"]["WorldCreate"]["properties"]["named"]
+    listed = named["x-named-worlds"]
+    assert [world["name"] for world in listed] == list(NAMED_WORLDS)
+    assert all(world["description"] == NAMED_WORLDS[world["name"]].description for world in listed)
