@@ -48,12 +48,19 @@ class PlanJobCreate(Strict):
     seed: Annotated[int, Field(ge=0, lt=2**31, description="the search's draws; attempt i is seed + i")] = 0
     noise: NoiseIn = NoiseIn()
     state: StateIn | None = Field(None, description="the body's velocity at touchdown 0; none: the 30:0.9 gait's")
+    launch_gait: bool = Field(
+        False,
+        description="the body arrives at touchdown 0 with its own first leg's gait's velocity, as a robot "
+        "launched on that leg does (for a live run that follows the plan); not with state",
+    )
     attempts: Annotated[int, Field(ge=0, le=MAX_ATTEMPTS, description="noisy climbs of the plan; 0: none")] = 0
     replans: Annotated[int, Field(ge=0, le=10, description="replans an attempt may make")] = 3
     cap: Annotated[int, Field(ge=1, le=10_000, description="most jumps an attempt")] = 200
 
     @model_validator(mode="after")
     def _within_budget(self) -> PlanJobCreate:
+        if self.launch_gait and self.state is not None:
+            raise ValueError("give state or launch_gait, not both")
         return within_budget(self, worst_case(self))
 
 
@@ -66,6 +73,7 @@ class PlanSpec:
     seed: int = 0
     noise: NoiseSpec = field(default_factory=NoiseSpec)
     state: StateSpec | None = None
+    launch_gait: bool = False
     attempts: int = 0
     replans: int = 3
     cap: int = 200
@@ -83,8 +91,9 @@ def run(spec: PlanSpec, context: JobContext) -> dict:
 
     world, goal, noise = world_of(spec), goal_in_l0(spec, context.robot), spec.noise.model()
     state = start_velocity(context.model) if spec.state is None else (spec.state.xdot, spec.state.ydot)
-    plan = plan_climb(context.model, world, goal, state, noise=noise, seed=spec.seed)
+    plan = plan_climb(context.model, world, goal, state, noise=noise, seed=spec.seed, launch_gait=spec.launch_gait)
     context.progress(1, 2 if spec.attempts and plan.reaches_goal else 1)
+    state = plan.steps[0].velocity if spec.launch_gait and plan.steps else state
     document = plan.to_dict(context.robot.leg_length) | {"world": label_of(spec), "state": [float(v) for v in state]}
     if spec.attempts and plan.reaches_goal:
         options = PlanSplitting(seed=spec.seed, cap=spec.cap, max_replans=spec.replans)

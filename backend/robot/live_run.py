@@ -1,18 +1,19 @@
 """A live run on the robot: its control loop, the one thread that owns the run's data.
 
 The loop sets the legs, arms and starts the robot, then watches the tracker: each touchdown it
-detects is recorded and, closed loop, its height goes through the run's law
-(:mod:`backend.robot.live_law`) to the leg of the touchdown after next — the one the robot
-positions during the coming stance. It ends when its jumps or time are used up, when stopped, or
-when anything goes wrong (e-stop, a fall, a restart of the robot, a lost link; closed loop, the
-tracker going blind: :mod:`backend.robot.tracker_watch`), each named
+detects is recorded and, closed loop, goes through the run's law (a height controller,
+:mod:`backend.robot.live_law`, or a plan's foot placement, :mod:`backend.robot.plan_law`) to the
+leg of the touchdown after next — the one the robot positions during the coming stance. It ends
+when its jumps or time are used up, when stopped, when its law ends it (a plan's goal or a missed
+foothold), or when anything goes wrong (e-stop, a fall, a restart of the robot, a lost link; closed
+loop, the tracker going blind: :mod:`backend.robot.tracker_watch`), each named
 (:mod:`backend.robot.run_endings`); whatever ended it, it then disarms the robot, confirmed by
 telemetry (:meth:`RobotLink.make_safe`). An open loop goes on through tracker gaps, each recorded.
 
-Only the loop's thread writes the run's records. Everyone else sees them two ways, neither of
-which shares anything mutable: :attr:`LiveRun.snapshot`, an immutable :class:`RunSnapshot`
-replaced whole after every change (the panel, the live 3D view), and :attr:`LiveRun.journal`, a
-queue of :class:`Record` s — each appended record, once, in order — that the journal writer drains
+Only the loop's thread writes the run's records. Everyone else sees them two ways, sharing nothing
+mutable: :attr:`LiveRun.snapshot`, an immutable :class:`RunSnapshot` replaced whole after every
+change (the panel, the live 3D view), and :attr:`LiveRun.journal`, a queue of :class:`Record` s —
+each appended record, once, in order — that the journal writer drains
 (:mod:`backend.services.robot_journal`)."""
 
 from __future__ import annotations
@@ -26,8 +27,9 @@ from dataclasses import dataclass, field, replace
 from backend.robot.link import LinkError, LinkState, RobotLink
 from backend.robot.live_law import LiveLaw, pitch_at
 from backend.robot.messages import Leg
+from backend.robot.plan_law import PlanLaw, RunEnds
 from backend.robot.run_endings import CLEAN_ENDINGS, LINK_LOST, end_safely, fault_names, robot_ending
-from backend.robot.touchdown import PITCH_LOOKBACK, Touchdown, scan_touchdowns
+from backend.robot.touchdown import PITCH_LOOKBACK, SideAt, Touchdown, scan_touchdowns
 from backend.robot.tracker import PoseHistory, pose_arrays
 from backend.robot.tracker_watch import TRACKER_TIMEOUT_MS, TrackerWatch, frames_heard
 from sim_core.model.controls import LegControl
@@ -123,15 +125,8 @@ class LiveRun:
     _stop_requests: queue.SimpleQueue[str] = field(default_factory=queue.SimpleQueue)
 
     def __post_init__(self) -> None:
-        self.snapshot = RunSnapshot(
-            self.run_id,
-            self.started,
-            self.jumps,
-            self.max_seconds,
-            self.target_m,
-            started_by=self.started_by,
-            first_pose=self.first_pose,
-        )
+        self.snapshot = RunSnapshot(self.run_id, self.started, self.jumps, self.max_seconds, self.target_m,
+                                    started_by=self.started_by, first_pose=self.first_pose)  # fmt: skip
 
     def stop(self, reason: str = "stopped") -> None:
         """Any thread: ask the loop to end; it sends nothing more once it has seen this (the first
@@ -171,14 +166,16 @@ def execute(
     tracker: PoseHistory,
     robot,
     legs: list[LegControl],
-    controller: LiveLaw | None,
+    controller: LiveLaw | PlanLaw | None,
     on_end: Callable[[LiveRun], None],
+    side_at: SideAt | None = None,
 ) -> None:
     """The run's control loop, on its own thread, to the end. Then the robot is made safe,
     ``on_end(run)`` stores the run, and only then the snapshot turns inactive and ``run.done`` is
     set, whatever happened. ``controller`` is the law closed at each touchdown (this thread
-    owns it from here), or None for open loop; ``robot`` the physical parameters (touchdown
-    detection, units)."""
+    owns it from here; it may end the run: :class:`RunEnds`), or None for open loop; ``robot``
+    the physical parameters (touchdown detection, units); ``side_at`` a world's sides (None:
+    parallel walls)."""
     commanded = run.commanded
     commanded.update({Leg.LEFT: legs[0], Leg.RIGHT: legs[1]})
     seen_poses = run.first_pose
@@ -225,7 +222,8 @@ def execute(
             if scan_from - first < len(poses):
                 arrays = pose_arrays(poses)
                 scan = scan_touchdowns(arrays["time"], arrays["x"], arrays["y"], robot, leg_for, arrays["pitch"],
-                                       start=scan_from - first, first_index=len(run.touchdowns))  # fmt: skip
+                                       start=scan_from - first, first_index=len(run.touchdowns),
+                                       side_at=side_at)  # fmt: skip
                 scan_from = first + scan.resume
                 run.touchdown_controls.extend(leg_for(touchdown.index) for touchdown in scan.touchdowns)
                 for touchdown in scan.touchdowns:
@@ -234,9 +232,13 @@ def execute(
                     if controller is not None:
                         leg = Leg.of(wall_of(touchdown.index + 2))  # the next touchdown's (climb numbering)
                         pitch = pitch_at(arrays["time"], arrays["pitch"], touchdown.time)
-                        control, law = controller.command(touchdown, pitch, commanded[leg].psi0)
+                        try:
+                            control, law = controller.command(touchdown, pitch, commanded[leg].psi0)
+                        except RunEnds as ending:  # the plan's goal, or a foot off its plan
+                            run.end_reason = str(ending)
+                            break
                         send(leg, control, f"{controller.name} after touchdown {touchdown.index}", **law)
-                if len(run.touchdowns) >= run.jumps:
+                if run.end_reason is None and len(run.touchdowns) >= run.jumps:
                     run.end_reason = "jumps done"
             time.sleep(POLL)
         _record_gaps(run, watch, ending=True)
@@ -290,11 +292,6 @@ def _record_gaps(run: LiveRun, watch: TrackerWatch, *, ending: bool = False) -> 
 
 def telemetry_dict(telemetry) -> dict:
     """A TELEMETRY message as the API and the stored run show it."""
-    return {
-        "seq": telemetry.seq,
-        "state": telemetry.state.name.lower(),
-        "psi_servo_deg": list(telemetry.psi_servo_deg),
-        "zeta_servo": list(telemetry.zeta_servo),
-        "battery_mv": telemetry.battery_mv,
-        "faults": telemetry.faults,
-    }
+    return {"seq": telemetry.seq, "state": telemetry.state.name.lower(), "psi_servo_deg": list(telemetry.psi_servo_deg),
+            "zeta_servo": list(telemetry.zeta_servo), "battery_mv": telemetry.battery_mv,
+            "faults": telemetry.faults}  # fmt: skip

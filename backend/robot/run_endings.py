@@ -16,7 +16,10 @@ from __future__ import annotations
 from backend.robot.link_types import LinkError, LinkState
 from backend.robot.messages import Fault
 
-CLEAN_ENDINGS = ("jumps done", "stopped", "time limit")  # a run that ended so is "done", else "failed"
+GOAL_REACHED = "goal reached"  # a run following a plan: a foot at the plan's goal
+MISSED_FOOTHOLD = "missed foothold"  # ... a foot landed off the plan's foothold
+OFF_PLAN = "off plan"  # ... no leg lands on the plan's next foothold (or the plan ended below its goal)
+CLEAN_ENDINGS = ("jumps done", "stopped", "time limit", GOAL_REACHED)  # a run that ended so is "done", else "failed"
 LEGACY_SELF_DISARMED = "robot disarmed (fell or timed out)"  # how runs before these names ended so
 
 FELL = "fell"

@@ -23,6 +23,7 @@ from sim_core.model.controls import LegControl
 from sim_core.model.params import PhysicalParams
 from sim_core.model.walls import Wall
 
+SideAt = Callable[[Wall, float], float]  # a world's side: its x [m] at a height [m]
 MIN_FIT_POSES = 4
 PITCH_LOOKBACK = 10  # poses looked back through for the newest pitch the markers gave
 
@@ -38,6 +39,7 @@ class Touchdown:
     body_height: float  # [m]
     foot_height: float  # [m]
     poses_fitted: int
+    body_x: float | None = None  # [m] where the body was at touchdown (x across the chute); None: stored before
 
     def to_dict(self) -> dict:
         """As JSON stores it (the wall as its sign, the state as a list)."""
@@ -55,14 +57,16 @@ def detect_touchdowns(
     robot: PhysicalParams,
     leg_for: Callable[[int], LegControl],
     pitch: np.ndarray | None = None,
+    side_at: SideAt | None = None,
 ) -> list[Touchdown]:
     """Touchdowns in a pose stream (SI, wall coordinates; ``leg_for(k)`` is touchdown k's controls;
-    ``pitch`` [rad] per pose, NaN where the markers gave none, or None).
+    ``pitch`` [rad] per pose, NaN where the markers gave none, or None; ``side_at(wall, y)`` the x
+    [m] of the chute's side at height ``y`` [m] in a world, None between parallel walls).
 
     A crossing whose flight could not be fitted (fewer than ``MIN_FIT_POSES`` flight poses) is
     skipped; the stream may start and end anywhere.
     """
-    return scan_touchdowns(time, x, y, robot, leg_for, pitch).touchdowns
+    return scan_touchdowns(time, x, y, robot, leg_for, pitch, side_at=side_at).touchdowns
 
 
 @dataclass(frozen=True)
@@ -83,6 +87,7 @@ def scan_touchdowns(
     *,
     start: int = 1,
     first_index: int = 0,
+    side_at: SideAt | None = None,
 ) -> Scan:
     """:func:`detect_touchdowns` from pose ``start`` on (the poses before it only give the pitch
     looked back to and the centre-line crossing at ``start``), numbering touchdowns from
@@ -103,7 +108,9 @@ def scan_touchdowns(
         number = first_index + len(touchdowns)
         leg = leg_for(number)
         psi = leg.psi0 - wall * pitch_before(pitch, i)  # the leg turned with the body
-        line = wall * (half - leg.zeta0 * robot.leg_length * math.cos(psi))
+        reach_x, reach_y = leg.zeta0 * robot.leg_length * math.cos(psi), leg.zeta0 * robot.leg_length * math.sin(psi)
+        side = wall * half if side_at is None else side_at(wall, y[i] - reach_y)  # where the foot meets it
+        line = side - wall * reach_x
         if wall * x[i] < wall * line:
             continue
         fit = slice(flight_start, i)  # flight poses before the line
@@ -125,8 +132,9 @@ def scan_touchdowns(
                 wall=wall,
                 state=state,
                 body_height=body,
-                foot_height=body - leg.zeta0 * robot.leg_length * math.sin(psi),
+                foot_height=body - reach_y,
                 poses_fitted=fit.stop - fit.start,
+                body_x=line,
             )
         )
     return Scan(touchdowns, len(time) if flight_start is None else flight_start)

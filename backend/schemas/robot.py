@@ -5,7 +5,7 @@ from __future__ import annotations
 import ipaddress
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, Field, ValidationInfo, field_validator
+from pydantic import BaseModel, Field, ValidationInfo, field_validator, model_validator
 
 from backend.robot.natnet import COMMAND_PORT, MULTICAST_GROUP, parse_version
 from backend.robot.ports import check_port
@@ -137,10 +137,16 @@ class ClosedLoopIn(Strict):
 
 
 class RobotRunCreate(Strict):
-    """A live run: the left and right legs' controls, bounded in jumps and time; optionally closed loop."""
+    """A live run: the left and right legs' controls, bounded in jumps and time; optionally closed
+    loop, or following a plan (``plan_job_id``: a finished ``plan`` job, in the world the robot
+    climbs; its legs start the run)."""
 
     experiment_id: RecordRef | None = None
-    controls: Annotated[list[LegIn], Field(min_length=2, max_length=2, description="[left, right]")]
+    controls: Annotated[list[LegIn] | None, Field(min_length=2, max_length=2, description="[left, right]")] = None
+    world_id: RecordRef | None = Field(None, description="the stored world the robot climbs; null: parallel walls")
+    plan_job_id: RecordRef | None = Field(
+        None, description="a finished plan job whose plan the run follows with the placement law (its world)"
+    )
     jumps: Annotated[int, Field(ge=1, le=10_000)] = 20
     max_seconds: Annotated[float, Field(gt=0.0, le=3600.0)] = 60.0
     closed_loop: ClosedLoopIn | None = None
@@ -158,6 +164,14 @@ class RobotRunCreate(Strict):
         str | None,
         Field(min_length=1, max_length=80, description="who runs it, as every panel is told (default: the client)"),
     ] = None
+
+    @model_validator(mode="after")
+    def _one_way_to_move(self) -> RobotRunCreate:
+        if (self.controls is None) == (self.plan_job_id is None):
+            raise ValueError("give either controls [left, right] or plan_job_id (its plan's legs), not both")
+        if self.plan_job_id is not None and self.closed_loop is not None:
+            raise ValueError("a run follows a plan or holds a height (closed_loop), not both")
+        return self
 
 
 class EstopLatchOut(BaseModel):

@@ -6,8 +6,7 @@ control loop's (:mod:`backend.robot.live_run`): the service starts it, asks it t
 its immutable snapshots; its journal writer (:mod:`backend.services.robot_journal`) stores it
 while it runs, and :mod:`backend.services.robot_records` folds it when it ends, or at the next
 start if the service died first. The e-stop waits for none of this: :meth:`RobotService.estop_now`
-runs it on the service's own e-stop thread, under no lock, bounded, and answers whether the robot
-acknowledged it.
+runs it on the service's own e-stop thread, under no lock, bounded, and answers if it was acknowledged.
 """
 
 from __future__ import annotations
@@ -28,6 +27,7 @@ from backend.schemas import RobotConnect, RobotRunCreate
 from backend.services.presets import resolve_model
 from backend.services.robot_estop import LATCH_SAVE_WAIT, latch_status, press
 from backend.services.robot_journal import JournalWriter
+from backend.services.robot_plans import run_world
 from backend.services.robot_records import open_robot_run, recover_interrupted
 from backend.services.robot_tracker import PoseSource, TrackerSlot
 from experiments.manifest import json_safe
@@ -232,21 +232,22 @@ class RobotService:
         link = self._connected()
         with self._lock:
             self._refuse_during_run("start another")
-            legs = [LegControl.from_degrees(leg.psi0_deg, leg.zeta0) for leg in body.controls]
+            with self.sessions() as session:  # the world climbed and the plan followed, if any (robot_plans.py)
+                where = run_world(session, body, self.robot, link.limits)
+            legs = where.legs or [LegControl.from_degrees(leg.psi0_deg, leg.zeta0) for leg in body.controls]
             for leg in legs:
                 link.limits.check(leg.psi0_deg, leg.zeta0)  # a clear 422 before anything moves
             # Designed (and compiled) first: an e-stop pressed meanwhile is seen by the checks below.
-            controller = self._law(body.closed_loop, legs, link.limits)
+            controller = where.law or self._law(body.closed_loop, legs, link.limits)
             if self.latch.held:
                 raise RobotUnavailable(f"the e-stop latch holds ({self.latch.state.reason()}): reset before you start")
             if link.state not in (LinkState.DISARMED, LinkState.ARMED):
                 raise RobotUnavailable(f"the robot is {link.state.value}; it must be disarmed or armed to start")
             tracker = self.tracker
             with self.sessions() as session:
-                where = {"url": link.url, "robot_address": f"0x{link.robot_address:016X}"}
-                run_id = open_robot_run(
-                    session, body, self.robot, tracker.calibration, started_by=started_by, link=where, person=person
-                )
+                on = {"url": link.url, "robot_address": f"0x{link.robot_address:016X}"}
+                run_id = open_robot_run(session, body, self.robot, tracker.calibration, started_by=started_by, link=on,
+                                        person=person, legs=legs, world_id=where.world_id)  # fmt: skip
             target_m = None if body.closed_loop is None else body.closed_loop.target_m
             run = LiveRun(
                 body.jumps,
@@ -259,8 +260,8 @@ class RobotService:
             )
             journal = JournalWriter(self.sessions, run, tracker, link, self.robot).start()
             self._run = run
-        threading.Thread(target=execute, args=(run, link, tracker, self.robot, legs, controller, journal.finish),
-                         name="robot-live-run", daemon=True).start()  # fmt: skip
+        threading.Thread(target=execute, args=(run, link, tracker, self.robot, legs, controller, journal.finish,
+                                               where.side_at), name="robot-live-run", daemon=True).start()  # fmt: skip
         return run.snapshot
 
     def wait_run(self, timeout: float) -> RunSnapshot | None:

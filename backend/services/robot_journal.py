@@ -60,7 +60,7 @@ class JournalWriter:
         self._finished.set()
         self._thread.join()
         self._append(self._collect())
-        status = "done" if run.end_reason in CLEAN_ENDINGS else "failed"
+        status = "done" if run.end_reason.split(":")[0] in CLEAN_ENDINGS else "failed"  # its family
         try:
             with self.sessions() as session:
                 fold_journal(session, run.run_id, status=status, end_reason=run.end_reason,

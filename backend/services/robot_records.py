@@ -28,6 +28,7 @@ from backend.robot.run_endings import robot_ending_record
 from backend.robot.touchdown import Touchdown, detect_touchdowns, height_gains
 from backend.schemas import RunDetail
 from backend.services.provenance import current_code_version
+from backend.services.robot_plans import world_sides
 from backend.services.runs import run_detail
 from backend.store.models import Run
 from backend.store.run_record import RunRecord
@@ -42,12 +43,13 @@ INTERRUPTED = "interrupted: the service stopped during the run; kept to its last
 
 def open_robot_run(
     session, request, robot, calibration, *, started_by: str | None = None, link: dict | None = None,
-    person: str | None = None,
+    person: str | None = None, legs=None, world_id: int | None = None,
 ) -> int:  # fmt: skip
     """Store a live run as it starts (status ``running``); returns its id. ``request`` is the
     :class:`~backend.schemas.RobotRunCreate`, ``robot`` the physical parameters, ``started_by`` who
     started it as the panels are told, ``person`` the token's (the run's ``created_by``), ``link``
-    the radio link it runs on (``url``, ``robot_address``)."""
+    the radio link it runs on (``url``, ``robot_address``), ``legs`` its start legs (a plan's, where it
+    follows one; else the request's), ``world_id`` the world it climbs."""
     model = robot.to_model()
     if request.experiment_id is not None:  # before anything moves: a 404, and the robot stays as it is
         stored_experiments.locked_experiment(session, request.experiment_id)
@@ -56,7 +58,8 @@ def open_robot_run(
         status="running",
         code_version=current_code_version(),
         model=json_safe(asdict(model)),
-        controls=[[leg.psi0_deg, leg.zeta0] for leg in request.controls],
+        controls=[[leg.psi0_deg, leg.zeta0] for leg in (request.controls or legs)],
+        world_id=world_id,
         jumps=request.jumps,
         **touchdown_columns([], {"rises": []}),
         results=json_safe(
@@ -67,6 +70,7 @@ def open_robot_run(
                 "calibration": asdict(calibration),
                 "tracker_timeout_ms": request.tracker_timeout_ms,
                 "closed_loop": None if request.closed_loop is None else request.closed_loop.model_dump(),
+                "plan_job_id": request.plan_job_id,
             }
         ),
         tags=tuple(request.tags),
@@ -184,11 +188,14 @@ def replay_run(session, run_id: int, robot=None, *, person: str | None = None) -
         raise Conflict(f"run {run_id} is a {source.kind} run without tracker frames; only robot runs can be replayed")
     frames = unpack_trajectory(source.trajectory)
     leg_for = recorded_leg_for(source)
-    touchdowns = detect_touchdowns(frames["time"], frames["x"], frames["y"], robot, leg_for, frames.get("pitch"))
+    side_at = None if source.world_id is None else world_sides(session, source.world_id, robot)  # its world's
+    touchdowns = detect_touchdowns(frames["time"], frames["x"], frames["y"], robot, leg_for, frames.get("pitch"),
+                                   side_at=side_at)  # fmt: skip
     analysis = touchdown_results(touchdowns, [leg_for(k) for k in range(len(touchdowns))], robot)
     record = RunRecord(
         kind="replay",
         status="done",
+        world_id=source.world_id,
         code_version=current_code_version(),
         model=source.model,
         controls=source.controls,

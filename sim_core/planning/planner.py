@@ -68,7 +68,8 @@ class PlanStep:
     def to_dict(self) -> dict:
         return {"jump": self.jump, "side": SIDES[self.side], "segment": self.segment,
                 "target": [float(self.target[0]), float(self.target[1])],
-                "psi0_deg": float(math.degrees(self.leg.psi0)), "zeta0": float(self.leg.zeta0)}  # fmt: skip
+                "psi0_deg": float(math.degrees(self.leg.psi0)), "zeta0": float(self.leg.zeta0),
+                "velocity": [float(self.velocity[0]), float(self.velocity[1])]}  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -113,17 +114,38 @@ def plan_climb(
     beam: int = BEAM,
     max_jumps: int = MAX_JUMPS,
     seed: int = 0,
+    launch_gait: bool = False,
 ) -> Plan:
     """The most robust plan from touchdown 0 (the foot on the left side at ``foot_y`` [l0], the
     body arriving with ``state``) to a foot at ``goal`` [l0] or higher; ``reaches_goal`` False
-    with the highest foot found when none does."""
+    with the highest foot found when none does. ``launch_gait``: the body arrives instead with the
+    velocity of the gait of touchdown 0's own leg — as a robot launched on that leg does (the
+    virtual robot, backend/robot/climber.py); a leg without a gait is not tried."""
     started = time.perf_counter()
     goal, foot_y = check_goal(world, goal, foot_y, footholds=False)
     nodes = []
     for leg in LEGS:
-        row, segment = first_touchdown(model, world, ControlSchedule.of(LegControl(*leg)), state, foot_y)
+        schedule = ControlSchedule.of(LegControl(*leg))
+        if launch_gait:
+            state = _launch_state(model, schedule)
+            if state is None:
+                continue
+        row, segment = first_touchdown(model, world, schedule, state, foot_y)
         nodes.append(_Node(row, 0, segment, tuple(leg), 0.0, ((row, 0, segment, tuple(leg)),)))
     return _best_plan(model, world, goal, nodes, foot_y, noise, samples, beam, max_jumps, seed, started)
+
+
+def _launch_state(model: ModelParams, schedule: ControlSchedule) -> tuple[float, float] | None:
+    """The velocity of the gait of ``schedule``'s one leg, found as the virtual robot finds it; None without one."""
+    from sim_core.model.errors import FixedPointNotFound
+    from sim_core.model.presets import START_GUESS
+    from sim_core.section.gait_search import gait_of
+
+    try:
+        state = gait_of(model, schedule, guess=START_GUESS).state
+    except FixedPointNotFound:
+        return None
+    return float(state[0]), float(state[1])
 
 
 def replan(model: ModelParams, world: World, goal: float, touchdown, *, liftoff=None, noise: NoiseModel | None = None,

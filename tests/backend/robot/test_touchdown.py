@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from backend.robot.touchdown import MIN_FIT_POSES, Touchdown, detect_touchdowns, height_gains, scan_touchdowns
-from sim_core import LegControl, get_preset
+from sim_core import ControlSchedule, LegControl, get_preset
 from sim_core.model.walls import Wall
 
 PAPER = get_preset("paper")
@@ -157,3 +157,35 @@ def test_a_touchdown_is_stored_as_json_and_read_back_whole():
     assert stored["wall"] == -1 and stored["state"] == [-0.93, -0.17]
     back = Touchdown.from_dict(stored)
     assert back == touchdown and back.wall is Wall.LEFT
+
+
+@pytest.mark.parametrize("name", ["narrowing", "staircase"])
+def test_in_a_world_a_touchdown_is_where_the_foot_meets_its_side(name):
+    """The world's own climb (sim_core's), sampled at 100 Hz: the touchdowns are found where the
+    foot meets the sides at its height; read as parallel walls, the leaning sides' are not."""
+    from sim_core.planning.planner import start_velocity
+    from sim_core.world.geometry import pack, side_x
+    from sim_core.world.named import named_world
+    from sim_core.world.trajectory import simulate_world_trajectory
+
+    model, metres, scales = PAPER.to_model(), PAPER.leg_length, PAPER.scales
+    world = named_world(name, model.d_hat)
+    schedule = ControlSchedule.from_degrees([(30.0, 0.9), (30.0, 0.9)])
+    path, climb = simulate_world_trajectory(model, world, schedule, start_velocity(model), 8,
+                                            sample_rate=100.0 * scales.time)  # fmt: skip
+    sides = pack(world, model.mu)
+
+    def side_at(wall, height_m):
+        return float(side_x(sides, 0 if wall == Wall.LEFT else 1, height_m / metres)) * metres
+
+    t, x, y = path.time * scales.time, path.x * metres, path.y * metres
+    found = detect_touchdowns(t, x, y, PAPER, lambda k: schedule[k + 1], side_at=side_at)
+    # The path ends at the last touchdown (no pose past its line), or goes on falling after a slip.
+    touched = min(len(found), len(climb.states) - 1)
+    assert touched >= max(4, len(climb.states) - 2)
+    np.testing.assert_allclose([(td.body_x, td.body_height) for td in found[:touched]],
+                               climb.states[1 : touched + 1, :2] * metres, atol=1e-3)  # fmt: skip
+    if name == "narrowing":
+        parallel = detect_touchdowns(t, x, y, PAPER, lambda k: schedule[k + 1])
+        seen = [td.body_x for td in parallel[:touched]]
+        assert not np.allclose(seen, climb.states[1 : len(seen) + 1, 0] * metres, atol=1e-3)
