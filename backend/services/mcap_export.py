@@ -13,7 +13,9 @@ The run's own channels, protobuf messages of package ``parkourlab`` (topics, fie
 Beside them, the same poses and numbers in the formats Foxglove and Rerun draw as they open the
 file (:mod:`backend.services.mcap_visuals`): the body as Foxglove's ``PoseInFrame``,
 ``FrameTransform`` and ``PointCloud`` in protobuf, the link's changes and the commands as
-Foxglove's ``Log``, and the height and touchdown series as ROS 2 number arrays, which Rerun plots.
+Foxglove's ``Log``, the height and touchdown series as ROS 2 number arrays, which Rerun plots, and
+the chute the run climbed — its stored world, else parallel walls — as a Foxglove ``SceneUpdate``
+and a ``PointCloud`` (:mod:`backend.services.mcap_world`).
 
 Timestamps (log time = publish time, UTC nanoseconds since the Unix epoch) are all on one clock,
 the tracker's, begun at the run's start: the rule is :mod:`backend.services.mcap_clock`'s.
@@ -82,7 +84,7 @@ def export_run(session: Session, run_id: int, stream: BinaryIO) -> dict[str, int
 
 def recording_of(session: Session, run_id: int) -> Recording:
     """The recording of a robot run that has ended, or of a replay whose source run is stored."""
-    from backend.services import mcap_visuals  # protobuf and Foxglove's schemas: loaded by exports only
+    from backend.services import mcap_visuals, mcap_world  # protobuf, Foxglove's schemas: loaded by exports only
 
     run = stored_runs.get_run(session, run_id)
     if run.kind not in EXPORTED_KINDS:
@@ -125,7 +127,10 @@ def recording_of(session: Session, run_id: int) -> Recording:
         ],
         "/robot/link": _on_clock(clock, source.results.get("transitions", [])),
     }
-    return Recording(run.id, messages | mcap_visuals.drawn(messages), _metadata(run, source))
+    # The chute, once at the recording's start: its earliest message, or its first frame's time.
+    start = min((time for timed in messages.values() for time, _ in timed), default=at(first_frame_time))
+    chute = mcap_world.messages(mcap_world.chute_of(session, source, frames), start)
+    return Recording(run.id, messages | mcap_visuals.drawn(messages) | chute, _metadata(run, source))
 
 
 def write_recording(recording: Recording, stream: BinaryIO) -> None:

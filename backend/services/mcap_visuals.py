@@ -10,6 +10,8 @@ Each is derived from the run's own channels and adds nothing to them; it is ther
   ``CoordinateFrame``), ``/tracker/transform`` (``foxglove.FrameTransform`` from frame ``chute`` to
   frame ``body``; Rerun: ``Transform3D``) and ``/tracker/body`` (``foxglove.PointCloud`` of one
   point, the body; Rerun: ``Points3D``), one message per tracker frame;
+- ``/world/scene`` (``foxglove.SceneUpdate``) and ``/world/points`` (``foxglove.PointCloud``; Rerun:
+  ``Points3D``): the chute the run climbed, once at the start (:mod:`backend.services.mcap_world`);
 - ``/robot/log`` (``foxglove.Log``; Rerun: ``TextLog``): a line per link change (a warning when the
   link is lost or the robot e-stopped) and per command sent, in the order they happened;
 - number series as ROS 2 ``std_msgs/msg/Float64MultiArray`` (CDR) holding one number each, which
@@ -42,6 +44,8 @@ from foxglove_schemas_protobuf.Vector3_pb2 import Vector3
 from google.protobuf.message import Message
 from mcap_protobuf.schema import register_schema
 
+from backend.services import mcap_world
+
 if TYPE_CHECKING:
     from mcap.writer import Writer
 
@@ -54,6 +58,7 @@ PROTOBUF_CHANNELS: dict[str, type[Message]] = {
     "/tracker/transform": FrameTransform,
     "/tracker/body": PointCloud,
     "/robot/log": Log,
+    **mcap_world.CHANNELS,  # the chute the run climbed, written by mcap_export from mcap_world
 }
 WARNED_STATES = ("disconnected", "estopped")  # a link change into these is logged as a warning
 

@@ -27,6 +27,7 @@ def test_export_writes_the_run_s_recording(tmp_path):
     assert printed["channels"] == {"/tracker/pose": 336, "/touchdowns": 5, "/commands": 3, "/telemetry": 6,
                                    "/model/prediction": 5, "/robot/link": 1, "/tracker/pose_in_frame": 336,
                                    "/tracker/transform": 336, "/tracker/body": 336, "/robot/log": 4,
+                                   "/world/scene": 1, "/world/points": 1,
                                    "/plot/height": 336, "/plot/touchdown/body_height": 5,
                                    "/plot/touchdown/foot_height": 5, "/plot/touchdown/rise": 4,
                                    "/plot/prediction/rise": 4}  # fmt: skip

@@ -83,6 +83,8 @@ def test_a_robot_run_reads_back_channel_by_channel(session):
         "/robot/link": len(results["transitions"]),
         **dict.fromkeys(PROTOBUF_CHANNELS, frames["time"].size),
         "/robot/log": len(results["transitions"]) + len(results["commands"]),
+        "/world/scene": 1,
+        "/world/points": 1,
         "/plot/height": frames["time"].size,
         "/plot/touchdown/body_height": len(results["touchdowns"]),
         "/plot/touchdown/foot_height": len(results["touchdowns"]),
@@ -91,7 +93,8 @@ def test_a_robot_run_reads_back_channel_by_channel(session):
     }
     assert expected == {"/tracker/pose": 336, "/touchdowns": 5, "/commands": 3, "/telemetry": 6,
                         "/model/prediction": 5, "/robot/link": 1, "/tracker/pose_in_frame": 336,
-                        "/tracker/transform": 336, "/tracker/body": 336, "/robot/log": 4, "/plot/height": 336,
+                        "/tracker/transform": 336, "/tracker/body": 336, "/robot/log": 4, "/world/scene": 1,
+                        "/world/points": 1, "/plot/height": 336,
                         "/plot/touchdown/body_height": 5, "/plot/touchdown/foot_height": 5, "/plot/touchdown/rise": 4,
                         "/plot/prediction/rise": 4}  # fmt: skip
     assert counts == expected
