@@ -205,3 +205,16 @@ def test_a_worlds_refusal_names_its_location_once(page):
     message = page.inner_text(".message.error")
     expected = "Create world: world.left.points[1]: y must increase strictly bottom to top: -5.0 after 0.0"
     assert message == expected, message
+
+
+def test_a_plans_monte_carlo_climbs_are_said(page):
+    """With ``attempts``, the result's "monte_carlo": its failures of its trials and their interval."""
+    job = {"spec": {"goal_height_m": 0.5}}
+    result = {"reaches_goal": True, "plan": [{}, {}], "chance": 0.9, "highest_m": 0.61, "seconds": 2.0,
+              "monte_carlo": {"trials": 40, "failures": 3, "failure_chance_ci95": [0.016, 0.204],
+                              "mean_attempt_jumps": 4.5, "mfpt_jumps": 60.0}}  # fmt: skip
+    words_of = "async ([job, result]) => (await import('/panel/plan_view.js')).planWords(7, job, result, 'stairs')"
+    words = page.evaluate(words_of, [job, result])
+    assert "reaches the goal 0.5 m in 2 touchdown(s)" in words
+    assert "40 noisy climbs by the placement law: 3 failed (7.5%, 95%: 1.6%–20.4%)" in words
+    assert "about 60 jumps to a failure" in words
