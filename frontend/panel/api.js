@@ -66,8 +66,8 @@ export function say(text, kind = "ok") {
 function explain(body, status) {
   if (body && Array.isArray(body.detail)) {
     return body.detail.map((e) => {
-      const field = (e.loc || []).filter((p) => p !== "body").join(".");
-      return field ? `${field}: ${e.msg}` : e.msg;
+      const { location, message } = Fields.apiError(e);
+      return location ? `${location}: ${message}` : message;
     }).join("; ");
   }
   if (body && body.detail) return body.detail;

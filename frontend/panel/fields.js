@@ -125,6 +125,17 @@ export const Fields = (() => {
     return values;
   }
 
+  // One error of a 422's detail: where (its loc, less "body", joined by dots) and the message in
+  // the user's words — pydantic's "Value error, " prefix dropped, and the location dropped where
+  // the service's message starts with it already (a ParameterError's "world.left.points[2]: …"),
+  // so that "where: message" says it once.
+  function apiError(error) {
+    const location = (error.loc || []).filter((part) => part !== "body").join(".");
+    let message = String(error.msg).replace(/^(Value|Assertion) error, /, "");
+    if (location && message.startsWith(`${location}: `)) message = message.slice(location.length + 2);
+    return { location, message };
+  }
+
   // A 422's errors put at their fields: ``locations`` maps a body location ("controls.0.zeta0")
   // to an input's name. Returns {left: the messages no field took, in the API's words; marked:
   // how many fields were marked}. A detail that is one sentence (a gait not found, say) names no
@@ -134,9 +145,7 @@ export const Fields = (() => {
     const left = [];
     let marked = 0;
     for (const error of detail) {
-      const location = (error.loc || []).filter((part) => part !== "body").join(".");
-      // pydantic prefixes a validator's own message with its kind ("Value error, …"): not the user's words.
-      const raw = String(error.msg).replace(/^(Value|Assertion) error, /, "");
+      const { location, message: raw } = apiError(error);
       // A rule across fields (psi0_low_deg must be below psi0_high_deg, the work too big) names its
       // fields in the API's words: said in the form's labels, at the first field it names.
       const named = namedFields(form, raw, locations);
@@ -191,5 +200,5 @@ export const Fields = (() => {
   // One pattern for whole API field names, the longest first (so "zeta0_low" is not read as "zeta0").
   const namePattern = (fields) => new RegExp(`\\b(${[...fields].sort((a, b) => b.length - a.length).join("|")})\\b`, "g");
 
-  return { ready, readFields, markApiErrors, clear, annotation, schema, plain };
+  return { ready, readFields, markApiErrors, apiError, mark, clear, annotation, schema, plain };
 })();

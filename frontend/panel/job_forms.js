@@ -5,24 +5,32 @@
 // request body's schema in the OpenAPI document (the catalog names it): a number field per
 // property that takes a plain number, its default filled in, its description as its title, its
 // range checked as every form's is (fields.js). A kind whose body needs more than numbers (legs,
-// a list) is left to its own fieldset in index.html, or to the API. So a job kind added to the
-// service's registry can be scheduled from the panel with no change here.
-import { $, on } from "./api.js";
+// a list) is left to its own fieldset in index.html, or to the API — save a stored world (a
+// chooser of worlds by name, a foothold study's random worlds, a world-mjtf job's legs:
+// job_world.js). So a job kind added to the service's registry can be scheduled from the panel
+// with no change here.
+import { $, say, on } from "./api.js";
 import { Fields } from "./fields.js";
 import { attributes, element } from "./dom.js";
 import { SQRT_GL0, checked, simControls } from "./forms.js";
 import { loadCatalog } from "./catalog.js";
+import { WORLD_PARTS, worldPart } from "./job_world.js";
 
 const SKIPPED = new Set(["kind", "experiment_id", "model"]);  // the kind is the chooser's; the others have their own controls
 
-// The simple number properties of ``request`` (a schema name), or null when a required one is not a number.
+// The simple number properties of ``request`` (a schema name) and the names of its world's
+// properties (job_world.js), or null when a required one is neither.
 async function numberFields(request) {
   const schema = await Fields.schema(request);
   if (!schema?.properties) return null;
   const required = new Set(schema.required || []);
-  const fields = [];
+  const fields = [], world = [];
   for (const [name, property] of Object.entries(schema.properties)) {
     if (SKIPPED.has(name)) continue;
+    if (WORLD_PARTS.has(name)) {
+      world.push(name);
+      continue;
+    }
     const plain = Fields.plain(property);
     if (!plain || !["number", "integer"].includes(plain.type)) {
       if (required.has(name)) return null;
@@ -30,37 +38,45 @@ async function numberFields(request) {
     }
     fields.push({ name, plain, required: required.has(name), title: property.description ?? plain.description ?? "" });
   }
-  return fields;
+  return { fields, world };
 }
 
 // A fieldset for ``kind`` ({name, title, request}) built from its schema, or null if it cannot be.
 async function generatedFieldset(kind) {
-  const fields = await numberFields(kind.request);
-  if (!fields) return null;
-  const fieldset = attributes(element("fieldset", null, element("legend", kind.title)), { "data-kind": kind.name, "data-generated": "" });
+  const found = await numberFields(kind.request);
+  if (!found) return null;
+  const { fields } = found;
+  const part = found.world.length ? worldPart(kind.name, found.world) : null;
+  if (found.world.length && !part) return null;
+  const fieldset = attributes(element("fieldset", null, element("legend", kind.title), ...(part?.nodes ?? [])),
+    { "data-kind": kind.name, "data-generated": "" });
   for (const field of fields) {
     const input = attributes(element("input", null), { name: `${kind.name}__${field.name}`, type: "number",
       step: field.plain.type === "integer" ? "1" : "any" });
     if (field.plain.default !== undefined && field.plain.default !== null) input.value = String(field.plain.default);
-    const label = element("label", `${field.name.replaceAll("_", " ")} `, input);
+    const label = element("label", `${field.name.replace(/_(m|deg|s)$/, " [$1]").replaceAll("_", " ")} `, input);  // goal_height_m: "goal height [m]"
     if (field.title) label.title = field.title;
     fieldset.append(label);
   }
   fieldset.hidden = true;
   fieldset.disabled = true;
-  return { fieldset, fields: fields.map((field) => ({ name: `${kind.name}__${field.name}`, rule: `${kind.request}.${field.name}`, optional: !field.required })) };
+  const numbers = fields.map((field) => ({ name: `${kind.name}__${field.name}`, rule: `${kind.request}.${field.name}`, optional: !field.required }));
+  return { fieldset, fields: numbers, part };
 }
 
-// The body and the 422's locations of a generated kind's form, from the checked values ``v``.
-function generatedBody(kind, fields, v) {
-  const body = { kind }, locations = {};
+// The body and the 422's locations of a generated kind's form, from the checked values ``v``
+// (null: its world's part marked a field).
+function generatedBody(form, kind, { fields, part }, v) {
+  const body = { kind }, locations = { ...part?.locations };
   for (const field of fields) {
     const property = field.name.slice(kind.length + 2);
     if (v[field.name] !== undefined) body[property] = v[field.name];
     locations[property] = field.name;
-    locations[`${kind}.${property}`] = field.name;
   }
-  return { body, locations };
+  const world = part ? part.body(form, v) : {};
+  if (world === null) return null;
+  for (const [property, input] of Object.entries(locations)) locations[`${kind}.${property}`] = input;
+  return { body: { ...body, ...world }, locations };
 }
 
 on("#job-kind", "change", (event) => {
@@ -73,7 +89,7 @@ on("#job-kind", "change", (event) => {
 // The kind chooser, from the service's catalog: a kind with its own fieldset in index.html, or
 // one built from its request's schema (job_forms.js), in the registry's order; a kind whose
 // body the panel cannot build (a gait search's legs) is left to the API.
-const GENERATED = new Map();  // kind -> its generated form's fields
+const GENERATED = new Map();  // kind -> its generated form: {fieldset, fields, part (its world's: job_world.js)}
 async function fillJobKinds() {
   const form = $("#job-form"), select = $("#job-kind");
   const options = [];
@@ -81,7 +97,7 @@ async function fillJobKinds() {
     if (!form.querySelector(`fieldset[data-kind="${kind.name}"]`)) {
       const made = await generatedFieldset(kind);
       if (!made) continue;
-      GENERATED.set(kind.name, made.fields);
+      GENERATED.set(kind.name, made);
       form.querySelector(":scope > .buttons").before(made.fieldset);
     }
     options.push(attributes(element("option", kind.title), { value: kind.name }));
@@ -131,9 +147,14 @@ const JOB_LOCATIONS = { psi0_deg: "psi0", zeta0s: "zeta0s", trials: "trials", ca
 // field is marked).
 export async function jobSpec(form) {
   const kind = form.elements.kind.value;
-  const v = await checked(form, JOB_FIELDS[kind] ?? GENERATED.get(kind));
+  const made = GENERATED.get(kind);
+  const v = await checked(form, JOB_FIELDS[kind] ?? [...made.fields, ...(made.part?.fields(form) ?? [])]);
+  if (made?.part && !made.part.chosen(form)) {
+    if (v !== null) say("Fix the marked field(s) first: nothing was sent.", "error");
+    return null;
+  }
   if (v === null) return null;
-  if (GENERATED.has(kind)) return generatedBody(kind, GENERATED.get(kind), v);
+  if (made) return generatedBody(form, kind, made, v);
   if (kind === "mjtf") {
     return { body: { kind, psi0_deg: v.psi0, trials: v.trials, cap: v.cap, seed: v.seed, zeta0s: v.zeta0s }, locations: JOB_LOCATIONS };
   }

@@ -8,12 +8,16 @@ import { hideControlStudy, showControlStudy } from "./control_study.js";
 import { hideViability, showViability } from "./viability.js";
 import { hideLoopMfpt, showLoopMfpt } from "./loop_mfpt.js";
 import { jobSpec } from "./job_forms.js";
+import { hidePlan, showPlan } from "./plan_view.js";
+import { hideWorldResults, showFootholdStudy, worldJobWords, worldMjtfWords } from "./world_results.js";
 
 const streams = new Map();
 const FINAL = ["done", "cancelled", "failed"];
 
 export function describeJob(job) {
   const spec = job.spec || {};
+  const inWorld = worldJobWords(job);
+  if (inWorld) return inWorld;
   if (job.kind === "mjtf") return `psi0 ${spec.psi0_deg}°, zeta0 ${(spec.zeta0s || []).join(", ")} × ${spec.trials} trials`;
   if (job.kind === "sweep") return `psi0 ${spec.psi0_deg}°, zeta0 ${spec.zeta0_low}–${spec.zeta0_high}, ${spec.steps} steps`;
   if (job.kind === "control-study") return `${(spec.controllers || []).join(", ")} to ${spec.target_m} m, ${spec.seeds} × ${spec.jumps} jumps`;
@@ -185,6 +189,22 @@ function showMfpt(id, result) {
   }], layout(`Job ${id}: mean first-passage time on two grids`, "cells of the chain", "jumps to failure"));
 }
 
+// The results' plot box hidden (a job drawn without it: a stale plot of the job before would stay).
+function hidePlot() {
+  const box = $("#job-plot");
+  if (!box.hidden && window.Plotly) Plotly.purge(box);
+  box.hidden = true;
+}
+
+// A world-mjtf job: its climbs in words, and how many jumps the trials lasted.
+function showWorldMjtf(id, result) {
+  const summary = $("#job-summary");
+  summary.textContent = worldMjtfWords(id, result);
+  summary.hidden = false;
+  draw("job-plot", [{ type: "histogram", x: result.jumps, name: "trials" }],
+    layout(`Job ${id}: jumps each climb lasted in "${result.world}"`, "jumps", "trials"));
+}
+
 // A job's results: its plot in the Jobs tab, or a word where it has none (the table's Show, and
 // an experiment's list of jobs).
 export async function showJob(id) {
@@ -193,6 +213,8 @@ export async function showJob(id) {
   hideControlStudy();
   hideViability();
   hideLoopMfpt();
+  hidePlan();
+  hideWorldResults();
   if (results.levels) {
     // Only the levels with trials are drawn; a job that is not done says so in the title.
     const missing = results.missing_zeta0s || [];
@@ -216,6 +238,14 @@ export async function showJob(id) {
     showLoopMfpt(id, results.result);
   } else if (job.kind === "viability") {
     showViability(id, results.result);
+  } else if (job.kind === "plan") {
+    hidePlot();
+    await showPlan(id, job, results.result);
+  } else if (job.kind === "foothold-study") {
+    hidePlot();
+    showFootholdStudy(id, job, results.result);
+  } else if (job.kind === "world-mjtf") {
+    showWorldMjtf(id, results.result);
   } else if (job.kind !== "gaits") {
     // A kind the panel draws no plot for: its figures are in its results (GET /api/v1/jobs/{id}/results).
     say(`Job ${id} (${job.kind}) is done: its result is at ${API}/jobs/${id}/results.`);

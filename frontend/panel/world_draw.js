@@ -85,7 +85,9 @@ function niceStep(range, count) {
 // Draw ``world`` into ``svg`` (replacing what it held). Options: thumbnail (small, no axes, no
 // vertices), frame (the extent to draw, e.g. kept while a vertex is dragged), selected ({side,
 // index, vertex?}), error ({side, index, vertex?, message}: marked at its segment, the message
-// beside it). Returns {frame, toWorld(clientX, clientY)}.
+// beside it), clip (an id: the sides clipped to the frame, for a frame smaller than the world).
+// Returns {frame, toWorld(clientX, clientY), toSvg(x, y): a world point's place in
+// the drawing, for marks drawn over it (a plan's targets)}.
 export function drawWorld(svg, world, options = {}) {
   const thumb = Boolean(options.thumbnail);
   const frame = options.frame ?? extent(world);
@@ -108,16 +110,22 @@ export function drawWorld(svg, world, options = {}) {
   svg.classList.add("world-svg");
   if (!thumb) svg.append(...axes(frame, px, py, left, top, scale, units));
   const all = SIDES.flatMap((side) => segments(world, side));
+  const clipped = options.clip ? { "clip-path": `url(#${options.clip})` } : {};
+  if (options.clip) {
+    const clip = svgElement("clipPath", { id: options.clip });
+    clip.append(svgElement("rect", { x: px(frame.xmin), y: py(frame.ymax), width: scale * spanX, height: scale * spanY }));
+    svg.append(clip);
+  }
   const mark = (spec, cls, widthPx) => all.filter((s) => spec && s.side === spec.side && s.index === segmentOf(spec))
     .map((s) => svgElement("line", { x1: px(s.a[0]), y1: py(s.a[1]), x2: px(s.b[0]), y2: py(s.b[1]), class: cls, "stroke-width": widthPx }));
   svg.append(...mark(options.error, "world-error-mark", 12), ...mark(options.selected, "world-selected-mark", 10));
   for (const s of all) {
     const line = svgElement("line", { x1: px(s.a[0]), y1: py(s.a[1]), x2: px(s.b[0]), y2: py(s.b[1]), class: "world-segment",
-      stroke: muColor(s.mu), "stroke-width": thumb ? 1.5 : 4, "stroke-linecap": "round", "data-side": s.side, "data-index": s.index });
+      stroke: muColor(s.mu), "stroke-width": thumb ? 1.5 : 4, "stroke-linecap": "round", "data-side": s.side, "data-index": s.index, ...clipped });
     if (s.mu === 0) line.setAttribute("stroke-dasharray", thumb ? "2 2" : "5 4");
     line.append(svgElement("title", {}, `${s.side} segment ${s.index}: mu ${muWords(s.mu)}, beta ${s.beta.toFixed(1)}°`));
     svg.append(line);
-    if (isFoothold(s)) svg.append(...foothold(s, px, py, thumb));
+    if (isFoothold(s)) svg.append(...foothold(s, px, py, thumb).map((node) => attributesOf(node, clipped)));
   }
   if (!thumb) {
     for (const side of SIDES) {
@@ -136,8 +144,13 @@ export function drawWorld(svg, world, options = {}) {
     const at = new DOMPoint(clientX, clientY).matrixTransform(svg.getScreenCTM().inverse());
     return [frame.xmin + (at.x - left) / scale, frame.ymax - (at.y - top) / scale];
   };
-  return { frame, toWorld };
+  return { frame, toWorld, toSvg: (x, y) => [px(x), py(y)] };
 }
+
+const attributesOf = (node, values) => {
+  for (const [name, value] of Object.entries(values)) node.setAttribute(name, value);
+  return node;
+};
 
 // The segment a mark names: a vertex's is the segment ending at it (the first point: segment 0).
 const segmentOf = (spec) => (spec.vertex ? Math.max(spec.index - 1, 0) : spec.index);

@@ -42,9 +42,10 @@ export async function worldById(id) {
 export const cachedWorld = (id) => byId.get(id);
 export const onWorldsChange = (listener) => listeners.push(listener);
 
-// Every chooser marked data-worlds: its first option (none, any) kept, then a world a line.
-function fillWorldChoosers(worlds) {
-  for (const select of document.querySelectorAll("select[data-worlds]")) {
+// Every chooser marked data-worlds (or those of ``selects``: one not in the page yet): its
+// first option (none, any) kept, then a world a line.
+export function fillWorldChoosers(worlds, selects = document.querySelectorAll("select[data-worlds]")) {
+  for (const select of selects) {
     const chosen = select.value;
     const keep = [...select.options].filter((node) => node.value === "");
     select.replaceChildren(...keep, ...worlds.map((world) => new Option(`${world.name} (#${world.id})`, String(world.id))));
