@@ -25,8 +25,10 @@ from frontend.viewer.geometry import (
 )
 from frontend.viewer.motion import Pose
 from frontend.viewer.node_rings import NodeRing, StreamedTrail, hidden_lines
+from frontend.viewer.world_slabs import world_slabs, world_width
 from sim_core import LegControl, PhysicalParams
 from sim_core.model.trajectory import STANCE
+from sim_core.world.world import World
 
 WALL_THICKNESS = 0.03  # [m]
 DEPTH = 0.35  # [m] how deep the walls are drawn (the model is planar)
@@ -92,12 +94,15 @@ class ChuteScene:
             )
             for name, side in (("left", -1), ("right", 1))
         ]
-        scene.add_box(
+        self.floor = scene.add_box(
             "/chute/floor",
             color=(170, 170, 175),
             dimensions=(robot.wall_distance + 2 * WALL_THICKNESS, DEPTH, 0.01),
             position=(0.0, 0.0, -0.005),
         )
+        self.world: World | None = None  # None: the parallel walls (set_world)
+        self._world_key: tuple | None = None
+        self._world_nodes: list = []
         self._wall_x = [side * (half + 0.5 * WALL_THICKNESS) for side in (-1, 1)]
         self._ruler_sections = 0  # the ruler grows in sections: "/chute/ruler", then "/chute/ruler/part_k"
         self._ruler_labels = 0
@@ -161,6 +166,29 @@ class ChuteScene:
             segments=np.concatenate([spine, np.stack([starts, ends], axis=1)]),
             labels=labels,
         )
+
+    def set_world(self, world: World | None, leg_length: float = 0.0, model_mu: float = math.inf) -> None:
+        """Draw ``world`` (``l0`` units, at ``leg_length`` [m], its open frictions ``model_mu``) in
+        place of the parallel walls: its sides as slabs (:mod:`frontend.viewer.world_slabs`) under
+        ``/chute/world/``, sent once; None: the parallel walls again. The same world again sends nothing."""
+        key = None if world is None else (id(world), leg_length, model_mu)
+        if key == self._world_key:
+            return
+        for node in self._world_nodes:
+            node.remove()
+        self._world_nodes, self.world, self._world_key = [], world, key
+        for wall in self.walls:
+            wall.visible = world is None
+        if world is None:
+            self.floor.dimensions = (self.robot.wall_distance + 2 * WALL_THICKNESS, DEPTH, 0.01)
+            self.floor.position = (0.0, 0.0, -0.005)
+            return
+        left, right = world_width(world, leg_length)
+        self.floor.dimensions = (right - left + 2 * WALL_THICKNESS, DEPTH, 0.01)
+        self.floor.position = (0.5 * (left + right), 0.0, -0.005)
+        for slab in world_slabs(world, leg_length, model_mu):
+            name, options = f"/chute/world/{slab.name}", {"position": slab.position, "wxyz": slab.wxyz}
+            self._world_nodes.append(self.scene.add_box(name, color=slab.color, dimensions=slab.dimensions, **options))
 
     @staticmethod
     def top_for(height):
@@ -239,12 +267,14 @@ class ChuteScene:
         if len(points) >= 2:
             self.ghost_jump_trails.show_next(points=polyline_segments(points))
 
-    def add_touchdown(self, wall: int, foot_height: float) -> None:
-        """Mark where a foot met ``wall`` (-1 left, +1 right) at ``foot_height`` [m]."""
-        self.touchdown_markers.show_next(position=self.touchdown_position(wall, foot_height))
+    def add_touchdown(self, wall: int, foot_height: float, foot_x: float | None = None) -> None:
+        """Mark where a foot met ``wall`` (-1 left, +1 right) at ``foot_height`` [m] (and
+        ``foot_x`` [m]: in a world; None: on the parallel wall)."""
+        self.touchdown_markers.show_next(position=self.touchdown_position(wall, foot_height, foot_x))
 
-    def touchdown_position(self, wall: int, foot_height: float) -> tuple[float, float, float]:
-        return (wall * 0.5 * self.robot.wall_distance, 0.0, foot_height)
+    def touchdown_position(self, wall: int, foot_height: float, foot_x: float | None = None):
+        x = wall * 0.5 * self.robot.wall_distance if foot_x is None else foot_x
+        return (x, 0.0, foot_height)
 
     def clear_history(self) -> None:
         """Hide trails and touchdown markers (a reset or a new run)."""

@@ -105,6 +105,7 @@ class ViewerSession:
             self.mode = self.modes[name]
             self.scene.clear_history()
             self.scene.show_ghost(None)
+            self.scene.set_world(None)  # a mode in a world draws it again in its next frame
             if name != "replay":
                 self.scene.robot = self.robot
             self.mode.activate()
