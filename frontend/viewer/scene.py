@@ -49,6 +49,7 @@ GHOST_TRAIL_COLOR = (80, 170, 230)
 TOUCHDOWN_COLOR = (240, 150, 0)
 FOOT_COLOR = (240, 150, 0)
 RULER_COLOR = (60, 60, 60)
+TARGET_HIT, TARGET_MISSED, AIM_COLOR = (40, 200, 70), (220, 40, 40), (250, 215, 0)  # a followed plan's footholds
 CAMERA_POSITION = (0.0, -1.25, 0.6)  # [m] level with the robot, in front of the chute
 CAMERA_LOOK_AT = (0.0, 0.0, 0.6)
 
@@ -136,6 +137,9 @@ class ChuteScene:
         self.ghost_jump_trails = NodeRing(
             "/chute/ghost/jump_", TRAIL_JUMPS, hidden_lines(scene, GHOST_TRAIL_COLOR, 0.003)
         )
+        self.targets = NodeRing("/chute/targets/", TOUCHDOWN_MARKERS, lambda name: scene.add_icosphere(
+            name, radius=0.014, color=TARGET_HIT, position=(0.0, 0.0, 0.0), visible=False))  # fmt: skip
+        self.aim, self._aim_at = None, None  # the next target, made when first shown
         # Live mode's: its nodes are made when first drawn (none in simulate, replay or a shared file).
         self.live_trail = StreamedTrail(scene, "/chute/trail/live/", LIVE_TRAIL_PIECES, TRAIL_COLOR, 0.003)
         self.live_ghost_trail = StreamedTrail(scene, "/chute/ghost/live/", GHOST_TRAIL_PIECES, GHOST_TRAIL_COLOR, 0.003)
@@ -276,10 +280,26 @@ class ChuteScene:
         x = wall * 0.5 * self.robot.wall_distance if foot_x is None else foot_x
         return (x, 0.0, foot_height)
 
+    def add_target(self, x: float, y: float, *, hit: bool) -> None:
+        """Mark a followed plan's foothold at ``(x, y)`` [m] once its touchdown has passed: hit or missed."""
+        self.targets.show_next(position=(x, -0.04, y), color=TARGET_HIT if hit else TARGET_MISSED)
+
+    def show_aim(self, x: float | None, y: float | None) -> None:
+        """The foothold the coming touchdown aims at (None: none); sent only when it moves."""
+        at = None if x is None else (float(x), -0.04, float(y))
+        if at == self._aim_at:
+            return
+        if self.aim is None:
+            self.aim = self.scene.add_icosphere("/chute/aim", radius=0.018, color=AIM_COLOR, visible=False)
+        if at is not None:
+            self.aim.position = at
+        self.aim.visible, self._aim_at = at is not None, at
+
     def clear_history(self) -> None:
         """Hide trails and touchdown markers (a reset or a new run)."""
-        for ring in (self.touchdown_markers, self.jump_trails, self.ghost_jump_trails):
+        for ring in (self.touchdown_markers, self.jump_trails, self.ghost_jump_trails, self.targets):
             ring.clear()
+        self.show_aim(None, None)
         self.live_trail.clear()
         self.live_ghost_trail.clear()
         self.trail.points = np.zeros((1, 2, 3))

@@ -66,7 +66,7 @@ class ViewerSession:
         gui.add_markdown(f"{link} · walls {robot.wall_distance:.2f} m apart")
         self.gui_mode = gui.add_dropdown("Mode", MODES, initial_value="simulate")
         self.modes = {
-            "simulate": SimulateMode(client, self.scene, self.lock, robot),
+            "simulate": SimulateMode(client, self.scene, self.lock, robot, context.sessions),
             "live": LiveMode(client, self.scene, self.lock, context.robot_service, context.sessions),
             "replay": ReplayMode(client, self.scene, self.lock, context.sessions),
         }
