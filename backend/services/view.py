@@ -7,7 +7,8 @@ routes under ``/api/v1/view`` talk to whatever it built through :class:`SceneVie
 simulator load.
 
 The view reads the store and the robot only through this module: :func:`stored_path` (a stored
-run's path, for replay and sharing), :func:`stored_path_key` (what a cached replay was made of)
+run's path and its world, for replay and sharing), :func:`stored_path_key` (what a cached replay
+was made of), :func:`stored_worlds` and :func:`stored_world` (the worlds simulate mode plans in)
 and :func:`commanded` (a live run's command for a leg, named by its wall).
 """
 
@@ -25,8 +26,10 @@ import numpy as np
 
 from backend.errors import Conflict
 from backend.repositories import runs as run_rows
+from backend.repositories import worlds as world_rows
 from backend.robot.messages import Leg
 from backend.services.robot import RobotService
+from backend.services.worlds import world_in_l0
 from backend.store.trajectory_blob import unpack_trajectory
 from sim_core.model.controls import LegControl
 from sim_core.model.walls import Wall
@@ -85,6 +88,8 @@ class StoredPath:
         created_at: when it was stored (UTC; None: not read).
         status, end_reason: how it ended (a robot run's reason, e.g. "e-stop"; None: not read).
         loop, controller, target: how it was driven ("open"/"closed", "pid", the height held [m]).
+        world_id, world: the stored world it climbed and that world's §8 JSON in ``l0`` (None:
+            parallel walls).
     """
 
     run_id: int
@@ -103,16 +108,20 @@ class StoredPath:
     loop: str | None = None
     controller: str | None = None
     target: float | None = None
+    world_id: int | None = None
+    world: dict | None = None
+
+
+VIEW_PRESET = "paper"  # a world stored in metres is read at this robot's leg length (the view's size)
 
 
 def stored_path(sessions: Callable, run_id: int) -> StoredPath:
-    """Stored run ``run_id`` as the view replays it. Raises NotFound when there is no such run,
-    Conflict when a robot or replay run has no tracker frames or the run climbed a stored world."""
+    """Stored run ``run_id`` as the view replays it, with the world it climbed (read in ``l0``).
+    Raises NotFound when there is no such run, Conflict when a robot or replay run has no tracker
+    frames."""
     with sessions() as session:
         run = run_rows.get_run(session, run_id)
-        if run.world_id is not None:  # drawn between parallel walls it would show walls it never met
-            raise Conflict(f"run {run_id} climbed world {run.world_id}, and the 3D view draws parallel walls only "
-                           "(worlds in the view are the next slice of issue 43)")  # fmt: skip
+        world = None if run.world_id is None else world_in_l0(session, run.world_id, VIEW_PRESET)
         source = run
         if run.kind == "replay":
             source = run_rows.get_run(session, int(run.results.get("source_run_id", 0)) or run_id)
@@ -124,7 +133,21 @@ def stored_path(sessions: Callable, run_id: int) -> StoredPath:
             run.id, run.kind, run.model, run.controls, run.start_state, run.jumps, path, touchdowns,
             jumps_completed=run.jumps_completed, climb=run.climb, created_at=run.created_at, status=run.status,
             end_reason=run.end_reason, loop=run.loop, controller=run.controller, target=run.target,
+            world_id=run.world_id, world=world,
         )  # fmt: skip
+
+
+def stored_worlds(sessions: Callable, limit: int = 100) -> list[tuple[int, str]]:
+    """The stored worlds' ``(id, name)``, newest first (at most ``limit``)."""
+    with sessions() as session:
+        worlds, _next = world_rows.page(session, limit=limit, cursor=None)
+        return [(world.id, world.name) for world in worlds]
+
+
+def stored_world(sessions: Callable, world_id: int) -> dict:
+    """Stored world ``world_id`` as the §8 JSON in ``l0`` (NotFound: none)."""
+    with sessions() as session:
+        return world_in_l0(session, world_id, VIEW_PRESET)
 
 
 def stored_path_key(sessions: Callable, run_id: int) -> tuple:

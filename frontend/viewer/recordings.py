@@ -6,6 +6,11 @@
   touchdowns found live;
 - ``replay`` runs: their source robot run's frames with the touchdowns found again.
 
+A run that climbed a stored world carries that world (drawn in place of the parallel walls,
+:meth:`frontend.viewer.scene.ChuteScene.set_world`); a sim run's path is then the world's
+(:func:`sim_core.world.trajectory.simulate_world_trajectory`, when none was stored), never the
+parallel walls'.
+
 Simulated runs are nondimensional; they are shown at the paper robot's size (its ``l0``, mass
 and ``g``), heights from the chute's floor as every climb has them (:mod:`sim_core.climb.sequencer`): the
 first foot touches at the floor.
@@ -26,6 +31,9 @@ from sim_core import ControlSchedule, LegControl, ModelParams, PhysicalParams, g
 from sim_core.climb.sequencer import start_height
 from sim_core.model.trajectory import STANCE
 from sim_core.model.walls import Wall, walls_of
+from sim_core.world.files import world_from_document
+from sim_core.world.trajectory import simulate_world_trajectory
+from sim_core.world.world import World
 
 # Per sqrt(l0/g), when a stored sim run has no path of its own: the panel's "Save run" rate (about
 # 160 samples/s at the paper robot's size). The simulation costs the same at any rate; trails and
@@ -45,6 +53,9 @@ class Recording:
         robot: the robot it is shown at (walls, leg length, energy colours).
         legs: the left and right legs' controls (the idle leg's pose), or None for tracker data.
         touchdowns: shape (n, 3): time [s], wall (a :class:`Wall` value: -1 left, +1 right), foot height [m].
+        world: the world it climbed (``l0`` units; None: the parallel walls), ``world_mu`` the
+            friction where the world leaves it open; ``touchdown_x``: shape (n,), each touchdown's
+            foot ``x`` [m] (None: on the parallel walls).
     """
 
     run_id: int
@@ -55,6 +66,14 @@ class Recording:
     legs: tuple[LegControl, LegControl] | None
     touchdowns: np.ndarray
     description: str = ""
+    world: World | None = None
+    world_mu: float = math.inf
+    touchdown_x: np.ndarray | None = None
+
+    def touchdown_marker(self, k: int) -> tuple[int, float, float | None]:
+        """Touchdown ``k``'s marker: its wall, foot height [m] and foot ``x`` [m] (None: on the wall)."""
+        _time, wall, foot_height = self.touchdowns[k]
+        return int(wall), float(foot_height), None if self.touchdown_x is None else float(self.touchdown_x[k])
 
     @property
     def duration(self) -> float:
@@ -120,7 +139,8 @@ def _legs(run: StoredPath) -> tuple[LegControl, LegControl]:
 
 def _label(run: StoredPath) -> str:
     controls = ", ".join(f"{psi:g}°:{zeta:g}" for psi, zeta in run.controls)
-    return f"run {run.run_id} ({run.kind}, {controls})"
+    world = "" if run.world is None else f", world {run.world_id} {run.world.get('name', '')!r}"
+    return f"run {run.run_id} ({run.kind}, {controls}{world})"
 
 
 KIND_WORDS = {"sim": "simulated", "robot": "on the robot", "replay": "a robot run analysed again"}
@@ -162,10 +182,15 @@ def _sim_recording(run: StoredPath) -> Recording:
     robot = PhysicalParams.from_model(
         _model_of(run), mass=paper.mass, leg_length=paper.leg_length, gravity=paper.gravity
     )
+    world = None if run.world is None else world_from_document(run.world)
+    schedule = ControlSchedule.from_degrees(run.controls)
     if run.path is not None:
         columns = run.path
+    elif world is not None:  # simulated again in its world, as quick_calls._world_climb did
+        columns = simulate_world_trajectory(
+            robot.to_model(), world, schedule, run.start_state, run.jumps, sample_rate=REPLAY_SAMPLE_RATE
+        )[0].columns()
     else:
-        schedule = ControlSchedule.from_degrees(run.controls)
         columns = simulate_trajectory(
             robot.to_model(), schedule, run.start_state, run.jumps, sample_rate=REPLAY_SAMPLE_RATE
         ).columns()
@@ -175,7 +200,8 @@ def _sim_recording(run: StoredPath) -> Recording:
     jump, phase = columns["jump"].astype(int), columns["phase"].astype(int)
     # The drawn leg reaches for the stance wall in stance and for the next wall in flight.
     leg_wall = walls_of(jump + (phase != STANCE))
-    first = start_height(_legs(run)[0], robot)  # the stored path has y = 0 at the first touchdown
+    # The map's stored path has y = 0 at the first touchdown; a world's is from the world's floor.
+    first = start_height(_legs(run)[0], robot) if world is None else 0.0
     clip = PathClip(
         time=columns["time"] * time_scale,
         x=columns["x"] * length,
@@ -189,7 +215,9 @@ def _sim_recording(run: StoredPath) -> Recording:
     )
     stance_starts = np.flatnonzero((phase == STANCE) & np.r_[True, np.diff(jump) != 0])
     touchdowns = np.column_stack([clip.time[stance_starts], clip.leg_wall[stance_starts], clip.foot_y[stance_starts]])
-    return Recording(run.run_id, run.kind, _label(run), clip, robot, _legs(run), touchdowns, describe(run))
+    return Recording(run.run_id, run.kind, _label(run), clip, robot, _legs(run), touchdowns, describe(run),
+                     world=world, world_mu=robot.to_model().mu,
+                     touchdown_x=None if world is None else clip.foot_x[stance_starts])  # fmt: skip
 
 
 def _tracker_recording(run: StoredPath) -> Recording:
@@ -199,4 +227,6 @@ def _tracker_recording(run: StoredPath) -> Recording:
     t0 = float(frames["time"][0])
     clip = PathClip.from_body(frames["time"] - t0, frames["x"], frames["y"])
     touchdowns = np.array([[td["time"] - t0, td["wall"], td["foot_height"]] for td in run.touchdowns]).reshape(-1, 3)
-    return Recording(run.run_id, run.kind, _label(run), clip, get_preset("paper"), None, touchdowns, describe(run))
+    world = None if run.world is None else world_from_document(run.world)
+    return Recording(run.run_id, run.kind, _label(run), clip, get_preset("paper"), None, touchdowns, describe(run),
+                     world=world, world_mu=get_preset("paper").to_model().mu)  # fmt: skip

@@ -25,8 +25,10 @@ from frontend.viewer.geometry import (
 )
 from frontend.viewer.motion import Pose
 from frontend.viewer.node_rings import NodeRing, StreamedTrail, hidden_lines
+from frontend.viewer.world_slabs import world_slabs, world_width
 from sim_core import LegControl, PhysicalParams
 from sim_core.model.trajectory import STANCE
+from sim_core.world.world import World
 
 WALL_THICKNESS = 0.03  # [m]
 DEPTH = 0.35  # [m] how deep the walls are drawn (the model is planar)
@@ -47,6 +49,7 @@ GHOST_TRAIL_COLOR = (80, 170, 230)
 TOUCHDOWN_COLOR = (240, 150, 0)
 FOOT_COLOR = (240, 150, 0)
 RULER_COLOR = (60, 60, 60)
+TARGET_HIT, TARGET_MISSED, AIM_COLOR = (40, 200, 70), (220, 40, 40), (250, 215, 0)  # a followed plan's footholds
 CAMERA_POSITION = (0.0, -1.25, 0.6)  # [m] level with the robot, in front of the chute
 CAMERA_LOOK_AT = (0.0, 0.0, 0.6)
 
@@ -92,12 +95,15 @@ class ChuteScene:
             )
             for name, side in (("left", -1), ("right", 1))
         ]
-        scene.add_box(
+        self.floor = scene.add_box(
             "/chute/floor",
             color=(170, 170, 175),
             dimensions=(robot.wall_distance + 2 * WALL_THICKNESS, DEPTH, 0.01),
             position=(0.0, 0.0, -0.005),
         )
+        self.world: World | None = None  # None: the parallel walls (set_world)
+        self._world_key: tuple | None = None
+        self._world_nodes: list = []
         self._wall_x = [side * (half + 0.5 * WALL_THICKNESS) for side in (-1, 1)]
         self._ruler_sections = 0  # the ruler grows in sections: "/chute/ruler", then "/chute/ruler/part_k"
         self._ruler_labels = 0
@@ -131,6 +137,9 @@ class ChuteScene:
         self.ghost_jump_trails = NodeRing(
             "/chute/ghost/jump_", TRAIL_JUMPS, hidden_lines(scene, GHOST_TRAIL_COLOR, 0.003)
         )
+        self.targets = NodeRing("/chute/targets/", TOUCHDOWN_MARKERS, lambda name: scene.add_icosphere(
+            name, radius=0.014, color=TARGET_HIT, position=(0.0, 0.0, 0.0), visible=False))  # fmt: skip
+        self.aim, self._aim_at = None, None  # the next target, made when first shown
         # Live mode's: its nodes are made when first drawn (none in simulate, replay or a shared file).
         self.live_trail = StreamedTrail(scene, "/chute/trail/live/", LIVE_TRAIL_PIECES, TRAIL_COLOR, 0.003)
         self.live_ghost_trail = StreamedTrail(scene, "/chute/ghost/live/", GHOST_TRAIL_PIECES, GHOST_TRAIL_COLOR, 0.003)
@@ -161,6 +170,29 @@ class ChuteScene:
             segments=np.concatenate([spine, np.stack([starts, ends], axis=1)]),
             labels=labels,
         )
+
+    def set_world(self, world: World | None, leg_length: float = 0.0, model_mu: float = math.inf) -> None:
+        """Draw ``world`` (``l0`` units, at ``leg_length`` [m], its open frictions ``model_mu``) in
+        place of the parallel walls: its sides as slabs (:mod:`frontend.viewer.world_slabs`) under
+        ``/chute/world/``, sent once; None: the parallel walls again. The same world again sends nothing."""
+        key = None if world is None else (id(world), leg_length, model_mu)
+        if key == self._world_key:
+            return
+        for node in self._world_nodes:
+            node.remove()
+        self._world_nodes, self.world, self._world_key = [], world, key
+        for wall in self.walls:
+            wall.visible = world is None
+        if world is None:
+            self.floor.dimensions = (self.robot.wall_distance + 2 * WALL_THICKNESS, DEPTH, 0.01)
+            self.floor.position = (0.0, 0.0, -0.005)
+            return
+        left, right = world_width(world, leg_length)
+        self.floor.dimensions = (right - left + 2 * WALL_THICKNESS, DEPTH, 0.01)
+        self.floor.position = (0.5 * (left + right), 0.0, -0.005)
+        for slab in world_slabs(world, leg_length, model_mu):
+            name, options = f"/chute/world/{slab.name}", {"position": slab.position, "wxyz": slab.wxyz}
+            self._world_nodes.append(self.scene.add_box(name, color=slab.color, dimensions=slab.dimensions, **options))
 
     @staticmethod
     def top_for(height):
@@ -239,17 +271,35 @@ class ChuteScene:
         if len(points) >= 2:
             self.ghost_jump_trails.show_next(points=polyline_segments(points))
 
-    def add_touchdown(self, wall: int, foot_height: float) -> None:
-        """Mark where a foot met ``wall`` (-1 left, +1 right) at ``foot_height`` [m]."""
-        self.touchdown_markers.show_next(position=self.touchdown_position(wall, foot_height))
+    def add_touchdown(self, wall: int, foot_height: float, foot_x: float | None = None) -> None:
+        """Mark where a foot met ``wall`` (-1 left, +1 right) at ``foot_height`` [m] (and
+        ``foot_x`` [m]: in a world; None: on the parallel wall)."""
+        self.touchdown_markers.show_next(position=self.touchdown_position(wall, foot_height, foot_x))
 
-    def touchdown_position(self, wall: int, foot_height: float) -> tuple[float, float, float]:
-        return (wall * 0.5 * self.robot.wall_distance, 0.0, foot_height)
+    def touchdown_position(self, wall: int, foot_height: float, foot_x: float | None = None):
+        x = wall * 0.5 * self.robot.wall_distance if foot_x is None else foot_x
+        return (x, 0.0, foot_height)
+
+    def add_target(self, x: float, y: float, *, hit: bool) -> None:
+        """Mark a followed plan's foothold at ``(x, y)`` [m] once its touchdown has passed: hit or missed."""
+        self.targets.show_next(position=(x, -0.04, y), color=TARGET_HIT if hit else TARGET_MISSED)
+
+    def show_aim(self, x: float | None, y: float | None) -> None:
+        """The foothold the coming touchdown aims at (None: none); sent only when it moves."""
+        at = None if x is None else (float(x), -0.04, float(y))
+        if at == self._aim_at:
+            return
+        if self.aim is None:
+            self.aim = self.scene.add_icosphere("/chute/aim", radius=0.018, color=AIM_COLOR, visible=False)
+        if at is not None:
+            self.aim.position = at
+        self.aim.visible, self._aim_at = at is not None, at
 
     def clear_history(self) -> None:
         """Hide trails and touchdown markers (a reset or a new run)."""
-        for ring in (self.touchdown_markers, self.jump_trails, self.ghost_jump_trails):
+        for ring in (self.touchdown_markers, self.jump_trails, self.ghost_jump_trails, self.targets):
             ring.clear()
+        self.show_aim(None, None)
         self.live_trail.clear()
         self.live_ghost_trail.clear()
         self.trail.points = np.zeros((1, 2, 3))

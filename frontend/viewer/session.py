@@ -66,7 +66,7 @@ class ViewerSession:
         gui.add_markdown(f"{link} · walls {robot.wall_distance:.2f} m apart")
         self.gui_mode = gui.add_dropdown("Mode", MODES, initial_value="simulate")
         self.modes = {
-            "simulate": SimulateMode(client, self.scene, self.lock, robot),
+            "simulate": SimulateMode(client, self.scene, self.lock, robot, context.sessions),
             "live": LiveMode(client, self.scene, self.lock, context.robot_service, context.sessions),
             "replay": ReplayMode(client, self.scene, self.lock, context.sessions),
         }
@@ -105,6 +105,7 @@ class ViewerSession:
             self.mode = self.modes[name]
             self.scene.clear_history()
             self.scene.show_ghost(None)
+            self.scene.set_world(None)  # a mode in a world draws it again in its next frame
             if name != "replay":
                 self.scene.robot = self.robot
             self.mode.activate()

@@ -78,6 +78,7 @@ def _recorded_html(recording: Recording, overlay: Recording | None, allowed_host
         refuse_foreign_origins(server, allowed_hosts)
         place_camera(server)
         scene = ChuteScene(server.scene, recording.robot)
+        scene.set_world(recording.world, recording.robot.leg_length, recording.world_mu)
         for ring in (scene.touchdown_markers, scene.jump_trails, scene.ghost_jump_trails):
             ring.node(0)  # made by viser, hidden: the template of the ring's other nodes
         serializer = server.get_scene_serializer()
@@ -194,8 +195,7 @@ def _history(out: RecordingWriter, scene: ChuteScene, recording: Recording, time
         out.frame = k
         for i in range(int(marked[k]), int(marked[k + 1])):
             if not ghost:
-                _time, wall, foot_height = recording.touchdowns[i]
-                marker = scene.touchdown_position(int(wall), float(foot_height))
+                marker = scene.touchdown_position(*recording.touchdown_marker(i))
                 _show_item(out, scene.touchdown_markers, i, position=marker)
             path = recording.jump_trail(i) if i > 0 else ()
             if len(path) >= 2:

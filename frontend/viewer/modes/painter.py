@@ -18,10 +18,10 @@ def show_frame(
     recording's arrays: what a frame shows is defined by :class:`Recording`'s ``touchdowns_until``,
     ``trail`` and ``jump_trail`` for both."""
     shown, ghost_shown = marked
+    scene.set_world(recording.world, recording.robot.leg_length, recording.world_mu)  # sent once
     now = int(recording.touchdowns_until(t))
     for k in range(shown, now):
-        _time, wall, foot_height = recording.touchdowns[k]
-        scene.add_touchdown(int(wall), float(foot_height))
+        scene.add_touchdown(*recording.touchdown_marker(k))
         if k > 0:
             scene.add_jump_trail(recording.jump_trail(k))
     pose = recording.clip.pose_at(t)

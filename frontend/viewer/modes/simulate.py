@@ -18,6 +18,7 @@ import viser
 
 from frontend.viewer.modes import Mode
 from frontend.viewer.modes.gait_search import CUSTOM, DEFAULT_START, GAIT_PRESETS, find_gait
+from frontend.viewer.modes.plan_follow import PlanFollow
 from frontend.viewer.motion import TRAIL_STRIDE
 from frontend.viewer.scene import ChuteScene
 from frontend.viewer.simulated_climb import Controls, SimulatedClimb
@@ -36,7 +37,7 @@ class SimulateMode(Mode):
 
     name = "simulate"
 
-    def __init__(self, client: viser.ClientHandle, scene: ChuteScene, lock, robot: PhysicalParams):
+    def __init__(self, client: viser.ClientHandle, scene: ChuteScene, lock, robot: PhysicalParams, sessions=None):
         super().__init__(client, scene, lock)
         self.base_robot = robot
         gui = client.gui
@@ -65,6 +66,7 @@ class SimulateMode(Mode):
             self.gui_target = self._ranged_slider("target [m]", 0.1, CHUTE_TOP, 0.01, 0.55, hint="the height held")
             self.gui_playback = gui.add_button_group("Playback", ("Play", "Pause", "Step jump", "Restart"))
             self.gui_speed = self._ranged_slider("speed [×]", 0.1, 4.0, 0.1, 1.0)
+            self.follow = PlanFollow(self, sessions, robot)  # a stored world: plan, follow, play
             self.gui_readout = gui.add_markdown("")
         self._control_handles = (self.gui_psi0_left, self.gui_zeta0_left, self.gui_psi0_right,
                                  self.gui_zeta0_right, self.gui_gravity, self.gui_damping)  # fmt: skip
@@ -163,6 +165,8 @@ class SimulateMode(Mode):
         elif choice == "Step jump":
             self.playing = False
             self.time = self.climb.next_touchdown_time(self.time)
+        elif choice == "Restart" and self.follow.active:
+            self.follow.restart()
         elif choice == "Restart":
             self.restart()
 
@@ -176,7 +180,8 @@ class SimulateMode(Mode):
         start = tuple(gait.state) if gait is not None and gait.stable else DEFAULT_START
         self.climb.set_controls(self.applied)
         self.climb.reset(start)
-        self.scene.clear_history()
+        if not self.follow.active:  # a followed plan on show keeps its scene
+            self.scene.clear_history()
         self.time, self._shown, self.playing = 0.0, 0, True
 
     # The closed loop ------------------------------------------------------------------------------
@@ -250,9 +255,14 @@ class SimulateMode(Mode):
         self._gait_generation += 1
         self._law_generation += 1
         self._gait_worker.shutdown(wait=False, cancel_futures=True)
+        self.follow.close()
 
     # Per frame ----------------------------------------------------------------------------------
     def frame(self, dt: float) -> None:
+        if self.follow.active:
+            self.follow.frame(dt, self.speed, self.playing)
+            return
+        self.scene.set_world(None)
         if self.playing:
             self.time += dt * self.speed
         pose = self.climb.pose_at(self.time)
@@ -271,6 +281,8 @@ class SimulateMode(Mode):
             self.playing = False
 
     def readout(self, updates_per_s: float) -> str:
+        if self.follow.active:
+            return f"{self.follow.readout()}  \nt = {self.follow.time:.1f} s · {updates_per_s:.0f} updates/s"
         t = self.time
         pose = self.climb.pose_at(t)
         plans = self.climb.plans
@@ -282,6 +294,7 @@ class SimulateMode(Mode):
         robot = self.climb.controls.robot
         notes = [note for note in (self.input_note, self.speed_note) if note]
         typed = f"**Not used:** {'; '.join(notes)} (the climb goes on as before)  \n" if notes else ""
+        typed += f"{self.follow.note}  \n" if self.follow.note else ""
         return typed + (
             f"**Jump** {pose.jump + 1} · **height** {pose.y:.3f} m · **climb/jump** {last}  \n"
             f"**Failure:** {failure}  \n"

@@ -155,3 +155,28 @@ def test_a_view_built_after_shutdown_gave_up_waiting_is_closed_too(monkeypatch):
     release.set()
     starter.wait(10)
     assert views[0].closed and starter.view is None
+
+
+def test_a_run_in_a_world_is_read_with_its_world_and_worlds_are_listed(settings):
+    """No longer refused: stored_path carries the run's world as the §8 JSON in l0; the worlds
+    simulate mode offers are listed newest first and read back in l0."""
+    from backend.services.view import stored_path, stored_world, stored_worlds
+
+    built = []
+    app = create_app(
+        settings, run_jobs=False, view_factory=lambda context: built.append(StandInView(context)) or built[-1]
+    )
+    with TestClient(app) as client:
+        auth = {"Authorization": f"Bearer {(settings.data_dir / 'api_token').read_text().strip()}"}
+        view = app.state.view_starter.wait(10)
+        first = client.post("/api/v1/worlds", json={"name": "steps", "named": "staircase"}, headers=auth).json()
+        second = client.post("/api/v1/worlds", json={"name": "drawn", "random": {"seed": 3}}, headers=auth)
+        assert second.status_code == 201, second.text
+        second = second.json()
+        body = {"controls": [{"psi0_deg": 30, "zeta0": 0.9}], "start": {"xdot": -1.0, "ydot": 0.5}, "jumps": 3,
+                "world_id": first["id"]}  # fmt: skip
+        run = client.post("/api/v1/runs", json=body, headers=auth).json()
+        path = stored_path(view.context.sessions, run["id"])
+        assert path.world_id == first["id"] and path.world["name"] == "steps" and path.world["units"] == "l0"
+        assert stored_worlds(view.context.sessions) == [(second["id"], "drawn"), (first["id"], "steps")]
+        assert stored_world(view.context.sessions, first["id"]) == path.world

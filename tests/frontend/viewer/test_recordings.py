@@ -3,10 +3,8 @@ shared file both take it (touchdowns passed, the trail of the jump under way), a
 loaded through the service. (Robot and replay runs are loaded in test_share.py's fixture.)"""
 
 import numpy as np
-import pytest
 from numpy.testing import assert_array_equal
 
-from backend.errors import Conflict
 from frontend.viewer.motion import PathClip
 from frontend.viewer.recordings import MAX_TRAIL_SECONDS, Recording, load_recording
 from sim_core import get_preset
@@ -52,15 +50,27 @@ def test_recordings_put_sim_runs_between_the_walls(service):
     assert np.all(np.abs(recording.clip.x) < half)
 
 
-def test_a_run_in_a_world_is_not_replayed_between_parallel_walls(service):
-    """Its stored path (or one simulated again from its controls) drawn between the view's walls
-    would show walls it never met: refused, said why."""
+def test_a_run_in_a_world_is_replayed_in_its_world(service):
+    """Its world is read and carried (drawn in place of the walls); its stored path, or one simulated
+    again in that world (never between parallel walls), puts each stance foot on the world's side."""
     client, auth, view = service
     world = client.post("/api/v1/worlds", json={"name": "replayed", "named": "staircase"}, headers=auth).json()
-    body = RUN | {"world_id": world["id"], "start": {"xdot": -1.0, "ydot": 0.5}, "trajectory_rate": 50}
-    run = client.post("/api/v1/runs", json=body, headers=auth).json()
-    with pytest.raises(Conflict, match=f"climbed world {world['id']}"):
-        load_recording(view.context.sessions, run["id"])
+    body = RUN | {"world_id": world["id"], "start": {"xdot": -1.0, "ydot": 0.5}}
+    stored = client.post("/api/v1/runs", json=body | {"trajectory_rate": 60}, headers=auth).json()
+    again = client.post("/api/v1/runs", json=body, headers=auth).json()
+    with_path, simulated = (load_recording(view.context.sessions, run["id"]) for run in (stored, again))
+    for recording in (with_path, simulated):
+        assert recording.world is not None and recording.world.name == "replayed"
+        assert f"world {world['id']}" in recording.label
+        l0, clip = recording.robot.leg_length, recording.clip
+        stance = clip.phase == 0
+        wall_x = [recording.world.side("left" if wall < 0 else "right").x_at(y / l0) * l0
+                  for wall, y in zip(clip.leg_wall[stance], clip.foot_y[stance], strict=True)]  # fmt: skip
+        np.testing.assert_allclose(clip.foot_x[stance], wall_x, atol=1e-9)
+        assert recording.touchdown_x is not None and len(recording.touchdown_x) == len(recording.touchdowns) >= 2
+    np.testing.assert_allclose(simulated.clip.y, with_path.clip.y, atol=1e-9)
+    parallel = 0.5 * ROBOT.wall_distance
+    assert not np.allclose(np.abs(with_path.touchdown_x), parallel), "not the parallel walls' feet"
 
 
 def _stored(**changes):
