@@ -55,7 +55,8 @@ def plan_command(
     from cli.plan_mfpt import check_mfpt_options
 
     splitting = check_mfpt_options(mfpt, replicas, runs, replans, monte_carlo, seed)
-    from sim_core.planning.planner import plan_climb, start_velocity
+    from sim_core.planning.launch import start_velocity
+    from sim_core.planning.planner import plan_climb
     from sim_core.world.named import resolve_world
 
     chosen, _description = resolve_world(world, setup.model.d_hat, setup.robot.scales.length)

@@ -118,7 +118,7 @@ def check(spec: FootholdStudySpec, robot) -> None:
 
 def _start(spec: FootholdStudySpec, context: JobContext) -> tuple[float, tuple[float, float], object]:
     """The goal [l0], the body's velocity at touchdown 0 and the noise, as the study runs them."""
-    from sim_core.planning.planner import start_velocity
+    from sim_core.planning.launch import start_velocity
 
     state = start_velocity(context.model) if spec.state is None else (spec.state.xdot, spec.state.ydot)
     return goal_in_l0(spec, context.robot), (float(state[0]), float(state[1])), spec.noise.model()

@@ -86,8 +86,9 @@ def check(spec: PlanSpec, robot) -> None:
 
 
 def run(spec: PlanSpec, context: JobContext) -> dict:
+    from sim_core.planning.launch import start_velocity
     from sim_core.planning.plan_splitting import PlanSplitting, plan_monte_carlo
-    from sim_core.planning.planner import plan_climb, start_velocity
+    from sim_core.planning.planner import plan_climb
 
     world, goal, noise = world_of(spec), goal_in_l0(spec, context.robot), spec.noise.model()
     state = start_velocity(context.model) if spec.state is None else (spec.state.xdot, spec.state.ydot)

@@ -81,7 +81,7 @@ def arguments(spec: WorldMjtfSpec, context: JobContext) -> list[tuple]:
 
     import numpy as np
 
-    from sim_core.planning.planner import start_velocity
+    from sim_core.planning.launch import start_velocity
 
     state = start_velocity(context.model) if spec.state is None else (spec.state.xdot, spec.state.ydot)
     goal = math.inf if spec.goal_height_m is None else goal_in_l0(spec, context.robot)

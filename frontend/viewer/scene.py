@@ -15,14 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 import viser
 
-from frontend.viewer.geometry import (
-    bow_leg,
-    energy_color,
-    idle_foot,
-    polyline_segments,
-    ruler_ticks,
-    to_scene,
-)
+from frontend.viewer.geometry import bow_leg, energy_color, idle_foot, polyline_segments, ruler_ticks, to_scene
 from frontend.viewer.motion import Pose
 from frontend.viewer.node_rings import NodeRing, StreamedTrail, hidden_lines
 from frontend.viewer.world_slabs import world_slabs, world_width

@@ -40,6 +40,7 @@ from sim_core.model.noise import NoiseModel
 from sim_core.model.params import ModelParams
 from sim_core.planning.goals import check_goal
 from sim_core.planning.landings import in_cone, noise_draws, standing_legs, with_margins
+from sim_core.planning.launch import launch_velocity
 from sim_core.world.climb import first_touchdown
 from sim_core.world.geometry import pack
 from sim_core.world.stride import world_flight, world_orbit_batch
@@ -94,14 +95,6 @@ class Plan:
         return ControlSchedule.of(*(step.leg for step in self.steps))
 
 
-def start_velocity(model: ModelParams) -> tuple[float, float]:
-    """The body's velocity at touchdown 0 when none is given: the 30:0.9 gait's (docs/worlds.md)."""
-    from sim_core.section.gait_search import gait_of
-
-    state = gait_of(model, ControlSchedule.from_degrees([(30.0, 0.9)])).state
-    return float(state[0]), float(state[1])
-
-
 def plan_climb(
     model: ModelParams,
     world: World,
@@ -127,25 +120,12 @@ def plan_climb(
     for leg in LEGS:
         schedule = ControlSchedule.of(LegControl(*leg))
         if launch_gait:
-            state = _launch_state(model, schedule)
+            state = launch_velocity(model, schedule)
             if state is None:
                 continue
         row, segment = first_touchdown(model, world, schedule, state, foot_y)
         nodes.append(_Node(row, 0, segment, tuple(leg), 0.0, ((row, 0, segment, tuple(leg)),)))
     return _best_plan(model, world, goal, nodes, foot_y, noise, samples, beam, max_jumps, seed, started)
-
-
-def _launch_state(model: ModelParams, schedule: ControlSchedule) -> tuple[float, float] | None:
-    """The velocity of the gait of ``schedule``'s one leg, found as the virtual robot finds it; None without one."""
-    from sim_core.model.errors import FixedPointNotFound
-    from sim_core.model.presets import START_GUESS
-    from sim_core.section.gait_search import gait_of
-
-    try:
-        state = gait_of(model, schedule, guess=START_GUESS).state
-    except FixedPointNotFound:
-        return None
-    return float(state[0]), float(state[1])
 
 
 def replan(model: ModelParams, world: World, goal: float, touchdown, *, liftoff=None, noise: NoiseModel | None = None,

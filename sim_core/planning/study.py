@@ -37,7 +37,8 @@ from sim_core.model.poincare import check_section_state
 from sim_core.model.validation import check_range
 from sim_core.planning.follow import follow_plan, law_us_per_jump
 from sim_core.planning.goals import check_goal
-from sim_core.planning.planner import PSI0_DEG, ZETA0, plan_climb, start_velocity
+from sim_core.planning.launch import start_velocity
+from sim_core.planning.planner import PSI0_DEG, ZETA0, plan_climb
 from sim_core.robustness.world_trials import REACHED, run_world_trials
 from sim_core.world.geometry import pack
 from sim_core.world.reach import reach_rows

@@ -29,7 +29,8 @@ from sim_core.model.noise import NO_NOISE, NoiseModel
 from sim_core.model.trajectory import STANCE
 from sim_core.model.walls import walls_of
 from sim_core.planning.followed_path import FollowedPath, followed_path
-from sim_core.planning.planner import plan_climb, start_velocity
+from sim_core.planning.launch import start_velocity
+from sim_core.planning.planner import plan_climb
 from sim_core.world.files import world_from_document
 from sim_core.world.world import SIDES, World
 

@@ -1,11 +1,11 @@
-"""Simulate mode: the model climbing in real time with the sliders' controls, or holding a height.
+"""Simulate mode: the model climbing in real time with the sliders' controls, holding a height, or
+following a plan in a stored world (:mod:`frontend.viewer.modes.plan_follow`).
 
 A slider acts from the next touchdown (:class:`frontend.viewer.simulated_climb.SimulatedClimb`); the
 readout names the gait of the controls in use, looked for in the background
-(:mod:`frontend.viewer.modes.gait_search`). A controller closes the loop as on the robot: from
-each touchdown the chosen law (designed in the background on the sliders' robot, about the gait
-of jumping in place at the left leg's angle) sets the next touchdown's leg, and the readout
-shows its command each jump.
+(:mod:`frontend.viewer.modes.gait_search`). A controller closes the loop as on the robot: from each
+touchdown the chosen law (designed in the background on the sliders' robot, about the gait of
+jumping in place at the left leg's angle) sets the next touchdown's leg; the readout shows its command.
 """
 
 from __future__ import annotations
@@ -43,22 +43,18 @@ class SimulateMode(Mode):
         gui = client.gui
         (left, right) = next(iter(GAIT_PRESETS.values()))
         with gui.add_folder("Simulate") as self.folder:
-            self.gui_preset = gui.add_dropdown(
-                "Gait preset", [*GAIT_PRESETS, CUSTOM], initial_value=next(iter(GAIT_PRESETS))
-            )
-            self.gui_symmetric = gui.add_checkbox(
-                "Symmetric (R = L)", initial_value=True, hint="both legs use the left leg's controls"
-            )
+            self.gui_preset = gui.add_dropdown("Gait preset", [*GAIT_PRESETS, CUSTOM],
+                                               initial_value=next(iter(GAIT_PRESETS)))  # fmt: skip
+            self.gui_symmetric = gui.add_checkbox("Symmetric (R = L)", initial_value=True,
+                                                  hint="both legs use the left leg's controls")  # fmt: skip
             self.gui_psi0_left = self._ranged_slider("psi0 L [°]", 15.0, 60.0, 0.5, left[0])
             self.gui_zeta0_left = self._ranged_slider("zeta0 L [l0]", 0.80, 0.99, 0.0005, left[1])
             self.gui_psi0_right = self._ranged_slider("psi0 R [°]", 15.0, 60.0, 0.5, right[0], disabled=True)
             self.gui_zeta0_right = self._ranged_slider("zeta0 R [l0]", 0.80, 0.99, 0.0005, right[1], disabled=True)
-            self.gui_gravity = self._ranged_slider(
-                "gravity [m/s²]", 0.3, 9.81, 0.01, robot.gravity, hint="the air table's tilt"
-            )
-            self.gui_damping = self._ranged_slider(
-                "damping [N·s/m]", 0.0, 3.0, 0.05, robot.c_zeta, hint="leg and pivot"
-            )
+            self.gui_gravity = self._ranged_slider("gravity [m/s²]", 0.3, 9.81, 0.01, robot.gravity,
+                                                   hint="the air table's tilt")  # fmt: skip
+            self.gui_damping = self._ranged_slider("damping [N·s/m]", 0.0, 3.0, 0.05, robot.c_zeta,
+                                                   hint="leg and pivot")  # fmt: skip
             self.gui_controller = gui.add_dropdown(
                 "Controller", (OPEN_LOOP, *NAMES), initial_value=OPEN_LOOP,
                 hint="close the loop: from each touchdown the law sets the next leg (the sliders set the first)",

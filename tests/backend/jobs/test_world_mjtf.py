@@ -14,7 +14,7 @@ from backend.services import job_runner, jobs, worlds
 from backend.store.models import Job, JobChunk
 from sim_core import get_preset
 from sim_core.model.noise import NoiseModel
-from sim_core.planning.planner import start_velocity
+from sim_core.planning.launch import start_velocity
 from sim_core.robustness.world_trials import REACHED, run_world_trials
 from sim_core.world.random_world import random_world
 from tests.backend.services.jobs_helpers import WAIT_S, job_now, wait_until

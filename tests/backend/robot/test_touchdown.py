@@ -163,7 +163,7 @@ def test_a_touchdown_is_stored_as_json_and_read_back_whole():
 def test_in_a_world_a_touchdown_is_where_the_foot_meets_its_side(name):
     """The world's own climb (sim_core's), sampled at 100 Hz: the touchdowns are found where the
     foot meets the sides at its height; read as parallel walls, the leaning sides' are not."""
-    from sim_core.planning.planner import start_velocity
+    from sim_core.planning.launch import start_velocity
     from sim_core.world.geometry import pack, side_x
     from sim_core.world.named import named_world
     from sim_core.world.trajectory import simulate_world_trajectory

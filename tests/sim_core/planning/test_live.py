@@ -12,8 +12,9 @@ from sim_core.control.placement import OFF_PLAN, PLACED
 from sim_core.model.noise import NO_NOISE
 from sim_core.planning.attempts import Attempts
 from sim_core.planning.follow import PSI0, SENT_PSI0, SENT_ZETA0, SIDE, XDOT, YDOT, ZETA0, X, Y
+from sim_core.planning.launch import start_velocity
 from sim_core.planning.live import LivePlan
-from sim_core.planning.planner import plan_climb, start_velocity
+from sim_core.planning.planner import plan_climb
 from sim_core.world.random_world import random_world
 
 

@@ -8,8 +8,9 @@ from sim_core.model.noise import NO_NOISE, NoiseModel
 from sim_core.model.validation import ParameterError
 from sim_core.planning.attempts import Attempts
 from sim_core.planning.follow import follow_plan
+from sim_core.planning.launch import start_velocity
 from sim_core.planning.plan_splitting import PlanSplitting, plan_mfpt, plan_monte_carlo
-from sim_core.planning.planner import plan_climb, start_velocity
+from sim_core.planning.planner import plan_climb
 from sim_core.world.random_world import random_world
 
 GOAL = 5.0  # [l0]

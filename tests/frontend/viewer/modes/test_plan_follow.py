@@ -10,7 +10,8 @@ import numpy as np
 from frontend.viewer.modes.plan_follow import NO_WORLD
 from sim_core.model.noise import NoiseModel
 from sim_core.planning.follow import follow_plan
-from sim_core.planning.planner import plan_climb, start_velocity
+from sim_core.planning.launch import start_velocity
+from sim_core.planning.planner import plan_climb
 from sim_core.world.files import world_from_document
 from tests.frontend.viewer.view_service import wait_for
 
