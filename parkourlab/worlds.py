@@ -9,7 +9,8 @@ from __future__ import annotations
 from collections.abc import Iterator, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-from parkourlab.bodies import Leg, State, legs, mapping, present, state
+from parkourlab.bodies import Leg, State, legs, mapping, present
+from parkourlab.bodies import state as body_state
 from parkourlab.types import Job, World
 
 if TYPE_CHECKING:
@@ -65,7 +66,7 @@ class WorldCalls:
         cap: int | None = None,
         seed: int | None = None,
         noise: Mapping[str, float] | None = None,
-        start: State | None = None,
+        state: State | None = None,
         model: Mapping[str, Any] | None = None,
         experiment_id: int | None = None,
     ) -> Job:
@@ -75,7 +76,7 @@ class WorldCalls:
         [m]. Its result is the command's ``--json``; each world is stored as it finishes (a
         restarted service goes on from there)."""
         spec = {"world_id": world_id, "random_worlds": mapping(random_worlds), "goal_height_m": goal_height_m}
-        spec |= {"trials": trials, "cap": cap, "seed": seed, "noise": mapping(noise), "state": state(start)}
+        spec |= {"trials": trials, "cap": cap, "seed": seed, "noise": mapping(noise), "state": body_state(state)}
         return self._job("foothold-study", spec, model, experiment_id)
 
     def submit_plan(
@@ -83,19 +84,28 @@ class WorldCalls:
         world_id: int,
         goal_height_m: float,
         *,
+        launch_gait: bool | None = None,
         attempts: int | None = None,
         replans: int | None = None,
         cap: int | None = None,
         seed: int | None = None,
         noise: Mapping[str, float] | None = None,
-        start: State | None = None,
+        state: State | None = None,
         model: Mapping[str, Any] | None = None,
         experiment_id: int | None = None,
     ) -> Job:
         """The most robust plan up the stored world ``world_id`` to ``goal_height_m`` [m] (``parkour
-        plan``); with ``attempts``, that many noisy climbs of it by the placement law, counted."""
-        spec = {"world_id": world_id, "goal_height_m": goal_height_m, "attempts": attempts, "replans": replans}
-        spec |= {"cap": cap, "seed": seed, "noise": mapping(noise), "state": state(start)}
+        plan``); with ``attempts``, that many noisy climbs of it by the placement law, counted.
+        ``launch_gait``: from the velocity a robot launched on the plan's first leg has (for a live
+        run that follows it, ``RobotRunCreate.plan_job_id``)."""
+        spec = {
+            "world_id": world_id,
+            "goal_height_m": goal_height_m,
+            "attempts": attempts,
+            "replans": replans,
+            "launch_gait": launch_gait,
+        }
+        spec |= {"cap": cap, "seed": seed, "noise": mapping(noise), "state": body_state(state)}
         return self._job("plan", spec, model, experiment_id)
 
     def submit_world_mjtf(
@@ -108,7 +118,7 @@ class WorldCalls:
         cap: int | None = None,
         seed: int | None = None,
         noise: Mapping[str, float] | None = None,
-        start: State | None = None,
+        state: State | None = None,
         model: Mapping[str, Any] | None = None,
         experiment_id: int | None = None,
     ) -> Job:
@@ -116,7 +126,7 @@ class WorldCalls:
         ``controls`` (legs ``(psi0_deg, zeta0)`` in turn), each to a failure, ``cap`` jumps or a
         foot at ``goal_height_m`` [m]."""
         spec = {"world_id": world_id, "controls": legs(controls), "goal_height_m": goal_height_m, "trials": trials}
-        spec |= {"cap": cap, "seed": seed, "noise": mapping(noise), "state": state(start)}
+        spec |= {"cap": cap, "seed": seed, "noise": mapping(noise), "state": body_state(state)}
         return self._job("world-mjtf", spec, model, experiment_id)
 
     def _job(self, kind: str, spec: dict, model: Mapping[str, Any] | None, experiment_id: int | None) -> Job:
