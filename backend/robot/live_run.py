@@ -23,18 +23,21 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 from backend.robot.link import LinkError, LinkState, RobotLink
 from backend.robot.live_law import LiveLaw, pitch_at
 from backend.robot.messages import Leg
-from backend.robot.plan_law import PlanLaw, RunEnds
-from backend.robot.run_endings import CLEAN_ENDINGS, LINK_LOST, end_safely, fault_names, robot_ending
+from backend.robot.run_endings import CLEAN_ENDINGS, LINK_LOST, RunEnds, end_safely, fault_names, robot_ending
 from backend.robot.touchdown import PITCH_LOOKBACK, SideAt, Touchdown, scan_touchdowns
 from backend.robot.tracker import PoseHistory, pose_arrays
 from backend.robot.tracker_watch import TRACKER_TIMEOUT_MS, TrackerWatch, frames_heard
 from sim_core.model.controls import LegControl
 from sim_core.model.errors import ParameterError
 from sim_core.model.walls import wall_of
+
+if TYPE_CHECKING:
+    from backend.robot.plan_law import PlanLaw
 
 POLL = 0.005  # [s] how often the loop looks at new poses
 

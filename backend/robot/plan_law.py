@@ -17,21 +17,20 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from backend.robot.limits import ServoLimits
-from backend.robot.run_endings import GOAL_REACHED, MISSED_FOOTHOLD, OFF_PLAN
+from backend.robot.run_endings import GOAL_REACHED, MISSED_FOOTHOLD, OFF_PLAN, RunEnds
 from backend.robot.touchdown import Touchdown
-from sim_core.control.placement import OFF_PLAN as NO_LEG
-from sim_core.control.placement import PLACED
 from sim_core.model.controls import NO_OFFSETS, LegControl, LegOffsets
 from sim_core.model.failures import OK, Failure
 from sim_core.model.walls import Wall
-from sim_core.planning.live import LivePlan
 from sim_core.world.world import SIDES
 
+if TYPE_CHECKING:  # the law's kernels load with its plan, never with the API (tests/backend/api/test_app.py)
+    from sim_core.planning.live import LivePlan
 
-class RunEnds(Exception):
-    """The law ends the run: ``str(error)`` is the end reason (:mod:`backend.robot.run_endings`)."""
+NO_LEG, PLACED = 0, 2  # sim_core.control.placement's OFF_PLAN and PLACED (a test checks they agree)
 
 
 @dataclass

@@ -78,3 +78,7 @@ def robot_ending_record(end_reason: str | None, faults, telemetry: list[dict]) -
         reported.update(fault_names(int(entry.get("faults", 0))))
     names = sorted(reported)
     return {"robot_faults": names, "fell": fell(end_reason, names)}
+
+
+class RunEnds(Exception):
+    """A run's law ends it (:mod:`backend.robot.plan_law`): ``str(error)`` is the end reason."""
