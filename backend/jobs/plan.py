@@ -2,7 +2,8 @@
 foothold by foothold, and optionally how often the placement law following it (with replanning)
 gets there under the noise, by plain Monte-Carlo attempts (docs/worlds.md). Its result is ``parkour
 plan --json`` — with ``reaches_goal`` false and the highest foot where no plan reaches the goal
-(the command refuses instead) — and, with ``attempts``, ``"monte_carlo"`` as the command's
+(the command refuses instead), the goal in leg lengths (``goal_l0``, the targets' unit) and the
+leg length (``leg_length_m``) — and, with ``attempts``, ``"monte_carlo"`` as the command's
 ``--mfpt --monte-carlo`` gives it. (The splitting estimate for rare failures stays the command's:
 docs/worlds.md says why it goes extinct where failures are rare.)"""
 
@@ -95,7 +96,12 @@ def run(spec: PlanSpec, context: JobContext) -> dict:
     plan = plan_climb(context.model, world, goal, state, noise=noise, seed=spec.seed, launch_gait=spec.launch_gait)
     context.progress(1, 2 if spec.attempts and plan.reaches_goal else 1)
     state = plan.steps[0].velocity if spec.launch_gait and plan.steps else state
-    document = plan.to_dict(context.robot.leg_length) | {"world": label_of(spec), "state": [float(v) for v in state]}
+    document = plan.to_dict(context.robot.leg_length) | {
+        "world": label_of(spec),
+        "state": [float(v) for v in state],
+        "goal_l0": goal,
+        "leg_length_m": context.robot.leg_length,
+    }
     if spec.attempts and plan.reaches_goal:
         options = PlanSplitting(seed=spec.seed, cap=spec.cap, max_replans=spec.replans)
         checked = plan_monte_carlo(context.model, world, plan, goal, noise, options, spec.attempts, spec.seed)

@@ -67,8 +67,9 @@ export async function showPlan(id, job, result) {
   fillTable("#job-plan-steps", steps.map((step) => element("tr", null, ...stepCells(step).map((text) => element("td", text)))),
     "No touchdowns: no leg gets the robot off the floor.");
   const svg = $("#job-plan-svg"), world = spec.world ?? stored?.world;
-  const l0 = await legLength(spec.model?.preset ?? "paper", result.state);
-  const goal = l0 ? spec.goal_height_m / l0 : null;
+  // The result says the goal in l0 (plans made before it did: from the preset's leg length, asked).
+  const l0 = result.goal_l0 === undefined ? await legLength(spec.model?.preset ?? "paper", result.state) : null;
+  const goal = result.goal_l0 ?? (l0 ? spec.goal_height_m / l0 : null);
   const drawn = drawWorld(svg, world, { frame: frameOf(world, steps, goal), clip: "job-plan-clip" });
   svg.setAttribute("aria-label", `World "${worldName}" with the plan's ${steps.length} foot targets`);
   if (goal !== null) svg.append(...goalLine(drawn, goal, spec.goal_height_m));

@@ -10,6 +10,7 @@ from backend.jobs.plan import PlanJobCreate
 from backend.schemas.job_budget import WORK_BUDGET_JUMPS
 from backend.schemas.worlds import WorldCreate
 from backend.services import job_runner, jobs, worlds
+from sim_core import get_preset
 from sim_core.model.errors import ParameterError
 from tests.backend.services.jobs_helpers import job_now
 from tests.cli.helpers import json_of
@@ -29,6 +30,8 @@ def test_a_plan_job_is_the_commands_plan_of_the_same_world(sessions, session, co
     result = dict(jobs.job_results(session, done.id).result)
     command = json_of("plan", "--world", "staircase", "--goal-height", "0.5", "--seed", "2")
     assert result.pop("world") == "stairs" and len(result.pop("state")) == 2 and done.world_id == stairs.id
+    metres = result.pop("leg_length_m")
+    assert result.pop("goal_l0") == pytest.approx(0.5 / metres, rel=1e-15) and metres == get_preset("paper").leg_length
     for document in (result, command):
         document.pop("seconds")
     assert result == command and command["reaches_goal"] and len(command["plan"]) >= 2
