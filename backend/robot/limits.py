@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from backend.robot.messages import on_the_wire
@@ -29,6 +30,12 @@ class ServoLimits:
         psi0_deg, zeta0 = on_the_wire(psi0_deg, zeta0)
         check_range("psi0_deg", psi0_deg, *self.psi0_deg, low_open=False, high_open=False)
         check_range("zeta0", zeta0, *self.zeta0, low_open=False, high_open=False)
+
+    def held(self, psi0: float, zeta0: float) -> tuple[tuple[float, float], bool]:
+        """A law's command ``(psi0 [rad], zeta0)`` held to the servos' range, and whether it had to be."""
+        low, high = (math.radians(bound) for bound in self.psi0_deg)
+        held = (min(max(psi0, low), high), min(max(zeta0, self.zeta0[0]), self.zeta0[1]))
+        return held, held != (psi0, zeta0)
 
     def allows(self, psi0_deg: float, zeta0: float) -> bool:
         try:

@@ -49,7 +49,6 @@ class LiveLaw:
     def __post_init__(self) -> None:
         self.stepped = SteppedLaw(self.law, self.first)  # compiled before the run starts
         self._psi0_offset = tuple(math.radians(offset) for offset in self.offsets.psi0_offset_deg)
-        self._psi0_range = tuple(math.radians(bound) for bound in self.limits.psi0_deg)
 
     @property
     def name(self) -> str:
@@ -68,10 +67,8 @@ class LiveLaw:
         psi0, zeta0, clipped = self.stepped.step(height, pitch, *touchdown.state, wall == Wall.LEFT)
         side = 1 if wall == Wall.RIGHT else 0
         angle = psi0 - self._psi0_offset[side] if LAWS[self.name].sets_leg_angle else leg_psi0
-        commanded = (angle, zeta0 - self.offsets.zeta0_offset[side])
-        held = (min(max(commanded[0], self._psi0_range[0]), self._psi0_range[1]),
-                min(max(commanded[1], self.limits.zeta0[0]), self.limits.zeta0[1]))  # fmt: skip
-        clipped = clipped or held != commanded
+        held, clipped_here = self.limits.held(angle, zeta0 - self.offsets.zeta0_offset[side])
+        clipped = clipped or clipped_here
         journal = {"controller": self.name, "clipped": clipped, "state": self.stepped.state}
         return LegControl(*held), journal
 

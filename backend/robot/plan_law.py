@@ -51,7 +51,6 @@ class PlanLaw:
         self.meant = {row: (math.radians(step["psi0_deg"]), step["zeta0"]) for row, step in
                       enumerate(self.plan.steps[:2])}  # fmt: skip
         self._psi0_offset = tuple(math.radians(offset) for offset in self.offsets.psi0_offset_deg)
-        self._psi0_range = tuple(math.radians(bound) for bound in self.limits.psi0_deg)
 
     def warm(self) -> None:
         """Compile the law's kernels (before the run starts: its first touchdown must not wait for them)."""
@@ -102,7 +101,5 @@ class PlanLaw:
     def _sent(self, side: int, psi0: float, zeta0: float) -> tuple[LegControl, bool]:
         """The leg ``(psi0, zeta0)`` meant for ``side`` as commanded: less the leg's offsets, held to
         the servos' range; and whether it was clipped."""
-        commanded = (psi0 - self._psi0_offset[side], zeta0 - self.offsets.zeta0_offset[side])
-        held = (min(max(commanded[0], self._psi0_range[0]), self._psi0_range[1]),
-                min(max(commanded[1], self.limits.zeta0[0]), self.limits.zeta0[1]))  # fmt: skip
-        return LegControl(*held), held != commanded
+        held, clipped = self.limits.held(psi0 - self._psi0_offset[side], zeta0 - self.offsets.zeta0_offset[side])
+        return LegControl(*held), clipped

@@ -65,3 +65,12 @@ def test_a_command_is_checked_as_the_message_carries_it():
     assert math.degrees(math.radians(30.0)) < 30.0
     tight.check(math.degrees(math.radians(30.0)), 0.9 + 1e-12)
     assert not tight.allows(40.006, 0.85) and not tight.allows(35.0, 0.90006)
+
+
+def test_a_laws_command_is_held_to_the_range_and_says_so():
+    """What both laws send (backend/robot/live_law.py, plan_law.py): inside, as it is; past an end, the end."""
+    inside = (math.radians(30.0), 0.9)
+    assert LIMITS.held(*inside) == (inside, False)
+    (psi0, zeta0), clipped = LIMITS.held(math.radians(75.0), 0.5)
+    assert clipped and (math.degrees(psi0), zeta0) == (pytest.approx(60.0), 0.75)
+    assert LIMITS.allows(math.degrees(psi0), zeta0)
