@@ -77,7 +77,6 @@ class NoiseSpec:
         return NoiseModel(**asdict(self))
 
 
-_PARTS = {"model": ModelSpec, "noise": NoiseSpec, "guess": StateSpec, "start": StateSpec, "state": StateSpec}
 _TUPLES = ("zeta0s", "controllers")  # lists stored, tuples in the frozen spec
 
 
@@ -88,7 +87,8 @@ def encode(spec) -> dict:
 
 @functools.cache
 def _part_of(cls: type, name: str) -> type | None:
-    """The dataclass a kind's own field holds (``RandomWorldsSpec | None``: RandomWorldsSpec), if any."""
+    """The dataclass a spec's field holds (``model: ModelSpec``, ``guess: StateSpec | None``: StateSpec), if any:
+    read from the spec's own annotations, so a kind's part of its own needs no list here."""
     hint = typing.get_type_hints(cls).get(name)
     options = typing.get_args(hint) if isinstance(hint, types.UnionType) else (hint,)  # not tuple[LegSpec, ...]
     return next((option for option in options if is_dataclass(option)), None)
@@ -102,7 +102,7 @@ def read_fields(cls: type, stored: dict):
         if spec_field.name not in stored:
             continue
         value = stored[spec_field.name]
-        part = _PARTS.get(spec_field.name) or _part_of(cls, spec_field.name)
+        part = _part_of(cls, spec_field.name)
         if part is not None and value is not None:
             value = part(**value)
         elif spec_field.name == "controls":
