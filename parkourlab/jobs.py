@@ -237,10 +237,17 @@ class JobCalls:
         return self._http.call("GET", f"/api/v1/jobs/{job_id(job)}", timeout=timeout)
 
     def jobs(
-        self, *, state: JobState | None = None, experiment_id: int | None = None, page_size: int = 200
+        self,
+        *,
+        state: JobState | None = None,
+        experiment_id: int | None = None,
+        kind: str | None = None,
+        world_id: int | None = None,
+        page_size: int = 200,
     ) -> Iterator[Job]:
-        """Every job (in ``state``, of ``experiment_id``, when given), newest first, page after page."""
-        params = {"state": state, "experiment_id": experiment_id}
+        """Every job (in ``state``, of ``experiment_id``, of ``kind``, in the stored world
+        ``world_id``: each when given), newest first, page after page."""
+        params = {"state": state, "experiment_id": experiment_id, "kind": kind, "world_id": world_id}
         return self._http.pages("/api/v1/jobs", params, page_size)
 
     def wait(

@@ -40,24 +40,34 @@ def state_of(session: Session, job_id: int) -> str | None:
     return session.scalar(select(Job.state).where(Job.id == job_id))
 
 
-def newest(
-    session: Session, *, state: JobState | None, limit: int, cursor: int | None, experiment_id: int | None
-) -> tuple[list[Job], int | None]:
-    """A keyset page of jobs, newest first, of one ``state`` and ``experiment_id`` where given."""
-    query = _of(newest_first(Job, limit, cursor), state, experiment_id)
+def newest(session: Session, *, limit: int, cursor: int | None, **only) -> tuple[list[Job], int | None]:
+    """A keyset page of jobs, newest first, ``only`` those of the filters given (:func:`_of`)."""
+    query = _of(newest_first(Job, limit, cursor), **only)
     return page(list(session.scalars(query)), limit)
 
 
-def count(session: Session, *, state: JobState | None, experiment_id: int | None) -> int:
+def count(session: Session, **only) -> int:
     """How many jobs :func:`newest` pages through."""
-    return session.scalar(_of(select(func.count()).select_from(Job), state, experiment_id)) or 0
+    return session.scalar(_of(select(func.count()).select_from(Job), **only)) or 0
 
 
-def _of(query, state: JobState | None, experiment_id: int | None):
-    if state is not None:
-        query = query.where(Job.state == state)
-    if experiment_id is not None:
-        query = query.where(Job.experiment_id == experiment_id)
+def _of(
+    query,
+    state: JobState | None = None,
+    experiment_id: int | None = None,
+    kind: str | None = None,
+    world_id: int | None = None,
+):
+    """``query`` of the jobs in ``state``, filed under ``experiment_id``, of ``kind`` and in the
+    stored world ``world_id``: each where given."""
+    for column, value in (
+        (Job.state, state),
+        (Job.experiment_id, experiment_id),
+        (Job.kind, kind),
+        (Job.world_id, world_id),
+    ):
+        if value is not None:
+            query = query.where(column == value)
     return query
 
 

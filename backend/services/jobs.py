@@ -86,13 +86,11 @@ def get_job(session: Session, job_id: int) -> JobOut:
     return public(job, standings(session).get(job_id) if job.state not in FINAL else None)
 
 
-def list_jobs(
-    session: Session, *, state: JobState | None, limit: int, cursor: int | None, experiment_id: int | None = None
-) -> JobPage:
-    rows, next_cursor = stored_jobs.newest(
-        session, state=state, limit=limit, cursor=cursor, experiment_id=experiment_id
-    )
-    total = stored_jobs.count(session, state=state, experiment_id=experiment_id)
+def list_jobs(session: Session, *, limit: int, cursor: int | None, **only) -> JobPage:
+    """A page of jobs, newest first; ``only`` filters them (state, experiment_id, kind, world_id:
+    each None for any)."""
+    rows, next_cursor = stored_jobs.newest(session, limit=limit, cursor=cursor, **only)
+    total = stored_jobs.count(session, **only)
     standing = standings(session) if any(row.state not in FINAL for row in rows) else {}
     return JobPage(items=[public(row, standing.get(row.id)) for row in rows], next_cursor=next_cursor, total=total)
 

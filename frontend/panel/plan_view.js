@@ -82,21 +82,21 @@ export async function showPlan(id, job, result) {
 
 // The world's extent up to a little above the plan's top (its highest target or the goal): a
 // tall world's climb is not squeezed into the bottom of the drawing.
-function frameOf(world, steps, goal) {
+export function frameOf(world, steps, goal) {
   const frame = extent(world);
   const top = Math.max(goal ?? -Infinity, ...steps.map((step) => step.target?.[1] ?? -Infinity));
   if (!Number.isFinite(top)) return frame;
   return { ...frame, ymax: Math.min(frame.ymax, top + Math.max(1, 0.25 * (top - frame.ymin))) };
 }
 
-function goalLine({ frame, toSvg }, goal, metres) {
+export function goalLine({ frame, toSvg }, goal, metres) {
   const [x1, y] = toSvg(frame.xmin, goal), [x2] = toSvg(frame.xmax, goal);
   return [svgElement("line", { x1, x2, y1: y, y2: y, class: "plan-goal" }),
     svgElement("text", { x: x2 + 6, y: y + 4, class: "plan-goal-text" }, `goal ${metres} m`)];
 }
 
 // The targets joined in order, then each as a numbered circle with its step in a tooltip.
-function targets({ toSvg }, steps) {
+export function targets({ toSvg }, steps) {
   const points = steps.filter((step) => Array.isArray(step.target)).map((step) => ({ step, at: toSvg(...step.target) }));
   const nodes = [];
   if (points.length > 1) {

@@ -5,6 +5,7 @@ import { onRobotEvent, statusSeen } from "./events.js";
 import { filedUnder, LEG_FIELDS, SIM_LOCATIONS, checked } from "./forms.js";
 import { draw, layout } from "./plots.js";
 import { definitions } from "./dom.js";
+import { followJournal, following, planRunBody } from "./robot_plan.js";
 
 // Every status (GET /robot, each answer to a robot call, each live message) goes through
 // showStatus; every value from it reaches the page as text.
@@ -58,6 +59,7 @@ export function showStatus(status) {
   statusSeen(status);  // the e-stop banner
   showRunOwner(status.run);
   followRun(status);
+  followJournal(status.run);
 }
 
 // Who runs the robot: while a live run goes, which run, since when and who started it, with its
@@ -203,16 +205,17 @@ const ROBOT_RUN_FIELDS = [...LEG_FIELDS, { name: "jumps", rule: "RobotRunCreate.
 const CLOSED_LOOP_FIELDS = [{ name: "target_m", rule: "ClosedLoopIn.target_m", unit: "m" }, { name: "kp", rule: "ClosedLoopIn.kp" },
   { name: "ki", rule: "ClosedLoopIn.ki" }, { name: "kd", rule: "ClosedLoopIn.kd" }];
 const ROBOT_RUN_LOCATIONS = { ...SIM_LOCATIONS, max_seconds: "max_seconds", tracker_timeout_ms: "tracker_timeout_ms", "closed_loop.target_m": "target_m",
-  "closed_loop.kp": "kp", "closed_loop.ki": "ki", "closed_loop.kd": "kd", "closed_loop.controller": "controller" };
+  "closed_loop.kp": "kp", "closed_loop.ki": "ki", "closed_loop.kd": "kd", "closed_loop.controller": "controller", plan_job_id: "plan_job_id" };
+const RUN_LIMIT_FIELDS = ROBOT_RUN_FIELDS.filter((field) => !LEG_FIELDS.includes(field));
 
 on("#robot-run-form", "submit", async (event) => {
   event.preventDefault();
-  const closed = event.target.elements.closed_loop.checked;
-  const v = await checked(event.target, closed ? [...ROBOT_RUN_FIELDS, ...CLOSED_LOOP_FIELDS] : ROBOT_RUN_FIELDS);
+  const closed = event.target.elements.closed_loop.checked, plan = following();
+  const v = await checked(event.target, plan ? RUN_LIMIT_FIELDS : closed ? [...ROBOT_RUN_FIELDS, ...CLOSED_LOOP_FIELDS] : ROBOT_RUN_FIELDS);
   if (v === null) return;
-  const body = { controls: [{ psi0_deg: v.psiL, zeta0: v.zetaL }, { psi0_deg: v.psiR, zeta0: v.zetaR }], jumps: v.jumps, max_seconds: v.max_seconds,
-    tracker_timeout_ms: v.tracker_timeout_ms };
-  if (closed) body.closed_loop = { controller: event.target.elements.controller.value, target_m: v.target_m, kp: v.kp, ki: v.ki, kd: v.kd };
+  const body = plan ? planRunBody(v) : { controls: [{ psi0_deg: v.psiL, zeta0: v.zetaL }, { psi0_deg: v.psiR, zeta0: v.zetaR }], jumps: v.jumps,
+    max_seconds: v.max_seconds, tracker_timeout_ms: v.tracker_timeout_ms };
+  if (closed && !plan) body.closed_loop = { controller: event.target.elements.controller.value, target_m: v.target_m, kp: v.kp, ki: v.ki, kd: v.kd };
   Object.assign(body, filedUnder(event.target));
   // The robot's state now, not as last shown: a disarmed robot is armed by the run and jumps.
   const current = await call("GET", "/robot");
@@ -224,7 +227,8 @@ on("#robot-run-form", "submit", async (event) => {
   } finally {
     pendingTarget = undefined;
   }
-  say(`Run started: ${body.jumps} jumps at most, ${body.max_seconds} s at most${body.closed_loop ? `, ${body.closed_loop.controller} holding ${body.closed_loop.target_m} m` : ""}.`);
+  const law = body.closed_loop ? `, ${body.closed_loop.controller} holding ${body.closed_loop.target_m} m` : body.plan_job_id ? `, following plan job ${body.plan_job_id}` : "";
+  say(`Run started: ${body.jumps} jumps at most, ${body.max_seconds} s at most${law}.`);
 });
 const stopRun = async () => showStatus(await call("POST", "/robot/runs/stop"));
 on("#stop-run", "click", stopRun);

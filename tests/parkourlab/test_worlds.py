@@ -58,6 +58,8 @@ def test_a_world_created_and_a_foothold_study_run_in_it(client):
     assert [row["world"] for row in result["worlds"]] == ["client holds"]
     assert result["methods"]["placement"]["trials"] == 3 and result["trials_per_world"] == 3
     assert client.world(world["id"])["jobs"] == 1
+    assert [listed["id"] for listed in client.jobs(kind="foothold-study", world_id=world["id"])] == [job["id"]]
+    assert list(client.jobs(kind="plan", world_id=world["id"])) == []
     with pytest.raises(Conflict) as caught:
         client.delete_world(world["id"])
     assert f"job {job['id']}" in str(caught.value)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import asyncio
 import json
 import time
-from typing import Annotated
+from typing import Annotated, Literal
 
 from fastapi import APIRouter, Query, Request
 from fastapi.encoders import jsonable_encoder
@@ -13,12 +13,13 @@ from fastapi.responses import StreamingResponse
 
 from backend import schemas
 from backend.api.deps import AUTHORIZED, Cursor, Db, PageLimit, RecordId, Runner, SubmittedVia, Who
-from backend.jobs import JobCreate
+from backend.jobs import BY_NAME, JobCreate
 from backend.services import jobs
 
 EVENT_POLL_S = 0.25  # progress comes from committed chunks; a quarter second is live enough
 
 router = APIRouter(prefix="/api/v1/jobs", tags=["jobs"])
+KindName = Literal[tuple(BY_NAME)]  # a registered kind's name: any other is a 422 naming the allowed ones
 
 
 @router.post("", status_code=202, dependencies=AUTHORIZED, response_model=schemas.JobOut)
@@ -36,8 +37,15 @@ async def list_jobs(
     cursor: Cursor = None,
     state: schemas.JobState | None = None,
     experiment_id: Annotated[int | None, Query(ge=1, le=schemas.MAX_ID, description="only this experiment's")] = None,
+    kind: Annotated[KindName | None, Query(description="only jobs of this kind")] = None,
+    world_id: Annotated[
+        int | None, Query(ge=1, le=schemas.MAX_ID, description="only jobs in this stored world")
+    ] = None,
 ) -> schemas.JobPage:
-    return await db(jobs.list_jobs, state=state, limit=limit, cursor=cursor, experiment_id=experiment_id)
+    """Jobs, newest first, a keyset page at a time; each filter given narrows them (the panel's
+    Robot tab asks for the finished ``plan`` jobs, say)."""
+    only = {"state": state, "experiment_id": experiment_id, "kind": kind, "world_id": world_id}
+    return await db(jobs.list_jobs, limit=limit, cursor=cursor, **only)
 
 
 @router.get("/{job_id}", response_model=schemas.JobOut)

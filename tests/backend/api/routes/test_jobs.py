@@ -146,6 +146,23 @@ def test_jobs_list_by_experiment(client, auth):
     assert client.get("/api/v1/jobs", params={"experiment_id": 0}).status_code == 422
 
 
+def test_jobs_list_by_kind_and_world(client, auth):
+    world = client.post("/api/v1/worlds", json={"name": "walls", "named": "parallel"}, headers=auth).json()["id"]
+    other = client.post("/api/v1/worlds", json={"name": "steps", "named": "staircase"}, headers=auth).json()["id"]
+    client.post("/api/v1/jobs", json={"zeta0s": [0.9], "trials": 1, "cap": 2}, headers=auth)
+    plan = {"kind": "plan", "world_id": world, "goal_height_m": 0.3}
+    planned = client.post("/api/v1/jobs", json=plan, headers=auth).json()["id"]
+    elsewhere = client.post("/api/v1/jobs", json=plan | {"world_id": other}, headers=auth).json()["id"]
+    page = client.get("/api/v1/jobs", params={"kind": "plan"}).json()
+    assert [job["id"] for job in page["items"]] == [elsewhere, planned] and page["total"] == 2
+    in_world = client.get("/api/v1/jobs", params={"kind": "plan", "world_id": world}).json()["items"]
+    assert [job["id"] for job in in_world] == [planned]
+    assert client.get("/api/v1/jobs", params={"kind": "mjtf", "world_id": world}).json()["items"] == []
+    refused = client.get("/api/v1/jobs", params={"kind": "plans"})
+    assert refused.status_code == 422 and refused.json()["detail"][0]["loc"] == ["query", "kind"]
+    assert "'plan'" in refused.json()["detail"][0]["msg"], "the message names the kinds allowed"
+
+
 def test_past_the_queue_budget_a_job_is_a_429_naming_it(client, auth, monkeypatch):
     from backend.services import job_queue
 
