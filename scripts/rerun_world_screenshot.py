@@ -2,8 +2,9 @@
 
 Starts ``parkour serve`` and the virtual robot (``parkour robot-sim --world FILE --noise off``) on
 a fresh data directory, stores ``random_world(--seed)`` (``POST /api/v1/worlds``; the robot climbs
-the same world, written to FILE), climbs it open loop (``POST /api/v1/robot/runs`` with its
-``world_id``, in real time; in random 5 this gait falls after its fourth touchdown), exports the
+the same world, written to FILE), plans a climb to ``--goal`` in it (a ``plan`` job, from the first
+leg's gait) and follows the plan (``POST /api/v1/robot/runs`` with its ``plan_job_id``, in real time:
+the placement law sends each next leg; open loop where no plan reaches the goal), exports the
 stored run (``parkour export``), converts it with Rerun's MCAP importer (``rerun mcap convert``, its
 default decoders), prints the entities (path, timed rows, components by archetype) and writes them
 to entities.txt beside the .rrd, then opens the .rrd in Rerun's web viewer (served here) in headless
@@ -11,7 +12,7 @@ Chromium (WebGL2 from SwiftShader: no GPU) with a blueprint: a 3D view of ``/wor
 ``/tracker`` (the world's points, the body's path, its last pose as axes) beside the height plot.
 The screenshot is taken once the page stops changing, at most ``--wait`` seconds (35-50 s here, 2 cores).
 
-Usage: PYTHONPATH=. python scripts/rerun_world_screenshot.py [--seed 5] [--jumps 12]
+Usage: PYTHONPATH=. python scripts/rerun_world_screenshot.py [--seed 5] [--jumps 40] [--goal 1.5]
     [--out docs/screenshots/rerun_world.png] [--size 1400x900] [--wait 60] [--keep DIR]
 """
 
@@ -44,8 +45,9 @@ FILES = "http://recording.invalid/"  # the page's fetches of the .rrd and .rbl, 
 ENV = {**os.environ, "CI": "true"}  # Rerun sends no usage data and asks nothing on a first run
 
 
-def robot_run_in_world(data: Path, seed: int, jumps: int) -> int:
-    """The stored run's id: the virtual robot climbing the stored world ``random_world(seed)``."""
+def robot_run_in_world(data: Path, seed: int, jumps: int, goal_m: float) -> int:
+    """The stored run's id: the virtual robot climbing the stored world ``random_world(seed)``,
+    following a plan job's plan to ``goal_m`` [m] (open loop where the planner finds none)."""
     port, robot_port, tracker_port = free_port(), free_port(), free_port(socket.SOCK_DGRAM)
     service = start_service(data, port, "--view-port", "0")
     robot = None
@@ -60,8 +62,17 @@ def robot_run_in_world(data: Path, seed: int, jumps: int) -> int:
             robot = start_robot_sim(robot_port, tracker_port, "--world", str(world_file), "--noise", "off")
             api.post("/api/v1/robot/connect", json={"url": f"socket://127.0.0.1:{robot_port}",
                                                     "tracker_port": tracker_port}).raise_for_status()  # fmt: skip
-            body = {"controls": [{"psi0_deg": p, "zeta0": z} for p, z in LEGS], "jumps": jumps,
-                    "world_id": world.json()["id"], "max_seconds": 600.0}  # fmt: skip
+            plan = {"kind": "plan", "world_id": world.json()["id"], "goal_height_m": goal_m, "launch_gait": True}
+            job = api.post("/api/v1/jobs", json=plan).raise_for_status().json()["id"]
+            while (state := api.get(f"/api/v1/jobs/{job}").json()["state"]) in ("queued", "running"):
+                time.sleep(0.5)
+            result = api.get(f"/api/v1/jobs/{job}/results").json()["result"]
+            if state == "done" and result["reaches_goal"]:  # the run follows the plan (the placement law)
+                body = {"plan_job_id": job, "jumps": jumps, "max_seconds": 600.0}
+            else:  # no plan to the goal in this world: the open-loop gait, which falls after a few jumps
+                print(f"plan job {job} {state}, no plan to {goal_m} m: climbing open loop")
+                body = {"controls": [{"psi0_deg": p, "zeta0": z} for p, z in LEGS], "jumps": jumps,
+                        "world_id": world.json()["id"], "max_seconds": 600.0}  # fmt: skip
             api.post("/api/v1/robot/runs", json=body).raise_for_status()
             while (status := api.get("/api/v1/robot").json())["run"]["active"]:
                 time.sleep(0.5)
@@ -144,7 +155,8 @@ def screenshot(files: dict[str, bytes], out: Path, width: int, height: int, wait
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seed", type=int, default=5)
-    parser.add_argument("--jumps", type=int, default=12)
+    parser.add_argument("--jumps", type=int, default=40)
+    parser.add_argument("--goal", type=float, default=1.5, help="[m] the plan's goal height")
     parser.add_argument("--out", type=Path, default=Path("docs/screenshots/rerun_world.png"))
     parser.add_argument("--size", default="1400x900", help="the browser's viewport, WIDTHxHEIGHT")
     parser.add_argument("--wait", type=float, default=60.0, help="[s] at most, for the viewer to draw the recording")
@@ -155,7 +167,7 @@ def main() -> None:
     work = args.keep or Path(tempfile.mkdtemp(prefix="parkour-rerun-world-"))
     work.mkdir(parents=True, exist_ok=True)
     data, mcap, rrd, rbl = work / "data", work / "run.mcap", work / "run.rrd", work / "view.rbl"
-    run_id = robot_run_in_world(data, args.seed, args.jumps)
+    run_id = robot_run_in_world(data, args.seed, args.jumps, args.goal)
     cli = [sys.executable, "-m", "cli", "export", str(run_id), "--out", str(mcap), "--data-dir", str(data)]
     subprocess.run(cli, check=True)
     convert = [sys.executable, "-m", "rerun_cli", "mcap", "convert", str(mcap), "-o", str(rrd), "--application-id", APP]
