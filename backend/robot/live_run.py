@@ -29,6 +29,7 @@ from backend.robot.link import LinkError, LinkState, RobotLink
 from backend.robot.live_law import LiveLaw, pitch_at
 from backend.robot.messages import Leg
 from backend.robot.run_endings import CLEAN_ENDINGS, LINK_LOST, RunEnds, end_safely, fault_names, robot_ending
+from backend.robot.run_snapshot import Record, RunSnapshot
 from backend.robot.touchdown import PITCH_LOOKBACK, SideAt, Touchdown, scan_touchdowns
 from backend.robot.tracker import PoseHistory, pose_arrays
 from backend.robot.tracker_watch import TRACKER_TIMEOUT_MS, TrackerWatch, frames_heard
@@ -42,62 +43,6 @@ if TYPE_CHECKING:
 POLL = 0.005  # [s] how often the loop looks at new poses
 
 __all__ = ["CLEAN_ENDINGS", "LiveRun", "Record", "RunSnapshot", "end_safely", "execute", "telemetry_dict"]
-
-
-@dataclass(frozen=True)
-class Record:
-    """One thing the run recorded, for its journal: ``kind`` is ``touchdown`` (``value`` is the
-    :class:`Touchdown` and the :class:`LegControl` it was made with), ``command``, ``telemetry`` or
-    ``tracker_gap`` (a dict); ``value`` is never changed after it is made. A command or telemetry has
-    ``time`` (Unix [s]) and ``tracker_time`` (of the run's newest frame then, or None), which places
-    it in a recording (:mod:`backend.services.mcap_clock`)."""
-
-    kind: str
-    value: object
-
-
-@dataclass(frozen=True)
-class RunSnapshot:
-    """What a live run is now, immutable: read it from any thread, as often as you like."""
-
-    run_id: int | None  # the stored run's id (it is stored when it starts)
-    started: float  # time.time()
-    jumps: int  # asked for
-    max_seconds: float
-    target_m: float | None = None  # closed loop: the height held [m]
-    active: bool = True
-    touchdowns: tuple[Touchdown, ...] = ()
-    touchdown_controls: tuple[LegControl, ...] = ()  # the controls each detected touchdown was made with
-    commanded: tuple[tuple[Leg, LegControl], ...] = ()  # what each leg is commanded now
-    commands: int = 0  # sent so far
-    end_reason: str | None = None
-    disarm: str | None = None  # how the ending left the robot: "disarmed", "estopped" or why unconfirmed
-    started_by: str | None = None  # who started it, as other panels are told
-    first_pose: int = 0  # the tracker's index of the run's first frame (its trail starts there)
-    tracker_gaps: tuple[dict, ...] = ()  # stretches without a pose past the run's tracker timeout
-    robot_faults: tuple[str, ...] = ()  # the robot's faults in its last telemetry at the end
-
-    def command_for(self, leg: Leg) -> LegControl | None:
-        return dict(self.commanded).get(leg)
-
-    def to_status(self) -> dict:
-        return {
-            "id": self.run_id,
-            "active": self.active,
-            "started": self.started,
-            "started_by": self.started_by,
-            "touchdowns": len(self.touchdowns),
-            "jumps": self.jumps,
-            "max_seconds": self.max_seconds,
-            "target_m": self.target_m,
-            "commands": self.commands,
-            "end_reason": self.end_reason,
-            "disarm": self.disarm,
-            "stored_run_id": self.run_id,
-            "tracker_gaps": len(self.tracker_gaps),
-            "longest_tracker_gap_ms": max((gap["ms"] for gap in self.tracker_gaps), default=None),
-            "robot_faults": list(self.robot_faults),
-        }
 
 
 @dataclass
@@ -120,6 +65,8 @@ class LiveRun:
     telemetry: list[dict] = field(default_factory=list)
     tracker_gaps: list[dict] = field(default_factory=list)
     robot_faults: tuple[str, ...] = ()
+    world_id: int | None = None  # the stored world it climbs (None: the parallel walls)
+    plan_job_id: int | None = None  # the plan job it follows (None: none)
     end_reason: str | None = None
     disarm: str | None = None
     journal: queue.SimpleQueue[Record] = field(default_factory=queue.SimpleQueue)
@@ -129,7 +76,8 @@ class LiveRun:
 
     def __post_init__(self) -> None:
         self.snapshot = RunSnapshot(self.run_id, self.started, self.jumps, self.max_seconds, self.target_m,
-                                    started_by=self.started_by, first_pose=self.first_pose)  # fmt: skip
+                                    started_by=self.started_by, first_pose=self.first_pose,
+                                    world_id=self.world_id, plan_job_id=self.plan_job_id)  # fmt: skip
 
     def stop(self, reason: str = "stopped") -> None:
         """Any thread: ask the loop to end; it sends nothing more once it has seen this (the first

@@ -249,15 +249,9 @@ class RobotService:
                 run_id = open_robot_run(session, body, self.robot, tracker.calibration, started_by=started_by, link=on,
                                         person=person, legs=legs, world_id=where.world_id)  # fmt: skip
             target_m = None if body.closed_loop is None else body.closed_loop.target_m
-            run = LiveRun(
-                body.jumps,
-                body.max_seconds,
-                target_m,
-                run_id=run_id,
-                first_pose=tracker.count(),
-                started_by=started_by,
-                tracker_timeout=body.tracker_timeout_ms / 1000.0,
-            )
+            run = LiveRun(body.jumps, body.max_seconds, target_m, run_id=run_id, first_pose=tracker.count(),
+                          started_by=started_by, tracker_timeout=body.tracker_timeout_ms / 1000.0,
+                          world_id=where.world_id, plan_job_id=body.plan_job_id)  # fmt: skip
             journal = JournalWriter(self.sessions, run, tracker, link, self.robot).start()
             self._run = run
         threading.Thread(target=execute, args=(run, link, tracker, self.robot, legs, controller, journal.finish,

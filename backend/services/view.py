@@ -8,8 +8,9 @@ simulator load.
 
 The view reads the store and the robot only through this module: :func:`stored_path` (a stored
 run's path and its world, for replay and sharing), :func:`stored_path_key` (what a cached replay
-was made of), :func:`stored_worlds` and :func:`stored_world` (the worlds simulate mode plans in)
-and :func:`commanded` (a live run's command for a leg, named by its wall).
+was made of), :func:`stored_worlds` and :func:`stored_world` (the worlds simulate mode plans in
+and a live run climbs), :func:`stored_plan_footholds` (the plan a live run follows) and
+:func:`commanded` (a live run's command for a leg, named by its wall).
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 
 from backend.errors import Conflict
+from backend.repositories import jobs as job_rows
 from backend.repositories import runs as run_rows
 from backend.repositories import worlds as world_rows
 from backend.robot.messages import Leg
@@ -33,6 +35,7 @@ from backend.services.worlds import world_in_l0
 from backend.store.trajectory_blob import unpack_trajectory
 from sim_core.model.controls import LegControl
 from sim_core.model.walls import Wall
+from sim_core.world.world import SIDES
 
 if TYPE_CHECKING:
     from backend.robot.live_run import RunSnapshot
@@ -148,6 +151,15 @@ def stored_world(sessions: Callable, world_id: int) -> dict:
     """Stored world ``world_id`` as the §8 JSON in ``l0`` (NotFound: none)."""
     with sessions() as session:
         return world_in_l0(session, world_id, VIEW_PRESET)
+
+
+def stored_plan_footholds(sessions: Callable, job_id: int) -> list[tuple[int, int, float, float]]:
+    """Plan job ``job_id``'s footholds, one per touchdown of its climb: side (0 left, 1 right),
+    segment, and target ``x``, ``y`` [l0]; none when it holds no plan (NotFound: no such job)."""
+    with sessions() as session:
+        job = job_rows.get(session, job_id)
+        steps = ((job.result or {}).get("plan") or []) if job.kind == "plan" else []
+        return [(SIDES.index(step["side"]), int(step["segment"]), *map(float, step["target"])) for step in steps]
 
 
 def stored_path_key(sessions: Callable, run_id: int) -> tuple:

@@ -10,15 +10,15 @@ trails are rings of reused nodes (:mod:`frontend.viewer.node_rings`).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 import viser
 
-from frontend.viewer.geometry import bow_leg, energy_color, idle_foot, polyline_segments, ruler_ticks, to_scene
+from frontend.viewer.geometry import bow_leg, energy_color, idle_foot, polyline_segments, to_scene
 from frontend.viewer.motion import Pose
 from frontend.viewer.node_rings import NodeRing, StreamedTrail, hidden_lines
-from frontend.viewer.world_slabs import world_slabs, world_width
+from frontend.viewer.ruler import Growth, grown
+from frontend.viewer.world_slabs import world_slabs, world_width, world_words
 from sim_core import LegControl, PhysicalParams
 from sim_core.model.trajectory import STANCE
 from sim_core.world.world import World
@@ -54,20 +54,6 @@ def place_camera(server: viser.ViserServer) -> None:
     server.initial_camera.up = (0.0, 0.0, 1.0)
 
 
-@dataclass(frozen=True)
-class Growth:
-    """What the walls and the ruler gain when they grow to ``top`` [m] (:meth:`ChuteScene.growth`):
-    the walls' new dimensions and positions, a ruler section (its node's name and segments: the
-    spine's new stretch and the new ticks) and the new height labels (name, text, position)."""
-
-    top: float
-    wall_dimensions: tuple[float, float, float]
-    wall_positions: tuple[tuple[float, float, float], ...]
-    section: str
-    segments: np.ndarray
-    labels: tuple[tuple[str, str, tuple[float, float, float]], ...]
-
-
 class ChuteScene:
     """The scene's nodes and how to move them."""
 
@@ -100,6 +86,9 @@ class ChuteScene:
         self._wall_x = [side * (half + 0.5 * WALL_THICKNESS) for side in (-1, 1)]
         self._ruler_sections = 0  # the ruler grows in sections: "/chute/ruler", then "/chute/ruler/part_k"
         self._ruler_labels = 0
+        self._ruler_x, self._ruler = -half, None  # [m] on the left wall's face; its first section (moves it all)
+        self._walls_words = f"walls {robot.wall_distance:.2f} m apart"
+        self.chute_words = self._walls_words  # what the view's header says of the chute (set_world)
         self.body = scene.add_icosphere("/chute/body", radius=BODY_RADIUS, color=BODY_COLOR)
         # The legs hang from the body (drawn relative to it): a client that repaints slowly moves
         # them with the body at once, even while it is still rebuilding their shape.
@@ -145,29 +134,15 @@ class ChuteScene:
         top = float(self.top_for(height))
         if top <= self.top:
             return None
-        fresh, majors = ruler_ticks(top, above=self.top if self._ruler_sections else -math.inf)
-        inner, front = -0.5 * self.robot.wall_distance, -0.5 * DEPTH
-        length = np.where(np.isin(fresh, majors), 0.04, 0.02)
-        starts = np.column_stack([np.full(fresh.size, inner), np.full(fresh.size, front), fresh])
-        ends = starts + np.column_stack([length, np.zeros(fresh.size), np.zeros(fresh.size)])
-        spine = np.array([[[inner, front, self.top if self._ruler_sections else 0.0], [inner, front, top]]])
-        labels = tuple(
-            (f"/chute/ruler/label_{i}", f"{mark:.2f} m", (inner + 0.045, front, float(mark)))
-            for i, mark in enumerate(majors, start=self._ruler_labels)
-        )
-        return Growth(
-            top=top,
-            wall_dimensions=(WALL_THICKNESS, DEPTH, top),
-            wall_positions=tuple((x, 0.0, 0.5 * top) for x in self._wall_x),
-            section="/chute/ruler" if self._ruler_sections == 0 else f"/chute/ruler/part_{self._ruler_sections}",
-            segments=np.concatenate([spine, np.stack([starts, ends], axis=1)]),
-            labels=labels,
-        )
+        return grown(self.top, top, sections=self._ruler_sections, labels=self._ruler_labels,
+                     spine=(self._ruler_x, -0.5 * DEPTH), wall_size=(WALL_THICKNESS, DEPTH),
+                     wall_x=self._wall_x)  # fmt: skip
 
     def set_world(self, world: World | None, leg_length: float = 0.0, model_mu: float = math.inf) -> None:
         """Draw ``world`` (``l0`` units, at ``leg_length`` [m], its open frictions ``model_mu``) in
         place of the parallel walls: its sides as slabs (:mod:`frontend.viewer.world_slabs`) under
-        ``/chute/world/``, sent once; None: the parallel walls again. The same world again sends nothing."""
+        ``/chute/world/``, sent once, the ruler on its left side at the floor and the header's words
+        its own (:attr:`chute_words`); None: the parallel walls again. The same world again sends nothing."""
         key = None if world is None else (id(world), leg_length, model_mu)
         if key == self._world_key:
             return
@@ -179,8 +154,10 @@ class ChuteScene:
         if world is None:
             self.floor.dimensions = (self.robot.wall_distance + 2 * WALL_THICKNESS, DEPTH, 0.01)
             self.floor.position = (0.0, 0.0, -0.005)
+            self._ruler.position, self.chute_words = (0.0, 0.0, 0.0), self._walls_words
             return
         left, right = world_width(world, leg_length)
+        self._ruler.position, self.chute_words = (left - self._ruler_x, 0.0, 0.0), world_words(world, leg_length)
         self.floor.dimensions = (right - left + 2 * WALL_THICKNESS, DEPTH, 0.01)
         self.floor.position = (0.5 * (left + right), 0.0, -0.005)
         for slab in world_slabs(world, leg_length, model_mu):
@@ -200,7 +177,10 @@ class ChuteScene:
         for wall, position in zip(self.walls, growth.wall_positions, strict=True):
             wall.dimensions = growth.wall_dimensions
             wall.position = position
-        self.scene.add_line_segments(growth.section, points=growth.segments, colors=RULER_COLOR, thickness=0.002)
+        section = self.scene.add_line_segments(growth.section, points=growth.segments, colors=RULER_COLOR,
+                                               thickness=0.002)  # fmt: skip
+        if self._ruler is None:
+            self._ruler = section  # the first section: the others hang from it
         for name, text, position in growth.labels:
             self.scene.add_label(name, text, position=position, font_screen_scale=0.7, anchor="center-left")
         self.grew(growth)

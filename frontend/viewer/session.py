@@ -62,8 +62,8 @@ class ViewerSession:
             self.gui_estop, self.gui_estop_said = self._estop_button(gui, context.robot_service)
         # target="_top": the panel embeds this view in a frame, and a plain link loaded a second
         # panel (and a second e-stop) inside it. viser renders a markdown's HTML as it is.
-        link = f'<a href="{html.escape(panel_url, quote=True)}" target="_top">← Control panel</a>'
-        gui.add_markdown(f"{link} · walls {robot.wall_distance:.2f} m apart")
+        self._link = f'<a href="{html.escape(panel_url, quote=True)}" target="_top">← Control panel</a>'
+        self.gui_header = gui.add_markdown(self._header())
         self.gui_mode = gui.add_dropdown("Mode", MODES, initial_value="simulate")
         self.modes = {
             "simulate": SimulateMode(client, self.scene, self.lock, robot, context.sessions),
@@ -90,6 +90,10 @@ class ViewerSession:
 
         button.on_click(press)
         return button, said
+
+    def _header(self) -> str:
+        """The link back to the panel and the chute the scene draws: the walls' distance, or a world's width."""
+        return f"{self._link} · {self.scene.chute_words}"
 
     @property
     def run_id(self) -> int | None:
@@ -127,6 +131,9 @@ class ViewerSession:
             if self.closed:
                 return
             self.mode.frame(dt)
+            header = self._header()
+            if header != self.gui_header.content:  # a mode drew a world, or the walls again
+                self.gui_header.content = header
             if readout_rate is not None:
                 self.mode.gui_readout.content = self.mode.readout(readout_rate)
 

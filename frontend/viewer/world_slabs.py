@@ -101,3 +101,16 @@ def world_slabs(world: World, leg_length: float, model_mu: float) -> tuple[Slab,
 def world_width(world: World, leg_length: float) -> tuple[float, float]:
     """[m] the floor's ends: the sides' ``x`` at the floor."""
     return world.left.x_at(0.0) * leg_length, world.right.x_at(0.0) * leg_length
+
+
+def world_words(world: World, leg_length: float) -> str:
+    """``world`` as the view's header says it (leg length ``leg_length`` [m]): its name and how far
+    apart its sides are [m], narrowest to widest. The gap is linear between the sides' vertices and
+    constant past them, so its extremes are at the vertices' heights."""
+    heights = np.union1d(world.left.points[:, 1], world.right.points[:, 1])
+    right = np.interp(heights, world.right.points[:, 1], world.right.points[:, 0])
+    gaps = (right - np.interp(heights, world.left.points[:, 1], world.left.points[:, 0])) * leg_length
+    narrowest, widest = f"{gaps.min():.2f}", f"{gaps.max():.2f}"
+    name = f"world {world.name!r}" if world.name else "an unnamed world"
+    apart = narrowest if narrowest == widest else f"{narrowest} m to {widest}"
+    return f"{name}, sides {apart} m apart"

@@ -3,7 +3,9 @@
 It reads the one robot through the robot service's immutable snapshots (``run_snapshot()``,
 ``tracker``, ``status()``), so everyone who chooses it sees the same robot; it never commands
 the robot. The ghost is the model's jump from each touchdown the live run detected, predicted
-with the paper's model or a calibration (:mod:`frontend.viewer.ghost_models`).
+with the paper's model or a calibration (:mod:`frontend.viewer.ghost_models`), between the
+parallel walls: a run in a stored world is drawn in that world (and the plan it follows, if any:
+:mod:`frontend.viewer.modes.live_world`), without the ghost.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import viser
 from backend.services.view import commanded
 from frontend.viewer.ghost_models import BASE, ghost_model, model_choices, realised
 from frontend.viewer.modes import Mode
+from frontend.viewer.modes.live_world import LiveWorld
 from frontend.viewer.motion import TRAIL_STRIDE, PathClip
 from frontend.viewer.scene import TOUCHDOWN_MARKERS, ChuteScene
 from frontend.viewer.simulated_climb import JumpPlan, model_jump
@@ -43,6 +46,7 @@ class LiveMode(Mode):
         self._ghosts: dict[int, JumpPlan] = {}
         self._marked = 0
         self._run = None
+        self.run_world = LiveWorld()  # the world the latest run climbs, read once per run
         self.last_error: float | None = None
         # The robot's trail is streamed (ChuteScene.live_trail) from the tracker's frames by their
         # index (PoseHistory.count), not their time: the camera's clock need not restart at a
@@ -68,6 +72,7 @@ class LiveMode(Mode):
             self._ghosts, self._marked, self.last_error = {}, 0, None  # a new run
             self._ghost_drawn = (-1, 0)
             self.scene.clear_history()
+            self.run_world = LiveWorld.of(run, self.sessions, self.scene.robot)
             # A run's trail starts at its own first frame, however late this view first sees it;
             # with no run, at the frames not drawn yet (or from now on).
             if run is not None and tracker is not None:
@@ -141,13 +146,16 @@ class LiveMode(Mode):
         service = self.robot_service
         tracker = None if service is None else service.tracker
         touchdowns = self._touchdowns(tracker)
+        run_world = self.run_world
+        run_world.draw(self.scene)  # sent once a run (again after a mode change)
         # After a mode change, only the markers the ring keeps are drawn again.
         for touchdown in touchdowns[max(self._marked, len(touchdowns) - TOUCHDOWN_MARKERS) :]:
-            self.scene.add_touchdown(touchdown.wall, touchdown.foot_height)
+            run_world.mark(self.scene, touchdown)
             previous = self._ghosts.get(touchdown.index - 1)
             if previous is not None and previous.failure is None:
                 self.last_error = touchdown.body_height - previous.next_height
         self._marked = len(touchdowns)
+        run_world.aim(self.scene, len(touchdowns), self._run is not None and self._run.active)
         if tracker is None:
             return
         self._extend_trail(tracker)
@@ -157,7 +165,9 @@ class LiveMode(Mode):
         body = PathClip.from_body([pose.time], [pose.x], [pose.y]).pose_at(pose.time)
         self.scene.show(body, None, None, follow=True)
         k = len(touchdowns) - 1
-        self._show_ghost(self._ghost(touchdowns, k) if touchdowns and self.gui_ghost.value else None, k, pose.time)
+        # The model's jump is between parallel walls: in a world it would fly through the sides.
+        ghost = bool(touchdowns) and self.gui_ghost.value and run_world.world is None
+        self._show_ghost(self._ghost(touchdowns, k) if ghost else None, k, pose.time)
 
     def readout(self, updates_per_s: float) -> str:
         service = self.robot_service
@@ -175,5 +185,6 @@ class LiveMode(Mode):
             f"**Link:** {status['state']} · **tracker:** {tracker['received']} frames, "
             f"{100 * tracker['loss']:.1f}% lost · {where}  \n"
             f"**Touchdowns this run:** {self._marked} · **model's touchdown height error (last jump):** {error}  \n"
+            f"{self.run_world.words()}"
             f"{updates_per_s:.0f} updates/s"
         )

@@ -51,3 +51,11 @@ def test_status_names_the_stored_run():
     status = RunSnapshot(run_id=3, started=10.0, jumps=4, max_seconds=60.0).to_status()
     assert (status["id"], status["stored_run_id"], status["active"], status["touchdowns"]) == (3, 3, True, 0)
     assert set(status) >= {"started", "jumps", "max_seconds", "commands", "end_reason", "disarm"}
+    assert (status["world_id"], status["plan_job_id"]) == (None, None), "parallel walls, no plan"
+
+
+def test_a_run_shows_the_world_it_climbs_and_the_plan_it_follows():
+    run = LiveRun(jumps=4, max_seconds=60.0, run_id=7, world_id=2, plan_job_id=5)
+    assert (run.snapshot.world_id, run.snapshot.plan_job_id) == (2, 5), "from its first snapshot (the live view's)"
+    run.publish()
+    assert run.snapshot.to_status()["world_id"] == 2 and run.snapshot.to_status()["plan_job_id"] == 5

@@ -81,3 +81,16 @@ def test_a_plan_run_is_refused_before_anything_moves(connected, sessions, sessio
         job = jobs.create_job(session, PlanJobCreate(kind="plan", world_id=walls.id, goal_height_m=0.5))
         connected.start_run(RobotRunCreate(plan_job_id=job.id))  # queued: not a finished plan
     assert connected.status()["state"] == "disarmed"
+
+
+def test_a_live_run_tells_the_live_view_the_world_it_climbs(connected, session):
+    """The live 3D view draws a run's world from its snapshot (frontend/viewer/modes/live_world.py)."""
+    walls = worlds.create(session, WorldCreate(name="walls", named="parallel"))
+    legs = [{"psi0_deg": 30.0, "zeta0": 0.87}, {"psi0_deg": 30.0, "zeta0": 0.9}]
+    snapshot = connected.start_run(RobotRunCreate(controls=legs, world_id=walls.id, jumps=2))
+    try:
+        assert (snapshot.world_id, snapshot.plan_job_id) == (walls.id, None)
+        assert connected.status()["run"]["world_id"] == walls.id
+    finally:
+        connected.stop_run()
+    assert not connected.run_snapshot().active and connected.run_snapshot().world_id == walls.id

@@ -18,6 +18,7 @@ from frontend.viewer.motion import PathClip
 from frontend.viewer.recordings import Recording
 from frontend.viewer.session import MODES, ViewerSession
 from sim_core import get_preset
+from sim_core.world.world import Side, World
 from tests.frontend.viewer.headless import HeadlessViewer
 from tests.frontend.viewer.view_service import wait_for
 
@@ -78,6 +79,21 @@ def test_a_stored_run_goes_on_this_browsers_timeline(session):
     session.set_mode("simulate")
     assert session.scene.robot is ROBOT, "the other modes draw the session's robot"
     assert session.run_id == 7, "the run stays on the timeline"
+
+
+def test_the_header_says_the_chute_the_scene_draws_the_walls_or_a_world(session):
+    walls = f"walls {ROBOT.wall_distance:.2f} m apart"
+    assert session.gui_header.content.endswith(f"Control panel</a> · {walls}")
+    ramp = World(Side(np.array([[-1.0, 0.0], [-2.0, 2.0]]), np.array([1.0])),
+                 Side(np.array([[1.0, 0.0], [1.0, 2.0]]), np.array([1.0])), "ramp")  # fmt: skip
+    session.replay(7, None, dataclasses.replace(replay_of(7), world=ramp, world_mu=1.0), None)
+    session.frame(0.1)
+    l0 = ROBOT.leg_length
+    assert session.gui_header.content.endswith(f" · world 'ramp', sides {2 * l0:.2f} m to {3 * l0:.2f} m apart")
+    assert "walls" not in session.gui_header.content, "no parallel walls in a world"
+    session.set_mode("simulate")
+    session.frame(0.1)
+    assert session.gui_header.content.endswith(f" · {walls}"), "the walls again"
 
 
 def test_each_frame_draws_the_mode_and_the_readout_when_asked(session):

@@ -15,6 +15,7 @@ from frontend.viewer.world_slabs import (
     SLAB_THICKNESS,
     friction_color,
     world_slabs,
+    world_words,
 )
 from sim_core import get_preset
 from sim_core.world.world import Side, World, parallel
@@ -70,9 +71,20 @@ def test_a_scene_draws_a_world_in_place_of_the_walls_once(server):
     assert len(nodes) == 6 and not any(wall.visible for wall in scene.walls)
     scene.set_world(WORLD, L0, 1.2)
     assert scene._world_nodes is nodes, "the same world again: nothing sent"
+    assert scene.chute_words == "world 'known', sides 0.20 m to 0.40 m apart", "the header's words"
+    half = 0.5 * scene.robot.wall_distance
+    assert scene._ruler.position == pytest.approx((-0.1 + half, 0.0, 0.0)), "the ruler on the left side's floor"
     scene.set_world(parallel(2.0), L0, 1.2)
     assert len(scene._world_nodes) == 4
     scene.set_world(None)
     assert scene._world_nodes == [] and all(wall.visible for wall in scene.walls)
+    assert scene.chute_words == "walls 0.54 m apart" and scene._ruler.position == pytest.approx((0.0, 0.0, 0.0))
     scene.add_touchdown(-1, 0.3, -0.25)
     assert scene.touchdown_markers.nodes[0].position == pytest.approx((-0.25, 0.0, 0.3))
+
+
+def test_a_world_is_said_by_its_name_and_how_far_apart_its_sides_are():
+    assert world_words(WORLD, L0) == "world 'known', sides 0.20 m to 0.40 m apart", "narrowest to widest"
+    assert world_words(parallel(2.0), L0) == "world 'parallel', sides 0.40 m apart"
+    unnamed = World(WORLD.left, WORLD.right)
+    assert world_words(unnamed, 0.1) == "an unnamed world, sides 0.10 m to 0.20 m apart"

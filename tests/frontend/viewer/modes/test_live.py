@@ -59,11 +59,11 @@ class Robot:
 
 
 class Live:
-    """Live mode on a viser server's scene, recorded frame by frame."""
+    """Live mode on a viser server's scene, recorded frame by frame; ``sessions``: its store (None: none)."""
 
-    def __init__(self, server: viser.ViserServer):
+    def __init__(self, server: viser.ViserServer, sessions=None):
         self.robot = Robot(PoseHistory(Calibration()))
-        self.mode = LiveMode(server, ChuteScene(server.scene, ROBOT), threading.RLock(), self.robot)
+        self.mode = LiveMode(server, ChuteScene(server.scene, ROBOT), threading.RLock(), self.robot, sessions)
         self.serializer = server.get_scene_serializer()
         self.frames = 0  # frames drawn so far
         self.ends: list[int] = []  # frames drawn by the end of each run
@@ -74,11 +74,12 @@ class Live:
         self.serializer.insert_sleep(1 / FRAME_RATE)
         self.frames += 1
 
-    def run(self, seconds: float, start_height: float) -> np.ndarray:
-        """A run of ``seconds``: its poses (n, 2) [m], fed at the tracker's rate while drawing."""
+    def run(self, seconds: float, start_height: float, **fields) -> np.ndarray:
+        """A run of ``seconds``: its poses (n, 2) [m], fed at the tracker's rate while drawing;
+        ``fields``: more of its snapshot's (``world_id``, say)."""
         first = self.robot.tracker.count()
         self.robot.run = RunSnapshot(
-            run_id=len(self.ends) + 1, started=time.time(), jumps=100, max_seconds=60.0, first_pose=first
+            run_id=len(self.ends) + 1, started=time.time(), jumps=100, max_seconds=60.0, first_pose=first, **fields
         )
         times = np.arange(0.0, seconds, 1 / TRACKER_RATE)  # the robot's clock: from 0 each run
         path = climb(times, start_height)
