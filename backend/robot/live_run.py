@@ -29,10 +29,11 @@ from backend.robot.link import LinkError, LinkState, RobotLink
 from backend.robot.live_law import LiveLaw, pitch_at
 from backend.robot.messages import Leg
 from backend.robot.run_endings import CLEAN_ENDINGS, LINK_LOST, RunEnds, end_safely, fault_names, robot_ending
-from backend.robot.run_snapshot import Record, RunSnapshot
+from backend.robot.run_snapshot import RECENT_COMMANDS, Record, RunSnapshot
 from backend.robot.touchdown import PITCH_LOOKBACK, SideAt, Touchdown, scan_touchdowns
 from backend.robot.tracker import PoseHistory, pose_arrays
 from backend.robot.tracker_watch import TRACKER_TIMEOUT_MS, TrackerWatch, frames_heard
+from experiments.manifest import json_safe
 from sim_core.model.controls import LegControl
 from sim_core.model.errors import ParameterError
 from sim_core.model.walls import wall_of
@@ -103,6 +104,7 @@ class LiveRun:
             touchdown_controls=tuple(self.touchdown_controls),
             commanded=tuple(self.commanded.items()),
             commands=len(self.commands),
+            recent_commands=tuple(json_safe(self.commands[-RECENT_COMMANDS:])),
             end_reason=self.end_reason,
             disarm=self.disarm,
             tracker_gaps=tuple(self.tracker_gaps),

@@ -10,6 +10,10 @@ from backend.robot.messages import Leg
 from backend.robot.touchdown import Touchdown
 from sim_core.model.controls import LegControl
 
+# The commands a status carries, newest last: a panel polling at 10 a second sees each of a run's
+# commands (a run's start sends two at once; a law one a touchdown) and the status stays small.
+RECENT_COMMANDS = 4
+
 
 @dataclass(frozen=True)
 class Record:
@@ -45,6 +49,7 @@ class RunSnapshot:
     robot_faults: tuple[str, ...] = ()  # the robot's faults in its last telemetry at the end
     world_id: int | None = None  # the stored world it climbs (None: the parallel walls)
     plan_job_id: int | None = None  # the plan job it follows (None: none)
+    recent_commands: tuple[dict, ...] = ()  # the newest commands sent (plain JSON), oldest first
 
     def command_for(self, leg: Leg) -> LegControl | None:
         return dict(self.commanded).get(leg)
@@ -68,4 +73,5 @@ class RunSnapshot:
             "robot_faults": list(self.robot_faults),
             "world_id": self.world_id,
             "plan_job_id": self.plan_job_id,
+            "recent_commands": list(self.recent_commands),
         }

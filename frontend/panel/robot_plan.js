@@ -3,7 +3,7 @@
 // (plan_view.js), and the run it starts is {plan_job_id, jumps, max_seconds, tracker_timeout_ms}
 // (the plan's first two legs start it; the service's placement law sends each next leg). The
 // journal: each command the run sent (its leg, why, and for a plan its target foothold), live
-// from the status's ``last_command`` and, once the run is stored, from the stored run; a stored
+// from the status's ``recent_commands`` and, once the run is stored, from the stored run; a stored
 // plan run's touchdowns are marked on the drawing where the feet met the world. Every value
 // reaches the page as text or as SVG attributes.
 import { $, call, on } from "./api.js";
@@ -15,7 +15,7 @@ import { worldById } from "./world_list.js";
 const form = () => $("#robot-run-form");
 const LEG_INPUTS = ["psiL", "zetaL", "psiR", "zetaR", "closed_loop"];
 const plans = new Map();  // plan job id -> {job, result} of the plans offered
-const journal = { key: null, rows: [], stored: null };  // the run shown: its key, commands seen, stored run id
+const journal = { key: null, rows: [], stored: null, plan: null };  // the run shown: key, commands seen, stored id, plan job
 let shown = null;  // the plan drawn: {id, job, result, drawn (world_draw's)}
 
 const fixed = (value, digits) => (typeof value === "number" && Number.isFinite(value) ? value.toFixed(digits) : "—");
@@ -27,6 +27,9 @@ export function planRunBody(values) {
     tracker_timeout_ms: values.tracker_timeout_ms };
 }
 
+// The drawing shows the plan chosen, or the plan of the run shown (started here or elsewhere).
+const showDrawing = () => { $("#robot-plan").hidden = !shown || !(following() || journal.plan === shown.id); };
+
 // Following a plan, the legs and the closed loop are the plan's: their fields are disabled.
 function followChanged() {
   const follow = following();
@@ -34,7 +37,7 @@ function followChanged() {
   if (follow) form().elements.closed_loop.checked = false;
   form().elements.closed_loop.dispatchEvent(new Event("change"));
   form().elements.plan_job_id.disabled = !follow;
-  $("#robot-plan").hidden = !follow || !shown;
+  showDrawing();
   if (follow) loadPlans().catch(() => {});
 }
 on("#follow-plan", "change", followChanged);
@@ -66,10 +69,13 @@ export async function loadPlans() {
 }
 
 // The chosen plan over its world: its targets numbered, the goal dashed (plan_view.js's marks).
-async function showChosen() {
-  const id = Number($("#plan-job").value);
+async function showChosen() { await showPlan(Number($("#plan-job").value)); }
+
+// Plan job ``id`` over its world (fetched if not offered yet: a run another panel started).
+async function showPlan(id) {
+  if (!plans.has(id) && id > 0) plans.set(id, { job: await call("GET", `/jobs/${id}`), result: (await call("GET", `/jobs/${id}/results`)).result });
   const chosen = plans.get(id);
-  if (!chosen) { shown = null; $("#robot-plan").hidden = true; return; }
+  if (!chosen || !chosen.result) { shown = null; showDrawing(); return; }
   const { job, result } = chosen;
   const world = job.spec?.world ?? (await worldById(job.world_id).catch(() => null))?.world;
   const steps = Array.isArray(result.plan) ? result.plan : [];
@@ -81,7 +87,7 @@ async function showChosen() {
   shown = { id, job, result, world, drawn };
   $("#robot-plan-about").textContent = `Job ${id}'s plan: numbered circles are each touchdown's foot target (blue: left side, ` +
     `orange: right side); dark crosses, once a run of it is stored, where that run's feet met the world.`;
-  $("#robot-plan").hidden = !following();
+  showDrawing();
 }
 
 // A command's row: when (since the run's start), the leg sent, why, and for a plan its target.
@@ -93,9 +99,11 @@ function commandCells(command, started) {
     aim, command.placed ?? "—", command.clipped ? "clipped" : "no"];
 }
 
+// A command missed (this panel saw no status while it was among the newest) is a row saying so.
 function showJournal(started) {
-  const rows = journal.rows.map((command, index) => element("tr", null, element("td", String(index + 1)),
-    ...commandCells(command, started).map((text) => element("td", String(text)))));
+  const rows = Array.from(journal.rows, (command, index) => element("tr", null, element("td", String(index + 1)),
+    ...(command ? commandCells(command, started) : ["—", "—", "—", "—", "not seen live: in the journal once stored", "—", "—", "—"])
+      .map((text) => element("td", String(text)))));
   fillTable("#robot-journal", rows, "No command sent yet.");
   $("#robot-journal").hidden = false;
 }
@@ -105,10 +113,20 @@ function showJournal(started) {
 export function followJournal(run) {
   if (!run || typeof run.started !== "number") return;
   const key = `${run.id ?? ""}@${run.started}`;
-  if (key !== journal.key) Object.assign(journal, { key, rows: [], stored: null });
-  const last = run.last_command;
-  if (last && run.commands > journal.rows.length && !journal.rows.some((row) => row.time === last.time)) {
-    journal.rows.push(last);
+  if (key !== journal.key) {
+    Object.assign(journal, { key, rows: [], stored: null, plan: run.plan_job_id ?? null });
+    $("#robot-journal-caption").textContent = `Run ${run.id ?? ""}'s journal: each command, as it is sent` +
+      `${journal.plan ? `, aimed at plan job ${journal.plan}'s footholds` : ""}.`;
+    fillTable("#robot-journal", [], "No command sent yet.");
+    $("#robot-plan-svg").querySelectorAll(".run-foot").forEach((node) => node.remove());
+    if (journal.plan && shown?.id !== journal.plan) showPlan(journal.plan).catch(() => {});
+    showDrawing();
+  }
+  // The status's newest commands are commands run.commands - recent.length + 1 ... run.commands.
+  const recent = Array.isArray(run.recent_commands) ? run.recent_commands : [];
+  const first = run.commands - recent.length;
+  if (journal.stored === null && recent.length && run.commands > journal.rows.length) {
+    recent.forEach((command, k) => { journal.rows[first + k] = command; });
     showJournal(run.started);
   }
   if (!run.active && run.stored_run_id != null && journal.stored !== run.stored_run_id) {

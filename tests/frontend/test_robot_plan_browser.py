@@ -26,6 +26,12 @@ pytestmark = [pytest.mark.slow, pytest.mark.realtime]
 
 ROBOT_STATE = "document.querySelector('#robot-state').textContent"
 PLAN_WITHIN_S = 120.0  # a hang guard for the plan job (kernels compiled in the job worker)
+# What the journal showed, each time it changed: (rows, caption).
+JOURNAL_SEEN = """window.__journal = [];
+new MutationObserver(() => window.__journal.push([
+  document.querySelectorAll('#robot-journal tbody td:nth-child(2)').length,
+  document.querySelector('#robot-journal-caption').textContent]))
+  .observe(document.querySelector('#robot-journal'), {subtree: true, childList: true, characterData: true});"""
 RUN_WITHIN_MS = 60_000  # a hang guard for a short climb in real time, not a timing assertion
 
 
@@ -85,6 +91,7 @@ def test_a_live_run_follows_a_chosen_plan_and_shows_its_journal(service):
             page.once("dialog", lambda dialog: dialog.accept())  # the robot is disarmed: starting arms it
             page.fill("#robot-run-form [name=jumps]", "40")
             page.fill("#robot-run-form [name=max_seconds]", "30")
+            page.evaluate(JOURNAL_SEEN)
             page.click("#live-run")
             said(page, f"following plan job {job}")
             until(page, "(document.querySelector('#robot-journal-caption').textContent || '').includes('as stored')",
@@ -96,6 +103,9 @@ def test_a_live_run_follows_a_chosen_plan_and_shows_its_journal(service):
             assert stored["world_id"] == world_id and results["plan_job_id"] == job
             assert results["end_reason"].startswith("goal reached"), results["end_reason"]
 
+            seen = page.evaluate("window.__journal")
+            live = [count for count, caption in seen if "as stored" not in caption]
+            assert live and max(live) >= 3, f"commands shown as they are sent, before the run is stored: {seen}"
             rows = page.eval_on_selector_all("#robot-journal tbody tr", "(rows) => rows.map((r) => r.innerText)")
             assert len(rows) == len(results["commands"]) >= 3, rows
             for row, command in zip(rows, results["commands"], strict=True):

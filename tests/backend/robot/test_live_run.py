@@ -59,3 +59,30 @@ def test_a_run_shows_the_world_it_climbs_and_the_plan_it_follows():
     assert (run.snapshot.world_id, run.snapshot.plan_job_id) == (2, 5), "from its first snapshot (the live view's)"
     run.publish()
     assert run.snapshot.to_status()["world_id"] == 2 and run.snapshot.to_status()["plan_job_id"] == 5
+
+
+def test_the_status_carries_the_newest_commands_as_plain_json():
+    import json
+
+    import numpy as np
+
+    from backend.robot.run_snapshot import RECENT_COMMANDS
+
+    run = LiveRun(jumps=4, max_seconds=60.0, run_id=7)
+    assert run.snapshot.to_status()["recent_commands"] == [], "nothing sent yet"
+    target = {"touchdown": np.int64(2), "side": "left", "segment": np.int64(6), "x_m": np.float64(-0.27), "y_m": 0.44}
+    command = {"time": 1.0, "leg": "left", "psi0_deg": 32.5, "zeta0": 0.8, "why": "plan after touchdown 0",
+               "target": target, "placed": "placed", "clipped": False}  # fmt: skip
+    run.record("command", command, run.commands)
+    run.publish()
+    status = run.snapshot.to_status()
+    assert status["commands"] == 1 and json.loads(json.dumps(status["recent_commands"])) == [
+        {**command, "target": {**target, "touchdown": 2, "segment": 6, "x_m": -0.27}}
+    ], "the panel's journal row, as the stored journal will have it"
+    for k in range(2, 8):
+        run.record("command", {**command, "time": float(k)}, run.commands)
+    run.publish()
+    status = run.snapshot.to_status()
+    assert status["commands"] == 7 and [sent["time"] for sent in status["recent_commands"]] == [
+        float(k) for k in range(8 - RECENT_COMMANDS, 8)
+    ], "the newest, oldest first: the panel numbers them from the count"
