@@ -1,7 +1,7 @@
 """Worlds through the client: store one (the §8 JSON, a named world, or random footholds from a
 seed), list, read back as posted, rename, delete; and the jobs that work in worlds (a foothold
-study, a plan, Mean Jumps To Failure in a world), followed as any job (:mod:`parkourlab.jobs`).
-The part of :class:`parkourlab.Client` that deals with ``/api/v1/worlds`` (docs/worlds.md,
+study, a plan, Mean Jumps To Failure in a world, the reach of a grid of schedules), followed as any
+job (:mod:`parkourlab.jobs`). The part of :class:`parkourlab.Client` that deals with ``/api/v1/worlds`` (docs/worlds.md,
 "Worlds in the service")."""
 
 from __future__ import annotations
@@ -129,6 +129,34 @@ class WorldCalls:
         spec |= {"cap": cap, "seed": seed, "noise": mapping(noise), "state": body_state(state)}
         return self._job("world-mjtf", spec, model, experiment_id)
 
+    def submit_reach(
+        self,
+        world_id: int,
+        *,
+        psi0_range: Sequence[float] | None = None,
+        psi0_steps: int | None = None,
+        zeta0_range: Sequence[float] | None = None,
+        zeta0_steps: int | None = None,
+        jumps: int | None = None,
+        foot_y: float | None = None,
+        state: State | None = None,
+        model: Mapping[str, Any] | None = None,
+        experiment_id: int | None = None,
+    ) -> Job:
+        """The reach of a grid of symmetric schedules in the stored world ``world_id`` (``parkour
+        reach``): ``psi0_steps`` leg angles over ``psi0_range`` ``(low, high)`` [deg] by
+        ``zeta0_steps`` leg lengths over ``zeta0_range`` [l0], each climbing up to ``jumps`` jumps
+        from touchdown 0 (the foot on the left side at ``foot_y`` [l0]). Its result is the
+        command's ``--json``: each cell's highest foot [l0] and how it ended."""
+        spec = {"world_id": world_id, "psi0_range": _pair(psi0_range), "psi0_steps": psi0_steps}
+        spec |= {"zeta0_range": _pair(zeta0_range), "zeta0_steps": zeta0_steps, "jumps": jumps, "foot_y": foot_y}
+        return self._job("reach", spec | {"state": body_state(state)}, model, experiment_id)
+
     def _job(self, kind: str, spec: dict, model: Mapping[str, Any] | None, experiment_id: int | None) -> Job:
         body = {"kind": kind} | present(spec | {"model": mapping(model), "experiment_id": experiment_id})
         return self._http.call("POST", "/api/v1/jobs", body=body)
+
+
+def _pair(values: Sequence[float] | None) -> list[float] | None:
+    """A ``(low, high)`` range as the API takes it: a list (None stays None)."""
+    return None if values is None else list(values)

@@ -29,6 +29,7 @@ from backend.jobs import (
     mfpt,
     mjtf,
     plan,
+    reach,
     sweep,
     viability,
     world_mjtf,
@@ -38,7 +39,7 @@ from backend.jobs.specs import UnreadableSpec, encode, read_fields
 
 KINDS: tuple[JobKind, ...] = (mjtf.KIND, sweep.KIND, basin.KIND, gaits.KIND, control_study.KIND, mfpt.KIND,
                               loop_mfpt.KIND, viability.KIND, atlas.KIND, foothold_study.KIND,
-                              plan.KIND, world_mjtf.KIND)  # fmt: skip
+                              plan.KIND, world_mjtf.KIND, reach.KIND)  # fmt: skip
 BY_NAME: dict[str, JobKind] = {kind.name: kind for kind in KINDS}
 JOB_KINDS: dict[str, type] = {kind.name: kind.request for kind in KINDS}  # the request body of each
 DEFAULT_KIND = "mjtf"  # a request without a kind (the first kind, which clients may leave out)

@@ -77,7 +77,7 @@ class NoiseSpec:
         return NoiseModel(**asdict(self))
 
 
-_TUPLES = ("zeta0s", "controllers")  # lists stored, tuples in the frozen spec
+_TUPLES = ("zeta0s", "controllers", "psi0_range", "zeta0_range")  # lists stored, tuples in the frozen spec
 
 
 def encode(spec) -> dict:

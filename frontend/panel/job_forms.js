@@ -3,10 +3,11 @@
 //
 // Forms made from the API: a job kind the page has no form for gets one built from its
 // request body's schema in the OpenAPI document (the catalog names it): a number field per
-// property that takes a plain number, its default filled in, its description as its title, its
-// range checked as every form's is (fields.js). A kind whose body needs more than numbers (legs,
-// a list) is left to its own fieldset in index.html, or to the API — save a stored world (a
-// chooser of worlds by name, a foothold study's random worlds, a world-mjtf job's legs:
+// property that takes a plain number — or a list of them, comma-separated (a reach job's range:
+// low, high) — its default filled in, its description as its title, its range checked as every
+// form's is (fields.js; a list's count and order are the API's to say). A kind whose body needs
+// more (legs, a list of names) is left to its own fieldset in index.html, or to the API — save a
+// stored world (a chooser of worlds by name, a foothold study's random worlds, a world-mjtf job's legs:
 // job_world.js). So a job kind added to the service's registry can be scheduled from the panel
 // with no change here.
 import { $, say, on } from "./api.js";
@@ -32,11 +33,12 @@ async function numberFields(request) {
       continue;
     }
     const plain = Fields.plain(property);
-    if (!plain || !["number", "integer"].includes(plain.type)) {
+    const items = plain?.type === "array" ? Fields.plain(plain.items) : null;  // a list of numbers, or not
+    if (!["number", "integer"].includes((items ?? plain)?.type)) {
       if (required.has(name)) return null;
       continue;
     }
-    fields.push({ name, plain, required: required.has(name), title: property.description ?? plain.description ?? "" });
+    fields.push({ name, plain, list: items !== null, required: required.has(name), title: property.description ?? plain.description ?? "" });
   }
   return { fields, world };
 }
@@ -51,16 +53,18 @@ async function generatedFieldset(kind) {
   const fieldset = attributes(element("fieldset", null, element("legend", kind.title), ...(part?.nodes ?? [])),
     { "data-kind": kind.name, "data-generated": "" });
   for (const field of fields) {
-    const input = attributes(element("input", null), { name: `${kind.name}__${field.name}`, type: "number",
-      step: field.plain.type === "integer" ? "1" : "any" });
-    if (field.plain.default !== undefined && field.plain.default !== null) input.value = String(field.plain.default);
+    const input = attributes(element("input", null), field.list ? { name: `${kind.name}__${field.name}`, size: 12 }
+      : { name: `${kind.name}__${field.name}`, type: "number", step: field.plain.type === "integer" ? "1" : "any" });
+    const initial = field.plain.default;
+    if (initial !== undefined && initial !== null) input.value = Array.isArray(initial) ? initial.join(", ") : String(initial);
     const label = element("label", `${field.name.replace(/_(m|deg|s)$/, " [$1]").replaceAll("_", " ")} `, input);  // goal_height_m: "goal height [m]"
     if (field.title) label.title = field.title;
     fieldset.append(label);
   }
   fieldset.hidden = true;
   fieldset.disabled = true;
-  const numbers = fields.map((field) => ({ name: `${kind.name}__${field.name}`, rule: `${kind.request}.${field.name}`, optional: !field.required }));
+  const numbers = fields.map((field) => ({ name: `${kind.name}__${field.name}`, rule: `${kind.request}.${field.name}`, optional: !field.required,
+    list: field.list }));
   return { fieldset, fields: numbers, part };
 }
 

@@ -10,6 +10,7 @@ import { hideLoopMfpt, showLoopMfpt } from "./loop_mfpt.js";
 import { jobSpec } from "./job_forms.js";
 import { hidePlan, showPlan } from "./plan_view.js";
 import { hideWorldResults, showFootholdStudy, worldJobWords, worldMjtfWords } from "./world_results.js";
+import { showReach } from "./reach_view.js";
 
 const streams = new Map();
 const FINAL = ["done", "cancelled", "failed"];
@@ -246,6 +247,8 @@ export async function showJob(id) {
     showFootholdStudy(id, job, results.result);
   } else if (job.kind === "world-mjtf") {
     showWorldMjtf(id, results.result);
+  } else if (job.kind === "reach") {
+    showReach(id, results.result);
   } else if (job.kind !== "gaits") {
     // A kind the panel draws no plot for: its figures are in its results (GET /api/v1/jobs/{id}/results).
     say(`Job ${id} (${job.kind}) is done: its result is at ${API}/jobs/${id}/results.`);

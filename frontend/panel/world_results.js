@@ -1,7 +1,8 @@
 // The results of the other jobs in worlds, in the Jobs tab: a foothold study (backend/jobs/
 // foothold_study.py, ``parkour foothold-study --json``) as a row per method — reached of trials,
 // failures by code, mean jumps, the planning's time — and a row per world; a world-mjtf job's
-// climbs in words. Every value reaches the page as text.
+// climbs in words; a reach job in the jobs table's words (its result: reach_view.js). Every value
+// reaches the page as text.
 import { $ } from "./api.js";
 import { element, fillTable } from "./dom.js";
 
@@ -49,6 +50,11 @@ export function worldJobWords(job) {
   const goal = typeof spec.goal_height_m === "number" ? ` to ${spec.goal_height_m} m` : "";
   if (job.kind === "plan") return `plan up ${world}${goal}${spec.attempts ? `, ${spec.attempts} noisy climbs` : ""}`;
   if (job.kind === "foothold-study") return `${world}${goal}, ${spec.trials} trials a world and method`;
+  if (job.kind === "reach") {
+    const range = (pair, unit) => (Array.isArray(pair) ? `${pair.join("–")}${unit}` : "");
+    return `reach of ${spec.psi0_steps} psi0 (${range(spec.psi0_range, "°")}) × ${spec.zeta0_steps} zeta0 (${range(spec.zeta0_range, "")}) ` +
+      `in ${world}, up to ${spec.jumps} jumps`;
+  }
   if (job.kind === "world-mjtf") {
     const legs = (spec.controls || []).map((leg) => `${leg.psi0_deg}°/${leg.zeta0}`).join(", ");
     return `${legs} in ${world}${goal}, ${spec.trials} trials`;

@@ -146,6 +146,13 @@ def reach_map(
     progress: Progress | None = None,
 ) -> ReachMap:
     """The reach of every symmetric schedule of the grid ``psi0_deg`` x ``zeta0s`` in ``world``."""
+    arguments = reach_chunks(model, world, psi0_deg, zeta0s, state, jumps, foot_y, chunk_rows)
+    return reach_of(world, state, foot_y, jumps, psi0_deg, zeta0s, chunk_map(reach_rows, arguments, progress))
+
+
+def _checked(psi0_deg, zeta0s, state, jumps, foot_y) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, float]:
+    """The grid's inputs checked (a ParameterError naming the first wrong one): ``(psi0_deg, zeta0s,
+    velocity, jumps, foot_y)`` as the map holds them."""
     velocity = check_section_state(state)
     jumps = check_jumps(jumps)
     foot_y = check_range("foot_y", foot_y)
@@ -158,11 +165,46 @@ def reach_map(
         raise ParameterError(
             "jumps", f"cells x jumps must be at most {MAX_CELL_JUMPS:,}, got {cells:,} x {jumps:,}: ask for fewer"
         )
+    return psi0_deg, zeta0s, velocity, jumps, foot_y
+
+
+def reach_chunks(
+    model: ModelParams,
+    world: World,
+    psi0_deg: Sequence[float],
+    zeta0s: Sequence[float],
+    state,
+    jumps: int,
+    foot_y: float = 0.0,
+    chunk_rows: int = DEFAULT_CHUNK_ROWS,
+) -> list[tuple]:
+    """The grid's chunks, checked: :func:`reach_rows`'s arguments for each block of ``chunk_rows``
+    rows of ``zeta0s``, in order (a job runs them one by one: ``backend/jobs/reach.py``)."""
+    psi0_deg, zeta0s, velocity, jumps, foot_y = _checked(psi0_deg, zeta0s, state, jumps, foot_y)
     psi0s = np.radians(psi0_deg)
-    rows = chunk_slices(zeta0s.size, chunk_rows)
-    arguments = [(model, world, psi0s, zeta0s[part], tuple(velocity), jumps, foot_y) for part in rows]
-    results = chunk_map(reach_rows, arguments, progress)
-    highest, last, completed, status, topped = (np.concatenate([result[k] for result in results]) for k in range(5))
+    return [(model, world, psi0s, zeta0s[part], tuple(velocity), jumps, foot_y)
+            for part in chunk_slices(zeta0s.size, chunk_rows)]  # fmt: skip
+
+
+def reach_of(
+    world: World,
+    state,
+    foot_y: float,
+    jumps: int,
+    psi0_deg: Sequence[float],
+    zeta0s: Sequence[float],
+    rows: Sequence[Sequence[np.ndarray]],
+) -> ReachMap:
+    """The map of the grid from its chunks' :func:`reach_rows` results (``rows``, in the order of
+    :func:`reach_chunks`; arrays, or the same as nested lists)."""
+    psi0_deg, zeta0s, velocity, jumps, foot_y = _checked(psi0_deg, zeta0s, state, jumps, foot_y)
+    types = (float, float, np.int64, np.int64, bool)
+    highest, last, completed, status, topped = (
+        np.concatenate([np.asarray(result[k], dtype=kind).reshape(-1, psi0_deg.size) for result in rows])
+        for k, kind in enumerate(types)
+    )
+    if highest.shape != (zeta0s.size, psi0_deg.size):
+        raise ValueError(f"the chunks hold {highest.shape[0]} rows of zeta0, the grid has {zeta0s.size}")
     return ReachMap(world.name or "unnamed", (float(velocity[0]), float(velocity[1])), foot_y, jumps, world.top,
                     psi0_deg, zeta0s, highest, last, completed, status, topped)  # fmt: skip
 

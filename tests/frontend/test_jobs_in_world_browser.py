@@ -1,8 +1,9 @@
 """Jobs in a stored world from the Jobs tab (issue 43), in headless Chromium against the real
 service: a plan scheduled in a world chosen by name and drawn over that world (a numbered target
 per touchdown, the steps' table as the API's result says), a foothold study on a chosen world or
-on random ones, a world-mjtf job with its legs, a goal above the world refused at its field, and a
-world's 422 said once in the banner (its location not repeated).
+on random ones, a world-mjtf job with its legs, a reach job drawn as a heatmap of its highest feet, a
+goal above the world refused at its field, and a world's 422 said once in the banner (its location
+not repeated).
 
 Set PARKOUR_SCREENSHOTS=1 to refresh docs/screenshots/plan_over_world.png and jobs_in_world.png.
 """
@@ -19,6 +20,7 @@ NEWEST = "document.querySelector('#job-table tbody tr:first-child {cell}')?.text
 BANNER = "document.querySelector('#messages .message')?.textContent ?? ''"
 CELLS = "[...document.querySelectorAll('{} tbody tr')].map((row) => [...row.cells].map((cell) => cell.textContent))"
 TARGETS = "[...document.querySelectorAll('#job-plan-svg g.plan-target')]"
+ENDING_WORDS = "async (codes) => codes.map((await import('/panel/reach_view.js')).endingWords)"
 BAD_WORLD = (
     '{"units": "l0", "left": {"points": [[-1, 0], [-1, -5]], "mu": [null]}, '
     '"right": {"points": [[1, 0], [1, 9]], "mu": [null]}}'
@@ -191,6 +193,37 @@ def test_a_foothold_study_on_random_worlds_and_a_world_mjtf_with_legs(page, serv
     assert [(leg["psi0_deg"], leg["zeta0"]) for leg in spec["controls"]] == [(30, 0.9), (28, 0.88)]
     page.click(f"#job-{job} button.show")
     until(page, "document.querySelector('#job-summary').textContent.includes('climb(s) in \"stairs\"')")
+
+
+def test_a_reach_job_on_a_chosen_world_is_drawn_as_a_heatmap_of_its_highest_feet(page, service, stairs):
+    _choose_kind(page, "reach")
+    _choose_world(page, "reach", stairs)
+    assert page.input_value("input[name=reach__psi0_range]") == "20, 40", "the request's default range"
+    page.fill("input[name=reach__psi0_range]", "35, 25")  # each in range, reversed: the API's 422, at its field
+    for name, value in {"psi0_steps": "3", "zeta0_steps": "2", "jumps": "10"}.items():
+        page.fill(f"input[name=reach__{name}]", value)
+    page.click("#submit-job")
+    until(page, "document.querySelector('input[name=reach__psi0_range]').getAttribute('aria-invalid') === 'true'")
+    assert "low below high" in page.inner_text("#reach__psi0_range-error")
+    page.fill("input[name=reach__psi0_range]", "25, 35")
+    job = _schedule_and_wait(page, service, "reach")
+    spec = _api(service, "GET", f"/jobs/{job}")["spec"]
+    assert (spec["world_id"], spec["psi0_range"], spec["psi0_steps"], spec["jumps"]) == (stairs["id"], [25, 35], 3, 10)
+    result = _api(service, "GET", f"/jobs/{job}/results")["result"]
+    page.click(f"#job-{job} button.show")
+    until(page, "document.getElementById('job-plot').data?.[0]?.type === 'heatmap'")
+    drawn = page.evaluate("(({x, y, z, text}) => ({x, y, z, text}))(document.getElementById('job-plot').data[0])")
+    assert drawn["x"] == result["psi0_deg"] == [25, 30, 35] and drawn["y"] == result["zeta0"]
+    assert drawn["z"] == [[h * result["l0_m"] for h in row] for row in result["highest"]], "in metres"
+    codes = sorted({code for row in result["ending"] for code in row} | set(result["outcomes"]))
+    said_as = dict(zip(codes, page.evaluate(ENDING_WORDS, codes), strict=True))
+    assert said_as["top"] == "reached the top" and said_as["floor"] == "fell to the floor"
+    hover = [[f"{said_as[code]} after {jumps} jump(s)" for code, jumps in zip(endings, done, strict=True)]
+             for endings, done in zip(result["ending"], result["completed"], strict=True)]  # fmt: skip
+    assert drawn["text"] == hover, "each cell's ending"
+    summary = page.inner_text("#job-summary")
+    assert f'6 schedule(s) (3 psi0 × 2 zeta0) in "{stairs["name"]}", up to 10 jumps each' in summary
+    assert all(f"{count} {said_as[code]}" in summary for code, count in result["outcomes"].items() if count)
 
 
 def test_a_worlds_refusal_names_its_location_once(page):

@@ -130,6 +130,10 @@ EVERY_FIELD = {
         3, [(30, 0.9)], goal_height_m=0.5, trials=5, cap=50, seed=2, noise={"velocity": 0.01}, state=(-0.9, 0.1),
         model={"preset": "paper"}, experiment_id=2,
     ),
+    "reach": lambda c: c.submit_reach(
+        3, psi0_range=(25.0, 35.0), psi0_steps=3, zeta0_range=(0.86, 0.92), zeta0_steps=2, jumps=30, foot_y=0.1,
+        state=(-1.0, 0.5), model={"preset": "paper"}, experiment_id=2,
+    ),
 }  # fmt: skip
 
 

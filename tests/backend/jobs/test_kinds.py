@@ -33,7 +33,8 @@ BODIES = {"mjtf": MJTF, "sweep": SWEEP, "basin": BASIN, "gaits": GAITS, "control
           "loop-mfpt": {"kind": "loop-mfpt"}, "viability": VIABILITY, "atlas": {"kind": "atlas"},
           "foothold-study": {"kind": "foothold-study", "random_worlds": {"count": 1}, "goal_height_m": 0.5},
           "plan": {"kind": "plan", "world_id": 1, "goal_height_m": 0.5},
-          "world-mjtf": {"kind": "world-mjtf", "world_id": 1, "controls": [LEG]}}  # fmt: skip
+          "world-mjtf": {"kind": "world-mjtf", "world_id": 1, "controls": [LEG]},
+          "reach": {"kind": "reach", "world_id": 1}}  # fmt: skip
 
 
 @pytest.mark.parametrize("kind", JOB_KINDS)
@@ -44,8 +45,8 @@ def test_a_job_is_read_as_the_kind_it_names(kind):
 
 def test_a_job_without_a_kind_is_mjtf_and_an_unknown_kind_is_refused():
     assert type(accepted(JobCreate, MJTF)) is MJTFJobCreate
-    assert refused(JobCreate, {"kind": "reach"}) == [()]
-    assert "'mjtf', 'sweep', 'basin', 'gaits'" in refusal_messages(JobCreate, {"kind": "reach"})
+    assert refused(JobCreate, {"kind": "no-such-kind"}) == [()]
+    assert "'mjtf', 'sweep', 'basin', 'gaits'" in refusal_messages(JobCreate, {"kind": "no-such-kind"})
 
 
 def test_errors_name_the_kind_then_the_field():

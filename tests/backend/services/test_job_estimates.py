@@ -65,7 +65,7 @@ def test_the_median_of_the_newest_holds_against_one_odd_job(session):
 def test_a_new_done_job_is_learned_at_once_and_unreadable_specs_are_skipped():
     started, finished = T0, T0 + datetime.timedelta(seconds=2.0)
     paces = learned_paces([("mjtf", {"version": 9, "kind": "mjtf"}, started, finished),
-                           ("reach", {"kind": "reach"}, started, finished)])  # fmt: skip
+                           ("no-such-kind", {"kind": "no-such-kind"}, started, finished)])  # fmt: skip
     assert dict(paces.by_kind) == {}
 
 

@@ -110,7 +110,7 @@ def test_sweep_basin_and_gait_search_jobs(client, auth):
     [
         ({"kind": "sweep", "zeta0_low": 0.95, "zeta0_high": 0.9}, "sweep"),
         ({"kind": "basin", "controls": [{"psi0_deg": 30, "zeta0": 0.9}], "grid": 10**6}, "grid"),
-        ({"kind": "reach"}, "kind"),
+        ({"kind": "no-such-kind"}, "kind"),
     ],
 )
 def test_bad_study_specs_are_a_422(client, auth, spec, field):
@@ -314,3 +314,23 @@ def test_bad_controller_mfpts_are_a_422_naming_the_field_never_a_500(client, aut
     errors = response.json()["detail"]
     assert any(field in map(str, error["loc"]) and says in error["msg"] for error in errors), errors
     assert client.get("/api/v1/jobs").json()["items"] == []
+
+
+def test_a_job_in_a_world_not_stored_is_a_404_and_a_reversed_range_a_422_naming_it(client, auth):
+    """The reach job (backend/jobs/reach.py) as the API takes it: its world looked up when accepted."""
+    missing = client.post("/api/v1/jobs", json={"kind": "reach", "world_id": 999}, headers=auth)
+    assert missing.status_code == 404 and "world" in missing.text, missing.text
+    world = client.post("/api/v1/worlds", json={"name": "stairs", "named": "staircase"}, headers=auth).json()
+    reversed_range = {"kind": "reach", "world_id": world["id"], "psi0_range": [40, 20]}
+    refused = client.post("/api/v1/jobs", json=reversed_range, headers=auth)
+    assert refused.status_code == 422, refused.text
+    (error,) = refused.json()["detail"]
+    assert error["loc"][-1] == "psi0_range" and "low below high, got [40, 20]" in error["msg"]
+    assert client.get("/api/v1/jobs").json()["items"] == [], "nothing stored, nothing queued"
+    small = {"kind": "reach", "world_id": world["id"], "psi0_steps": 2, "zeta0_steps": 2, "jumps": 5}
+    job = client.post("/api/v1/jobs", json=small, headers=auth)
+    assert job.status_code == 202 and job.json()["world_id"] == world["id"], job.text
+    done = _wait(client, job.json()["id"])
+    assert done["state"] == "done" and done["completed"] == done["total"] == 1
+    result = client.get(f"/api/v1/jobs/{done['id']}/results").json()["result"]
+    assert result["world"] == "stairs" and len(result["highest"]) == 2 and sum(result["outcomes"].values()) == 4
