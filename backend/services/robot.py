@@ -15,6 +15,7 @@ import asyncio
 import concurrent.futures
 import threading
 import time
+from functools import partial
 from pathlib import Path
 
 from backend.robot.latch import EstopLatch
@@ -22,6 +23,7 @@ from backend.robot.limits import ServoLimits
 from backend.robot.link import LinkError, LinkState, RobotLink
 from backend.robot.live_law import LiveLaw, live_law_for
 from backend.robot.live_run import LiveRun, RunSnapshot, execute, telemetry_dict
+from backend.robot.still_heap import on_a_still_heap
 from backend.robot.supervisor import LinkSupervisor
 from backend.schemas import RobotConnect, RobotRunCreate
 from backend.services.presets import resolve_model
@@ -254,8 +256,8 @@ class RobotService:
                           world_id=where.world_id, plan_job_id=body.plan_job_id)  # fmt: skip
             journal = JournalWriter(self.sessions, run, tracker, link, self.robot).start()
             self._run = run
-        threading.Thread(target=execute, args=(run, link, tracker, self.robot, legs, controller, journal.finish,
-                                               where.side_at), name="robot-live-run", daemon=True).start()  # fmt: skip
+        loop = partial(execute, run, link, tracker, self.robot, legs, controller, journal.finish, where.side_at)
+        threading.Thread(target=on_a_still_heap, args=(loop,), name="robot-live-run", daemon=True).start()
         return run.snapshot
 
     def wait_run(self, timeout: float) -> RunSnapshot | None:
