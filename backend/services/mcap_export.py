@@ -8,7 +8,8 @@ The run's own channels, protobuf messages of package ``parkourlab`` (topics, fie
 - ``/commands``, ``/telemetry``, ``/robot/link``: what the PC sent, what the robot reported, the
   link's state changes;
 - ``/model/prediction``: the model's prediction of each touchdown from the first (none with fewer
-  than two touchdowns).
+  than two touchdowns): the Poincaré map's, or in a stored world the model's climb there
+  (:mod:`backend.services.run_prediction`; the metadata's ``prediction_model`` says which).
 
 Beside them, the same poses and numbers in the formats Foxglove and Rerun draw as they open the
 file (:mod:`backend.services.mcap_visuals`): the body as Foxglove's ``PoseInFrame``,
@@ -226,6 +227,17 @@ def _metadata(run: Run, source: Run) -> dict[str, str]:
         "end_reason": results.get("end_reason"),
         "disarm": results.get("disarm"),
         "tracker": results.get("tracker"),
+        "prediction_model": _prediction_model(run.results.get("prediction")),
         "time_convention": TIME_CONVENTION,
     }
     return {name: value if isinstance(value, str) else json.dumps(json_safe(value)) for name, value in values.items()}
+
+
+def _prediction_model(prediction: dict | None) -> str | None:
+    """Which model made the run's prediction, for people (None: it has none)."""
+    if prediction is None:
+        return None
+    world = prediction.get("world")  # absent: parallel walls (backend.services.run_prediction)
+    if world is None:
+        return "the Poincaré map between parallel walls"
+    return f"the model's climb in world {world['id']} ({world['name']})"

@@ -50,7 +50,8 @@ MESSAGES: dict[str, tuple[str, ...]] = {
     "Telemetry": ("time: double", "tracker_time: double?", "seq: uint32", "state: string", "psi_servo_deg: double[]",
                   "zeta_servo: double[]", "battery_mv: uint32", "faults: uint32"),
     # The model's prediction of touchdown index (0: the measured start), the Poincaré map iterated with
-    # the measured controls, beside what was measured; rises [l0] absent for touchdown 0.
+    # the measured controls (in a stored world, the model's climb there: metadata prediction_model),
+    # beside what was measured; rises [l0] absent for touchdown 0.
     "Prediction": ("index: uint32", "state: double[]", "measured_state: double[]", "rise: double?",
                    "measured_rise: double?"),
     # A change of the robot link's state.

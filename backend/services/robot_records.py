@@ -24,17 +24,19 @@ from backend.errors import Conflict, NotFound
 from backend.repositories import experiments as stored_experiments
 from backend.repositories import robot_runs
 from backend.repositories import runs as stored_runs
+from backend.repositories import worlds as stored_worlds
 from backend.robot.run_endings import robot_ending_record
 from backend.robot.touchdown import Touchdown, detect_touchdowns, height_gains
 from backend.schemas import RunDetail
 from backend.services.provenance import current_code_version
 from backend.services.robot_plans import world_sides
+from backend.services.run_prediction import run_prediction
 from backend.services.runs import run_detail
-from backend.store.models import Run
+from backend.store.models import Run, World
 from backend.store.run_record import RunRecord
 from backend.store.trajectory_blob import pack_trajectory, unpack_trajectory
 from experiments.manifest import json_safe
-from sim_core.model.controls import ControlSchedule, LegControl
+from sim_core.model.controls import LegControl
 from sim_core.model.presets import get_preset
 
 FRAME_COLUMNS = ("time", "x", "y", "pitch")
@@ -104,7 +106,7 @@ def fold_journal(
         transitions.extend(data["transitions"])
         gaps.extend(data.get("tracker_gaps", []))  # entries written before gaps were recorded have none
         tracker = data["tracker"] or tracker
-    analysis = touchdown_results(touchdowns, controls, robot)
+    analysis = touchdown_results(touchdowns, controls, robot, _world_of(session, run.world_id))
     run.status = status
     if entries:
         run.duration_s = max(run.duration_s, _seconds_between(run.created_at, entries[-1].written_at))
@@ -156,21 +158,19 @@ def touchdown_columns(touchdowns: list[Touchdown], analysis: dict) -> dict:
     }
 
 
-def touchdown_results(touchdowns: list[Touchdown], controls: list[LegControl], robot) -> dict:
+def touchdown_results(
+    touchdowns: list[Touchdown], controls: list[LegControl], robot, world: World | None = None
+) -> dict:
     """What a robot or replay run stores about its touchdowns: each touchdown, its section state,
-    the height gains, and the model's prediction from the first touchdown with the same controls."""
-    from sim_core.model.poincare import iterate_map
-
+    the height gains, and the model's prediction from the first touchdown with the same controls
+    in the chute the run climbed (``world``, its stored world; None: parallel walls;
+    :mod:`backend.services.run_prediction`)."""
     gains = height_gains(touchdowns, robot) if len(touchdowns) > 1 else np.empty(0)
-    prediction = None
-    if len(touchdowns) > 1:
-        schedule = ControlSchedule.of(*controls[: len(touchdowns)])
-        prediction = iterate_map(robot.to_model(), schedule, touchdowns[0].state, len(touchdowns) - 1).to_dict()
     return {
         "touchdowns": [td.to_dict() for td in touchdowns],
         "states": [list(td.state) for td in touchdowns],
         "rises": gains.tolist(),
-        "prediction": prediction,
+        "prediction": run_prediction(touchdowns, controls, robot, world),
     }
 
 
@@ -191,7 +191,8 @@ def replay_run(session, run_id: int, robot=None, *, person: str | None = None) -
     side_at = None if source.world_id is None else world_sides(session, source.world_id, robot)  # its world's
     touchdowns = detect_touchdowns(frames["time"], frames["x"], frames["y"], robot, leg_for, frames.get("pitch"),
                                    side_at=side_at)  # fmt: skip
-    analysis = touchdown_results(touchdowns, [leg_for(k) for k in range(len(touchdowns))], robot)
+    controls = [leg_for(k) for k in range(len(touchdowns))]
+    analysis = touchdown_results(touchdowns, controls, robot, _world_of(session, source.world_id))
     record = RunRecord(
         kind="replay",
         status="done",
@@ -206,7 +207,7 @@ def replay_run(session, run_id: int, robot=None, *, person: str | None = None) -
                 "source_run_id": run_id,
                 "closed_loop": source.results.get("closed_loop"),  # driven as the run it replays
                 **analysis,
-                "touchdown_controls": [[leg_for(k).psi0_deg, leg_for(k).zeta0] for k in range(len(touchdowns))],
+                "touchdown_controls": [[leg.psi0_deg, leg.zeta0] for leg in controls],
             }
         ),
         tags=(*source.tags, "replay"),
@@ -232,6 +233,11 @@ def recorded_leg_for(source: Run) -> Callable[[int], LegControl]:
         return recorded[k] if k < len(recorded) else alternating[(k + 1) % 2]
 
     return leg_for
+
+
+def _world_of(session, world_id: int | None) -> World | None:
+    """The stored world a run climbed (None: parallel walls); one a run uses is never deleted."""
+    return None if world_id is None else stored_worlds.get(session, world_id)
 
 
 def _seconds_between(start: datetime.datetime, end: datetime.datetime) -> float:

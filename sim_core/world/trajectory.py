@@ -26,7 +26,7 @@ from sim_core.model.trajectory import (
     stance_piece,
 )
 from sim_core.model.validation import check_range
-from sim_core.world.climb import WorldClimb, first_touchdown
+from sim_core.world.climb import WorldClimb, first_touchdown, section_orbit
 from sim_core.world.geometry import LEFT, pack
 from sim_core.world.stride import world_jump
 from sim_core.world.world import World
@@ -69,15 +69,13 @@ def simulate_world_trajectory(
     touchdowns = np.array(states)
     climb = WorldClimb(touchdowns, np.array(on_side), np.array(on_segment), failure,
                        None if failure is None else len(states))  # fmt: skip
-    legs = schedule.as_array()[np.arange(len(states)) % len(schedule)]
-    feet = touchdowns[:, 1] - legs[:, 1] * np.sin(legs[:, 0])
-    flip = np.where(climb.sides == LEFT, 1.0, -1.0)
+    orbit = section_orbit(climb, schedule)  # the touchdowns as the map's section states and rises
     columns = joined_columns(pieces)
     trajectory = Trajectory(
         **columns,
         touchdown_times=np.array(touchdown_times),
-        section_states=np.column_stack([flip * touchdowns[:, 2], touchdowns[:, 3]]),
-        rises=np.diff(feet),
+        section_states=orbit.states,
+        rises=orbit.rises,
         failure=failure,
         failed_jump=climb.failed_jump,
     )
