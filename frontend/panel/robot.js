@@ -6,6 +6,7 @@ import { filedUnder, LEG_FIELDS, SIM_LOCATIONS, checked } from "./forms.js";
 import { draw, layout } from "./plots.js";
 import { definitions } from "./dom.js";
 import { followJournal, following, planRunBody } from "./robot_plan.js";
+import { cachedWorld } from "./world_list.js";
 
 // Every status (GET /robot, each answer to a robot call, each live message) goes through
 // showStatus; every value from it reaches the page as text.
@@ -30,6 +31,8 @@ function describeRun(run) {
   if (run.jumps !== undefined) parts.push(`jumps ${run.jumps}`);  // as the service counts them
   if (typeof run.started === "number") parts.push(`started ${clock(run.started)}${startedBy(run)}`);
   if (run.max_seconds !== undefined) parts.push(`time limit ${run.max_seconds} s`);
+  if (run.world_id != null) parts.push(`in world ${run.world_id}${cachedWorld(run.world_id) ? ` "${cachedWorld(run.world_id).name}"` : ""}`);
+  if (run.plan_job_id != null) parts.push(`following plan job ${run.plan_job_id}`);
   if (run.tracker_gaps) parts.push(`tracker gaps: ${run.tracker_gaps} (longest ${Math.round(run.longest_tracker_gap_ms)} ms)`);
   if (!run.active && Array.isArray(run.robot_faults) && run.robot_faults.length) parts.push(`robot faults: ${run.robot_faults.join(", ")}`);
   if (!run.active && run.disarm) parts.push(`disarm: ${run.disarm}`);

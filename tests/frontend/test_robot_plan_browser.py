@@ -113,6 +113,8 @@ def test_a_live_run_follows_a_chosen_plan_and_shows_its_journal(service):
                 if "target" in command:
                     target = command["target"]
                     assert f"touchdown {target['touchdown']}: {target['side']} segment {target['segment']}" in row, row
+            shown = page.text_content("#robot-status")
+            assert f"in world {world_id}" in shown and f"following plan job {job}" in shown, shown
             caption = page.text_content("#robot-journal-caption")
             assert f"plan job {job}" in caption and "goal reached" in caption, caption
             assert page.locator("#robot-plan-svg .run-foot").count() == len(results["touchdowns"]) >= 3
