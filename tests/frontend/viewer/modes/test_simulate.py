@@ -33,16 +33,20 @@ def test_half_typed_values_never_reach_the_simulator(browsers):
     simulate = session.modes["simulate"]
     wait_for(lambda: simulate.gait_note != "searching…")
     in_use = simulate.climb.controls
-    for handle, typed in ((simulate.gui_psi0_left, 0.0), (simulate.gui_zeta0_left, 0.9999), (simulate.gui_gravity, 0)):
-        whole = handle.value
-        handle.value = typed  # what a number box sends on the way to a whole value
-        assert simulate.climb.controls == in_use, handle.label
-        assert handle.label in simulate.input_note and "must be" in simulate.input_note
-        assert "**Not used:**" in simulate.readout(60.0)
-        handle.value = whole  # typed to the end
-        assert simulate.input_note is None and simulate.climb.controls == in_use
-    simulate.gui_speed.value, before = -3.0, simulate.time
-    simulate.frame(0.1)
+    # Under the session's lock, as the view's own loop draws: a frame drawn from this thread beside
+    # the loop's raced it for the scene's nodes ("removed BoxHandle", once on a loaded machine).
+    with session.lock:
+        half_typed = ((simulate.gui_psi0_left, 0.0), (simulate.gui_zeta0_left, 0.9999), (simulate.gui_gravity, 0))
+        for handle, typed in half_typed:
+            whole = handle.value
+            handle.value = typed  # what a number box sends on the way to a whole value
+            assert simulate.climb.controls == in_use, handle.label
+            assert handle.label in simulate.input_note and "must be" in simulate.input_note
+            assert "**Not used:**" in simulate.readout(60.0)
+            handle.value = whole  # typed to the end
+            assert simulate.input_note is None and simulate.climb.controls == in_use
+        simulate.gui_speed.value, before = -3.0, simulate.time
+        simulate.frame(0.1)
     assert simulate.time > before, "a half-typed speed leaves the speed in use, never backwards"
 
 
