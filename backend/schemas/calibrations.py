@@ -94,9 +94,17 @@ class TouchdownPrediction(BaseModel):
     calibrated_residual: Channels | None = None
 
 
+class PredictedIn(BaseModel):
+    id: int
+    name: str
+
+
 class TouchdownComparison(BaseModel):
     run_id: int
     base: str
     preset: str | None
+    world: PredictedIn | None = Field(
+        None, description="the stored world the run climbed, each prediction a jump in it; null: parallel walls"
+    )
     touchdowns: list[TouchdownPrediction]
     rms: dict[str, Channels] = Field(description="RMS residual per model")

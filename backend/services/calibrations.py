@@ -20,6 +20,7 @@ from sqlalchemy.orm import Session
 from backend.errors import Conflict
 from backend.repositories import calibrations as stored_presets
 from backend.repositories import runs as stored_runs
+from backend.repositories import worlds as stored_worlds
 from backend.robot.run_endings import robot_ending_record
 from backend.schemas.calibrations import (
     PRESET_PATTERN,
@@ -40,6 +41,8 @@ from sim_core.model.errors import ParameterError
 from sim_core.model.params import ModelParams, PhysicalParams
 from sim_core.model.presets import PRESETS, get_preset
 from sim_core.model.walls import Wall
+from sim_core.world.files import world_from_document
+from sim_core.world.world import World as SimWorld
 
 CALIBRATED_KINDS = ("robot", "replay")
 PRESET_NAME = re.compile(PRESET_PATTERN)
@@ -94,8 +97,14 @@ def fit_touchdowns(series: list[TouchdownSeries], base: ModelParams) -> Calibrat
     return calibrate(series, base)
 
 
-def predict_touchdowns(series: TouchdownSeries, models: dict) -> dict:
-    """:func:`sim_core.calibration.calibrate.one_jump_predictions`, loaded where it runs."""
+def predict_touchdowns(series: TouchdownSeries, models: dict, world: SimWorld | None = None) -> dict:
+    """:func:`sim_core.calibration.calibrate.one_jump_predictions` between parallel walls, or in
+    ``world`` (a run that climbed one, in ``l0``)
+    :func:`sim_core.calibration.world_jumps.world_one_jump_predictions`; loaded where it runs."""
+    if world is not None:
+        from sim_core.calibration.world_jumps import world_one_jump_predictions
+
+        return world_one_jump_predictions(series, models, world)
     from sim_core.calibration.calibrate import one_jump_predictions
 
     return one_jump_predictions(series, models)
@@ -115,7 +124,7 @@ def calibrate_runs(
     if stored_presets.exists(session, name):
         raise Conflict(f"a preset named {name!r} exists; choose another name or delete it")
     robot = get_preset(base)
-    series = [touchdown_series(session, _calibration_run(session, run_id), robot) for run_id in run_ids]
+    series = [touchdown_series(session, _between_walls(_calibration_run(session, run_id)), robot) for run_id in run_ids]
     session.rollback()  # no read transaction held open while the fit runs
     fitted = fit(series, robot.to_model())
     preset = _stored(fitted, name=name, base=base, robot=robot, run_ids=run_ids)
@@ -208,6 +217,15 @@ def _calibration_run(session: Session, run_id: int) -> Run:
     return run
 
 
+def _between_walls(run: Run) -> Run:
+    """``run``, if it climbed the parallel walls the fit's map assumes; a run in a world is refused."""
+    if run.world_id is not None:
+        raise ParameterError(
+            "runs", f"run {run.id} climbed world {run.world_id}; calibration fits runs between parallel walls"
+        )
+    return run
+
+
 def _tracked(session: Session, run: Run) -> Run | None:
     """The robot run whose tracker frames and commands ``run`` has: itself, or a replay's source."""
     if run.kind == "replay":
@@ -237,8 +255,9 @@ def _pitch_at(run: Run | None, times: list[float]) -> np.ndarray:
 def touchdown_predictions(session: Session, run_id: int, *, preset: str | None, predict=None) -> TouchdownComparison:
     """A robot or replay run's touchdowns as measured, as the base model predicts each from the one
     before, and (``preset``, a stored calibration) as the calibrated model does, with the residuals
-    and their RMS. ``predict`` is :func:`sim_core.calibration.calibrate.one_jump_predictions` or a call of it
-    in a compute worker."""
+    and their RMS; a run in a world is predicted by each model's jump in that world (``world``: its
+    id and name; None: between parallel walls). ``predict`` is :func:`predict_touchdowns` or a call
+    of it in a compute worker."""
     run = _calibration_run(session, run_id)
     stored = None if preset is None else get_stored_preset(session, preset)
     base_name = stored.base if stored is not None else "paper"
@@ -248,8 +267,11 @@ def touchdown_predictions(session: Session, run_id: int, *, preset: str | None, 
     if stored is not None:
         robot, offsets = preset_params(session, preset)
         models["calibrated"] = (robot.to_model(), offsets)
+    world = None if run.world_id is None else stored_worlds.get(session, run.world_id)
+    chute = None if world is None else world_from_document(world.document, base.leg_length)  # a world in m needs l0
+    named = None if world is None else {"id": world.id, "name": world.name}
     session.rollback()
-    found = (predict or predict_touchdowns)(series, models)
+    found = (predict or predict_touchdowns)(series, models, chute)
     touchdowns = run.results.get("touchdowns") or []
     rows = []
     for row, k in enumerate(found["index"]):
@@ -262,7 +284,9 @@ def touchdown_predictions(session: Session, run_id: int, *, preset: str | None, 
         rows.append(entry)
     rms = {name: _channels(finite_rms(found[name] - found["measured"], axis=0)) for name in models}
     return TouchdownComparison.model_validate(
-        json_safe({"run_id": run_id, "base": base_name, "preset": preset, "touchdowns": rows, "rms": rms})
+        json_safe(
+            {"run_id": run_id, "base": base_name, "preset": preset, "world": named, "touchdowns": rows, "rms": rms}
+        )
     )
 
 

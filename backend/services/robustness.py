@@ -4,7 +4,8 @@
 A robot run failed when its telemetry reported the FELL fault (the firmware's "a jump failed"),
 or — without telemetry — when the robot disarmed on its own; a run stopped otherwise (its jumps
 done, a stop, a time limit, a lost link) is censored. Its jumps are those between its first and
-last touchdown. A replay counts as the robot run it was made from, once.
+last touchdown. A replay counts as the robot run it was made from, once. A run in a world is
+refused (the model's runs are simulated between parallel walls).
 """
 
 from __future__ import annotations
@@ -65,6 +66,9 @@ def _robot_run(session: Session, run_id: int) -> Run:
         raise Conflict(f"run {run_id} is a {run.kind} run; the study compares the robot's runs")
     if run.status == "running":
         raise Conflict(f"run {run_id} is still running")
+    if run.world_id is not None:  # the model's jumps to failure are simulated between parallel walls
+        raise ParameterError("runs", f"run {run_id} climbed world {run.world_id}; the study compares runs between "
+                                     "parallel walls")  # fmt: skip
     return run
 
 

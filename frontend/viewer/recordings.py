@@ -3,7 +3,8 @@
 - ``sim`` runs: the stored sampled path, or, when the run kept none, the same path simulated
   again from its stored model, controls and start state (the simulator is deterministic);
 - ``robot`` runs: the tracker frames (body only: the camera does not see the legs) and the
-  touchdowns found live;
+  touchdowns found live, each marked in a world where its foot met the world's side at its
+  height (:func:`frontend.viewer.modes.live_world.foot_on_side`, as live mode marks it);
 - ``replay`` runs: their source robot run's frames with the touchdowns found again.
 
 A run that climbed a stored world carries that world (drawn in place of the parallel walls,
@@ -26,6 +27,7 @@ import numpy as np
 
 from backend.errors import Conflict
 from backend.services.view import StoredPath, stored_path
+from frontend.viewer.modes.live_world import foot_on_side
 from frontend.viewer.motion import TRAIL_STRIDE, PathClip
 from sim_core import ControlSchedule, LegControl, ModelParams, PhysicalParams, get_preset, simulate_trajectory
 from sim_core.climb.sequencer import start_height
@@ -228,5 +230,9 @@ def _tracker_recording(run: StoredPath) -> Recording:
     clip = PathClip.from_body(frames["time"] - t0, frames["x"], frames["y"])
     touchdowns = np.array([[td["time"] - t0, td["wall"], td["foot_height"]] for td in run.touchdowns]).reshape(-1, 3)
     world = None if run.world is None else world_from_document(run.world)
-    return Recording(run.run_id, run.kind, _label(run), clip, get_preset("paper"), None, touchdowns, describe(run),
-                     world=world, world_mu=get_preset("paper").to_model().mu)  # fmt: skip
+    robot = get_preset("paper")  # the world was read in l0 at its leg length (backend.services.view.VIEW_PRESET)
+    # In a world each foot is marked where it met its side at its height, as live mode marks it.
+    feet = None if world is None else np.array([foot_on_side(world, robot.leg_length, int(wall), height)
+                                                for _time, wall, height in touchdowns])  # fmt: skip
+    return Recording(run.run_id, run.kind, _label(run), clip, robot, None, touchdowns, describe(run),
+                     world=world, world_mu=robot.to_model().mu, touchdown_x=feet)  # fmt: skip

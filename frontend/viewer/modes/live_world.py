@@ -30,6 +30,14 @@ from sim_core.world.world import World
 GHOST_WORDS = "the model's ghost jumps between parallel walls: not drawn in a world"
 
 
+def foot_on_side(world: World, leg_length: float, wall: int, foot_height: float) -> float:
+    """[m] the ``x`` where a foot on ``wall`` (-1 left, +1 right) at ``foot_height`` [m] meets
+    ``world``'s side (``world`` in ``l0``, drawn at ``leg_length`` [m]): a live touchdown's marker,
+    and a stored robot run's in replay (:mod:`frontend.viewer.recordings`)."""
+    side = world.left if wall == Wall.LEFT else world.right
+    return side.x_at(foot_height / leg_length) * leg_length
+
+
 @dataclass(frozen=True)
 class LiveWorld:
     """A live run's world as drawn: ``world`` (``l0``; None: the parallel walls) at ``leg_length``
@@ -74,8 +82,7 @@ class LiveWorld:
         """[m] where ``touchdown``'s foot met its side, at the foot's height; None: on the parallel wall."""
         if self.world is None:
             return None
-        side = self.world.left if touchdown.wall == Wall.LEFT else self.world.right
-        return side.x_at(touchdown.foot_height / self.leg_length) * self.leg_length
+        return foot_on_side(self.world, self.leg_length, touchdown.wall, touchdown.foot_height)
 
     def mark(self, scene: ChuteScene, touchdown) -> None:
         """``touchdown``'s marker at its foot and, following a plan, its target: hit or missed."""

@@ -5,11 +5,15 @@ import numpy as np
 import pytest
 
 from backend import errors
-from backend.services import calibrations
+from backend.schemas.worlds import WorldCreate
+from backend.services import calibrations, worlds
 from backend.services.robot_records import replay_run
 from backend.services.robustness import robustness
 from sim_core.model.errors import ParameterError
 from sim_core.model.noise import NoiseModel
+from sim_core.world.climb import climb_world
+from sim_core.world.files import world_from_document
+from tests.backend.services.test_run_prediction import GAIT, JUMPS, ROBOT, START, store_run, tracked
 from tests.tracked_climbs import Truth, store_tracked_run, store_varied_runs, tracked_climb
 
 TRUTH = Truth.of(alpha=72.0, c_zeta=1.25, c_psi=0.8, psi0_offset_deg=(0.6, -0.8), zeta0_offset=(0.004, -0.005))
@@ -57,3 +61,9 @@ def test_what_the_study_cannot_compare_says_why(session, calibrated, make_run):
         with pytest.raises(ParameterError) as error:
             robustness(session, "bench", **options)
         assert error.value.field == field
+    world = worlds.create(session, WorldCreate(name="narrowing chute", named="narrowing"))
+    climb = climb_world(ROBOT.to_model(), world_from_document(world.world, ROBOT.leg_length), GAIT, START, JUMPS)
+    in_world = store_run(session, tracked(climb), world.id).id
+    with pytest.raises(ParameterError, match=f"run {in_world} climbed world {world.id}") as error:
+        robustness(session, "bench", [in_world], trials=5, cap=50)
+    assert error.value.field == "runs"

@@ -4,6 +4,7 @@ deleted; only with the token; bad requests name their field (backend/api/routes/
 import pytest
 
 from sim_core.model.noise import NoiseModel
+from sim_core.world.files import world_from_document
 from tests.tracked_climbs import Truth, store_varied_runs
 
 TRUTH = Truth.of(alpha=72.0, c_zeta=1.25, c_psi=0.8, psi0_offset_deg=(0.6, -0.8), zeta0_offset=(0.004, -0.005))
@@ -73,3 +74,22 @@ def test_bad_calibration_requests_name_what_is_wrong(client, auth):
     assert status == 409 and "robot and replay runs" in detail
     assert client.get(f"/api/v1/runs/{run['id']}/touchdowns").status_code == 409
     assert client.get("/api/v1/calibrations/nothing").status_code == 404
+
+
+def test_a_run_in_a_world_is_compared_in_it_and_refused_by_calibration(client, auth):
+    """/touchdowns of a run in a stored world: each touchdown the model's jump in that world (the
+    compute worker given the world), the world named; calibrating it is a 422 naming the run."""
+    from sim_core.world.climb import climb_world
+    from tests.backend.services.test_run_prediction import GAIT, JUMPS, ROBOT, START, store_run, tracked
+    from tests.backend.services.test_touchdowns_in_worlds import CHANNELS, TIGHT
+
+    world = client.post("/api/v1/worlds", json={"name": "narrowing chute", "named": "narrowing"}, headers=auth).json()
+    chute = world_from_document(world["world"], ROBOT.leg_length)
+    with client.app.state.sessions() as session:
+        run = store_run(session, tracked(climb_world(ROBOT.to_model(), chute, GAIT, START, JUMPS)), world["id"]).id
+    compared = client.get(f"/api/v1/runs/{run}/touchdowns").json()
+    assert compared["world"] == {"id": world["id"], "name": "narrowing chute"} and len(compared["touchdowns"]) > 4
+    assert max(abs(row["paper_residual"][channel]) for row in compared["touchdowns"] for channel in CHANNELS) < TIGHT
+    refused = client.post("/api/v1/calibrations", json={"runs": [run], "name": "x"}, headers=auth)
+    assert refused.status_code == 422 and refused.json()["detail"][0]["loc"] == ["body", "runs"]
+    assert f"run {run} climbed world {world['id']}" in refused.json()["detail"][0]["msg"]

@@ -1,11 +1,27 @@
 """Replay mode (frontend/viewer/modes/replay.py) in a browser's view of the service's 3D view: a
 stored run with a ghost on a timeline, its height plot, and what it says of a run id it cannot
 use. The frame it draws is held equal to the shared file's in tests/frontend/viewer/test_share.py.
+A stored robot run in a world marks its touchdowns on the world's sides (last test).
 """
 
-import numpy as np
+import math
+import threading
 
+import numpy as np
+import pytest
+
+from backend.robot.touchdown import detect_touchdowns
+from backend.schemas.worlds import WorldCreate
+from backend.services import worlds
+from backend.services.robot_plans import sides_at
+from backend.store.database import make_engine, migrate, session_factory, sqlite_url
+from frontend.viewer.modes.replay import ReplayMode
+from frontend.viewer.scene import ChuteScene
 from frontend.viewer.viser_adapter import slider_marks
+from sim_core.model.walls import Wall
+from sim_core.world.files import world_from_document
+from sim_core.world.trajectory import simulate_world_trajectory
+from tests.frontend.viewer.test_share import SceneTree, decode_recording
 from tests.frontend.viewer.view_service import RUN, wait_for
 
 
@@ -116,3 +132,57 @@ def test_a_time_or_speed_typed_past_its_slider_is_refused(service, browsers):
     with session.lock:
         replay.frame(0.5)
     assert replay.time == 1.5, "played at the speed in use"
+
+
+@pytest.fixture
+def sessions(tmp_path):
+    engine = make_engine(sqlite_url(tmp_path))
+    migrate(engine)
+    yield session_factory(engine)
+    engine.dispose()
+
+
+def test_a_robot_run_in_a_world_marks_each_touchdown_where_its_foot_met_the_side(server, sessions):
+    """A stored robot run in the narrowing world, its touchdowns detected from the frames of
+    sim_core's climb there: replayed to its end, each marker is on the world's side at its foot's
+    height (as live mode marks a live run's, tests/frontend/viewer/modes/test_live_world.py) —
+    where the climb's feet were, not on the parallel walls. Drawn on a private viser server's
+    scene, what the browser gets decoded as it decodes it."""
+    from tests.backend.services.test_run_prediction import GAIT, JUMPS, ROBOT, START, store_run
+
+    with sessions() as session:
+        world = worlds.create(session, WorldCreate(name="narrowing chute", named="narrowing"))
+        chute = world_from_document(world.world, ROBOT.leg_length)
+        path, climb = simulate_world_trajectory(ROBOT.to_model(), chute, GAIT, START, JUMPS,
+                                                sample_rate=100.0 * ROBOT.scales.time)  # fmt: skip
+        path = path.to_si(ROBOT)
+        frames = {"time": path.time, "x": path.x, "y": path.y}
+        touchdowns = detect_touchdowns(*frames.values(), ROBOT, lambda k: GAIT[k + 1], side_at=sides_at(chute, ROBOT))
+        run = store_run(session, touchdowns, world.id, {**frames, "pitch": np.full(path.time.size, math.nan)}).id
+    assert len(touchdowns) == JUMPS - 1
+    replay = ReplayMode(server, ChuteScene(server.scene, ROBOT), threading.RLock(), sessions)
+    serializer = server.get_scene_serializer()
+    replay.load(run)
+    replay.time = replay.end
+    replay.frame(1 / 60)
+    serializer.insert_sleep(1 / 60)
+    messages = decode_recording(serializer.serialize())["messages"]
+    tree = SceneTree()
+    for _time, message in messages:
+        tree.apply(message)
+    drawn = tree.shown()
+    markers = sorted(node["position"] for name, node in drawn.items() if name.startswith("/chute/touchdowns/"))
+
+    l0 = ROBOT.leg_length
+    on_sides = [(chute.side("left" if td.wall == Wall.LEFT else "right").x_at(td.foot_height / l0) * l0, 0.0,
+                 td.foot_height) for td in touchdowns]  # fmt: skip
+    np.testing.assert_allclose(markers, sorted(on_sides), atol=1e-6, err_msg="each foot on its side at its height")
+    # The climb's own feet (touchdown k + 1 of the climb is detected touchdown k), to the detector's error.
+    legs = np.array([[GAIT[k].psi0, GAIT[k].zeta0] for k in range(1, JUMPS)])
+    mirror = np.where(climb.sides[1:JUMPS] == 0, 1.0, -1.0)
+    feet_x = (climb.states[1:JUMPS, 0] - mirror * legs[:, 1] * np.cos(legs[:, 0])) * l0
+    np.testing.assert_allclose(
+        [x for x, _y, _z in on_sides], feet_x, atol=2e-3 * l0, err_msg="where the climb's feet were"
+    )
+    half = 0.5 * ROBOT.wall_distance
+    assert np.abs(np.abs(feet_x) - half).max() > 0.01, "the parallel walls' x is not the world's"
