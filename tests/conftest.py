@@ -116,3 +116,15 @@ def virtual(request):
     robot = VirtualRobot(tracker_to=("127.0.0.1", port), noise=NO_NOISE, speed=speed, seed=2).start()
     yield robot, port
     robot.stop()
+
+
+@pytest.fixture
+def sessions(tmp_path):
+    """A real, migrated SQLite store in a temporary directory: the session factory the service
+    hands its parts (``sessionmaker``, expire_on_commit off)."""
+    from backend.store.database import make_engine, migrate, session_factory, sqlite_url
+
+    engine = make_engine(sqlite_url(tmp_path))
+    migrate(engine)
+    yield session_factory(engine)
+    engine.dispose()

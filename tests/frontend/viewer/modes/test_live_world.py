@@ -14,12 +14,10 @@ import dataclasses
 import math
 
 import numpy as np
-import pytest
 
 from backend.robot.touchdown import Touchdown
 from backend.schemas.worlds import WorldCreate
 from backend.services import worlds
-from backend.store.database import make_engine, migrate, session_factory, sqlite_url
 from backend.store.models import Job
 from frontend.viewer.modes.live_world import GHOST_WORDS
 from frontend.viewer.scene import AIM_COLOR, TARGET_HIT, TARGET_MISSED
@@ -39,14 +37,6 @@ FUNNEL = World(
     "funnel",
 )
 LEG = LegControl.from_degrees(30, 0.9)
-
-
-@pytest.fixture
-def sessions(tmp_path):
-    engine = make_engine(sqlite_url(tmp_path))
-    migrate(engine)
-    yield session_factory(engine)
-    engine.dispose()
 
 
 @dataclasses.dataclass

@@ -8,13 +8,11 @@ import math
 import threading
 
 import numpy as np
-import pytest
 
 from backend.robot.touchdown import detect_touchdowns
 from backend.schemas.worlds import WorldCreate
 from backend.services import worlds
 from backend.services.robot_plans import sides_at
-from backend.store.database import make_engine, migrate, session_factory, sqlite_url
 from frontend.viewer.modes.replay import ReplayMode
 from frontend.viewer.scene import ChuteScene
 from frontend.viewer.viser_adapter import slider_marks
@@ -132,14 +130,6 @@ def test_a_time_or_speed_typed_past_its_slider_is_refused(service, browsers):
     with session.lock:
         replay.frame(0.5)
     assert replay.time == 1.5, "played at the speed in use"
-
-
-@pytest.fixture
-def sessions(tmp_path):
-    engine = make_engine(sqlite_url(tmp_path))
-    migrate(engine)
-    yield session_factory(engine)
-    engine.dispose()
 
 
 def test_a_robot_run_in_a_world_marks_each_touchdown_where_its_foot_met_the_side(server, sessions):
