@@ -47,14 +47,41 @@ def plan_command(
         int | None,
         typer.Option("--monte-carlo", help="With --mfpt: as many plain attempts beside it, to check it (1-100000)."),
     ] = None,
+    importance_sampling: Annotated[
+        int | None,
+        typer.Option(
+            "--importance-sampling",
+            help="With --mfpt: as many importance-sampled climbs beside it, the noise widened and each climb "
+            "weighed by its draws: for rare failures (2-100000).",
+        ),
+    ] = None,
+    is_scale: Annotated[
+        float | None,
+        typer.Option(
+            "--is-scale", help="With --importance-sampling: the factor on the widened sigmas (1-5, default 1.5)."
+        ),
+    ] = None,
+    is_draws: Annotated[
+        str | None,
+        typer.Option(
+            "--is-draws",
+            help="With --importance-sampling: the draws widened, comma-separated of psi0, zeta0, velocity, pitch "
+            "(default all).",
+        ),
+    ] = None,
+    is_first_leg: Annotated[
+        bool,
+        typer.Option("--is-first-leg", help="With --importance-sampling: widen touchdown 0's draws only."),
+    ] = False,
     as_json: JsonOption = False,
 ) -> None:
     """A sequence of footholds and leg commands from touchdown 0 to --goal-height, the most robust
     under the noise options (each jump's share of noisy draws that land and hold, multiplied);
     with --mfpt, how often the placement law's climbs of it fail (docs/worlds.md)."""
-    from cli.plan_mfpt import check_mfpt_options
+    from cli.plan_mfpt import check_importance_options, check_mfpt_options
 
     splitting = check_mfpt_options(mfpt, replicas, runs, replans, monte_carlo, seed)
+    importance = check_importance_options(mfpt, importance_sampling, is_scale, is_draws, is_first_leg)
     from sim_core.planning.launch import start_velocity
     from sim_core.planning.planner import plan_climb
     from sim_core.world.named import resolve_world
@@ -79,7 +106,7 @@ def plan_command(
         from cli.plan_mfpt import plan_mfpt_document
 
         document["mfpt"] = plan_mfpt_document(setup.model, chosen, plan, goal_height / metres, noise, splitting,
-                                              monte_carlo)  # fmt: skip
+                                              monte_carlo, importance)  # fmt: skip
     if as_json:
         print_json(document)
         return

@@ -8,7 +8,8 @@ of threads or workers; each takes the noise as one record, :meth:`sim_core.model
 and :class:`NoiseSampler` (a numpy ``Generator``), which the climb sequencer
 (:mod:`sim_core.climb.sequencer`) uses for the virtual robot. Both draw in the same order: a
 pitch step, then ``psi0``, then ``zeta0`` of the next leg; after the jump, ``xdot`` then ``ydot``;
-a zero standard deviation draws nothing.
+a zero standard deviation draws nothing. The ``tallied_`` kernels draw exactly as theirs and also
+count what they drew (a followed plan's trials, which importance sampling weighs by their draws).
 """
 
 from __future__ import annotations
@@ -101,6 +102,56 @@ def disturbed_state(xdot, ydot, noise):
 def pitch_step(pitch, noise):
     """The next jump's pitch [rad], drawn."""
     return drifted_pitch(pitch, _draw(noise.sigma_pitch))
+
+
+# The compiled sampler, tallying its draws (importance sampling) ----------------------------------
+# The same generator calls as the kernels above, in the same order, so a trial draws exactly what
+# they draw; each draw is also added to ``tally`` (TALLY_SIZE floats: per kind of draw, in
+# NoiseRecord's order of the sigmas, the draws made and the sum of their squares in units of their
+# standard deviation, i.e. of the standard normals drawn). An importance-sampled trial draws from a
+# proposal (sigmas scaled) and is weighed by its draws' likelihood ratio, which needs only that
+# tally (sim_core.planning.plan_importance). MJTF and the PID study keep the kernels above.
+TALLY_PSI0, TALLY_ZETA0, TALLY_VELOCITY, TALLY_PITCH = range(4)  # NoiseRecord's sigma_* in order
+TALLY_KINDS = ("psi0", "zeta0", "velocity", "pitch")
+TALLY_SIZE = 2 * len(TALLY_KINDS)  # [2 kind]: the draws of that kind, [2 kind + 1]: their squares
+
+
+@kernel
+def tallied_draw(sigma, tally, kind):
+    """:func:`_draw`'s draw, counted in ``tally[2 kind]`` and its square in units of ``sigma`` added to
+    ``tally[2 kind + 1]``."""
+    if sigma <= 0.0:
+        return 0.0  # nothing drawn, nothing tallied: a zero sigma is no random variable
+    draw = np.random.normal(0.0, sigma)
+    standard = draw / sigma
+    tally[2 * kind] += 1.0
+    tally[2 * kind + 1] += standard * standard
+    return draw
+
+
+@kernel
+def tallied_commanded_controls(k, pitch, psi0, zeta0, noise, tally):
+    """:func:`commanded_controls`, its draws tallied in ``tally``."""
+    right_leg = k % 2 == 1
+    psi0_draw = tallied_draw(noise.sigma_psi0, tally, TALLY_PSI0)
+    zeta0_draw = tallied_draw(noise.sigma_zeta0, tally, TALLY_ZETA0)
+    return noisy_controls(
+        psi0, zeta0, right_leg, pitch, noise.asymmetry_psi0, noise.asymmetry_zeta0, psi0_draw, zeta0_draw
+    )
+
+
+@kernel
+def tallied_disturbed_state(xdot, ydot, noise, tally):
+    """:func:`disturbed_state`, its draws tallied in ``tally``."""
+    xdot_draw = tallied_draw(noise.sigma_velocity, tally, TALLY_VELOCITY)
+    ydot_draw = tallied_draw(noise.sigma_velocity, tally, TALLY_VELOCITY)
+    return disturbed(xdot, ydot, xdot_draw, ydot_draw)
+
+
+@kernel
+def tallied_pitch_step(pitch, noise, tally):
+    """:func:`pitch_step`, its draw tallied in ``tally``."""
+    return drifted_pitch(pitch, tallied_draw(noise.sigma_pitch, tally, TALLY_PITCH))
 
 
 # The Python sampler (a numpy Generator) ----------------------------------------------------------

@@ -15,6 +15,11 @@ on, or the plan ends below the goal — the compiled loop stops *before* that li
 the planner (:func:`sim_core.planning.planner.replan`) plans again from that lift-off, and the
 loop goes on with the draws where they were. A trial ends at the goal (a foot at or above it),
 at a failure (the floor included), or at ``cap`` jumps.
+
+Every draw is also tallied in the trial (from :data:`TALLY`: by kind, the standard normals drawn,
+counted and their squares summed, :func:`sim_core.model.noise_rules.tallied_draw`): a trial drawn
+from an importance sampling's proposal is weighed by them (:mod:`sim_core.planning.plan_importance`);
+the draws themselves are the same.
 """
 
 from __future__ import annotations
@@ -39,21 +44,24 @@ from sim_core.control.placement import (
 from sim_core.model.failures import FLOOR, FLOOR_HEIGHT, OK
 from sim_core.model.integrate import PSI, PSI_DOT, STATE_SIZE, ZETA_DOT
 from sim_core.model.noise import NoiseModel
-from sim_core.model.noise_rules import commanded_controls, pitch_step, seed_trial
+from sim_core.model.noise_rules import TALLY_SIZE, seed_trial, tallied_commanded_controls, tallied_pitch_step
 from sim_core.model.params import ModelParams
 from sim_core.model.stride import liftoff_velocity
 from sim_core.planning.planner import Plan, replan
-from sim_core.robustness.world_trials import disturbed_on_side
+from sim_core.robustness.world_trials import tallied_disturbed_on_side
 from sim_core.world.geometry import SideArrays, pack
 from sim_core.world.stride import foothold_stance, world_flight
 from sim_core.world.world import World
 
 # A trial's state at a touchdown (one float array, in and out of the compiled loop): the body, its
 # side and segment, the leg as realised (the physics') and as sent (the law's), the pitch, the jump,
-# and the lift-off that follows once the stance has run
+# and the lift-off that follows once the stance has run; then the trial's draws so far by kind,
+# counted and their squares summed in units of their standard deviations (the tally an
+# importance-sampled trial is weighed by, sim_core.planning.plan_importance; a plain trial's is unread)
 X, Y, XDOT, YDOT, SIDE, SEGMENT, PSI0, ZETA0, SENT_PSI0, SENT_ZETA0, PITCH, JUMP = range(12)
 LIFT_X, LIFT_Y, LIFT_XDOT, LIFT_YDOT = range(12, 16)  # the lift-off under way, tracked (wall coordinates)
-TRIAL_SIZE = 16
+TALLY = 16  # noise_rules' tally: TALLY_SIZE slots
+TRIAL_SIZE = TALLY + TALLY_SIZE
 REACHED, CAPPED, REPLAN = -1, -2, -3  # how the loop stops, beside a failure's code
 MAX_REPLANS = 3  # a trial's replans at most; then the law's best leg goes out, on plan or not
 
@@ -75,10 +83,12 @@ def plan_aims(plan: Plan) -> np.ndarray:
 @kernel
 def start_trial(trial, aims, foot_x, foot_y, segment, xdot, ydot, seed, noise):
     """Seed the generator and fill ``trial`` with touchdown 0: the foot at ``(foot_x, foot_y)`` on the
-    left side's ``segment``, the plan's first leg sent and realised with fresh draws."""
+    left side's ``segment``, the plan's first leg sent and realised with fresh draws (tallied from
+    none)."""
     seed_trial(seed)
+    trial[TALLY:] = 0.0
     sent_psi0, sent_zeta0 = aims[0, 5], aims[0, 6]
-    psi0, zeta0 = commanded_controls(0, 0.0, sent_psi0, sent_zeta0, noise)
+    psi0, zeta0 = tallied_commanded_controls(0, 0.0, sent_psi0, sent_zeta0, noise, trial[TALLY:])
     trial[X], trial[Y] = foot_x + zeta0 * math.cos(psi0), foot_y + zeta0 * math.sin(psi0)
     trial[XDOT], trial[YDOT], trial[SIDE], trial[SEGMENT] = xdot, ydot, 0.0, segment
     trial[PSI0], trial[ZETA0], trial[SENT_PSI0], trial[SENT_ZETA0] = psi0, zeta0, sent_psi0, sent_zeta0
@@ -98,8 +108,9 @@ def follow(trial, aims, row, goal, cap, may_replan, noise, model, sides, setting
     (:data:`REACHED`), a failure (its code), ``cap`` jumps in all (:data:`CAPPED`) or, where
     ``may_replan``, the robot off its plan at a lift-off (:data:`REPLAN`, before that lift-off's
     draws; the lift-off in ``trial``). Returns ``(outcome, row)``, the plan's row of the touchdown
-    ``trial`` holds."""
+    ``trial`` holds. Its draws are tallied in ``trial`` (from :data:`TALLY`)."""
     no_record = np.empty((0, STATE_SIZE))
+    tally = trial[TALLY:]  # a view: the tally goes on in the trial
     final = np.empty(STATE_SIZE)
     while True:
         if trial[Y] - trial[ZETA0] * math.sin(trial[PSI0]) >= goal:
@@ -123,8 +134,8 @@ def follow(trial, aims, row, goal, cap, may_replan, noise, model, sides, setting
         turned = psi0 - (trial[PITCH] if next_on_left else -trial[PITCH])
         sent_psi0 = min(max(turned, settings[PSI0_LOW]), settings[PSI0_HIGH])
         k = int(trial[JUMP])
-        next_pitch = pitch_step(trial[PITCH], noise)
-        next_psi0, next_zeta0 = commanded_controls(k + 1, next_pitch, sent_psi0, zeta0, noise)
+        next_pitch = tallied_pitch_step(trial[PITCH], noise, tally)
+        next_psi0, next_zeta0 = tallied_commanded_controls(k + 1, next_pitch, sent_psi0, zeta0, noise, tally)
         status, x, y, xdot, ydot, segment, _ = world_flight(
             trial[LIFT_X], trial[LIFT_Y], trial[LIFT_XDOT], trial[LIFT_YDOT], side, next_psi0, next_zeta0, sides
         )
@@ -133,7 +144,7 @@ def follow(trial, aims, row, goal, cap, may_replan, noise, model, sides, setting
         if y < FLOOR_HEIGHT:
             return FLOOR, row
         side = 1 - side
-        xdot, ydot = disturbed_on_side(side, xdot, ydot, noise)  # as MJTF's world trials
+        xdot, ydot = tallied_disturbed_on_side(side, xdot, ydot, noise, tally)  # as MJTF's world trials
         trial[X], trial[Y], trial[XDOT], trial[YDOT] = x, y, xdot, ydot
         trial[SIDE], trial[SEGMENT], trial[PSI0], trial[ZETA0] = side, segment, next_psi0, next_zeta0
         trial[SENT_PSI0], trial[SENT_ZETA0], trial[PITCH], trial[JUMP] = sent_psi0, zeta0, next_pitch, k + 1

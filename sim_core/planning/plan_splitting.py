@@ -21,7 +21,8 @@ What it can and cannot do (docs/worlds.md, "The MFPT of a plan"): splitting gain
 attempt passes through touchdowns ever nearer failing; a plan's attempt is a handful of jumps, and
 at low noise its failures are decided within one jump's draws from touchdowns that look like any
 other — nothing to split at. There, every run goes extinct (``p`` 0, said so) and Monte-Carlo
-(:func:`plan_monte_carlo`, 0.3 ms an attempt without replanning) is the estimate.
+(:func:`plan_monte_carlo`, 0.3 ms an attempt without replanning) or importance sampling of the
+draws that decide (:mod:`sim_core.planning.plan_importance`) is the estimate.
 """
 
 from __future__ import annotations

@@ -19,7 +19,13 @@ from sim_core._jit import kernel, parallel_kernel
 from sim_core.model.failures import FLOOR, FLOOR_HEIGHT, OK
 from sim_core.model.integrate import STATE_SIZE
 from sim_core.model.noise import NoiseModel
-from sim_core.model.noise_rules import disturbed_state, perturbed_controls, pitch_step, seed_trial
+from sim_core.model.noise_rules import (
+    disturbed_state,
+    perturbed_controls,
+    pitch_step,
+    seed_trial,
+    tallied_disturbed_state,
+)
 from sim_core.model.params import ModelParams
 from sim_core.model.poincare import check_section_state
 from sim_core.model.validation import check_range
@@ -92,6 +98,15 @@ def disturbed_on_side(side, xdot, ydot, noise):
     drawn in that side's stance frame, as the map's section state is disturbed."""
     mirror = 1.0 if side == 0 else -1.0
     flipped_xdot, ydot = disturbed_state(mirror * xdot, ydot, noise)
+    return mirror * flipped_xdot, ydot
+
+
+@kernel
+def tallied_disturbed_on_side(side, xdot, ydot, noise, tally):
+    """:func:`disturbed_on_side`, its draws tallied in ``tally``
+    (:func:`sim_core.model.noise_rules.tallied_draw`: a followed plan's, importance-sampled)."""
+    mirror = 1.0 if side == 0 else -1.0
+    flipped_xdot, ydot = tallied_disturbed_state(mirror * xdot, ydot, noise, tally)
     return mirror * flipped_xdot, ydot
 
 

@@ -47,3 +47,36 @@ def test_mfpt_options_are_checked_naming_the_option():
     assert "--replicas" in one_line_error(*ARGS, "--goal-height", "1.0", "--mfpt", "--replicas", "1")
     assert "--monte-carlo" in one_line_error(*ARGS, "--goal-height", "1.0", "--mfpt", "--monte-carlo", "0")
     assert "--replans" in one_line_error(*ARGS, "--goal-height", "1.0", "--mfpt", "--replans", "-1")
+
+
+def test_importance_sampling_beside_the_mfpt():
+    """Its object beside Monte-Carlo's (whose keys stay as they were), the options as asked."""
+    plan = json_of(*ARGS, "--goal-height", "1.0", "--mfpt", "--replicas", "2", "--runs", "2", "--replans", "0",
+                   "--monte-carlo", "20", "--importance-sampling", "200", "--is-scale", "2", "--is-draws",
+                   "psi0,zeta0", "--is-first-leg")  # fmt: skip
+    mfpt = plan["mfpt"]
+    assert set(mfpt["monte_carlo"]) == {"trials", "failures", "failure_chance", "failure_chance_ci95",
+                                        "mean_attempt_jumps", "mfpt_jumps", "seconds"}  # fmt: skip
+    sampled = mfpt["importance_sampling"]
+    assert set(sampled) == {
+        "trials", "scale", "scaled", "first_leg_only", "failures_under_proposal", "failure_chance", "standard_error",
+        "relative_error", "failure_chance_ci95", "effective_sample_size", "effective_failures",
+        "mean_attempt_jumps", "mfpt_jumps", "warning", "seconds"}  # fmt: skip
+    assert (sampled["trials"], sampled["scale"], sampled["scaled"], sampled["first_leg_only"]) == (
+        200, 2.0, ["psi0", "zeta0"], True)  # fmt: skip
+    assert 0 <= sampled["failures_under_proposal"] <= 200 and 0 < sampled["effective_sample_size"] <= 200
+    low, high = sampled["failure_chance_ci95"]
+    assert low <= sampled["failure_chance"] and (high is None or sampled["failure_chance"] <= high)
+
+
+def test_importance_sampling_options_are_checked_naming_the_option():
+    mfpt = (*ARGS, "--goal-height", "1.0", "--mfpt")
+    assert "--importance-sampling: needs --mfpt" in one_line_error(*ARGS, "--goal-height", "1.0",
+                                                                   "--importance-sampling", "10")  # fmt: skip
+    assert "--is-scale: needs --importance-sampling" in one_line_error(*mfpt, "--is-scale", "2")
+    assert "--is-first-leg: needs --importance-sampling" in one_line_error(*mfpt, "--is-first-leg")
+    assert "--importance-sampling: must be in" in one_line_error(*mfpt, "--importance-sampling", "1")
+    for scale in ("0.5", "6", "nan"):
+        assert "--is-scale" in one_line_error(*mfpt, "--importance-sampling", "10", "--is-scale", scale)
+    said = one_line_error(*mfpt, "--importance-sampling", "10", "--is-draws", "psi0,yaw")
+    assert "--is-draws" in said and "psi0, zeta0, velocity, pitch" in said
