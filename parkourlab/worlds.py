@@ -91,11 +91,14 @@ class WorldCalls:
         seed: int | None = None,
         noise: Mapping[str, float] | None = None,
         state: State | None = None,
+        importance_sampling: Mapping[str, Any] | None = None,
         model: Mapping[str, Any] | None = None,
         experiment_id: int | None = None,
     ) -> Job:
         """The most robust plan up the stored world ``world_id`` to ``goal_height_m`` [m] (``parkour
-        plan``); with ``attempts``, that many noisy climbs of it by the placement law, counted.
+        plan``); with ``attempts``, that many noisy climbs of it by the placement law, counted;
+        with ``importance_sampling`` (``{"trials", "scale", "draws", "first_leg"}``), importance-
+        sampled climbs for a failure chance too rare for plain attempts (docs/worlds.md).
         ``launch_gait``: from the velocity a robot launched on the plan's first leg has (for a live
         run that follows it, ``RobotRunCreate.plan_job_id``)."""
         spec = {
@@ -104,6 +107,7 @@ class WorldCalls:
             "attempts": attempts,
             "replans": replans,
             "launch_gait": launch_gait,
+            "importance_sampling": None if importance_sampling is None else dict(importance_sampling),
         }
         spec |= {"cap": cap, "seed": seed, "noise": mapping(noise), "state": body_state(state)}
         return self._job("plan", spec, model, experiment_id)

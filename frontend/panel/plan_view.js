@@ -54,6 +54,14 @@ export function planWords(id, job, result, worldName) {
       `${typeof low === "number" ? `, 95%: ${percent(low)}–${percent(high)}` : ""}), ${fixed(mc.mean_attempt_jumps, 1)} jumps a climb on average` +
       `${mc.mfpt_jumps ? `, about ${Math.round(mc.mfpt_jumps)} jumps to a failure` : ""}.`);
   }
+  const is = result.importance_sampling;
+  if (is) {
+    const [low, high] = is.failure_chance_ci95 ?? [];
+    const widened = `${(is.scaled ?? []).join(", ")} draws × ${is.scale}${is.first_leg_only ? " at touchdown 0" : ""}`;
+    words.push(`${is.trials} importance-sampled climbs (${widened}): failure chance ${fixed(is.failure_chance, 6)}` +
+      `${typeof low === "number" ? ` (95%: ${fixed(low, 6)}–${fixed(high, 6)})` : ""}, effective sample size ` +
+      `${fixed(is.effective_sample_size, 0)}${is.warning ? ` — ${is.warning}` : ""}.`);
+  }
   return words.join(" ");
 }
 

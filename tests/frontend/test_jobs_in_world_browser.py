@@ -251,3 +251,24 @@ def test_a_plans_monte_carlo_climbs_are_said(page):
     assert "reaches the goal 0.5 m in 2 touchdown(s)" in words
     assert "40 noisy climbs by the placement law: 3 failed (7.5%, 95%: 1.6%–20.4%)" in words
     assert "about 60 jumps to a failure" in words
+
+
+def test_a_plans_importance_sampled_climbs_are_said(page):
+    """With ``importance_sampling``: the climbs, what was widened, the chance, its interval, the ESS and any warning."""
+    job = {"spec": {"goal_height_m": 0.5}}
+    sampled = {"trials": 10000, "scale": 3.0, "scaled": ["psi0", "zeta0"], "first_leg_only": True,
+               "failure_chance": 4.4e-5, "failure_chance_ci95": [3.4e-5, 5.3e-5], "effective_sample_size": 812.4,
+               "warning": "<b>few</b> effective failures"}  # fmt: skip
+    result = {
+        "reaches_goal": True,
+        "plan": [{}],
+        "chance": 0.99,
+        "highest_m": 0.6,
+        "seconds": 1.0,
+        "importance_sampling": sampled,
+    }
+    words_of = "async ([job, result]) => (await import('/panel/plan_view.js')).planWords(7, job, result, 'stairs')"
+    words = page.evaluate(words_of, [job, result])
+    assert "10000 importance-sampled climbs (psi0, zeta0 draws × 3 at touchdown 0)" in words, words
+    assert "failure chance 0.000044 (95%: 0.000034–0.000053), effective sample size 812" in words, words
+    assert words.endswith("— <b>few</b> effective failures."), "the service's words, as text"

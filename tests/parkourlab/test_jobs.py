@@ -124,7 +124,8 @@ EVERY_FIELD = {
     ),
     "plan": lambda c: c.submit_plan(
         3, 0.5, launch_gait=False, attempts=10, replans=1, cap=50, seed=2, noise={"velocity": 0.01},
-        state=(-0.9, 0.1), model={"preset": "paper"}, experiment_id=2,
+        state=(-0.9, 0.1), importance_sampling={"trials": 20, "scale": 2.0, "draws": ["psi0"], "first_leg": True},
+        model={"preset": "paper"}, experiment_id=2,
     ),
     "world-mjtf": lambda c: c.submit_world_mjtf(
         3, [(30, 0.9)], goal_height_m=0.5, trials=5, cap=50, seed=2, noise={"velocity": 0.01}, state=(-0.9, 0.1),

@@ -56,10 +56,47 @@ def test_a_goal_no_plan_reaches_is_said_not_failed(sessions, session, compute):
         assert result["highest_m"] < 1.9 and "monte_carlo" not in result
 
 
+def test_a_plans_importance_sampling_is_sim_cores(sessions, session, compute):
+    from sim_core.model.noise import NoiseModel
+    from sim_core.planning.launch import start_velocity
+    from sim_core.planning.plan_importance import plan_importance
+    from sim_core.planning.plan_splitting import PlanSplitting
+    from sim_core.planning.planner import plan_climb
+    from sim_core.world.files import world_from_document
+
+    held = worlds.create(session, WorldCreate(name="holds 4", random={"seed": 4}))
+    sampling = {"trials": 300, "scale": 2.0, "draws": ["psi0"], "first_leg": True}
+    done = planned(sessions, session, compute, world_id=held.id, seed=3, replans=0, importance_sampling=sampling)
+    result = jobs.job_results(session, done.id).result
+    assert "monte_carlo" not in result and (done.completed, done.total) == (2, 2), "the search, then the climbs"
+    robot = get_preset("paper")
+    model, world, goal = robot.to_model(), world_from_document(held.world), 0.5 / robot.leg_length
+    plan = plan_climb(model, world, goal, start_velocity(model), seed=3)
+    options = PlanSplitting(seed=3, cap=200, max_replans=0)
+    expected = plan_importance(model, world, plan, goal, NoiseModel(), options, 300, 3, 2.0, scaled=("psi0",),
+                               first_leg_only=True).to_dict()  # fmt: skip
+    got = result["importance_sampling"]
+    for document in (got, expected):
+        document.pop("seconds")
+    assert got == expected and got["trials"] == 300 and got["scaled"] == ["psi0"] and got["first_leg_only"]
+
+
+def test_the_plan_jobs_importance_limits_are_sim_cores():
+    from backend.jobs.plan import DRAW_KINDS, SCALE_LIMITS
+    from sim_core.model.noise_rules import TALLY_KINDS
+    from sim_core.planning import plan_importance
+
+    assert (DRAW_KINDS, SCALE_LIMITS) == (TALLY_KINDS, plan_importance.SCALE_LIMITS)
+
+
 @pytest.mark.parametrize(
     ("changes", "field"),
     [({}, "world_id"), ({"world_id": 1, "goal_height_m": 0}, "goal_height_m"), ({"world_id": 1, "attempts": -1},
-     "attempts"), ({"world_id": 1, "attempts": 100_000, "cap": 10_000}, "over the limit")],
+     "attempts"), ({"world_id": 1, "attempts": 100_000, "cap": 10_000}, "over the limit"),
+     ({"world_id": 1, "importance_sampling": {"trials": 100, "scale": 6}}, "importance_sampling.scale"),
+     ({"world_id": 1, "importance_sampling": {"trials": 100, "draws": ["leg"]}}, "importance_sampling.draws"),
+     ({"world_id": 1, "importance_sampling": {"trials": 1}}, "importance_sampling.trials"),
+     ({"world_id": 1, "importance_sampling": {"trials": 100_000}, "cap": 10_000}, "importance_sampling.trials) x cap")],
 )  # fmt: skip
 def test_a_bad_plan_is_refused_naming_the_field(changes, field):
     with pytest.raises(ValidationError) as refused:
