@@ -5,7 +5,8 @@ virtual robot runs too) and drawn as a :class:`~frontend.viewer.motion.PathClip`
 coordinates, docs/model.md §2).
 
 - :class:`JumpPlan` — one simulated jump and its clip;
-- :func:`model_jump` — one jump of the model from a touchdown (live mode's ghost);
+- :func:`model_jump` — one jump of the model from a touchdown (live mode's ghost; in a world:
+  :func:`frontend.viewer.world_ghost.world_jump`);
 - :class:`Controls` — what simulate mode's sliders set: both legs and the robot;
 - :class:`SimulatedClimb` — the model climbing in real time, each jump with the controls of the
   moment it starts, the next leg read at lift-off as the robot does, ending at a failing jump, at
@@ -45,8 +46,9 @@ class JumpPlan:
     clip: PathClip
 
     @classmethod
-    def of(cls, jump: Jump, robot: PhysicalParams) -> JumpPlan:
-        samples, wall = jump.samples, jump.wall
+    def of(cls, jump: Jump, robot: PhysicalParams, samples: Samples | None = None) -> JumpPlan:
+        """``jump`` drawn from its own samples, or from ``samples`` (its samples with more beside them)."""
+        samples, wall = jump.samples if samples is None else samples, jump.wall
         clip = PathClip(
             **{name: getattr(samples, name) for name in Samples.COLUMNS},
             leg_wall=np.where(samples.phase == STANCE, wall, wall.other),

@@ -3,9 +3,11 @@
 It reads the one robot through the robot service's immutable snapshots (``run_snapshot()``,
 ``tracker``, ``status()``), so everyone who chooses it sees the same robot; it never commands
 the robot. The ghost is the model's jump from each touchdown the live run detected, predicted
-with the paper's model or a calibration (:mod:`frontend.viewer.ghost_models`), between the
-parallel walls: a run in a stored world is drawn in that world (and the plan it follows, if any:
-:mod:`frontend.viewer.modes.live_world`), without the ghost.
+with the paper's model or a calibration (:mod:`frontend.viewer.ghost_models`): between the
+parallel walls (:func:`frontend.viewer.simulated_climb.model_jump`), or, for a run in a stored world
+(drawn in that world, with the plan it follows if any: :mod:`frontend.viewer.modes.live_world`),
+in that world's sides (:func:`frontend.viewer.world_ghost.world_jump`). A jump the model fails is
+drawn up to the failure, and the readout says why.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from frontend.viewer.modes.live_world import LiveWorld
 from frontend.viewer.motion import TRAIL_STRIDE, PathClip
 from frontend.viewer.scene import TOUCHDOWN_MARKERS, ChuteScene
 from frontend.viewer.simulated_climb import JumpPlan, model_jump
+from frontend.viewer.world_ghost import in_leg_lengths, world_jump
 
 
 class LiveMode(Mode):
@@ -134,9 +137,15 @@ class LiveMode(Mode):
             realised(offsets, controls[k], touchdown.wall),
             realised(offsets, next_leg, touchdown.wall.other),
         )
+        world = self.run_world.world
         try:
-            plan = model_jump(robot, touchdown.state, leg, next_leg, wall=touchdown.wall,
-                              start_time=touchdown.time, start_height=touchdown.body_height)  # fmt: skip
+            if world is None:
+                plan = model_jump(robot, touchdown.state, leg, next_leg, wall=touchdown.wall,
+                                  start_time=touchdown.time, start_height=touchdown.body_height)  # fmt: skip
+            else:  # the foot on the side it met, at its height: as History's prediction in a world
+                plan = world_jump(robot, in_leg_lengths(world, self.run_world.leg_length, robot), touchdown.state,
+                                  leg, next_leg, wall=touchdown.wall, start_time=touchdown.time,
+                                  foot_height=touchdown.foot_height)  # fmt: skip
         except (ValueError, ArithmeticError):
             plan = None
         self._ghosts[k] = plan
@@ -165,9 +174,18 @@ class LiveMode(Mode):
         body = PathClip.from_body([pose.time], [pose.x], [pose.y]).pose_at(pose.time)
         self.scene.show(body, None, None, follow=True)
         k = len(touchdowns) - 1
-        # The model's jump is between parallel walls: in a world it would fly through the sides.
-        ghost = bool(touchdowns) and self.gui_ghost.value and run_world.world is None
+        ghost = bool(touchdowns) and self.gui_ghost.value
         self._show_ghost(self._ghost(touchdowns, k) if ghost else None, k, pose.time)
+
+    def ghost_words(self) -> str:
+        """The readout's line of the ghost's jump under way when the model fails it ("" otherwise)."""
+        plan = self._ghosts.get(self._marked - 1) if self.gui_ghost.value else None
+        if plan is None or plan.failure is None:
+            return ""
+        where = "in the world" if self.run_world.world is not None else "between the walls"
+        failure = plan.failure
+        return (f"**Model ghost:** the model's jump from touchdown {self._marked - 1} fails {where}: "
+                f"{failure.code} — {failure.message}; drawn up to it  \n")  # fmt: skip
 
     def readout(self, updates_per_s: float) -> str:
         service = self.robot_service
@@ -185,6 +203,7 @@ class LiveMode(Mode):
             f"**Link:** {status['state']} · **tracker:** {tracker['received']} frames, "
             f"{100 * tracker['loss']:.1f}% lost · {where}  \n"
             f"**Touchdowns this run:** {self._marked} · **model's touchdown height error (last jump):** {error}  \n"
+            f"{self.ghost_words()}"
             f"{self.run_world.words()}"
             f"{updates_per_s:.0f} updates/s"
         )

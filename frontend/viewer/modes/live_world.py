@@ -6,8 +6,9 @@ replay draws a stored run's world) and, when it follows a plan, its ``plan_job_i
 (:func:`backend.services.view.stored_plan_footholds`). The world's sides are drawn in place of the
 parallel walls, each touchdown marked where the foot met its side, and a followed plan's footholds
 as simulate mode's "Follow a plan" marks them: each touchdown's target hit (green) or missed (red)
-once it has passed, the next one aimed at (yellow) while the run goes on. A run in no world climbs
-the parallel walls.
+once it has passed, the next one aimed at (yellow) while the run goes on. Live mode's ghost jumps
+in the world's sides (:func:`frontend.viewer.world_ghost.world_jump`). A run in no world climbs the
+parallel walls.
 """
 
 from __future__ import annotations
@@ -26,8 +27,6 @@ from sim_core.model.errors import ParameterError
 from sim_core.model.walls import Wall
 from sim_core.world.files import world_from_document
 from sim_core.world.world import World
-
-GHOST_WORDS = "the model's ghost jumps between parallel walls: not drawn in a world"
 
 
 def foot_on_side(world: World, leg_length: float, wall: int, foot_height: float) -> float:
@@ -115,4 +114,4 @@ class LiveWorld:
             return "" if self.note == "" else f"**World:** {self.note}  \n"
         plan = "" if self.plan_job_id is None else f" · following plan job {self.plan_job_id}"
         note = "" if self.note == "" else f" · {self.note}"
-        return f"**Climbing** world {self.world_id} {self.world.name!r}{plan}{note} · {GHOST_WORDS}  \n{LEGEND}  \n"
+        return f"**Climbing** world {self.world_id} {self.world.name!r}{plan}{note}  \n{LEGEND}  \n"
