@@ -50,10 +50,12 @@ followChanged();
 export async function loadPlans() {
   const page = await call("GET", "/jobs?kind=plan&state=done&limit=100");
   const select = $("#plan-job"), chosen = select.value;
+  const fresh = page.items.filter((job) => !plans.has(job.id));  // results asked at once, not one after another
+  const results = await Promise.all(fresh.map((job) => call("GET", `/jobs/${job.id}/results`)));
+  fresh.forEach((job, k) => plans.set(job.id, { job, result: results[k].result }));
   const options = [];
   for (const job of page.items) {
-    const result = plans.get(job.id)?.result ?? (await call("GET", `/jobs/${job.id}/results`)).result;
-    plans.set(job.id, { job, result });
+    const { result } = plans.get(job.id);
     const world = (await worldById(job.world_id).catch(() => null))?.name ?? `world ${job.world_id}`;
     const reach = result?.reaches_goal ? `${result.plan.length} touchdowns` : `does not reach it (highest foot ${fixed(result?.highest_m, 3)} m)`;
     const option = element("option", `job ${job.id}: "${world}" to ${job.spec?.goal_height_m} m, ${reach}`);
@@ -142,7 +144,9 @@ async function storedJournal(runId, started) {
   showJournal(started);
   $("#robot-journal-caption").textContent = `Run ${runId}'s journal (as stored): each command the run sent` +
     `${results.plan_job_id ? `, aimed at plan job ${results.plan_job_id}'s footholds` : ""}; it ended "${results.end_reason ?? "—"}".`;
-  if (results.plan_job_id && shown?.id === results.plan_job_id) markFeet(results.touchdowns ?? [], shown.result.leg_length_m);
+  if (!results.plan_job_id) return;
+  if (shown?.id !== results.plan_job_id) await showPlan(results.plan_job_id);  // a run this panel did not start
+  if (shown?.id === results.plan_job_id) markFeet(results.touchdowns ?? [], shown.result.leg_length_m);
 }
 
 // Where a side is at height ``y`` [l0]: its segment spanning y, interpolated (null: none does).
