@@ -103,7 +103,7 @@ class ModelIn(Strict):
 
 class StateIn(Strict):
     xdot: Annotated[float, Field(lt=0.0, ge=-100.0, description="section xdot [sqrt(g l0)], < 0")]
-    ydot: Annotated[float, Field(ge=-100.0, le=100.0)]
+    ydot: Annotated[float, Field(ge=-100.0, le=100.0, description="section ydot [sqrt(g l0)]")]
 
 
 class Health(BaseModel):

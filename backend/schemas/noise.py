@@ -14,13 +14,43 @@ _NOISE = NoiseModel()  # the noise's defaults
 
 
 class NoiseIn(Strict):
-    psi0_deg: Annotated[float, Field(ge=0.0, lt=SIGMA_LIMITS["psi0_deg"])] = _NOISE.psi0_deg
-    zeta0: Annotated[float, Field(ge=0.0, lt=SIGMA_LIMITS["zeta0"])] = _NOISE.zeta0
-    velocity: Annotated[float, Field(ge=0.0, lt=SIGMA_LIMITS["velocity"])] = _NOISE.velocity
-    pitch_drift_deg: Annotated[float, Field(ge=0.0, lt=SIGMA_LIMITS["pitch_drift_deg"])] = _NOISE.pitch_drift_deg
+    psi0_deg: Annotated[
+        float,
+        Field(ge=0.0, lt=SIGMA_LIMITS["psi0_deg"], description="the leg angle's standard deviation at touchdown [deg]"),
+    ] = _NOISE.psi0_deg
+    zeta0: Annotated[
+        float,
+        Field(ge=0.0, lt=SIGMA_LIMITS["zeta0"], description="the leg length's standard deviation at touchdown [l0]"),
+    ] = _NOISE.zeta0
+    velocity: Annotated[
+        float,
+        Field(
+            ge=0.0,
+            lt=SIGMA_LIMITS["velocity"],
+            description="each section-state component's standard deviation after a jump [sqrt(g l0)]",
+        ),
+    ] = _NOISE.velocity
+    pitch_drift_deg: Annotated[
+        float,
+        Field(
+            ge=0.0,
+            lt=SIGMA_LIMITS["pitch_drift_deg"],
+            description="the standard deviation of the pitch random walk's step a jump [deg]",
+        ),
+    ] = _NOISE.pitch_drift_deg
     asymmetry_psi0_deg: Annotated[
-        float, Field(gt=-ASYMMETRY_LIMITS["asymmetry_psi0_deg"], lt=ASYMMETRY_LIMITS["asymmetry_psi0_deg"])
+        float,
+        Field(
+            gt=-ASYMMETRY_LIMITS["asymmetry_psi0_deg"],
+            lt=ASYMMETRY_LIMITS["asymmetry_psi0_deg"],
+            description="the right leg's constant leg-angle offset [deg]",
+        ),
     ] = _NOISE.asymmetry_psi0_deg
     asymmetry_zeta0: Annotated[
-        float, Field(gt=-ASYMMETRY_LIMITS["asymmetry_zeta0"], lt=ASYMMETRY_LIMITS["asymmetry_zeta0"])
+        float,
+        Field(
+            gt=-ASYMMETRY_LIMITS["asymmetry_zeta0"],
+            lt=ASYMMETRY_LIMITS["asymmetry_zeta0"],
+            description="the right leg's constant leg-length offset [l0]",
+        ),
     ] = _NOISE.asymmetry_zeta0

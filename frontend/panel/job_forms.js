@@ -5,27 +5,32 @@
 // request body's schema in the OpenAPI document (the catalog names it): a number field per
 // property that takes a plain number — or a list of them, comma-separated (a reach job's range:
 // low, high) — its default filled in, its description as its title, its range checked as every
-// form's is (fields.js; a list's count and order are the API's to say). A kind whose body needs
-// more (legs, a list of names) is left to its own fieldset in index.html, or to the API — save a
-// stored world (a chooser of worlds by name, a foothold study's random worlds, a world-mjtf job's legs:
-// job_world.js). So a job kind added to the service's registry can be scheduled from the panel
-// with no change here.
+// form's is (fields.js; a list's count and order are the API's to say) — and a fieldset per
+// property that is an object of its own (a starting state, the noise, a plan's importance
+// sampling: job_object_fields.js), an optional one behind its checkbox "set <name>". A kind whose
+// body needs more (legs, a list of names) is left to its own fieldset in index.html, or to the API
+// — save a stored world (a chooser of worlds by name, a foothold study's random worlds, a
+// world-mjtf job's legs: job_world.js). So a job kind added to the service's registry can be
+// scheduled from the panel with no change here.
 import { $, say, on } from "./api.js";
 import { Fields } from "./fields.js";
 import { attributes, element } from "./dom.js";
 import { SQRT_GL0, checked, simControls } from "./forms.js";
 import { loadCatalog } from "./catalog.js";
 import { WORLD_PARTS, worldPart } from "./job_world.js";
+import { objectField, words } from "./job_object_fields.js";
 
-const SKIPPED = new Set(["kind", "experiment_id", "model"]);  // the kind is the chooser's; the others have their own controls
+// The kind is the chooser's, the experiment the "in experiment" choice's; no job form sets the
+// model (each job runs the paper's, the service's default, as the forms in index.html do).
+const SKIPPED = new Set(["kind", "experiment_id", "model"]);
 
-// The simple number properties of ``request`` (a schema name) and the names of its world's
-// properties (job_world.js), or null when a required one is neither.
-async function numberFields(request) {
-  const schema = await Fields.schema(request);
+// The simple number properties of ``kind``'s request, its object fields (job_object_fields.js) and
+// the names of its world's properties (job_world.js), or null when a required one is none of these.
+async function numberFields(kind) {
+  const schema = await Fields.schema(kind.request);
   if (!schema?.properties) return null;
   const required = new Set(schema.required || []);
-  const fields = [], world = [];
+  const fields = [], world = [], objects = [];
   for (const [name, property] of Object.entries(schema.properties)) {
     if (SKIPPED.has(name)) continue;
     if (WORLD_PARTS.has(name)) {
@@ -35,19 +40,21 @@ async function numberFields(request) {
     const plain = Fields.plain(property);
     const items = plain?.type === "array" ? Fields.plain(plain.items) : null;  // a list of numbers, or not
     if (!["number", "integer"].includes((items ?? plain)?.type)) {
-      if (required.has(name)) return null;
+      const object = objectField(kind.name, kind.request, name, property, required.has(name));
+      if (object) objects.push(object);
+      else if (required.has(name)) return null;
       continue;
     }
     fields.push({ name, plain, list: items !== null, required: required.has(name), title: property.description ?? plain.description ?? "" });
   }
-  return { fields, world };
+  return { fields, world, objects };
 }
 
 // A fieldset for ``kind`` ({name, title, request}) built from its schema, or null if it cannot be.
 async function generatedFieldset(kind) {
-  const found = await numberFields(kind.request);
+  const found = await numberFields(kind);
   if (!found) return null;
-  const { fields } = found;
+  const { fields, objects } = found;
   const part = found.world.length ? worldPart(kind.name, found.world) : null;
   if (found.world.length && !part) return null;
   const fieldset = attributes(element("fieldset", null, element("legend", kind.title), ...(part?.nodes ?? [])),
@@ -57,25 +64,31 @@ async function generatedFieldset(kind) {
       : { name: `${kind.name}__${field.name}`, type: "number", step: field.plain.type === "integer" ? "1" : "any" });
     const initial = field.plain.default;
     if (initial !== undefined && initial !== null) input.value = Array.isArray(initial) ? initial.join(", ") : String(initial);
-    const label = element("label", `${field.name.replace(/_(m|deg|s)$/, " [$1]").replaceAll("_", " ")} `, input);  // goal_height_m: "goal height [m]"
+    const label = element("label", `${words(field.name)} `, input);  // goal_height_m: "goal height [m]"
     if (field.title) label.title = field.title;
     fieldset.append(label);
   }
+  fieldset.append(...objects.map((object) => object.node));
   fieldset.hidden = true;
   fieldset.disabled = true;
   const numbers = fields.map((field) => ({ name: `${kind.name}__${field.name}`, rule: `${kind.request}.${field.name}`, optional: !field.required,
     list: field.list }));
-  return { fieldset, fields: numbers, part };
+  return { fieldset, fields: numbers, part, objects };
 }
 
 // The body and the 422's locations of a generated kind's form, from the checked values ``v``
 // (null: its world's part marked a field).
-function generatedBody(form, kind, { fields, part }, v) {
+function generatedBody(form, kind, { fields, part, objects }, v) {
   const body = { kind }, locations = { ...part?.locations };
   for (const field of fields) {
     const property = field.name.slice(kind.length + 2);
     if (v[field.name] !== undefined) body[property] = v[field.name];
     locations[property] = field.name;
+  }
+  for (const object of objects) {
+    const value = object.value(form, v);
+    if (value !== undefined) body[object.name] = value;
+    Object.assign(locations, object.locations);
   }
   const world = part ? part.body(form, v) : {};
   if (world === null) return null;
@@ -93,7 +106,7 @@ on("#job-kind", "change", (event) => {
 // The kind chooser, from the service's catalog: a kind with its own fieldset in index.html, or
 // one built from its request's schema (job_forms.js), in the registry's order; a kind whose
 // body the panel cannot build (a gait search's legs) is left to the API.
-const GENERATED = new Map();  // kind -> its generated form: {fieldset, fields, part (its world's: job_world.js)}
+const GENERATED = new Map();  // kind -> its generated form: {fieldset, fields, part (its world's: job_world.js), objects}
 async function fillJobKinds() {
   const form = $("#job-form"), select = $("#job-kind");
   const options = [];
@@ -152,8 +165,11 @@ const JOB_LOCATIONS = { psi0_deg: "psi0", zeta0s: "zeta0s", trials: "trials", ca
 export async function jobSpec(form) {
   const kind = form.elements.kind.value;
   const made = GENERATED.get(kind);
-  const v = await checked(form, JOB_FIELDS[kind] ?? [...made.fields, ...(made.part?.fields(form) ?? [])]);
-  if (made?.part && !made.part.chosen(form)) {
+  const v = await checked(form, JOB_FIELDS[kind]
+    ?? [...made.fields, ...(made.part?.fields(form) ?? []), ...made.objects.flatMap((object) => object.fields(form))]);
+  // Its world chosen and its lists of names counted, each marked where it is not (all in this one pass).
+  const refused = made ? [made.part && !made.part.chosen(form), ...made.objects.map((object) => !object.valid(form))] : [];
+  if (refused.some(Boolean)) {
     if (v !== null) say("Fix the marked field(s) first: nothing was sent.", "error");
     return null;
   }
