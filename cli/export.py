@@ -1,5 +1,6 @@
-"""``parkour export``: a stored robot or replay run as an MCAP recording, which Foxglove and Rerun
-open (the format: docs/service.md, "Recordings"; the writer: backend/services/mcap_export.py)."""
+"""``parkour export``: a stored run — robot, replay, or simulated with its path — as an MCAP recording,
+which Foxglove and Rerun open (the format: docs/service.md, "Recordings"; the writers:
+backend/services/mcap_export.py, a simulation's backend/services/mcap_sim.py)."""
 
 from __future__ import annotations
 
@@ -18,14 +19,15 @@ app = typer.Typer(rich_markup_mode=None)
 @app.command("export")
 @handles_errors
 def export_command(
-    run_id: Annotated[int, typer.Argument(help="The run's id (a robot or replay run).", min=1)],
+    run_id: Annotated[int, typer.Argument(help="The run's id (a robot, replay or simulated run).", min=1)],
     out: Annotated[
         Path | None, typer.Option("--out", help="The MCAP file to write; default parkourlab-run-RUN_ID.mcap.")
     ] = None,
     data_dir: DataDirOption = None,
     json_output: JsonOption = False,
 ) -> None:
-    """Export a robot or replay run as MCAP: tracker poses, touchdowns, commands, telemetry, the model's prediction."""
+    """Export a run as MCAP: a robot or replay run's tracker poses, touchdowns, commands, telemetry and the model's
+    prediction; a simulated run's path (stored with trajectory_rate) and touchdowns on the same channels."""
     from backend.errors import Conflict, NotFound
     from backend.services import mcap_export
 

@@ -233,8 +233,9 @@ class Client(JobCalls, WorldCalls):
         return self._http.download("/api/v1/runs/export", path, {"format": format} | run_filters(filters))
 
     def export_mcap(self, run_id: int, path: str | Path) -> Path:
-        """A robot or replay run as an MCAP recording (Foxglove, Rerun) written to ``path``;
-        Conflict for a simulated run (its path is :meth:`trajectory`)."""
+        """A run as an MCAP recording (Foxglove, Rerun) written to ``path``: a robot or replay run,
+        or a simulated run stored with its path (``trajectory_rate``); Conflict for one stored
+        without (its touchdowns are in :meth:`run`) or still running."""
         return self._http.download(f"/api/v1/runs/{run_id}/export.mcap", Path(path))
 
     # Experiments -------------------------------------------------------------------------------

@@ -1,6 +1,8 @@
-"""A robot or replay run as an MCAP recording (https://mcap.dev), which Foxglove and Rerun open.
+"""A stored run as an MCAP recording (https://mcap.dev), which Foxglove and Rerun open: a robot
+run's or a replay's here, a simulated run's in :mod:`backend.services.mcap_sim`, both made of the
+same parts (:mod:`backend.services.mcap_recording`), so that a simulation opens beside a robot run.
 
-The run's own channels, protobuf messages of package ``parkourlab`` (topics, fields and units:
+A robot run's own channels, protobuf messages of package ``parkourlab`` (topics, fields and units:
 :mod:`backend.services.mcap_schemas`):
 
 - ``/tracker/pose``: one message per tracker frame;
@@ -27,52 +29,42 @@ A replay run has no frames, commands or telemetry of its own: its recording is i
 (frames, commands, telemetry, link, and times from the source's start) with the replay's own
 touchdowns and prediction. The run's metadata — id, kind, model, controls, code version,
 calibration, how it ended — is a Metadata record named ``parkourlab.run`` (text as it is, any
-other value as JSON text).
-Simulated runs are not recordings (nondimensional, no clock) and are refused with a Conflict.
+other value as JSON text). A run still running, a replay whose source is gone and a simulated run
+without a stored path are refused with a Conflict.
 """
 
 from __future__ import annotations
 
-import json
-import math
-from collections.abc import Iterator
-from dataclasses import dataclass
-from functools import partial
 from typing import BinaryIO
 
 from sqlalchemy.orm import Session
 
 from backend.errors import Conflict
 from backend.repositories import runs as stored_runs
+from backend.services import mcap_sim
 from backend.services.mcap_clock import TrackerClock, utc
+from backend.services.mcap_recording import (
+    METADATA_NAME,
+    Recording,
+    metadata_text,
+    poses,
+    touchdown,
+    with_drawings,
+    write_recording,
+)
 from backend.services.robot_records import recorded_leg_for
 from backend.store.models import Run
 from backend.store.trajectory_blob import unpack_trajectory
-from experiments.manifest import json_safe
 
-EXPORTED_KINDS = ("robot", "replay")
-METADATA_NAME = "parkourlab.run"
+__all__ = ["EXPORTED_KINDS", "METADATA_NAME", "Recording", "export_run", "recording_of"]
+
+EXPORTED_KINDS = ("robot", "replay", "sim")
 TIME_CONVENTION = (
     "log time = publish time = UTC ns on the tracker's clock: recorded_at + (t - the first frame's t); t a frame's, "
     "touchdown's or prediction's tracker time, a command's or telemetry's tracker_time (the newest frame's when it "
     "was sent or heard), else its Unix time carried to the tracker's clock through the run's (time, tracker_time) "
     "pairs (backend/services/mcap_clock.py)"
 )
-
-
-@dataclass(frozen=True)
-class Recording:
-    """What a run's MCAP holds before it is written: each topic's messages as (log time [ns],
-    message), in the order they happened — a dict of its fields on the channels of
-    :mod:`~backend.services.mcap_schemas`, a protobuf message or a float on those of
-    :mod:`~backend.services.mcap_visuals` — and the run's metadata (:func:`_metadata`)."""
-
-    run_id: int
-    messages: dict[str, list[tuple[int, object]]]
-    metadata: dict[str, str]
-
-    def counts(self) -> dict[str, int]:
-        return {topic: len(messages) for topic, messages in self.messages.items()}
 
 
 def export_run(session: Session, run_id: int, stream: BinaryIO) -> dict[str, int]:
@@ -84,21 +76,27 @@ def export_run(session: Session, run_id: int, stream: BinaryIO) -> dict[str, int
 
 
 def recording_of(session: Session, run_id: int) -> Recording:
-    """The recording of a robot run that has ended, or of a replay whose source run is stored."""
-    from backend.services import mcap_visuals, mcap_world  # protobuf, Foxglove's schemas: loaded by exports only
-
+    """The recording of a run that has ended: a robot run's, a replay's whose source run is stored,
+    or a simulated run's with a stored path (:func:`backend.services.mcap_sim.recording`)."""
     run = stored_runs.get_run(session, run_id)
     if run.kind not in EXPORTED_KINDS:
-        raise Conflict(f"run {run_id} is a {run.kind} run: only robot and replay runs are recordings (MCAP);"
-                       f" its path is at /api/v1/runs/{run_id}/trajectory")  # fmt: skip
+        raise Conflict(f"run {run_id} is a {run.kind} run: only {', '.join(EXPORTED_KINDS)} runs export as MCAP")
     if run.status == "running":
         raise Conflict(f"run {run_id} is still running; export it once it has ended")
+    if run.kind == "sim":
+        return mcap_sim.recording(session, run)
+    return _recorded(session, run)
+
+
+def _recorded(session: Session, run: Run) -> Recording:
+    """A robot run's recording, or a replay's: its source run's frames, commands, telemetry and link
+    with its own touchdowns and prediction."""
     source = run
     if run.kind == "replay":
         source_id = run.results.get("source_run_id")
         source = stored_runs.find(session, source_id) if isinstance(source_id, int) else None
         if source is None:
-            raise Conflict(f"replay run {run_id}'s source run {source_id} is gone: its frames were not kept")
+            raise Conflict(f"replay run {run.id}'s source run {source_id} is gone: its frames were not kept")
     frames = unpack_trajectory(source.trajectory) if source.trajectory is not None else None
     first_frame_time = float(frames["time"][0]) if frames is not None and frames["time"].size else 0.0
     commands, telemetry = source.results.get("commands", []), source.results.get("telemetry", [])
@@ -113,11 +111,11 @@ def recording_of(session: Session, run_id: int) -> Recording:
         leg_for = recorded_leg_for(source)
         controls = [{"psi0_deg": leg.psi0_deg, "zeta0": leg.zeta0} for leg in map(leg_for, range(len(touchdowns)))]
     rises = results.get("rises", [])
-    poses = [(at(frame["tracker_time"]), frame) for frame in _poses(frames)]
+    tracked = [] if frames is None else poses(frames["time"], frames["x"], frames["y"], frames.get("pitch"))
     messages = {
-        "/tracker/pose": poses,
+        "/tracker/pose": [(at(pose["tracker_time"]), pose) for pose in tracked],
         "/touchdowns": [
-            (at(td["time"]), _touchdown(td, controls[k] if k < len(controls) else None, rises))
+            (at(td["time"]), touchdown(td, controls[k] if k < len(controls) else None, rises))
             for k, td in enumerate(touchdowns)
         ],
         "/commands": _on_clock(clock, commands),
@@ -128,61 +126,8 @@ def recording_of(session: Session, run_id: int) -> Recording:
         ],
         "/robot/link": _on_clock(clock, source.results.get("transitions", [])),
     }
-    # The chute, once at the recording's start: its earliest message, or its first frame's time.
-    start = min((time for timed in messages.values() for time, _ in timed), default=at(first_frame_time))
-    chute = mcap_world.messages(mcap_world.chute_of(session, source, frames), start)
-    return Recording(run.id, messages | mcap_visuals.drawn(messages) | chute, _metadata(run, source))
-
-
-def write_recording(recording: Recording, stream: BinaryIO) -> None:
-    """The recording as MCAP on ``stream``: a schema and channel per topic (even one without
-    messages; the run's own channels first), the metadata record, then every message in log-time order."""
-    from mcap.writer import Writer  # the exports load it, not the service's start
-    from mcap_protobuf.schema import register_schema
-
-    from backend.services import mcap_schemas, mcap_visuals
-
-    writer = Writer(stream)
-    writer.start(profile="", library="parkourlab")
-    channels = {}
-    for topic, name in mcap_schemas.TOPICS.items():
-        schema_id = register_schema(writer, mcap_schemas.message_class(name))
-        channels[topic] = (writer.register_channel(topic, "protobuf", schema_id), partial(mcap_schemas.encode, topic))
-    channels |= mcap_visuals.register(writer)
-    writer.add_metadata(METADATA_NAME, recording.metadata)
-    timed = sorted(
-        ((time, topic, sequence, message) for topic in channels
-         for sequence, (time, message) in enumerate(recording.messages[topic])),
-        key=lambda item: item[0],
-    )  # fmt: skip
-    for time, topic, sequence, message in timed:
-        channel_id, encoder = channels[topic]
-        writer.add_message(channel_id, log_time=time, data=encoder(message), publish_time=time, sequence=sequence)
-    writer.finish()
-
-
-def _poses(frames: dict | None) -> Iterator[dict]:
-    if frames is None:
-        return
-    times, xs, ys = frames["time"].tolist(), frames["x"].tolist(), frames["y"].tolist()
-    pitches = frames["pitch"].tolist() if "pitch" in frames else [math.nan] * len(times)
-    for t, x, y, pitch in zip(times, xs, ys, pitches, strict=True):
-        yield {"tracker_time": t, "x": x, "y": y, "pitch": pitch if math.isfinite(pitch) else None}
-
-
-def _touchdown(stored: dict, control: dict | None, rises: list) -> dict:
-    k = stored["index"]
-    return {
-        "index": k,
-        "tracker_time": stored["time"],
-        "wall": stored["wall"],
-        "state": stored["state"],
-        "body_height": stored["body_height"],
-        "foot_height": stored["foot_height"],
-        "poses_fitted": stored["poses_fitted"],
-        "control": control,
-        "rise": rises[k - 1] if 0 < k <= len(rises) else None,
-    }
+    drawn = with_drawings(session, source, frames, messages, at(first_frame_time))
+    return Recording(run.id, drawn, _metadata(run, source))
 
 
 def _predictions(prediction: dict | None, touchdowns: list[dict], rises: list) -> list[dict]:
@@ -230,7 +175,7 @@ def _metadata(run: Run, source: Run) -> dict[str, str]:
         "prediction_model": _prediction_model(run.results.get("prediction")),
         "time_convention": TIME_CONVENTION,
     }
-    return {name: value if isinstance(value, str) else json.dumps(json_safe(value)) for name, value in values.items()}
+    return metadata_text(values)
 
 
 def _prediction_model(prediction: dict | None) -> str | None:

@@ -2,7 +2,9 @@
 (:mod:`backend.services.mcap_export` writes them beside the run's own channels of
 :mod:`backend.services.mcap_schemas`; docs/service.md, "Recordings").
 
-Each is derived from the run's own channels and adds nothing to them; it is there to be drawn:
+Each is derived from the run's own channels and adds nothing to them; it is there to be drawn (a
+simulated run's recording, :mod:`backend.services.mcap_sim`, has those drawn from its body's path
+and touchdowns only):
 
 - the tracked body in Foxglove's own schemas, encoded as protobuf (``foxglove-schemas-protobuf``),
   which Foxglove's 3D panel and Rerun's MCAP importer (its ``foxglove`` decoder) both read:
@@ -30,7 +32,7 @@ from __future__ import annotations
 
 import math
 import struct
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from operator import methodcaller
 from typing import TYPE_CHECKING
 
@@ -95,33 +97,44 @@ _CDR_LE = b"\x00\x01\x00\x00"
 
 def drawn(messages: dict[str, list[tuple[int, dict]]]) -> dict[str, list[tuple[int, object]]]:
     """This module's channels, topic -> [(log time [ns], message)], from the run's own channels
-    (field dicts; times kept): protobuf messages for :data:`PROTOBUF_CHANNELS`, floats for :data:`SERIES`."""
-    poses = messages["/tracker/pose"]
-    touchdowns = messages["/touchdowns"]
-    predictions = messages["/model/prediction"]
-    return {
+    (field dicts; times kept): protobuf messages for :data:`PROTOBUF_CHANNELS`, floats for :data:`SERIES`.
+    A channel drawn from channels the run does not have is left out: ``/robot/log`` without
+    ``/robot/link`` and ``/commands``, ``/plot/prediction/rise`` without ``/model/prediction`` (a
+    simulation's recording)."""
+    poses = messages.get("/tracker/pose", [])
+    touchdowns = messages.get("/touchdowns", [])
+    drawings = {
         "/tracker/pose_in_frame": [(time, pose_in_frame(time, pose)) for time, pose in poses],
         "/tracker/transform": [(time, body_transform(time, pose)) for time, pose in poses],
         "/tracker/body": [(time, body_point(time, pose)) for time, pose in poses],
-        "/robot/log": robot_log(messages["/robot/link"], messages["/commands"]),
+    }
+    if "/robot/link" in messages or "/commands" in messages:
+        drawings["/robot/log"] = robot_log(messages.get("/robot/link", []), messages.get("/commands", []))
+    drawings |= {
         "/plot/height": [(time, pose["y"]) for time, pose in poses],
         "/plot/touchdown/body_height": [(time, td["body_height"]) for time, td in touchdowns],
         "/plot/touchdown/foot_height": [(time, td["foot_height"]) for time, td in touchdowns],
         "/plot/touchdown/rise": [(time, td["rise"]) for time, td in touchdowns if td["rise"] is not None],
-        "/plot/prediction/rise": [(time, p["rise"]) for time, p in predictions if p["rise"] is not None],
     }
+    if "/model/prediction" in messages:
+        predictions = messages["/model/prediction"]
+        drawings["/plot/prediction/rise"] = [(time, p["rise"]) for time, p in predictions if p["rise"] is not None]
+    return drawings
 
 
-def register(writer: Writer) -> dict[str, tuple[int, Callable[[object], bytes]]]:
-    """Register this module's schemas and channels on ``writer``, in order; topic -> (channel id,
-    the function that encodes one of its messages)."""
+def register(writer: Writer, topics: Collection[str]) -> dict[str, tuple[int, Callable[[object], bytes]]]:
+    """Register this module's schemas and channels that are among ``topics`` on ``writer``, in
+    order; topic -> (channel id, the function that encodes one of its messages)."""
     channels: dict[str, tuple[int, Callable[[object], bytes]]] = {}
     for topic, schema in PROTOBUF_CHANNELS.items():
-        channel_id = writer.register_channel(topic, "protobuf", register_schema(writer, schema))
-        channels[topic] = (channel_id, methodcaller("SerializeToString"))
-    series_schema = writer.register_schema(SERIES_SCHEMA, "ros2msg", SERIES_MSGDEF.encode())
-    for topic in SERIES:
-        channels[topic] = (writer.register_channel(topic, "cdr", series_schema), series_cdr)
+        if topic in topics:
+            channel_id = writer.register_channel(topic, "protobuf", register_schema(writer, schema))
+            channels[topic] = (channel_id, methodcaller("SerializeToString"))
+    series = [topic for topic in SERIES if topic in topics]
+    if series:
+        series_schema = writer.register_schema(SERIES_SCHEMA, "ros2msg", SERIES_MSGDEF.encode())
+        for topic in series:
+            channels[topic] = (writer.register_channel(topic, "cdr", series_schema), series_cdr)
     return channels
 
 

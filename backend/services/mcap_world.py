@@ -18,12 +18,13 @@ start:
   the slabs' colours. Rerun 0.41's importer draws no ``SceneUpdate`` (it keeps the message as a
   struct at ``/world/scene``) but draws this as coloured ``Points3D``.
 
-Which chute: the run's stored world (``runs.world_id``; a replay's, its source run's), read with
-the robot's leg length (:data:`ROBOT_PRESET`'s: the run stores its nondimensional model only); a
-run without one climbed parallel walls — every run stored before worlds — drawn as two vertical
-walls ``d_hat l0`` apart (its model's ``d_hat``) with the model's ``mu``, from the floor to a leg
-length above the body's highest frame. Past a world's first and last vertices a side goes on as a
-vertical wall with the model's ``mu`` (docs/model.md §8); that is not drawn.
+Which chute: the run's stored world (``runs.world_id``; a replay's, its source run's; a simulated
+run's, its own), read with the robot's leg length (:data:`ROBOT_PRESET`'s: the run stores its
+nondimensional model only); a run without one climbed parallel walls — every run stored before
+worlds — drawn as two vertical walls ``d_hat l0`` apart (its model's ``d_hat``) with the model's
+``mu``, from the floor to a leg length above the body's highest frame. Past a world's first and
+last vertices a side goes on as a vertical wall with the model's ``mu`` (docs/model.md §8); that is
+not drawn.
 """
 
 from __future__ import annotations
@@ -49,7 +50,7 @@ from sim_core.world.world import SIDES, Side, World, parallel
 
 FRAME = "chute"
 CHANNELS = {"/world/scene": SceneUpdate, "/world/points": PointCloud}  # topic -> Foxglove schema
-ROBOT_PRESET = "paper"  # the robot of the service's robot runs and replays (RobotService, replay_run)
+ROBOT_PRESET = "paper"  # the robot of the service's robot runs and replays (RobotService, replay_run); mcap_sim's scale
 DEPTH = 0.2  # [m] a slab's extent across the plane of the climb (along y)
 FOOTHOLD, NO_GRIP = 0.02, 0.005  # [m] a slab's thickness, into the wall
 FOOTHOLD_ALPHA, NO_GRIP_ALPHA = 1.0, 0.35
@@ -75,7 +76,8 @@ class Chute:
 
 
 def chute_of(session: Session, source: Run, frames: dict | None) -> Chute:
-    """The chute recorded run ``source`` climbed (its frames [m], if any, for parallel walls' height)."""
+    """The chute run ``source`` climbed — a robot run, or a simulated one (:mod:`backend.services.mcap_sim`) —
+    (its body's heights ``frames["y"]`` [m], if any, for parallel walls' height)."""
     l0 = get_preset(ROBOT_PRESET).leg_length
     if source.world_id is not None:
         stored = stored_worlds.get(session, source.world_id)

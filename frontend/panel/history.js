@@ -16,8 +16,11 @@ import "./compare.js";
 
 export { loadExperiments };
 // A robot or replay run that has ended downloads as an MCAP recording (Foxglove, Rerun open it),
-// and shows its touchdowns beside the model's predictions (touchdowns.js).
+// and shows its touchdowns beside the model's predictions (touchdowns.js); a simulated run stored
+// with its path downloads as one too (its path and touchdowns on the same channels), to open beside them.
 export const RECORDED_KINDS = ["robot", "replay"];
+const exportsMcap = (run) => (RECORDED_KINDS.includes(run.kind) && run.status !== "running")
+  || (run.kind === "sim" && run.has_trajectory);
 // The runs in the basket (Compare, 3D's ghost, Calibrate: calibration.js), as last listed.
 export const selectedRuns = () => basketRuns();
 
@@ -94,10 +97,11 @@ function created(run) {
 }
 
 function recordingLink(run) {
-  if (!RECORDED_KINDS.includes(run.kind) || run.status === "running") return [];
-  return [" ", attributes(element("a", "MCAP"), { href: `${API}/runs/${run.id}/export.mcap`, download: "", class: "export-mcap",
-    "aria-label": `download run ${run.id} as an MCAP recording (Foxglove, Rerun)` }), " ",
-  attributes(element("button", "touchdowns"), { type: "button", class: "show-touchdowns", "data-run": run.id,
+  if (!exportsMcap(run)) return [];
+  const mcap = [" ", attributes(element("a", "MCAP"), { href: `${API}/runs/${run.id}/export.mcap`, download: "", class: "export-mcap",
+    "aria-label": `download run ${run.id} as an MCAP recording (Foxglove, Rerun)` })];
+  if (!RECORDED_KINDS.includes(run.kind)) return mcap;
+  return [...mcap, " ", attributes(element("button", "touchdowns"), { type: "button", class: "show-touchdowns", "data-run": run.id,
     "aria-label": `run ${run.id}'s touchdowns, measured and predicted` })];
 }
 

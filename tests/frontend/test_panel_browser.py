@@ -499,6 +499,8 @@ def test_a_robot_run_downloads_as_mcap_from_history(page, service, data_dir):
     base, token = service
     simulated = page.request.post(f"{base}/api/v1/runs", data=RUN, headers={"Authorization": f"Bearer {token}"})
     assert simulated.status == 201, simulated.text()
+    with_path = page.request.post(f"{base}/api/v1/runs", data=RUN | {"trajectory_rate": 20.0},
+                                  headers={"Authorization": f"Bearer {token}"}).json()["id"]  # fmt: skip
     engine = make_engine(sqlite_url(data_dir))  # a robot run as a live run stores one, beside the service
     with session_factory(engine)() as session:
         run_id = store_robot_run(session)
@@ -510,11 +512,15 @@ def test_a_robot_run_downloads_as_mcap_from_history(page, service, data_dir):
     assert page.inner_text(link) == "MCAP" and page.get_attribute(link, "download") == ""
     assert page.get_attribute(link, "href") == f"/api/v1/runs/{run_id}/export.mcap"
     rows = page.evaluate(
-        "[...document.querySelectorAll('#run-table tbody tr')]"
-        ".map((row) => [row.children[2].textContent, !!row.querySelector('a.export-mcap')])"
+        "[...document.querySelectorAll('#run-table tbody tr')].map((row) => [row.id, row.children[2].textContent,"
+        " !!row.querySelector('a.export-mcap'), !!row.querySelector('button.show-touchdowns')])"
     )
-    assert {kind for kind, linked in rows if linked} <= {"robot", "replay"}
-    assert any(kind == "sim" and not linked for kind, linked in rows), "a simulated run is no recording"
+    assert [linked for row, *linked in rows if row == f"run-{with_path}"] == [["sim", True, False]], (
+        "a simulated run with its path downloads too (no measured touchdowns to show)"
+    )
+    assert {kind for _row, kind, linked, _ in rows if linked} <= {"robot", "replay", "sim"}
+    assert any(kind == "sim" and not linked for _row, kind, linked, _ in rows), "one stored without its path: none"
+    assert page.get_attribute(f"#run-{with_path} a.export-mcap", "href") == f"/api/v1/runs/{with_path}/export.mcap"
     recording = page.request.get(f"{base}{page.get_attribute(link, 'href')}")
     assert recording.ok and recording.headers["content-type"] == "application/octet-stream"
     summary = make_reader(io.BytesIO(recording.body())).get_summary()

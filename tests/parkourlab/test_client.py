@@ -146,7 +146,7 @@ def test_exports_to_files(client, paging_runs, tmp_path):
     records = json.loads(client.export_runs(tmp_path / "runs.json", tag="paging", zeta0_min=0.895).read_text())
     assert [record["leg0.zeta0"] for record in records] == [0.9]
     target = tmp_path / "sim.mcap"
-    with pytest.raises(Conflict, match="only robot and replay runs"):
+    with pytest.raises(Conflict, match="sim run stored without its path"):
         client.export_mcap(paging_runs[0]["id"], target)
     assert list(tmp_path.glob("sim.mcap*")) == [], "a refused download leaves no file"
 

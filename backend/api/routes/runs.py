@@ -117,9 +117,10 @@ async def get_trajectory(run_id: RecordId, db: Db) -> Response:
 
 @router.get("/{run_id}/export.mcap", response_class=McapResponse)
 async def export_mcap(run_id: RecordId, db: Db) -> McapResponse:
-    """A robot or replay run as an MCAP recording, which Foxglove and Rerun open: tracker poses,
-    touchdowns, commands, telemetry, link changes and the model's prediction (docs/service.md).
-    A simulated or still running run is a 409."""
+    """A run as an MCAP recording, which Foxglove and Rerun open (docs/service.md): a robot or replay
+    run's tracker poses, touchdowns, commands, telemetry, link changes and the model's prediction; a
+    simulated run's stored path and touchdowns on the same channels. A run still running, a replay
+    whose source is gone, or a simulated run stored without its path is a 409."""
     stream = io.BytesIO()
     await db(mcap_export.export_run, run_id, stream)
     disposition = f'attachment; filename="parkourlab-run-{run_id}.mcap"'

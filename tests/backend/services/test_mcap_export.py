@@ -1,7 +1,7 @@
 """Robot and replay runs as MCAP recordings, read back with the mcap reader and mcap-protobuf-support
 (backend/services/mcap_export.py), and their clock: a lagging robot's commands, telemetry and link
 changes among its frames. The channels drawn in Foxglove's and Rerun's formats are read in
-test_mcap_visuals.py."""
+test_mcap_visuals.py, simulated runs' recordings in test_mcap_sim.py."""
 
 import datetime
 import io
@@ -168,8 +168,8 @@ def test_a_replay_is_its_source_s_recording_with_its_own_touchdowns(session):
 
 
 def test_runs_that_are_no_recordings_are_refused(session, make_run):
-    simulated = make_run()
-    with pytest.raises(errors.Conflict, match="sim run: only robot and replay runs are recordings"):
+    simulated = make_run()  # stored without its path (a simulated run with one: test_mcap_sim.py)
+    with pytest.raises(errors.Conflict, match="sim run stored without its path: nothing to record"):
         export_run(session, simulated.id, io.BytesIO())
     running = open_robot_run(session, REQUEST, get_preset("paper"), Calibration())
     with pytest.raises(errors.Conflict, match="still running"):

@@ -89,7 +89,7 @@ def test_a_basket_exports_groups_and_lists_by_its_ids(client, auth):
     assert too_many.status_code == 422 and too_many.json()["detail"][0]["loc"] == ["query", "ids"]
 
 
-def test_a_robot_run_downloads_as_mcap(client, auth):
+def test_a_robot_or_simulated_run_downloads_as_mcap(client, auth):
     with client.app.state.sessions() as session:
         robot_run = store_robot_run(session)
     response = client.get(f"/api/v1/runs/{robot_run}/export.mcap")
@@ -102,9 +102,14 @@ def test_a_robot_run_downloads_as_mcap(client, auth):
     assert client.get(f"/api/v1/runs/{replay['id']}/export.mcap").status_code == 200
     missing = client.get("/api/v1/runs/999/export.mcap")
     assert (missing.status_code, missing.json()) == (404, {"detail": "run 999 does not exist"})
-    simulated = client.post("/api/v1/runs", json=RUN, headers=auth).json()
-    refused = client.get(f"/api/v1/runs/{simulated['id']}/export.mcap")
-    assert refused.status_code == 409 and "only robot and replay runs are recordings" in refused.json()["detail"]
+    simulated = client.post("/api/v1/runs", json=RUN | {"trajectory_rate": 20.0}, headers=auth).json()
+    recorded = client.get(f"/api/v1/runs/{simulated['id']}/export.mcap")
+    summary = make_reader(io.BytesIO(recorded.content)).get_summary()
+    counts = {summary.channels[i].topic: n for i, n in summary.statistics.channel_message_counts.items()}
+    assert recorded.status_code == 200 and counts["/touchdowns"] == 5 and "/commands" not in counts
+    pathless = client.post("/api/v1/runs", json=RUN, headers=auth).json()
+    refused = client.get(f"/api/v1/runs/{pathless['id']}/export.mcap")
+    assert refused.status_code == 409 and "sim run stored without its path" in refused.json()["detail"]
     assert client.get("/api/v1/runs/0/export.mcap").status_code == 422
 
 
