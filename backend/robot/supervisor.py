@@ -45,7 +45,7 @@ class Connect:
     """Close the current link (if any), then open ``link``; answered with its state or a LinkError."""
 
     link: RobotLink
-    timeout: float = CONNECT_TIMEOUT
+    timeout: float
     answer: concurrent.futures.Future = field(default_factory=concurrent.futures.Future)
 
 
@@ -90,9 +90,10 @@ class LinkSupervisor:
         self._next_try = 0.0
 
     # Requests (any thread) ---------------------------------------------------------------------
-    def connect(self, link: RobotLink, timeout: float = CONNECT_TIMEOUT) -> LinkState:
-        """Hand ``link`` to the supervisor, which closes the current one and opens this; raises LinkError."""
-        return self._ask(Connect(link, timeout))
+    def connect(self, link: RobotLink, timeout: float | None = None) -> LinkState:
+        """Hand ``link`` to the supervisor, which closes the current one and opens this; raises
+        LinkError. ``timeout`` [s] for the robot's first telemetry (None: :data:`CONNECT_TIMEOUT`)."""
+        return self._ask(Connect(link, CONNECT_TIMEOUT if timeout is None else timeout))
 
     def disconnect(self) -> None:
         """Close the current link and stop retrying it (a no-op when there is none, or after shutdown)."""
