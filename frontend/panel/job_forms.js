@@ -30,7 +30,7 @@ async function numberFields(kind) {
   const schema = await Fields.schema(kind.request);
   if (!schema?.properties) return null;
   const required = new Set(schema.required || []);
-  const fields = [], world = [], objects = [];
+  const fields = [], world = [], objects = [], switches = [];
   for (const [name, property] of Object.entries(schema.properties)) {
     if (SKIPPED.has(name)) continue;
     if (WORLD_PARTS.has(name)) {
@@ -38,6 +38,10 @@ async function numberFields(kind) {
       continue;
     }
     const plain = Fields.plain(property);
+    if (plain?.type === "boolean") {  // a yes/no of the request's own (a plan's launch_gait): a checkbox
+      switches.push({ name, initial: plain.default === true, title: property.description ?? plain.description ?? "" });
+      continue;
+    }
     const items = plain?.type === "array" ? Fields.plain(plain.items) : null;  // a list of numbers, or not
     if (!["number", "integer"].includes((items ?? plain)?.type)) {
       const object = objectField(kind.name, kind.request, name, property, required.has(name));
@@ -47,7 +51,7 @@ async function numberFields(kind) {
     }
     fields.push({ name, plain, list: items !== null, required: required.has(name), title: property.description ?? plain.description ?? "" });
   }
-  return { fields, world, objects };
+  return { fields, world, objects, switches };
 }
 
 // A fieldset for ``kind`` ({name, title, request}) built from its schema, or null if it cannot be.
@@ -68,18 +72,29 @@ async function generatedFieldset(kind) {
     if (field.title) label.title = field.title;
     fieldset.append(label);
   }
+  for (const flag of found.switches) {
+    const box = attributes(element("input", null), { name: `${kind.name}__${flag.name}`, type: "checkbox" });
+    box.checked = flag.initial;
+    const label = attributes(element("label", null, box, ` ${words(flag.name)}`), { class: "inline" });
+    if (flag.title) label.title = flag.title;
+    fieldset.append(label);
+  }
   fieldset.append(...objects.map((object) => object.node));
   fieldset.hidden = true;
   fieldset.disabled = true;
   const numbers = fields.map((field) => ({ name: `${kind.name}__${field.name}`, rule: `${kind.request}.${field.name}`, optional: !field.required,
     list: field.list }));
-  return { fieldset, fields: numbers, part, objects };
+  return { fieldset, fields: numbers, part, objects, switches: found.switches.map((flag) => flag.name) };
 }
 
 // The body and the 422's locations of a generated kind's form, from the checked values ``v``
 // (null: its world's part marked a field).
-function generatedBody(form, kind, { fields, part, objects }, v) {
+function generatedBody(form, kind, { fields, part, objects, switches }, v) {
   const body = { kind }, locations = { ...part?.locations };
+  for (const name of switches) {
+    body[name] = form.elements[`${kind}__${name}`].checked;
+    locations[name] = `${kind}__${name}`;
+  }
   for (const field of fields) {
     const property = field.name.slice(kind.length + 2);
     if (v[field.name] !== undefined) body[property] = v[field.name];
@@ -106,7 +121,7 @@ on("#job-kind", "change", (event) => {
 // The kind chooser, from the service's catalog: a kind with its own fieldset in index.html, or
 // one built from its request's schema (job_forms.js), in the registry's order; a kind whose
 // body the panel cannot build (a gait search's legs) is left to the API.
-const GENERATED = new Map();  // kind -> its generated form: {fieldset, fields, part (its world's: job_world.js), objects}
+const GENERATED = new Map();  // kind -> its generated form: {fieldset, fields, part (its world's: job_world.js), objects, switches}
 async function fillJobKinds() {
   const form = $("#job-form"), select = $("#job-kind");
   const options = [];

@@ -111,6 +111,22 @@ def test_importance_sampling_unset_is_left_out_of_the_body(page, service, stairs
         _cancel(service, job)
 
 
+def test_a_plans_launch_gait_is_a_checkbox_sent_as_it_stands(page, service, stairs):
+    """A yes/no of the request's own (a plan for the robot: from the velocity a robot launched on its
+    first leg has) is a checkbox, its default the schema's; sent as true or false."""
+    _plan_form(page, stairs, sampled=False)
+    box = "input[name=plan__launch_gait]"
+    assert not page.is_checked(box) and "robot" in (page.get_attribute(f"label:has({box})", "title") or "")
+    for chosen in (True, False):
+        page.set_checked(box, chosen)
+        body, job = _submitted(page)
+        try:
+            stored = _api(service, "GET", f"/jobs/{job}")["spec"]
+            assert body["launch_gait"] is chosen and stored["launch_gait"] is chosen
+        finally:
+            _cancel(service, job)
+
+
 def test_a_reach_jobs_state_is_sent_as_xdot_and_ydot(page, service, stairs):
     page.click("nav [data-tab=jobs]")
     page.select_option("#job-kind", "reach")
